@@ -1,0 +1,36 @@
+"""``stringstab demo``: run the whole pipeline on bundled data."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``demo``."""
+    from ..demo import STEPS
+
+    p = sub.add_parser(
+        "demo",
+        help="run a demo of the whole pipeline on bundled data",
+        description="Steps: " + ", ".join(name for name, _ in STEPS),
+    )
+    p.add_argument("--out", default="demo-out", help="output directory (default: demo-out)")
+    p.add_argument("--only", action="append", metavar="STEP", help="run only this step (repeatable)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``demo``."""
+    from ..demo import STEPS, run_demo
+    from ..errors import StringStabError
+
+    names = [n for n, _ in STEPS]
+    for o in args.only or []:
+        if o not in names:
+            raise StringStabError(f"--only: unknown step {o!r}; expected one of {names}")
+    run_demo(args.out, only=args.only)
+    print(f"demo done: outputs in {args.out}/ (summary.json)")
+    return 0

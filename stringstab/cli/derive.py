@@ -1,0 +1,164 @@
+"""``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import sympy as sp
+
+from ..errors import StringStabError
+from ..symbolic import derive_all, parse_substitutions
+
+__all__ = ["add_parser", "derive_document", "run"]
+
+_LABELS = {
+    "gamma": ("Γ(s)", r"\Gamma(s)"),
+    "gamma_numerator": ("N(s)", r"N(s)"),
+    "gamma_denominator": ("D(s)", r"D(s)"),
+    "psi1": ("Ψ1", r"\Psi_1"),
+    "psi2": ("Ψ2", r"\Psi_2"),
+    "psi3": ("Ψ3", r"\Psi_3"),
+    "lambda": ("Λ", r"\Lambda"),
+    "grad_psi2": ("∇_K Ψ2", r"\nabla_K \Psi_2"),
+    "grad_psi3": ("∇_K Ψ3", r"\nabla_K \Psi_3"),
+    "hurwitz": ("Hurwitz (each > 0)", r"\text{Hurwitz}"),
+}
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``derive``."""
+    p = sub.add_parser(
+        "derive",
+        help="derive Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions symbolically",
+        description=(
+            "Derive, from the IDL vehicle model (eqs 3-9), the transfer function Γ(s) "
+            "(eq 11), the Taylor coefficients Ψ1-Ψ3 and Λ of |D(jω)|²−|N(jω)|² (eqs 12-15), "
+            "their gradients (eqs 25-26) and the Hurwitz conditions of Γ's denominator."
+        ),
+    )
+    p.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    p.add_argument(
+        "--errata",
+        action="store_true",
+        help="compare with the formulas printed in the IDL paper",
+    )
+    p.add_argument(
+        "--substitute",
+        metavar="NAME=V,...",
+        help="specialise, e.g. tau=0.1,delta=0.2,headway=1.1 (also k_x, k_v, k_a)",
+    )
+    p.add_argument(
+        "--delay-order",
+        default="exact",
+        metavar="N|exact",
+        help="Taylor order of e^{-δs} used for Ψ (default: exact delay; the paper's Ψ1 is 3)",
+    )
+    p.add_argument("--out", metavar="FILE", help="write to FILE instead of standard output")
+    p.set_defaults(func=run)
+
+
+def _delay_order(text: str) -> int | None:
+    if text == "exact":
+        return None
+    try:
+        n = int(text)
+    except ValueError as e:
+        raise StringStabError(f"--delay-order must be 'exact' or an integer >= 0; got {text!r}") from e
+    if n < 0:
+        raise StringStabError(f"--delay-order must be 'exact' or an integer >= 0; got {text!r}")
+    return n
+
+
+def derive_document(
+    delay_order: int | None = None, substitute: str | None = None, with_errata: bool = False
+) -> dict[str, Any]:
+    """The JSON document of ``stringstab derive --format json`` (strings parse with ``sympify``)."""
+    subs = parse_substitutions(substitute)
+    exprs = derive_all(delay_order, subs)
+    doc: dict[str, Any] = {}
+    for key, val in exprs.items():
+        doc[key] = [str(v) for v in val] if isinstance(val, list) else str(val)
+    doc["symbols"] = ["k_x", "k_v", "k_a", "tau", "delta", "headway", "s", "omega"]
+    doc["substitute"] = {str(k): str(v) for k, v in subs.items()}
+    doc["delay_order"] = "exact" if delay_order is None else delay_order
+    doc["conventions"] = {
+        "psi": "Psi1, Psi2, Psi3 are the omega^6, omega^4, omega^2 coefficients of |D(j omega)|^2 - |N(j omega)|^2",
+        "hurwitz": "each expression must be > 0 for internal stability",
+        "printed_forms_correspond_to": "delay_order=3 (3rd-order Taylor polynomial of exp(-delta*s)), omega order 6",
+    }
+    if with_errata:
+        from ..errata import errata
+
+        kw = {str(k): float(v) for k, v in subs.items() if str(k) in ("tau", "delta", "headway")}
+        doc["errata"] = [e.as_dict() for e in errata(**kw)]
+    return doc
+
+
+def _text(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
+    lines = ["# stringstab derive: derived from the IDL model (eqs 3-9)"]
+    if doc["substitute"]:
+        lines.append("# substituted: " + ", ".join(f"{k}={v}" for k, v in doc["substitute"].items()))
+    lines.append(f"# delay in Psi: {doc['delay_order']}")
+    for key, (label, _) in _LABELS.items():
+        val = exprs[key]
+        if isinstance(val, list):
+            lines.append(f"{label}:")
+            lines.extend(f"    {v}" for v in val)
+        else:
+            lines.append(f"{label} = {val}")
+    if "errata" in doc:
+        lines.append("")
+        lines.append("# errata: printed (IDL paper) vs derived")
+        for e in doc["errata"]:
+            status = "OK " if e["matches"] else "ERR"
+            lines.append(f"[{status}] eq {e['equation']} {e['name']}")
+            if not e["matches"]:
+                lines.append(f"      printed - derived = {e['difference']}")
+                lines.append(f"      {e['explanation']}")
+                if e["impact"]:
+                    lines.append(f"      impact: {json.dumps(e['impact'])}")
+    return "\n".join(lines) + "\n"
+
+
+def _latex(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
+    syms = {sp.Symbol("headway", positive=True): sp.Symbol("T^*")}
+    out = ["% stringstab derive --format latex (needs amsmath)", r"\begin{align*}"]
+    rows = []
+    for key, (_, tex) in _LABELS.items():
+        val = exprs[key]
+        if key == "hurwitz":
+            rows.append(tex + r" &:\ " + r",\quad ".join(sp.latex(v.subs(syms)) + " > 0" for v in val))
+        elif isinstance(val, list):
+            rows.append(
+                tex + r" &= \begin{pmatrix}" + r" \\ ".join(sp.latex(v.subs(syms)) for v in val)
+                + r"\end{pmatrix}"
+            )
+        else:
+            rows.append(tex + " &= " + sp.latex(val.subs(syms)))
+    out.append(" \\\\\n".join(rows))
+    out.append(r"\end{align*}")
+    if "errata" in doc:
+        out.append("% errata (printed - derived):")
+        for e in doc["errata"]:
+            if not e["matches"]:
+                out.append(f"% eq {e['equation']} {e['name']}: {e['difference']}")
+    return "\n".join(out) + "\n"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``derive``."""
+    delay_order = _delay_order(args.delay_order)
+    doc = derive_document(delay_order, args.substitute, args.errata)
+    if args.format == "json":
+        text = json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
+    else:
+        exprs = derive_all(delay_order, parse_substitutions(args.substitute))
+        text = _text(exprs, doc) if args.format == "text" else _latex(exprs, doc)
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    else:
+        print(text, end="")
+    return 0

@@ -1,0 +1,17 @@
+"""The main job runs and writes what it says."""
+
+import json
+
+from stringstab.cli import main
+
+
+def test_demo_derive_step(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path), "--only", "derive"]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert "eq 13 (psi2)" in summary["derive"]["errata"]
+    doc = json.loads((tmp_path / "derive" / "derive.json").read_text())
+    assert "psi1" in doc
+
+
+def test_demo_unknown_step(tmp_path, capsys):
+    assert main(["demo", "--out", str(tmp_path), "--only", "nope"]) == 2

@@ -1,0 +1,47 @@
+"""The errata report: which printed formulas differ, and by exactly what."""
+
+import sympy as sp
+
+from stringstab import errata
+from stringstab import symbolic as S
+
+
+def _rows():
+    return {e.key: e for e in errata()}
+
+
+def test_matching_equations():
+    rows = _rows()
+    for key in ("gamma_numerator", "psi3", "grad_psi3"):
+        assert rows[key].matches, key
+        assert rows[key].wrong_terms == []
+
+
+def test_gamma_denominator_tau_for_headway():
+    d = sp.sympify(_rows()["gamma_denominator"].difference, locals=dict(
+        tau=S.tau, headway=S.headway, k_x=S.k_x, s=S.s))
+    assert sp.expand(d - (S.tau - S.headway) * S.k_x * S.s) == 0
+
+
+def test_psi2_difference_is_swap_and_sign():
+    d = sp.sympify(_rows()["psi2"].difference, locals={str(x): x for x in (*S.GAINS, *S.PARAMS)})
+    expect = (-2 * S.tau * (S.k_x + S.k_v * S.headway) + S.k_a * S.k_x * S.delta**2) - (
+        -2 * S.tau * (S.k_v + S.k_x * S.headway) - S.k_a * S.k_x * S.delta**2
+    )
+    assert sp.expand(d - expect) == 0
+
+
+def test_grad_psi2_has_spurious_one():
+    row = _rows()["grad_psi2"]
+    assert not row.matches
+    assert row.wrong_terms[0].startswith("component 1 (k_x)")
+    assert "+ 1" in row.wrong_terms[0]
+
+
+def test_impacts_are_measured_shares():
+    rows = _rows()
+    for key in ("psi1", "psi2", "lambda"):
+        share = rows[key].impact["sign_disagreement"]
+        assert 0 < share < 1
+    assert 0 < rows["gamma_denominator"].impact["hurwitz_disagreement"] < 1
+    assert rows["proposition1"].impact["verdict_disagreement_printed_vs_derived"] > 0
