@@ -1,0 +1,177 @@
+"""Vectorised string-stability criteria: Hurwitz, Proposition 1 and the types I-IV.
+
+All functions broadcast over arrays of gains (and parameters) and are built from
+the *derived* SymPy expressions of :mod:`stringstab.symbolic` (or, for the
+``printed`` source, from :mod:`stringstab.printed`), turned into NumPy with
+``lambdify`` at the edge.
+
+Two Taylor-based verdicts are offered, because they differ:
+
+``derived``
+    the derived Ψ1, Ψ2, Ψ3, Λ (exact-delay series) with the *corrected* logic of
+    Proposition 1: Ψ1ω⁴ + Ψ2ω² + Ψ3 ≥ 0 for all ω² ≥ 0 iff
+    Ψ1 ≥ 0 ∧ Ψ3 ≥ 0 ∧ (Ψ2 ≥ 0 ∨ Λ ≤ 0);
+``printed``
+    the IDL paper's printed eqs 12-15 with its printed logic
+    (Ψ1, Ψ2, Ψ3 ≥ 0) ∨ Λ ≤ 0, as a reader of the paper would apply it.
+
+Neither is a certificate (they truncate the frequency series at ω⁶); see
+:mod:`stringstab.certificate` for the exact one.
+
+References
+----------
+IDL paper, Proposition 1 (eqs 12-15) and §3.3 (types I-IV).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .params import as_gains, check_params
+from .symbolic import lambdify_psi
+
+__all__ = [
+    "TYPE_NAMES",
+    "TaylorCriteria",
+    "hurwitz",
+    "hurwitz_margin",
+    "stability_type",
+    "taylor_criteria",
+]
+
+Array = npt.NDArray[np.float64]
+
+#: Names of the stability types of IDL §3.3, indexed by the integer codes 1-4.
+TYPE_NAMES: dict[int, str] = {1: "I", 2: "II", 3: "III", 4: "IV"}
+
+
+def hurwitz(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike = 0.0,
+    *, tau: float, headway: float, rtol: float = 0.0,
+) -> npt.NDArray[np.bool_]:
+    """Internal stability of Γ: is τs³ + s² + (k_v + T*k_x)s + k_x Hurwitz?
+
+    The conditions, derived by :func:`stringstab.symbolic.hurwitz_conditions`, are
+    k_x > 0 and k_v + (T* − τ)k_x > 0 (with τ > 0).  ``rtol`` demands each
+    condition exceed ``rtol`` times the scale of its terms (a margin).
+
+    Examples
+    --------
+    >>> hurwitz([1.0, -1.0, 1.0], [0.5, 0.5, -1.2], tau=0.1, headway=1.1)
+    array([ True, False, False])
+    """
+    kx, kv, _ = as_gains(k_x, k_v, k_a)
+    c1 = kx
+    c2 = kv + (headway - tau) * kx
+    s1 = rtol * np.abs(kx)
+    s2 = rtol * (np.abs(kv) + abs(headway - tau) * np.abs(kx))
+    return np.asarray((c1 > s1) & (c2 > s2))
+
+
+def hurwitz_margin(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float
+) -> Array:
+    """Decay rate −max Re(p) over the poles p of Γ (> 0 iff internally stable).
+
+    Computed as the eigenvalues of the companion matrices, vectorised.
+
+    Examples
+    --------
+    >>> float(np.round(hurwitz_margin(1.0, 0.5, tau=0.1, headway=1.1), 4))
+    0.9016
+    """
+    kx, kv, _ = as_gains(k_x, k_v, 0.0)
+    shape = kx.shape
+    kx, kv = kx.ravel(), kv.ravel()
+    n = kx.size
+    C = np.zeros((n, 3, 3))
+    C[:, 0, :] = -np.stack([np.full(n, 1.0 / tau), (kv + headway * kx) / tau, kx / tau], axis=1)
+    C[:, 1, 0] = 1.0
+    C[:, 2, 1] = 1.0
+    ev = np.linalg.eigvals(C) if n else np.zeros((0, 3))
+    return np.asarray(-ev.real.max(axis=1).reshape(shape))
+
+
+def stability_type(psi2: npt.ArrayLike, psi3: npt.ArrayLike, lam: npt.ArrayLike) -> npt.NDArray[np.int8]:
+    """Stability type 1-4 (I-IV) of IDL §3.3 from Ψ2, Ψ3 and Λ.
+
+    I: Ψ2 ≥ 0 and Ψ3 ≥ 0; II: Ψ3 ≥ 0, Ψ2 < 0, Λ ≤ 0; III: Ψ3 < 0;
+    IV: Ψ3 ≥ 0, Ψ2 < 0, Λ > 0.
+
+    Examples
+    --------
+    >>> stability_type([1.0, -1.0, 1.0, -1.0], [1.0, 1.0, -1.0, 1.0], [0.0, -1.0, 0.0, 2.0])
+    array([1, 2, 3, 4], dtype=int8)
+    """
+    p2, p3, lm = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (psi2, psi3, lam)))
+    t = np.full(p2.shape, 4, dtype=np.int8)
+    t[(p3 >= 0) & (p2 < 0) & (lm <= 0)] = 2
+    t[(p3 >= 0) & (p2 >= 0)] = 1
+    t[p3 < 0] = 3
+    return t
+
+
+@dataclass(frozen=True)
+class TaylorCriteria:
+    """Ψ1, Ψ2, Ψ3, Λ, the Proposition-1 verdict and the type, as arrays."""
+
+    source: str
+    psi1: Array
+    psi2: Array
+    psi3: Array
+    lam: Array
+    stable: npt.NDArray[np.bool_]
+    type: npt.NDArray[np.int8]
+
+    def row(self, i: Any) -> dict[str, Any]:
+        """The JSON object ``{"psi1","psi2","psi3","lambda","verdict","type"}`` of element i."""
+        return {
+            "psi1": float(self.psi1[i]),
+            "psi2": float(self.psi2[i]),
+            "psi3": float(self.psi3[i]),
+            "lambda": float(self.lam[i]),
+            "verdict": "stable" if bool(self.stable[i]) else "unstable",
+            "type": TYPE_NAMES[int(self.type[i])],
+        }
+
+
+def taylor_criteria(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: float, delta: float, headway: float, source: str = "derived",
+) -> TaylorCriteria:
+    """Proposition 1 (IDL eqs 12-15) and the type I-IV, vectorised.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains (broadcast together).
+    tau, delta, headway : float
+        Model parameters.
+    source : {"derived", "printed"}
+        ``"derived"``: derived Ψ with the corrected logic; ``"printed"``: the
+        printed Ψ with the printed logic (see the module docstring).
+
+    Returns
+    -------
+    TaylorCriteria
+
+    Examples
+    --------
+    >>> c = taylor_criteria(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
+    >>> bool(c.stable), int(c.type)
+    (False, 4)
+    """
+    tau, delta, headway = check_params(tau, delta, headway)
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    psi1, psi2, psi3, lam = lambdify_psi(source)(kx, kv, ka, tau, delta, headway)
+    if source == "derived":
+        stable = (psi1 >= 0) & (psi3 >= 0) & ((psi2 >= 0) | (lam <= 0))
+    else:
+        stable = ((psi1 >= 0) & (psi2 >= 0) & (psi3 >= 0)) | (lam <= 0)
+    return TaylorCriteria(
+        source, psi1, psi2, psi3, lam, np.asarray(stable), stability_type(psi2, psi3, lam)
+    )
