@@ -33,9 +33,59 @@ def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     return {"files": ["derive.json", "derive.tex", "derive.txt"], "errata": wrong}
 
 
+#: Paper-style gain triples for the certify step: the two of ``stringstab certify --help``,
+#: a moderate CACC-like triple, one with Ψ3 < 0 and one that is not internally stable.
+DEMO_TRIPLES = ["0.9,-0.5,1.1", "1.3,0,0.6", "0.45,0.6,0.3", "0.2,0.7,0", "-0.5,1,1"]
+
+
+def _step_certify(out: Path, log: Log) -> dict[str, Any]:
+    """Certify a few triples and a bundled gain time series (exact delay)."""
+    from .cli import main
+
+    rollout = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
+    files = []
+    for fmt in ("json", "table"):
+        name = f"triples.{'txt' if fmt == 'table' else fmt}"
+        main(["certify", *DEMO_TRIPLES, "--format", fmt, "--out", str(out / name)])
+        files.append(name)
+    for fmt in ("json", "csv", "table"):
+        name = f"rollout.{'txt' if fmt == 'table' else fmt}"
+        main(["certify", "--file", str(rollout), "--format", fmt, "--out", str(out / name)])
+        files.append(name)
+    triples = json.loads((out / "triples.json").read_text())
+    for r in triples["results"]:
+        sup = "inf" if r["sup_gain"] is None else f"{r['sup_gain']:.4g}"
+        log(
+            f"K=({r['k_x']:g}, {r['k_v']:g}, {r['k_a']:g}): {r['verdict']} (sup|Γ| = {sup}); "
+            f"printed Proposition 1: {r['taylor_printed']['verdict']}"
+        )
+    rollout_doc = json.loads((out / "rollout.json").read_text())
+    s = rollout_doc["summary"]
+    first_bad: dict[str, float] = {}
+    for r in rollout_doc["results"]:
+        if r["verdict"] != "certified":
+            first_bad.setdefault(str(r["vehicle"]), r["t"])
+    log(
+        f"gain time series ({rollout.name}): {s['certified']} of {s['n']} rows certified "
+        f"(M_fss = {s['m_fss']:.3f}); first uncertified t per vehicle: {first_bad}"
+    )
+    return {
+        "files": files,
+        "params": triples["params"],
+        "triples": [
+            {"K": [r["k_x"], r["k_v"], r["k_a"]], "verdict": r["verdict"],
+             "taylor_printed": r["taylor_printed"]["verdict"]}
+            for r in triples["results"]
+        ],
+        "rollout": s,
+        "rollout_first_uncertified_t": first_bad,
+    }
+
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
+    ("certify", _step_certify),
 ]
 
 

@@ -1,0 +1,181 @@
+"""Benchmark of the exact certificate against python-control and a dense frequency sweep.
+
+The same ``--n`` random gain triples K uniform in [-2, 2]³ (``--seed``) are certified
+
+(a) by :func:`stringstab.certificate.certify_batch` (exact delay, sound), in one call;
+(b) the python-control way, one triple at a time: the delay replaced by
+    ``control.pade(delta, 5)``, our own stability check of the poles
+    (``control.poles``), then ``control.norm(sys, "inf")`` (which alone returns
+    the L∞ norm and never checks stability); verdict "certified" when stable and
+    the norm is ≤ 1 + 1e-5 (``control.norm``'s own bisection tolerance is a
+    relative 1e-6, so a triple whose true supremum is exactly |Γ(0)| = 1 comes
+    back as 1 + O(1e-6)).  ``--pade-subset`` times (b) on a random subset when
+    the full set is too slow;
+(c) by an independent check: Hurwitz by ``numpy.roots`` and, for stable Γ, a
+    ``--points`` (10⁶) point sweep of |Γ(jω)| with :func:`stringstab.frequency.gain`
+    on [0, Ω], where Ω is the largest root of the cubic
+    ½τω³ − |k_a|ω² − (½|c| + |k_v|)ω − |k_x| (c = k_v + T*k_x), beyond which
+    |Γ(jω)| ≤ (|k_x| + |k_v|ω + |k_a|ω²) / (ω(τω² − |c|)) ≤ ½.
+
+A triple is *borderline* for the sweep when its largest pole real part is within
+1e-9 of 0, or when m = min over swept ω ≥ 1e-3 of (1 − |Γ(jω)|²)/min(1, ω²)
+satisfies |m| ≤ 1e-6 (m → Ψ3/k_x² as ω → 0, where |Γ| → 1; the plain
+``|peak − 1|`` cannot separate anything since every Hurwitz triple has
+|Γ(0)| = 1).  Otherwise the sweep decides: certified iff Hurwitz and m > 0.
+
+Prints its figures; asserts nothing about time.  Example::
+
+    python analysis/bench_certify.py --n 10000 --seed 0 --pade-subset 1000
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import warnings
+
+import numpy as np
+
+from stringstab.certificate import certify_batch
+from stringstab.frequency import gain
+from stringstab.params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+
+PADE_TOL = 1e-5
+STAB_BORDER = 1e-9
+SWEEP_BORDER = 1e-6
+OMEGA_FLOOR = 1e-3
+
+
+def python_control_verdicts(K, tau, delta, headway, order):
+    """(b): Padé delay, own pole check, ``control.norm(·, 'inf')``; returns (certified, norm)."""
+    import control
+
+    num_d, den_d = control.pade(delta, order) if delta > 0 else ([1.0], [1.0])
+    num_d, den_d = np.asarray(num_d, float), np.asarray(den_d, float)
+    certified = np.zeros(len(K), dtype=bool)
+    norms = np.full(len(K), np.inf)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for i, (kx, kv, ka) in enumerate(K):
+            den = np.polymul([tau, 1.0, kv + headway * kx, kx], den_d)
+            num = np.polyadd(np.polymul([kv, kx], den_d), np.polymul([ka, 0.0, 0.0], num_d))
+            sys = control.tf(num, den)
+            if np.all(np.real(control.poles(sys)) < 0):
+                norms[i] = float(control.norm(sys, "inf"))
+                certified[i] = norms[i] <= 1.0 + PADE_TOL
+    return certified, norms
+
+
+def sweep(K, tau, delta, headway, points, chunk=50_000):
+    """(c): roots and a dense sweep; returns (decided_certified, borderline, peak, omega_max)."""
+    n = len(K)
+    cert = np.zeros(n, dtype=bool)
+    border = np.zeros(n, dtype=bool)
+    peak = np.full(n, np.inf)
+    omax = np.full(n, np.nan)
+    for i, (kx, kv, ka) in enumerate(K):
+        c = kv + headway * kx
+        re_max = np.roots([tau, 1.0, c, kx]).real.max()
+        if abs(re_max) <= STAB_BORDER:
+            border[i] = True
+        if re_max >= 0:
+            continue
+        cubic = np.roots([0.5 * tau, -abs(ka), -(0.5 * abs(c) + abs(kv)), -abs(kx)])
+        om = max(cubic[np.abs(cubic.imag) < 1e-12].real.max(), 1.0)
+        omax[i] = om
+        w = np.linspace(0.0, om, points)
+        p, m = 0.0, np.inf
+        for s in range(0, points, chunk):
+            ws = w[s:s + chunk]
+            g = gain(ws, kx, kv, ka, tau=tau, delta=delta, headway=headway)
+            p = max(p, float(g.max()))
+            keep = ws >= OMEGA_FLOOR
+            if keep.any():
+                m = min(m, float(((1.0 - g[keep] ** 2) / np.minimum(1.0, ws[keep] ** 2)).min()))
+        peak[i] = p
+        border[i] |= abs(m) <= SWEEP_BORDER
+        cert[i] = m > 0
+    return cert, border, peak, omax
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=10_000, help="number of random triples (default 10^4)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--pade-subset", type=int, default=0,
+                    help="run (b) on this many random triples of the n (0: all)")
+    ap.add_argument("--pade-order", type=int, default=5)
+    ap.add_argument("--sweep-subset", type=int, default=0,
+                    help="run the sweep (c) on this many random triples (0: all)")
+    ap.add_argument("--points", type=int, default=1_000_000, help="sweep points per triple")
+    ap.add_argument("--tau", type=float, default=DEFAULT_TAU)
+    ap.add_argument("--delta", type=float, default=DEFAULT_DELTA)
+    ap.add_argument("--headway", type=float, default=DEFAULT_HEADWAY)
+    args = ap.parse_args(argv)
+    prm = {"tau": args.tau, "delta": args.delta, "headway": args.headway}
+
+    rng = np.random.default_rng(args.seed)
+    K = rng.uniform(-2.0, 2.0, size=(args.n, 3))
+    print(f"# {args.n} triples K ~ U[-2, 2]^3, seed {args.seed}; "
+          f"tau={args.tau}, delta={args.delta}, headway={args.headway}")
+
+    # (a) exact batch, one run (a tiny warm-up call first so imports are not timed)
+    certify_batch([1.0], [1.0], [0.0], **prm)
+    t0 = time.perf_counter()
+    b = certify_batch(K[:, 0], K[:, 1], K[:, 2], **prm)
+    ta = (time.perf_counter() - t0) / args.n
+    s = b.summary()
+    print(f"(a) certify_batch (exact delay): {ta * 1e6:9.1f} us/triple   "
+          f"certified {s['certified']}, not_certified {s['not_certified']}, "
+          f"inconclusive {s['inconclusive']}")
+
+    # (b) python-control (warm-up call first so the import of control is not timed)
+    python_control_verdicts(K[:1], args.tau, args.delta, args.headway, args.pade_order)
+    m = args.n if args.pade_subset <= 0 else min(args.pade_subset, args.n)
+    idx = np.sort(rng.choice(args.n, size=m, replace=False)) if m < args.n else np.arange(args.n)
+    t0 = time.perf_counter()
+    pc_cert, pc_norm = python_control_verdicts(K[idx], args.tau, args.delta, args.headway,
+                                               args.pade_order)
+    tb = (time.perf_counter() - t0) / m
+    subset = "all" if m == args.n else f"random subset of {m}"
+    print(f"(b) python-control Padé({args.pade_order}) + poles + norm('inf'): {tb * 1e6:9.1f} "
+          f"us/triple ({subset}); certified {int(pc_cert.sum())} of {m}")
+    print(f"    ratio (b)/(a): {tb / ta:.0f}x")
+    va = b.verdict[idx]
+    decided = va != "inconclusive"
+    dis = decided & ((va == "certified") != pc_cert)
+    print(f"    verdict disagreements (a) vs (b): {int(dis.sum())} of {int(decided.sum())} "
+          f"decided by (a) ({int((~decided).sum())} inconclusive in (a))")
+    for j in np.flatnonzero(dis)[:5]:
+        i = idx[j]
+        print(f"      K=({K[i, 0]:.6f}, {K[i, 1]:.6f}, {K[i, 2]:.6f}): (a) {va[j]} "
+              f"sup {b.sup_gain[i]:.9g}, hurwitz margin {b.hurwitz_margin[i]:.3g}; "
+              f"(b) norm {pc_norm[j]:.9g}")
+
+    # (c) independent roots + dense sweep
+    m = args.n if args.sweep_subset <= 0 else min(args.sweep_subset, args.n)
+    idx = np.sort(rng.choice(args.n, size=m, replace=False)) if m < args.n else np.arange(args.n)
+    t0 = time.perf_counter()
+    sw_cert, border, peak, _ = sweep(K[idx], args.tau, args.delta, args.headway, args.points)
+    tc = (time.perf_counter() - t0) / m
+    va = b.verdict[idx]
+    ok = ~border
+    dis = ok & (va != "inconclusive") & ((va == "certified") != sw_cert)
+    inc = ok & (va == "inconclusive")
+    unsound = (va == "certified") & (peak > 1.0 + 1e-9)
+    subset = "all" if m == args.n else f"random subset of {m}"
+    print(f"(c) numpy.roots + {args.points:.0e}-point sweep of |Γ(jω)| ({subset}): "
+          f"{tc * 1e3:.1f} ms/triple")
+    print(f"    borderline (|max Re pole| <= {STAB_BORDER:g} or |min (1-|Γ|²)/min(1,ω²)| <= "
+          f"{SWEEP_BORDER:g}): {int(border.sum())}")
+    print(f"    disagreements (a) vs sweep on the {int(ok.sum())} non-borderline triples: "
+          f"{int(dis.sum())}; inconclusive in (a) among them: {int(inc.sum())}")
+    print(f"    certified by (a) with swept peak > 1 + 1e-9: {int(unsound.sum())}")
+    for j in np.flatnonzero(dis | inc)[:5]:
+        i = idx[j]
+        print(f"      K=({K[i, 0]:.6f}, {K[i, 1]:.6f}, {K[i, 2]:.6f}): (a) {va[j]} "
+              f"sup {b.sup_gain[i]:.9g}; sweep peak {peak[j]:.9g}, certified {sw_cert[j]}")
+
+
+if __name__ == "__main__":
+    main()

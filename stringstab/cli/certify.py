@@ -1,0 +1,174 @@
+"""``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
+
+Reads triples from the command line or a file (:mod:`stringstab.gainio`),
+certifies them with :func:`stringstab.certificate.certify_batch` and writes a
+table, JSON or CSV.  Exit code 0 when every triple is certified, 1 when any is
+not (``not_certified`` or ``inconclusive``), 2 on bad input (nothing printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+from ..errors import StringStabError
+from ..gainio import FORMATS, GainTable, parse_triple, read_gains, write_results
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+
+__all__ = ["PROGRESS_ROWS", "add_parser", "run"]
+
+#: Show a progress bar when there are more rows than this (or stderr is a terminal).
+PROGRESS_ROWS = 10_000
+
+_EPILOG = f"""\
+examples:
+  stringstab certify 0.9,-0.5,1.1 1.3,0,0.6
+  stringstab certify -0.5,1,1 --delta 0.3              # negative gains need no quoting
+  stringstab certify --file rollout.csv --format json --out certificates.json
+  stringstab certify 0.9,-0.5,1.1 --method pade         # also python-control's Padé numbers
+
+input files: CSV with a header k_x,k_v,k_a (a gain time series adds t and
+optionally vehicle), JSON (a list of {{"k_x","k_v","k_a"}} objects or of triples,
+bare or under "gains"), or NPZ (arrays k_x, k_v, k_a [, t, vehicle] or K (n,3)).
+
+exit status: 0 every triple certified; 1 some triple not_certified or
+inconclusive; 2 bad input (no verdicts printed, no file written).
+defaults: tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s (IDL paper
+Table 2; tau from Zhou et al. 2020). See docs/certify.md.
+"""
+
+# argparse (< 3.13) reads "-0.5,1,1" as an unknown option; treat anything that
+# starts like a negative number (or -inf/-nan, rejected later with a clear
+# message) as a positional.
+_NEGATIVE = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``certify``."""
+    p = sub.add_parser(
+        "certify",
+        help="certify gain triples K = [k_x, k_v, k_a] as string stable (exact delay)",
+        description=(
+            "Certify whether each gain triple K = [k_x, k_v, k_a] is string stable: Γ(s) "
+            "(IDL eq 11, derived) is internally stable and sup_ω |Γ(jω)| ≤ 1 with the exact "
+            "delay e^{-jδω}. Reports the verdict (certified / not_certified / inconclusive), "
+            "sup|Γ|, its frequency, the margin, and the Taylor Proposition 1 (derived and "
+            "printed Ψ) for comparison."
+        ),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p._negative_number_matcher = _NEGATIVE  # type: ignore[attr-defined]
+    p.add_argument(
+        "triples", nargs="*", metavar="K_X,K_V,K_A",
+        help="gain triples, e.g. 0.9,-0.5,1.1 (or use --file)",
+    )
+    p.add_argument("--file", "-f", metavar="F",
+                   help="read triples from a .csv, .json or .npz file ('-' reads CSV/JSON from stdin)")
+    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
+                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
+    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
+                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
+    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
+                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    p.add_argument("--method", choices=("exact", "pade"), default="exact",
+                   help="exact: the sound certificate (default); pade: the same, plus "
+                        "python-control's Padé + norm('inf') numbers, warning where they disagree")
+    p.add_argument("--pade-order", default="5", metavar="N",
+                   help="Padé order of the delay for --method pade (default: 5)")
+    p.add_argument("--format", choices=FORMATS, default="table", help="output format (default: table)")
+    p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
+    p.add_argument("--no-progress", action="store_true",
+                   help=f"never show the progress bar (default: shown on a terminal or > {PROGRESS_ROWS} rows)")
+    p.set_defaults(func=run)
+
+
+def _gains(args: argparse.Namespace) -> GainTable:
+    if args.triples and args.file:
+        raise StringStabError(
+            f"expected gain triples or --file, not both; got {len(args.triples)} triple(s) "
+            f"and --file {args.file}"
+        )
+    if args.file:
+        return read_gains(args.file)
+    if not args.triples:
+        raise StringStabError("expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none")
+    triples = [
+        parse_triple(t, where=f"triple {i + 1} {t!r}") for i, t in enumerate(args.triples)
+    ]
+    return GainTable.from_triples(triples, source="<command line>")
+
+
+def _pade_order(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError as e:
+        raise StringStabError(f"--pade-order must be an integer >= 1; got {text!r}") from e
+    if n < 1:
+        raise StringStabError(f"--pade-order must be an integer >= 1; got {text!r}")
+    return n
+
+
+def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
+    bad = [(i, r) for i, r in enumerate(records) if r.get("pade") and not r["pade"].get("agrees", True)]
+    if not bad:
+        return
+    print(
+        f"stringstab certify: warning: python-control (Padé order {order}) disagrees with the "
+        f"exact certificate on {len(bad)} of {len(records)} row(s); the exact verdict is reported",
+        file=sys.stderr,
+    )
+    for i, r in bad[:5]:
+        pade = r["pade"]
+        print(
+            f"  row {i + 1}: K=({r['k_x']:g}, {r['k_v']:g}, {r['k_a']:g}) exact {r['verdict']} "
+            f"(sup|Γ| {r['sup_gain'] if r['sup_gain'] is not None else 'inf'}), "
+            f"pade {pade['verdict']} (stable {pade['stable']}, norm {pade['hinf']})",
+            file=sys.stderr,
+        )
+    if len(bad) > 5:
+        print(f"  ... and {len(bad) - 5} more", file=sys.stderr)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input."""
+    tau, delta, headway = check_params(args.tau, args.delta, args.headway)
+    order = _pade_order(args.pade_order)
+    if args.out:
+        out = Path(args.out)
+        if out.is_dir() or not out.resolve().parent.is_dir():
+            raise StringStabError(
+                f"--out {args.out}: expected a file path in an existing directory"
+            )
+    table = _gains(args)
+
+    from ..certificate import certify_batch
+
+    n = len(table)
+    progress = not args.no_progress and (sys.stderr.isatty() or n > PROGRESS_ROWS)
+    with warnings.catch_warnings():
+        # Padé disagreements are reported once, below, instead of per row.
+        warnings.simplefilter("ignore")
+        batch = certify_batch(
+            table.k_x, table.k_v, table.k_a, tau=tau, delta=delta, headway=headway,
+            method=args.method, pade_order=order, progress=progress,
+        )
+    records = [{**table.meta(i), **rec} for i, rec in enumerate(batch.records())]
+    params: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "method": args.method}
+    if args.method == "pade":
+        params["pade_order"] = order
+    summary = batch.summary()
+    write_results(records, args.out or sys.stdout, args.format, params=params, summary=summary)
+    if args.method == "pade":
+        _warn_disagreements(records, order)
+    if args.out:
+        print(
+            f"stringstab certify: {summary['certified']} of {summary['n']} certified; "
+            f"wrote {args.format} to {args.out}",
+            file=sys.stderr,
+        )
+    return 0 if summary["certified"] == summary["n"] else 1
