@@ -1,0 +1,363 @@
+"""The IDL paper's evaluation metrics (§4.2), on simulated or measured trajectories.
+
+Every function works on NumPy arrays whose *last axis is time* (sampled every ``dt``) and
+broadcasts over the leading axes (vehicles, platoons).  Positions are front bumpers and the
+``gap`` is bumper to bumper (the paper's Δx, eq 4): gap = x_{i−1} − x_i − length.
+
+==========================  ===================================  ==========
+metric                      function                             IDL eq
+==========================  ===================================  ==========
+TTC                         :func:`time_to_collision`            19
+TIT                         :func:`time_integrated_ttc`          31-32
+jerk squared c              :func:`jerk_squared`                 33
+M_CI (mean squared jerk)    :func:`comfort_index`                34
+time headway h              :func:`time_headway`                 22
+M_effi                      :func:`efficiency_index`             35
+m_p (damping ratio)         :func:`damping_ratio`                29
+M_lss                       :func:`lss_index`                    30
+M_fss                       :func:`fss_ratio`                    27-28
+collisions                  :func:`collision_count`              —
+==========================  ===================================  ==========
+
+Notes on the printed equations
+------------------------------
+* **Eq 29 is garbled**: it prints m_p^i = sqrt(Σ_t acc_t^{i 2} / Σ_t acc_{t−1}^{i 2}), a ratio
+  of one vehicle's accelerations to themselves shifted by one step (≈ 1 always).  The text
+  defines m_p as the "acceleration L2 norm cumulative damping ratio" of Shi et al. (2021) and
+  reads m_p < 1 as "the cumulative squared acceleration of the following vehicle is lower than
+  that of the leading vehicle", so the intended form — implemented here — is the follower
+  over its predecessor:  m_p^i = sqrt(Σ_t (acc_t^i)² / Σ_t (acc_t^{i−1})²).
+* Eq 30 names its mean "M_fss" and the text uses M_lss/M_TSS for it; here it is M_lss, the
+  mean of m_p over the followers (the paper's i = 2..N with i = 1 the leader).
+* Eq 22 prints h = (x^i − x^{i−1}) / v^i (negative as written); h = gap / v is meant.  It is
+  undefined at standstill: where v ≤ v_min = 0.001 m/s (Table 2) h is NaN and M_effi (eq 35)
+  averages over the moments where h is defined (eq 35 divides by every moment; the two agree
+  whenever no vehicle stands still).
+* Eq 31 writes the time step as τ; it is Δt here (τ is the actuator lag elsewhere).
+* Eq 34 divides by N·T; M_CI is called the *mean* squared jerk, so the mean over the N·(T−1)
+  jerk samples is returned.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import StringStabError
+
+__all__ = [
+    "collision_count",
+    "comfort_index",
+    "damping_ratio",
+    "efficiency_index",
+    "fss_ratio",
+    "jerk_squared",
+    "lss_index",
+    "platoon_damping_ratios",
+    "platoon_metrics",
+    "time_headway",
+    "time_integrated_ttc",
+    "time_to_collision",
+]
+
+Array = npt.NDArray[np.float64]
+ArrayLike = npt.ArrayLike
+
+#: TTC* threshold of the safety metrics, s (IDL Table 2).
+TTC_STAR = 3.0
+#: Lower speed bound v_min, m/s (IDL Table 2).
+V_MIN = 0.001
+
+
+def _dt(dt: Any) -> float:
+    try:
+        d = float(dt)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"dt must be a number > 0 s; got {dt!r}") from e
+    if not (math.isfinite(d) and d > 0):
+        raise StringStabError(f"dt must be a finite number > 0 s; got {dt!r}")
+    return d
+
+
+def time_to_collision(gap: ArrayLike, speed: ArrayLike, pred_speed: ArrayLike) -> Array:
+    """Time to collision TTC (IDL eq 19).
+
+    TTC = gap / (v_i − v_{i−1}) if the follower is faster than its predecessor, else ∞.
+    A negative value means the vehicles already overlap (gap < 0) while closing.
+
+    Parameters
+    ----------
+    gap : array_like
+        Bumper-to-bumper gap, m.
+    speed, pred_speed : array_like
+        Speeds of the follower and of its predecessor, m/s.
+
+    Returns
+    -------
+    ndarray
+        TTC, s (``inf`` when not closing).
+
+    Examples
+    --------
+    >>> time_to_collision([10.0, 10.0], [12.0, 10.0], [10.0, 12.0]).tolist()
+    [5.0, inf]
+    """
+    g = np.asarray(gap, dtype=np.float64)
+    closing = np.asarray(speed, dtype=np.float64) - np.asarray(pred_speed, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(np.where(closing > 0, g / np.where(closing > 0, closing, 1.0), np.inf))
+
+
+def time_integrated_ttc(ttc: ArrayLike, dt: float, *, ttc_star: float = TTC_STAR,
+                        axis: int = -1) -> Array:
+    """Time-integrated time to collision TIT (IDL eqs 31-32; Minderhoud & Bovy 2001).
+
+    TIT = Σ_t (TTC* − TTC_t) · Δt · ϑ_t with ϑ_t = 1 if 0 ≤ TTC_t ≤ TTC*, else 0.
+
+    Parameters
+    ----------
+    ttc : array_like
+        TTC series, s (time along ``axis``).
+    dt : float
+        Sampling step, s (the τ of eq 31).
+    ttc_star : float
+        Threshold TTC*, s (Table 2: 3 s).
+    axis : int
+        Time axis.
+
+    Returns
+    -------
+    ndarray
+        TIT per series, s².
+
+    Examples
+    --------
+    >>> float(time_integrated_ttc([1.0, 2.0, 5.0, np.inf], 0.1))
+    0.30000000000000004
+    """
+    d = _dt(dt)
+    x = np.asarray(ttc, dtype=np.float64)
+    inside = (x >= 0) & (x <= ttc_star)
+    return np.asarray(np.sum(np.where(inside, ttc_star - x, 0.0), axis=axis) * d)
+
+
+def jerk_squared(accel: ArrayLike, dt: float, *, axis: int = -1) -> Array:
+    """Squared jerk c_t = ((acc_t − acc_{t−Δt}) / Δt)² (IDL eq 33), m²/s⁶.
+
+    Returns one sample fewer than ``accel`` along ``axis``.
+
+    Examples
+    --------
+    >>> jerk_squared([0.0, 0.1, 0.3], 0.1).round(12).tolist()
+    [1.0, 4.0]
+    """
+    d = _dt(dt)
+    return np.asarray((np.diff(np.asarray(accel, dtype=np.float64), axis=axis) / d) ** 2)
+
+
+def comfort_index(accel: ArrayLike, dt: float, *, axis: int = -1) -> float:
+    """M_CI, the mean squared jerk over every vehicle and moment (IDL eq 34), m²/s⁶.
+
+    Examples
+    --------
+    >>> round(comfort_index([[0.0, 0.1, 0.3], [0.0, 0.0, 0.0]], 0.1), 12)
+    1.25
+    """
+    return float(np.mean(jerk_squared(accel, dt, axis=axis)))
+
+
+def time_headway(gap: ArrayLike, speed: ArrayLike, *, v_min: float = V_MIN) -> Array:
+    """Time headway h = gap / v (IDL eq 22), s; NaN where v ≤ ``v_min`` (standstill).
+
+    Examples
+    --------
+    >>> time_headway([22.0, 2.0], [20.0, 0.0]).tolist()
+    [1.1, nan]
+    """
+    g = np.asarray(gap, dtype=np.float64)
+    v = np.asarray(speed, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(np.where(v > v_min, g / np.where(v > v_min, v, 1.0), np.nan))
+
+
+def efficiency_index(headway: ArrayLike) -> float:
+    """M_effi, the mean time headway over every vehicle and moment where it is defined (eq 35), s.
+
+    Returns NaN if h is nowhere defined (every vehicle always stopped).
+
+    Examples
+    --------
+    >>> efficiency_index([[1.0, 2.0], [np.nan, 3.0]])
+    2.0
+    """
+    h = np.asarray(headway, dtype=np.float64)
+    ok = np.isfinite(h)
+    return float(h[ok].mean()) if ok.any() else float("nan")
+
+
+def damping_ratio(accel: ArrayLike, pred_accel: ArrayLike, *, axis: int = -1) -> Array:
+    """Acceleration L2 damping ratio m_p of a follower over its predecessor (IDL eq 29, intended).
+
+    m_p = sqrt(Σ_t acc_t^{i 2} / Σ_t acc_t^{i−1 2}).  The printed eq 29 divides by the same
+    vehicle's shifted accelerations, which is a typesetting error (see the module notes).
+    m_p < 1: the follower's acceleration energy is smaller than its predecessor's.
+
+    Examples
+    --------
+    >>> float(damping_ratio([0.0, 0.5, -0.5], [0.0, 1.0, -1.0]))
+    0.5
+    """
+    a = np.asarray(accel, dtype=np.float64)
+    p = np.asarray(pred_accel, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(np.sqrt(np.sum(a * a, axis=axis) / np.sum(p * p, axis=axis)))
+
+
+def platoon_damping_ratios(accel: ArrayLike) -> Array:
+    """m_p of every follower of a platoon relative to its predecessor (eq 29, intended form).
+
+    Parameters
+    ----------
+    accel : array_like (..., N + 1, T)
+        Accelerations, vehicle 0 the leader.
+
+    Returns
+    -------
+    ndarray (..., N)
+
+    Examples
+    --------
+    >>> platoon_damping_ratios([[1.0, -1.0], [0.5, -0.5], [0.4, -0.4]]).tolist()
+    [0.5, 0.8]
+    """
+    a = np.asarray(accel, dtype=np.float64)
+    if a.ndim < 2 or a.shape[-2] < 2:
+        raise StringStabError(f"accel must have shape (..., N + 1 >= 2, T); got {a.shape}")
+    return damping_ratio(a[..., 1:, :], a[..., :-1, :])
+
+
+def lss_index(m_p: ArrayLike) -> Array:
+    """M_lss, the mean damping ratio over the followers (IDL eq 30), along the last axis.
+
+    Examples
+    --------
+    >>> float(lss_index([0.5, 0.7, 0.9]))
+    0.7
+    """
+    return np.asarray(np.mean(np.asarray(m_p, dtype=np.float64), axis=-1))
+
+
+def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, delta: float,
+              headway: float) -> float:
+    """M_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28), in %.
+
+    m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
+    (:func:`stringstab.certificate.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
+    else 0 ("inconclusive" counts as 0); M_fss = 100 · Σ m_fss / (N · T/Δt).  Identical
+    triples are certified once.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains at every (vehicle, moment), any common shape.
+    tau, delta, headway : float
+        τ, δ and T*, s.
+
+    Returns
+    -------
+    float
+        Percentage in [0, 100].
+
+    Examples
+    --------
+    >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1)
+    50.0
+    """
+    from .certificate import certify_batch
+    from .params import as_gains
+
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    K = np.stack([kx.ravel(), kv.ravel(), ka.ravel()], axis=1)
+    if K.shape[0] == 0:
+        raise StringStabError("fss_ratio needs at least one gain triple")
+    uniq, inverse = np.unique(K, axis=0, return_inverse=True)
+    cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway)
+    ok = np.asarray(cert.verdict == "certified")[np.ravel(inverse)]
+    return float(100.0 * ok.mean())
+
+
+def collision_count(gap: ArrayLike, *, axis: int = -1) -> npt.NDArray[np.int64]:
+    """Number of collisions per series: entries into gap ≤ 0 (a run starting in collision counts).
+
+    Examples
+    --------
+    >>> collision_count([[1.0, 0.0, -1.0, 2.0, -0.5], [1.0, 1.0, 1.0, 1.0, 1.0]]).tolist()
+    [2, 0]
+    """
+    c = np.moveaxis(np.asarray(gap, dtype=np.float64) <= 0, axis, -1)
+    first = c[..., :1]
+    entries = c[..., 1:] & ~c[..., :-1]
+    return np.asarray(first.sum(axis=-1) + entries.sum(axis=-1), dtype=np.int64)
+
+
+def _collided_positions(collided: npt.NDArray[np.bool_]) -> list[Any]:
+    """1-based follower positions that collided ([platoon, position] pairs for a batch)."""
+    if collided.ndim == 1:
+        return [int(i) + 1 for i in np.flatnonzero(collided)]
+    return [[int(p), int(i) + 1] for p, i in np.argwhere(collided)]
+
+
+def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
+                    certificate: bool = True) -> dict[str, Any]:
+    """All IDL metrics of a simulated run (:class:`stringstab.traffic.PlatoonResult`).
+
+    Followers only (the leader is prescribed).  For a batch of platoons, per-vehicle lists are
+    nested per platoon and the scalar indices pool every platoon.
+
+    Returns
+    -------
+    dict
+        ``m_p`` (eq 29, per follower), ``max_m_p``, ``M_lss`` (eq 30), ``TIT`` (eqs 31-32,
+        summed over followers) and ``TIT_per_vehicle``, ``M_CI`` (eq 34), ``M_effi`` (eq 35),
+        ``min_ttc``, ``min_gap``, ``min_headway``, ``collisions`` (events) and
+        ``collided_vehicles`` (1-based positions), ``M_fss`` (eq 27, % — None if the controller
+        is not of the eq-4 form or ``certificate`` is False).
+    """
+    mp = np.asarray(result.damping_ratios)
+    out: dict[str, Any] = {
+        "m_p": mp.round(6).tolist(),
+        "max_m_p": float(np.max(mp)),
+        "M_lss": float(np.mean(mp)),
+        "collisions": int(np.sum(result.collision_events)),
+        "collided_vehicles": _collided_positions(np.asarray(result.collided)),
+        "min_gap": float(np.min(result.min_gap)),
+    }
+    if result.speed is not None:
+        gap = result.gap
+        spd = result.speed
+        ttc = time_to_collision(gap, spd[..., 1:, :], spd[..., :-1, :])
+        tit = time_integrated_ttc(ttc, result.dt, ttc_star=ttc_star)
+        h = time_headway(gap, spd[..., 1:, :])
+        out.update(
+            TIT=float(np.sum(tit)),
+            TIT_per_vehicle=tit.round(6).tolist(),
+            M_CI=comfort_index(result.accel[..., 1:, :], result.dt),
+            M_effi=efficiency_index(h),
+            min_ttc=float(np.min(np.where(ttc >= 0, ttc, np.inf))) if ttc.size else float("inf"),
+            min_headway=float(np.nanmin(h)) if np.isfinite(h).any() else float("nan"),
+            ttc_star=ttc_star,
+        )
+    out["M_fss"] = None
+    if certificate and result.gains is not None and result.params.get("headway") is not None:
+        taus = np.unique(np.asarray(result.params["tau"], dtype=np.float64))
+        if taus.size == 1:
+            G = result.gains
+            out["M_fss"] = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
+                                     delta=result.params["delta"], headway=result.params["headway"])
+    for key in ("min_ttc", "min_headway", "M_effi"):
+        if key in out and not math.isfinite(out[key]):
+            out[key] = None
+    return out

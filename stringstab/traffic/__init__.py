@@ -1,0 +1,92 @@
+"""The traffic simulator: leaders, platoon dynamics, controllers and Gymnasium environments.
+
+* :mod:`~stringstab.traffic.leaders` — lead-vehicle trajectories (driving cycles, synthetic
+  profiles, NGSIM pairs, CSV files) and a train/test split;
+* :mod:`~stringstab.traffic.platoon` — vectorised platoon dynamics (IDL eqs 1-2, 5-7) and
+  :func:`simulate`;
+* :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM;
+* :mod:`~stringstab.traffic.reward` — the IDL reward (eqs 18-24);
+* :mod:`~stringstab.traffic.env` — a Gymnasium environment and a batched version for training;
+* :mod:`~stringstab.traffic.plots` — figures like the IDL paper's Figs 7-8.
+"""
+
+from __future__ import annotations
+
+from .controllers import (
+    CACCController,
+    Controller,
+    FunctionController,
+    IDMController,
+    LinearController,
+    MixedController,
+    Observation,
+    TimeVaryingLinearController,
+)
+from .env import SCALES, BatchedCarFollowingEnv, CarFollowingEnv, state_vector
+from .leaders import (
+    CYCLES,
+    SYNTHETIC,
+    FollowingPair,
+    Trajectory,
+    cycle,
+    from_accel_segments,
+    from_speed,
+    hard_acceleration,
+    hard_braking,
+    leader_by_name,
+    load_csv,
+    load_ngsim_pairs,
+    paper_mix,
+    sinusoid,
+    stop_and_go,
+    train_test_split,
+)
+from .output import save_trajectories, write_run
+from .platoon import Limits, Platoon, PlatoonResult, simulate
+from .plots import plot_damping_ratios, plot_platoon, plot_vehicles
+from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
+
+__all__ = [
+    "CYCLES",
+    "SCALES",
+    "SYNTHETIC",
+    "BatchedCarFollowingEnv",
+    "CACCController",
+    "CarFollowingEnv",
+    "Controller",
+    "FollowingPair",
+    "FunctionController",
+    "IDMController",
+    "Limits",
+    "LinearController",
+    "MixedController",
+    "Observation",
+    "Platoon",
+    "PlatoonResult",
+    "TimeVaryingLinearController",
+    "Trajectory",
+    "comfort_reward",
+    "cycle",
+    "efficiency_reward",
+    "from_accel_segments",
+    "from_speed",
+    "hard_acceleration",
+    "hard_braking",
+    "headway_density",
+    "leader_by_name",
+    "load_csv",
+    "load_ngsim_pairs",
+    "paper_mix",
+    "plot_damping_ratios",
+    "plot_platoon",
+    "plot_vehicles",
+    "reward",
+    "safety_reward",
+    "save_trajectories",
+    "simulate",
+    "sinusoid",
+    "state_vector",
+    "stop_and_go",
+    "train_test_split",
+    "write_run",
+]

@@ -1,0 +1,475 @@
+"""Car-following controllers: the IDL linear law (eq 4), time-varying gains, CACC and IDM.
+
+Every controller maps an :class:`Observation` of a batch of followers (arrays of any common
+shape, typically ``(n_platoons, n_followers)``) to desired accelerations u (m/s²).  The
+simulator (:mod:`stringstab.traffic.platoon`) then limits u to the acceleration bounds and
+passes it through the vehicle's actuator lag.
+
+* :class:`LinearController` — the IDL paper's eq 4, u = k_x Δp + k_v Δv + k_a a_{i−1}(t − δ)
+  with Δp = gap − (T* v + l_0) (eq 3);
+* :class:`TimeVaryingLinearController` — the same law with gains that change over time, from a
+  schedule array, a CSV file or a policy callable (the IDL agent outputs K each step, eq 17);
+* :class:`CACCController` — the CACC of van Arem, van den Broek & Visser (2006), the IDL
+  paper's model-based baseline (§4.1.4), with the predecessor's acceleration received δ late;
+* :class:`IDMController` — the Intelligent Driver Model (Treiber, Hennecke & Helbing 2000), a
+  stand-in for human-driven followers;
+* :class:`FunctionController` — any callable (e.g. a pure-RL acceleration policy);
+* :class:`MixedController` — different controllers at different positions of the platoon.
+
+References
+----------
+.. [IDL] Z. Yi, M. Xu, S. Wang, Transportation Research Part C 184 (2026) 105541, eqs 3-4, 17.
+.. [Arem2006] B. van Arem, C. J. G. van Driel, R. Visser, "The impact of cooperative adaptive
+   cruise control on traffic-flow characteristics", IEEE Trans. ITS 7(4) (2006) 429-436.
+.. [IDM] M. Treiber, A. Hennecke, D. Helbing, "Congested traffic states in empirical
+   observations and microscopic simulations", Phys. Rev. E 62 (2000) 1805-1824.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import StringStabError
+from ..params import DEFAULT_HEADWAY, as_gains
+
+__all__ = [
+    "DEFAULT_STANDSTILL",
+    "CACCController",
+    "Controller",
+    "FunctionController",
+    "IDMController",
+    "LinearController",
+    "MixedController",
+    "Observation",
+    "TimeVaryingLinearController",
+]
+
+Array = npt.NDArray[np.float64]
+
+#: Standstill spacing l_0, m (IDL paper Table 2).
+DEFAULT_STANDSTILL = 2.0
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """What every follower of a batch knows at one step (arrays of one shape).
+
+    Attributes
+    ----------
+    step : int
+        Step index k (t = k·dt).
+    t, dt : float
+        Time and step, s.
+    gap : array
+        Bumper-to-bumper distance to the predecessor Δx, m (≤ 0 is a collision).
+    speed, accel : array
+        The follower's own speed (m/s) and acceleration (m/s²).
+    pred_speed : array
+        The predecessor's speed, m/s.
+    rel_speed : array
+        Δv = pred_speed − speed, m/s.
+    pred_accel : array
+        The predecessor's current acceleration (what a sensor would see), m/s².
+    pred_accel_delayed : array
+        a_{i−1}(t − δ), the predecessor's acceleration received over the delayed link, m/s².
+    """
+
+    step: int
+    t: float
+    dt: float
+    gap: Array
+    speed: Array
+    accel: Array
+    pred_speed: Array
+    rel_speed: Array
+    pred_accel: Array
+    pred_accel_delayed: Array
+
+
+class Controller:
+    """Interface of a car-following controller (subclass and override :meth:`command`)."""
+
+    #: True if :meth:`gains` returns a different K at different steps.
+    time_varying: bool = False
+
+    def command(self, obs: Observation) -> Array:
+        """Desired accelerations u (m/s²), shaped like ``obs.gap``."""
+        raise NotImplementedError
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """The gap (m) at which a follower cruising at ``speed`` behind an equal-speed leader
+        has u = 0 (used to start a platoon in equilibrium)."""
+        return DEFAULT_STANDSTILL + DEFAULT_HEADWAY * np.asarray(speed, dtype=np.float64)
+
+    def gains(self, obs: Observation) -> Array | None:
+        """The eq-4 gain vector K = (k_x, k_v, k_a) in force, shape ``(..., 3)``, or None if
+        the controller is not of the eq-4 form (then M_fss, eq 27, is undefined)."""
+        return None
+
+    @property
+    def headway(self) -> float | None:
+        """T* of the equivalent eq-4 law (for the certificate), or None."""
+        return None
+
+    def describe(self) -> dict[str, Any]:
+        """A JSON-ready description."""
+        return {"controller": type(self).__name__}
+
+
+def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"{name} must be a number; got {value!r}") from e
+    if not math.isfinite(x) or x < 0 or (x == 0 and not allow_zero):
+        raise StringStabError(f"{name} must be a finite number {'>=' if allow_zero else '>'} 0; got {value!r}")
+    return x
+
+
+class LinearController(Controller):
+    """The IDL linear law with fixed gains (IDL paper eqs 3-4).
+
+    u = k_x (gap − T* v − l_0) + k_v (v_{i−1} − v) + k_a a_{i−1}(t − δ)
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float or array
+        Gains; arrays broadcast against the batch (e.g. shape ``(n_followers,)`` for a gain
+        per position).
+    headway : float
+        Desired time headway T*, s (eq 3).
+    standstill : float
+        Standstill spacing l_0, m (eq 3).
+
+    Examples
+    --------
+    >>> c = LinearController(1.2, 0.5, 0.6)
+    >>> float(c.equilibrium_gap(20.0))
+    24.0
+    """
+
+    def __init__(self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *,
+                 headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL) -> None:
+        self.k_x, self.k_v, self.k_a = as_gains(k_x, k_v, k_a)
+        self._headway = _positive("headway (T*)", headway, allow_zero=True)
+        self.standstill = _positive("standstill spacing l0", standstill, allow_zero=True)
+        self._kxT = self.k_x * self._headway
+        self._kxl = self.k_x * self.standstill
+        self._K = np.stack([self.k_x, self.k_v, self.k_a], axis=-1)
+
+    @property
+    def headway(self) -> float:
+        return self._headway
+
+    def command(self, obs: Observation) -> Array:
+        u = self.k_x * obs.gap
+        u -= self._kxT * obs.speed
+        u -= self._kxl
+        u += self.k_v * obs.rel_speed
+        u += self.k_a * obs.pred_accel_delayed
+        return u
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+
+    def gains(self, obs: Observation) -> Array:
+        return self._K
+
+    def describe(self) -> dict[str, Any]:
+        return {"controller": "linear", "k_x": self.k_x.tolist(), "k_v": self.k_v.tolist(),
+                "k_a": self.k_a.tolist(), "headway": self._headway, "standstill": self.standstill}
+
+
+class TimeVaryingLinearController(Controller):
+    """The eq-4 law with gains that change over time.
+
+    Parameters
+    ----------
+    schedule : array of shape (T, ..., 3) or callable
+        Either gains per step (row ``k`` is used at step k; the last row is held after the
+        end; extra middle axes broadcast against the batch), or a callable
+        ``schedule(obs) -> array (..., 3)`` — e.g. an IDL policy mapping the eq-16 state to K.
+    headway, standstill : float
+        T* (s) and l_0 (m).
+
+    Examples
+    --------
+    >>> c = TimeVaryingLinearController([[1.0, 0.5, 0.2], [2.0, 0.5, 0.2]])
+    >>> c.time_varying
+    True
+    """
+
+    time_varying = True
+
+    def __init__(self, schedule: npt.ArrayLike | Callable[[Observation], npt.ArrayLike], *,
+                 headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL) -> None:
+        self._headway = _positive("headway (T*)", headway, allow_zero=True)
+        self.standstill = _positive("standstill spacing l0", standstill, allow_zero=True)
+        self._fn: Callable[[Observation], npt.ArrayLike] | None
+        if callable(schedule):
+            self._fn, self._table = schedule, None
+        else:
+            tab = np.asarray(schedule, dtype=np.float64)
+            if tab.ndim < 2 or tab.shape[-1] != 3 or tab.shape[0] < 1:
+                raise StringStabError(
+                    f"a gain schedule must have shape (T, ..., 3) with columns k_x, k_v, k_a; got {tab.shape}"
+                )
+            if not np.isfinite(tab).all():
+                raise StringStabError("a gain schedule must be finite; found NaN or inf")
+            self._fn, self._table = None, tab
+        self._last: tuple[int, Array] | None = None
+
+    @classmethod
+    def from_csv(cls, path: str | Path, *, headway: float = DEFAULT_HEADWAY,
+                 standstill: float = DEFAULT_STANDSTILL) -> TimeVaryingLinearController:
+        """Gains from a CSV file with header ``t, k_x, k_v, k_a`` held from each t to the next.
+
+        Raises
+        ------
+        StringStabError
+            If the file is missing, its columns differ, or times are not increasing.
+        """
+        p = Path(path)
+        try:
+            with p.open(newline="", encoding="utf-8-sig") as fh:
+                rows = [r for r in csv.reader(fh) if r]
+        except OSError as e:
+            raise StringStabError(f"cannot read gain file {str(p)!r}: {e.strerror or e}") from e
+        want = ["t", "k_x", "k_v", "k_a"]
+        if not rows or [c.strip().lower() for c in rows[0]] != want:
+            raise StringStabError(
+                f"gain file {str(p)!r}: expected columns {want}; found {rows[0] if rows else []}"
+            )
+        try:
+            arr = np.array([[float(c) for c in r] for r in rows[1:]], dtype=np.float64)
+        except ValueError as e:
+            raise StringStabError(f"gain file {str(p)!r}: not a number ({e})") from e
+        if arr.shape[0] < 1 or arr.shape[1:] != (4,) or not np.isfinite(arr).all():
+            raise StringStabError(f"gain file {str(p)!r}: needs at least one row of 4 finite numbers")
+        if (np.diff(arr[:, 0]) <= 0).any():
+            raise StringStabError(f"gain file {str(p)!r}: t must be strictly increasing")
+        times, table = arr[:, 0], arr[:, 1:]
+
+        def schedule(obs: Observation) -> Array:
+            i = int(np.searchsorted(times, obs.t + 1e-9, side="right")) - 1
+            return table[max(i, 0)]
+
+        return cls(schedule, headway=headway, standstill=standstill)
+
+    @property
+    def headway(self) -> float:
+        return self._headway
+
+    def gains(self, obs: Observation) -> Array:
+        if self._last is not None and self._last[0] == obs.step:
+            return self._last[1]
+        if self._fn is not None:
+            K = np.asarray(self._fn(obs), dtype=np.float64)
+            if K.shape[-1:] != (3,):
+                raise StringStabError(f"a gain policy must return (..., 3) arrays; got shape {K.shape}")
+        else:
+            assert self._table is not None
+            K = self._table[min(obs.step, self._table.shape[0] - 1)]
+        self._last = (obs.step, K)
+        return K
+
+    def command(self, obs: Observation) -> Array:
+        K = self.gains(obs)
+        k_x, k_v, k_a = K[..., 0], K[..., 1], K[..., 2]
+        return np.asarray(
+            k_x * (obs.gap - self._headway * obs.speed - self.standstill)
+            + k_v * obs.rel_speed + k_a * obs.pred_accel_delayed
+        )
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+
+    def describe(self) -> dict[str, Any]:
+        return {"controller": "time-varying linear", "headway": self._headway,
+                "standstill": self.standstill}
+
+
+class CACCController(Controller):
+    """The CACC of van Arem et al. (2006), the IDL paper's model-based baseline (§4.1.4).
+
+    u = min(a_v, a_d), a_v = k (v_int − v),
+    a_d = k_a a_{i−1}(t − δ) + k_v (v_{i−1} − v) + k_d (gap − r_ref),
+    r_ref = max(r_min, t_system v).
+
+    Their safe distance r_safe = v²/2 (1/d_{i−1} − 1/d_i) vanishes for equal braking
+    capabilities and is omitted.  As in the IDL paper, the predecessor's acceleration arrives δ
+    late.  In car following (a_d < a_v and t_system v > r_min) this is eq 4 with
+    (k_x, k_v, k_a) = (k_d, k_v, k_a) and T* = t_system, which is what :meth:`gains` reports
+    for M_fss.
+
+    Parameters
+    ----------
+    k_a, k_v, k_d, k : float
+        Gains; van Arem et al.'s values 1.0, 0.58 s⁻¹, 0.1 s⁻² and 0.3 s⁻¹ by default.
+    t_system : float
+        Time gap, s.  Van Arem et al. used 0.5 s; the default is the IDL paper's T* = 1.1 s so
+        that the baseline and the IDL controller keep the same spacing policy (the IDL paper
+        reports 1.44 s mean headway for its CACC, incompatible with 0.5 s).
+    r_min : float
+        Minimum distance, m.
+    speed_intended : float
+        Cruise speed v_int of the speed-control mode, m/s (IDL Table 2 v_max).
+
+    Examples
+    --------
+    >>> CACCController().gains(None).tolist()
+    [0.1, 0.58, 1.0]
+    """
+
+    def __init__(self, *, k_a: float = 1.0, k_v: float = 0.58, k_d: float = 0.1, k: float = 0.3,
+                 t_system: float = DEFAULT_HEADWAY, r_min: float = DEFAULT_STANDSTILL,
+                 speed_intended: float = 33.3) -> None:
+        self.k_a, self.k_v, self.k_d, self.k = (float(k_a), float(k_v), float(k_d), float(k))
+        self.t_system = _positive("t_system", t_system, allow_zero=True)
+        self.r_min = _positive("r_min", r_min, allow_zero=True)
+        self.speed_intended = float(speed_intended)
+        self._K = np.array([self.k_d, self.k_v, self.k_a])
+
+    @property
+    def headway(self) -> float:
+        return self.t_system
+
+    def command(self, obs: Observation) -> Array:
+        r_ref = np.maximum(self.r_min, self.t_system * obs.speed)
+        a_d = (self.k_a * obs.pred_accel_delayed + self.k_v * obs.rel_speed
+               + self.k_d * (obs.gap - r_ref))
+        return np.minimum(self.k * (self.speed_intended - obs.speed), a_d)
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        return np.maximum(self.r_min, self.t_system * np.asarray(speed, dtype=np.float64))
+
+    def gains(self, obs: Observation | None) -> Array:
+        return self._K
+
+    def describe(self) -> dict[str, Any]:
+        return {"controller": "cacc (van Arem et al. 2006)", "k_a": self.k_a, "k_v": self.k_v,
+                "k_d": self.k_d, "k": self.k, "t_system": self.t_system, "r_min": self.r_min,
+                "speed_intended": self.speed_intended}
+
+
+class IDMController(Controller):
+    """The Intelligent Driver Model (Treiber et al. 2000), a human-driver stand-in.
+
+    u = a [1 − (v/v_0)^4 − (s*/s)²],  s* = s_0 + max(0, v T + v (v − v_{i−1}) / (2√(a b))).
+
+    Human drivers receive no communicated acceleration.  The defaults are the highway values
+    of Treiber et al. (2000), Table 1: v_0 = 120 km/h (here the IDL v_max 33.3 m/s), T = 1.6 s,
+    s_0 = 2 m, a = 0.73 m/s², b = 1.67 m/s².  The gap in the formula is floored at 1 cm so u
+    stays finite during a collision (which the simulator still reports).
+
+    Examples
+    --------
+    >>> round(float(IDMController().equilibrium_gap(20.0)), 2)
+    36.45
+    """
+
+    def __init__(self, *, desired_speed: float = 33.3, time_headway: float = 1.6,
+                 min_gap: float = 2.0, max_accel: float = 0.73, comfortable_decel: float = 1.67,
+                 exponent: float = 4.0) -> None:
+        self.v0 = _positive("desired_speed", desired_speed)
+        self.T = _positive("time_headway", time_headway, allow_zero=True)
+        self.s0 = _positive("min_gap", min_gap, allow_zero=True)
+        self.a = _positive("max_accel", max_accel)
+        self.b = _positive("comfortable_decel", comfortable_decel)
+        self.exponent = _positive("exponent", exponent)
+        self._ab2 = 2.0 * math.sqrt(self.a * self.b)
+
+    def command(self, obs: Observation) -> Array:
+        v = obs.speed
+        s_star = self.s0 + np.maximum(0.0, v * self.T - v * obs.rel_speed / self._ab2)
+        s = np.maximum(obs.gap, 0.01)
+        return self.a * (1.0 - (v / self.v0) ** self.exponent - (s_star / s) ** 2)
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        v = np.minimum(np.asarray(speed, dtype=np.float64), 0.999 * self.v0)
+        return (self.s0 + v * self.T) / np.sqrt(1.0 - (v / self.v0) ** self.exponent)
+
+    def describe(self) -> dict[str, Any]:
+        return {"controller": "idm (Treiber et al. 2000)", "desired_speed": self.v0,
+                "time_headway": self.T, "min_gap": self.s0, "max_accel": self.a,
+                "comfortable_decel": self.b, "exponent": self.exponent}
+
+
+class FunctionController(Controller):
+    """A controller from a callable ``fn(obs) -> u`` (e.g. a pure-RL acceleration policy).
+
+    Parameters
+    ----------
+    fn : callable
+        Returns desired accelerations shaped like ``obs.gap``.
+    headway, standstill : float
+        The equilibrium spacing policy used to start a platoon (l_0 + T* v).
+    """
+
+    def __init__(self, fn: Callable[[Observation], npt.ArrayLike], *,
+                 headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL) -> None:
+        self.fn = fn
+        self._headway, self.standstill = float(headway), float(standstill)
+
+    def command(self, obs: Observation) -> Array:
+        return np.broadcast_to(np.asarray(self.fn(obs), dtype=np.float64), obs.gap.shape).copy()
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+
+
+class MixedController(Controller):
+    """Different controllers at different platoon positions (e.g. IDM humans among CAVs).
+
+    Parameters
+    ----------
+    controllers : sequence of Controller
+        The candidates.
+    assignment : sequence of int
+        For each follower position (1..N), the index of its controller.
+
+    Every candidate is evaluated on the whole batch and the results are selected per position,
+    so the cost is the sum of the candidates'.  :meth:`gains` returns K only if every candidate
+    is of the eq-4 form with one headway.
+    """
+
+    def __init__(self, controllers: Sequence[Controller], assignment: Sequence[int]) -> None:
+        self.controllers = list(controllers)
+        self.assignment = np.asarray(assignment, dtype=np.int64)
+        if self.assignment.ndim != 1 or not self.controllers:
+            raise StringStabError("MixedController needs controllers and a 1-D assignment per position")
+        if (self.assignment < 0).any() or (self.assignment >= len(self.controllers)).any():
+            raise StringStabError(
+                f"assignment indices must be in [0, {len(self.controllers) - 1}]; got {self.assignment.tolist()}"
+            )
+        self.time_varying = any(c.time_varying for c in self.controllers)
+
+    def command(self, obs: Observation) -> Array:
+        return np.asarray(np.choose(self.assignment, [c.command(obs) for c in self.controllers]))
+
+    def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        v = np.asarray(speed, dtype=np.float64)
+        shape = np.broadcast_shapes(v.shape, (self.assignment.size,))
+        gaps = [np.broadcast_to(c.equilibrium_gap(v), shape) for c in self.controllers]
+        return np.asarray(np.choose(self.assignment, gaps))
+
+    @property
+    def headway(self) -> float | None:
+        hs = {c.headway for c in self.controllers}
+        return hs.pop() if len(hs) == 1 else None
+
+    def gains(self, obs: Observation) -> Array | None:
+        gs = [c.gains(obs) for c in self.controllers]
+        if any(g is None for g in gs) or self.headway is None:
+            return None
+        shape = (*obs.gap.shape, 3)
+        stacked = [np.broadcast_to(g, shape) for g in gs if g is not None]
+        return np.asarray(np.choose(self.assignment[:, None], stacked))

@@ -1,0 +1,391 @@
+"""Gymnasium environments for one controlled follower (the IDL paper's training set-up, §3.2.2, §4.1.2).
+
+A controlled vehicle follows a recorded or synthetic leader.  Each step it observes the
+normalised state of eq 16, acts, and receives the reward of eqs 18-24
+(:mod:`~stringstab.traffic.reward`).  The vehicle obeys the platoon dynamics of
+:mod:`~stringstab.traffic.platoon` (third-order model with lag τ, delayed leader acceleration,
+limits and collision detection).
+
+Two action modes:
+
+``action="gains"`` (IDL, eq 17)
+    the action is K = (k_x, k_v, k_a) ∈ [−2, 2]³ (Table 2); an optional ``gain_filter`` (e.g. a
+    string-stability repair, §3.3) maps it before the eq-4 law computes u;
+``action="accel"`` (pure RL)
+    the action is the desired acceleration u ∈ [−7.6, 3] m/s².
+
+State (eq 16): s = [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc] with Δp = gap − (T* v + l_0),
+α_p = 25, α_v = 2.5, α_acc = 4.5 (Table 2).
+
+An episode runs over one leader (a :class:`~stringstab.traffic.leaders.Trajectory`, started in
+equilibrium, or a :class:`~stringstab.traffic.leaders.FollowingPair`, started where the recorded
+human follower was, as in the paper §4.1.2) until its last sample (``truncated``) or a
+collision (``terminated``, when ``terminate_on_collision``; the paper ends training events at a
+collision and lets test events continue).
+
+:class:`CarFollowingEnv` is a standard ``gymnasium.Env``.  :class:`BatchedCarFollowingEnv` steps
+``num_envs`` independent episodes at once with NumPy, for fast training; see its docstring for
+the (simple) API.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any, Literal
+
+import gymnasium as gym
+import numpy as np
+import numpy.typing as npt
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from ..errors import StringStabError
+from ..metrics import TTC_STAR, time_headway, time_to_collision
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from .controllers import DEFAULT_STANDSTILL, Observation
+from .leaders import FollowingPair, Trajectory, cycle
+from .platoon import DEFAULT_LENGTH, Limits, Model, Platoon
+from .reward import reward
+
+__all__ = ["SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "state_vector"]
+
+Array = npt.NDArray[np.float64]
+ActionMode = Literal["gains", "accel"]
+
+#: α_p, α_v, α_acc of eq 16 (Table 2).
+SCALES = (25.0, 2.5, 4.5)
+
+
+def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
+                 standstill: float = DEFAULT_STANDSTILL,
+                 scales: tuple[float, float, float] = SCALES) -> Array:
+    """The IDL state (eq 16) of every follower in ``obs``, shape ``(*obs.gap.shape, 3)``.
+
+    s = [(gap − T* v − l_0)/α_p, (v_{i−1} − v)/α_v, a_{i−1}(t − δ)/α_acc].  Usable as the input
+    of a gain policy inside :class:`~stringstab.traffic.controllers.TimeVaryingLinearController`.
+    """
+    dp = obs.gap - headway * obs.speed - standstill
+    return np.stack([dp / scales[0], obs.rel_speed / scales[1],
+                     obs.pred_accel_delayed / scales[2]], axis=-1)
+
+
+class _Core:
+    """``n`` independent leader–follower episodes over a shared list of leaders."""
+
+    def __init__(self, leaders: Sequence[Trajectory | FollowingPair], n: int, *, action: ActionMode,
+                 tau: float, delta: float, headway: float, standstill: float, model: Model,
+                 limits: Limits | None, length: float, gain_bounds: tuple[float, float],
+                 weights: tuple[float, float, float], ttc_star: float,
+                 scales: tuple[float, float, float], terminate_on_collision: bool,
+                 gain_filter: Callable[[Array], npt.ArrayLike] | None) -> None:
+        items = list(leaders)
+        if not items:
+            raise StringStabError("the environment needs at least one leader trajectory or pair")
+        trs = []
+        for it in items:
+            if isinstance(it, FollowingPair):
+                trs.append(it.leader)
+            elif isinstance(it, Trajectory):
+                trs.append(it)
+            else:
+                raise StringStabError(f"leaders must be Trajectory or FollowingPair; got {type(it).__name__}")
+        dts = {tr.dt for tr in trs}
+        if len(dts) != 1:
+            raise StringStabError(f"all leaders must share one step dt; got {sorted(dts)}")
+        if action not in ("gains", "accel"):
+            raise StringStabError(f"action must be 'gains' or 'accel'; got {action!r}")
+        lo, hi = (float(b) for b in gain_bounds)
+        if not lo < hi:
+            raise StringStabError(f"gain_bounds must be (low, high) with low < high; got {gain_bounds!r}")
+        self.items, self.n, self.dt = items, int(n), trs[0].dt
+        self.action, self.gain_bounds = action, (lo, hi)
+        self.headway, self.standstill = float(headway), float(standstill)
+        self.weights, self.ttc_star, self.scales = weights, float(ttc_star), scales
+        self.terminate_on_collision, self.gain_filter = terminate_on_collision, gain_filter
+        self.lengths = np.array([tr.n_steps for tr in trs])
+        T = int(self.lengths.max())
+        pad = [(tr.position, tr.speed, tr.accel) for tr in trs]
+        self.LX = np.zeros((len(trs), T))
+        self.LV = np.zeros((len(trs), T))
+        self.LA = np.zeros((len(trs), T))
+        for j, (x, v, a) in enumerate(pad):
+            m = x.shape[0]
+            self.LX[j, :m], self.LV[j, :m], self.LA[j, :m] = x, v, a
+            self.LX[j, m:], self.LV[j, m:] = x[-1], v[-1]
+        init_gap, init_speed = [], []
+        for it, tr in zip(items, trs):
+            if isinstance(it, FollowingPair):
+                init_gap.append(float(it.gap[0]))
+                init_speed.append(float(it.follower.speed[0]))
+            else:
+                init_gap.append(self.standstill + self.headway * float(tr.speed[0]))
+                init_speed.append(float(tr.speed[0]))
+        self.init_gap, self.init_speed = np.array(init_gap), np.array(init_speed)
+        self.platoon = Platoon(self.n, 1, dt=self.dt, tau=tau, delta=delta, model=model,
+                               limits=limits, length=length)
+        self.which = np.zeros(self.n, dtype=np.int64)
+        self.k = np.zeros(self.n, dtype=np.int64)
+        self.obs: Observation | None = None
+        self.ret = np.zeros(self.n)
+
+    def leader_now(self) -> tuple[Array, Array, Array]:
+        kk = np.minimum(self.k, self.lengths[self.which] - 1)
+        return self.LX[self.which, kk], self.LV[self.which, kk], self.LA[self.which, kk]
+
+    def reset_rows(self, rows: npt.NDArray[np.int64], which: npt.NDArray[np.int64]) -> None:
+        self.which[rows] = which
+        self.k[rows] = 0
+        self.ret[rows] = 0.0
+        self.platoon.reset(self.LX[which, 0], self.LV[which, 0], self.LA[which, 0],
+                           gap=self.init_gap[which][:, None], speed=self.init_speed[which][:, None],
+                           accel=0.0, rows=rows)
+
+    def observe(self) -> Observation:
+        self.obs = self.platoon.observe(*self.leader_now())
+        return self.obs
+
+    def state(self) -> npt.NDArray[np.float32]:
+        assert self.obs is not None
+        return state_vector(self.obs, headway=self.headway, standstill=self.standstill,
+                            scales=self.scales)[:, 0, :].astype(np.float32)
+
+    def command(self, actions: npt.ArrayLike) -> tuple[Array, Array | None]:
+        assert self.obs is not None
+        a = np.asarray(actions, dtype=np.float64).reshape(self.n, -1)
+        if self.action == "accel":
+            if a.shape[1] != 1:
+                raise StringStabError(f"accel actions must have 1 value per env; got shape {a.shape}")
+            return a[:, :1], None
+        if a.shape[1] != 3:
+            raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
+        K = np.clip(a, *self.gain_bounds)
+        if self.gain_filter is not None:
+            K = np.asarray(self.gain_filter(K), dtype=np.float64).reshape(self.n, 3)
+        o = self.obs
+        u = (K[:, :1] * (o.gap - self.headway * o.speed - self.standstill)
+             + K[:, 1:2] * o.rel_speed + K[:, 2:3] * o.pred_accel_delayed)
+        return u, K
+
+    def step(self, actions: npt.ArrayLike) -> tuple[Array, npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]]:
+        u, K = self.command(actions)
+        prev_accel = self.platoon.accel[:, 1].copy()
+        u_lim = self.platoon.advance(u)
+        self.k += 1
+        o = self.observe()
+        gap, spd, pspd = o.gap[:, 0], o.speed[:, 0], o.pred_speed[:, 0]
+        r, r_f, r_j, r_e = reward(gap, spd, pspd, o.accel[:, 0], prev_accel, weights=self.weights,
+                                  ttc_star=self.ttc_star)
+        collision = gap <= 0
+        terminated = collision & self.terminate_on_collision
+        truncated = (self.k >= self.lengths[self.which] - 1) & ~terminated
+        self.ret += r
+        info: dict[str, Any] = {
+            "gap": gap.copy(), "speed": spd.copy(), "accel": o.accel[:, 0].copy(),
+            "command": u_lim[:, 0].copy(), "ttc": time_to_collision(gap, spd, pspd),
+            "headway": time_headway(gap, spd), "r_f": r_f, "r_j": r_j, "r_e": r_e,
+            "collision": collision, "leader_index": self.which.copy(), "t": self.k * self.dt,
+        }
+        if K is not None:
+            info["gains"] = K
+        return np.asarray(r, dtype=np.float64), terminated, truncated, info
+
+
+def _spaces(action: ActionMode, gain_bounds: tuple[float, float],
+            limits: Limits | None) -> tuple[spaces.Box, spaces.Box]:
+    obs_space = spaces.Box(-np.inf, np.inf, shape=(3,), dtype=np.float32)
+    if action == "gains":
+        act_space = spaces.Box(float(gain_bounds[0]), float(gain_bounds[1]), shape=(3,), dtype=np.float32)
+    else:
+        lim = limits or Limits()
+        act_space = spaces.Box(lim.accel_min, lim.accel_max, shape=(1,), dtype=np.float32)
+    return obs_space, act_space
+
+
+def _default_leaders() -> list[Trajectory]:
+    return [cycle(name, dt=0.1) for name in ("udds", "hwfet", "us06", "wltc3b")]
+
+
+class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]]):
+    """One controlled follower behind a leader (IDL paper §3.2.2): a ``gymnasium.Env``.
+
+    Parameters
+    ----------
+    leaders : sequence of Trajectory or FollowingPair, optional
+        Episodes to draw from (default: the four bundled driving cycles at Δt = 0.1 s).
+    action : {"gains", "accel"}
+        IDL gain vector K (eq 17) or pure-RL acceleration.
+    tau, delta, headway, standstill : float
+        τ (s), δ (s), T* (s), l_0 (m).
+    model : {"lag", "kinematic"}
+        Vehicle update (see :mod:`stringstab.traffic.platoon`).
+    limits : Limits, optional
+        Acceleration and speed bounds (Table 2).
+    length : float
+        Vehicle length, m.
+    gain_bounds : (float, float)
+        Range of each gain (Table 2: [−2, 2]).
+    weights : (float, float, float)
+        ω₁, ω₂, ω₃ of eq 18.
+    ttc_star : float
+        TTC*, s.
+    scales : (float, float, float)
+        α_p, α_v, α_acc of eq 16.
+    terminate_on_collision : bool
+        End the episode at a collision (training, §4.1.2).
+    gain_filter : callable, optional
+        ``K (n, 3) -> K' (n, 3)`` applied to gain actions (e.g. a string-stability repair).
+    order : {"random", "sequential"}
+        How :meth:`reset` picks the next leader (``options={"index": i}`` picks one).
+
+    Examples
+    --------
+    >>> from stringstab.traffic import paper_mix
+    >>> env = CarFollowingEnv([paper_mix()])
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape, env.action_space.shape
+    ((3,), (3,))
+    >>> obs, r, terminated, truncated, info = env.step(np.array([1.2, 0.5, 0.6], dtype=np.float32))
+    >>> bool(terminated), -1.0 <= r <= 0.0
+    (False, True)
+    """
+
+    metadata: dict[str, Any] = {"render_modes": []}  # noqa: RUF012 (gymnasium API)
+
+    def __init__(self, leaders: Sequence[Trajectory | FollowingPair] | None = None, *,
+                 action: ActionMode = "gains", tau: float = DEFAULT_TAU, delta: float = DEFAULT_DELTA,
+                 headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL,
+                 model: Model = "lag", limits: Limits | None = None, length: float = DEFAULT_LENGTH,
+                 gain_bounds: tuple[float, float] = (-2.0, 2.0),
+                 weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
+                 ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
+                 terminate_on_collision: bool = True,
+                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None,
+                 order: Literal["random", "sequential"] = "random") -> None:
+        if order not in ("random", "sequential"):
+            raise StringStabError(f"order must be 'random' or 'sequential'; got {order!r}")
+        self._core = _Core(leaders if leaders is not None else _default_leaders(), 1, action=action,
+                           tau=tau, delta=delta, headway=headway, standstill=standstill, model=model,
+                           limits=limits, length=length, gain_bounds=gain_bounds, weights=weights,
+                           ttc_star=ttc_star, scales=scales,
+                           terminate_on_collision=terminate_on_collision, gain_filter=gain_filter)
+        self.observation_space, self.action_space = _spaces(action, gain_bounds, limits)  # type: ignore[assignment]
+        self.order = order
+        self._next = 0
+
+    @property
+    def n_leaders(self) -> int:
+        """Number of leaders (episodes) available."""
+        return len(self._core.items)
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
+        """Start an episode on the next leader (``options={"index": i}`` chooses it)."""
+        super().reset(seed=seed)
+        m = self.n_leaders
+        if options and "index" in options:
+            j = int(options["index"])
+            if not 0 <= j < m:
+                raise StringStabError(f"options['index'] must be in [0, {m - 1}]; got {j}")
+        elif self.order == "sequential":
+            j = self._next % m
+        else:
+            j = int(self.np_random.integers(m))
+        self._next = j + 1
+        self._core.reset_rows(np.array([0]), np.array([j]))
+        self._core.observe()
+        return self._core.state()[0], {"leader_index": j}
+
+    def step(self, action: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]:
+        """Apply one action; returns (state, reward, terminated, truncated, info)."""
+        if self._core.obs is None:
+            raise StringStabError("call reset() before step()")
+        r, term, trunc, info = self._core.step(np.asarray(action)[None])
+        info = {k: (v[0] if isinstance(v, np.ndarray) and v.shape[:1] == (1,) else v)
+                for k, v in info.items()}
+        info = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in info.items()}
+        return self._core.state()[0], float(r[0]), bool(term[0]), bool(trunc[0]), info
+
+
+class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[Any]]):
+    """``num_envs`` independent car-following episodes stepped together (NumPy, no subprocesses).
+
+    The same model and parameters as :class:`CarFollowingEnv` (see it for the parameters);
+    episodes draw their leader at random from ``leaders`` (seeded by :meth:`reset`).
+
+    API (a Gymnasium ``VectorEnv`` with *same-step* autoreset):
+
+    * ``obs, info = env.reset(seed=0)`` — ``obs`` is float32 ``(num_envs, 3)``;
+    * ``obs, reward, terminated, truncated, info = env.step(actions)`` with ``actions`` of
+      shape ``(num_envs, 3)`` (gains) or ``(num_envs, 1)`` (accel); ``reward``, ``terminated``,
+      ``truncated`` have shape ``(num_envs,)``.  A sub-environment whose episode ended in this
+      step is reset at once: its row of ``obs`` is the first state of its new episode, its last
+      state is in ``info["final_obs"]`` (NaN rows elsewhere, mask ``info["_final_obs"]``) and its
+      episode return in ``info["episode_return"]`` (NaN elsewhere).  Other ``info`` entries
+      (``gap``, ``speed``, ``accel``, ``r_f``, ``r_j``, ``r_e``, ``collision``, ``gains``, …) are
+      arrays of shape ``(num_envs,)`` describing the step just taken.
+
+    Examples
+    --------
+    >>> from stringstab.traffic import paper_mix
+    >>> env = BatchedCarFollowingEnv(4, [paper_mix()])
+    >>> obs, _ = env.reset(seed=0)
+    >>> obs, r, term, trunc, info = env.step(np.tile([1.2, 0.5, 0.6], (4, 1)))
+    >>> obs.shape, r.shape
+    ((4, 3), (4,))
+    """
+
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.SAME_STEP}  # noqa: RUF012
+
+    def __init__(self, num_envs: int, leaders: Sequence[Trajectory | FollowingPair] | None = None,
+                 *, action: ActionMode = "gains", tau: float = DEFAULT_TAU,
+                 delta: float = DEFAULT_DELTA, headway: float = DEFAULT_HEADWAY,
+                 standstill: float = DEFAULT_STANDSTILL, model: Model = "lag",
+                 limits: Limits | None = None, length: float = DEFAULT_LENGTH,
+                 gain_bounds: tuple[float, float] = (-2.0, 2.0),
+                 weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
+                 ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
+                 terminate_on_collision: bool = True,
+                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None) -> None:
+        if int(num_envs) < 1:
+            raise StringStabError(f"num_envs must be >= 1; got {num_envs!r}")
+        self.num_envs = int(num_envs)
+        self._core = _Core(leaders if leaders is not None else _default_leaders(), self.num_envs,
+                           action=action, tau=tau, delta=delta, headway=headway,
+                           standstill=standstill, model=model, limits=limits, length=length,
+                           gain_bounds=gain_bounds, weights=weights, ttc_star=ttc_star,
+                           scales=scales, terminate_on_collision=terminate_on_collision,
+                           gain_filter=gain_filter)
+        self.single_observation_space, self.single_action_space = _spaces(action, gain_bounds, limits)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+
+    def _draw(self, n: int) -> npt.NDArray[np.int64]:
+        return np.asarray(self.np_random.integers(len(self._core.items), size=n), dtype=np.int64)
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
+        """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``."""
+        super().reset(seed=seed)
+        rows = np.arange(self.num_envs)
+        self._core.reset_rows(rows, self._draw(self.num_envs))
+        self._core.observe()
+        return self._core.state(), {"leader_index": self._core.which.copy()}
+
+    def step(self, actions: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], Array,
+                                                   npt.NDArray[np.bool_], npt.NDArray[np.bool_],
+                                                   dict[str, Any]]:
+        """Step every sub-environment (see the class docstring)."""
+        if self._core.obs is None:
+            raise StringStabError("call reset() before step()")
+        r, term, trunc, info = self._core.step(actions)
+        done = term | trunc
+        info["final_obs"] = np.full((self.num_envs, 3), np.nan, dtype=np.float32)
+        info["_final_obs"] = done.copy()
+        info["episode_return"] = np.where(done, self._core.ret, np.nan)
+        if done.any():
+            rows = np.flatnonzero(done)
+            info["final_obs"][rows] = self._core.state()[rows]
+            self._core.reset_rows(rows, self._draw(rows.size))
+            self._core.observe()
+        return self._core.state(), r, term, trunc, info
