@@ -82,10 +82,36 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     }
 
 
+def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
+    """A 10-vehicle platoon behind the §5.1-style leader: certified gains vs the CACC baseline."""
+    from .cli import main
+
+    runs = {
+        "certified": ["--controller", "linear", "--gains", "1.2,0.5,0.6"],
+        "cacc": ["--controller", "cacc"],
+    }
+    summary: dict[str, Any] = {}
+    for name, extra in runs.items():
+        main(["simulate", "--leader", "mix", "--followers", "10", *extra, "--out", str(out / name)])
+        doc = json.loads((out / name / "metrics.json").read_text())
+        cert = doc["certificate"] or {}
+        log(
+            f"{name}: K={cert.get('k_x')},{cert.get('k_v')},{cert.get('k_a')} "
+            f"({cert.get('verdict')}); m_p = {', '.join(f'{v:.2f}' for v in doc['m_p'])}; "
+            f"max m_p {doc['max_m_p']:.3f}, collisions {doc['collisions']}, TIT {doc['TIT']:.3f}, "
+            f"M_CI {doc['M_CI']:.3f}, M_fss {doc['M_fss']}%"
+        )
+        summary[name] = {k: doc[k] for k in ("m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_CI",
+                                             "M_effi", "M_fss")}
+        summary[name]["files"] = [f"{name}/{f}" for f in doc["files"].values()]
+    return summary
+
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
     ("certify", _step_certify),
+    ("simulate", _step_simulate),
 ]
 
 

@@ -518,7 +518,7 @@ def stop_and_go(
 PAPER_MIX_SEGMENTS: tuple[tuple[float, float], ...] = (
     (0.0, 10.0), (-3.0, 2.0), (0.0, 8.0), (3.0, 3.0), (0.0, 10.0),
     (-7.6, 2.5), (0.0, 5.0), (3.0, 5.0), (0.0, 10.0), (-5.0, 2.0), (0.0, 5.0),
-    (2.0, 5.0), (0.0, 10.0), (-7.6, 2.5), (0.0, 5.0), (3.0, 6.0), (0.0, 15.0),
+    (2.0, 5.0), (0.0, 10.0), (-7.6, 2.5), (0.0, 5.0), (3.0, 6.0), (0.0, 34.0),
 )
 
 
@@ -527,14 +527,14 @@ def paper_mix(*, dt: float = 0.1) -> Trajectory:
 
     The paper synthesises its Fig. 7 leader "from multiple representative driving profiles"
     with abrupt braking down to −7.6 m/s² and sudden accelerations up to 3 m/s², but does not
-    publish it.  This one (106 s from 20 m/s, :data:`PAPER_MIX_SEGMENTS`) brakes at −3, −7.6,
+    publish it.  This one (125 s from 20 m/s, :data:`PAPER_MIX_SEGMENTS`) brakes at −3, −7.6,
     −5 and −7.6 m/s² (the last to a full stop) and accelerates at 3, 3, 2 and 3 m/s².
 
     Examples
     --------
     >>> tr = paper_mix()
     >>> tr.duration, float(tr.accel.min()), float(tr.accel.max()), float(tr.speed.min())
-    (106.0, -7.6, 3.0, 0.0)
+    (125.0, -7.6, 3.0, 0.0)
     """
     return from_accel_segments(list(PAPER_MIX_SEGMENTS), speed0=20.0, dt=dt, name="paper-mix")
 
