@@ -334,6 +334,11 @@ def _read_csv(text: str, source: str) -> GainTable:
     except csv.Error as e:
         raise StringStabError(f"{source}: not a readable CSV file ({e})") from e
     header = records[0]
+    if len(header) == 1 and (sep := next((d for d in ";\t|" if d in header[0]), None)):
+        raise StringStabError(
+            f"{source}, line {lines[0][0]}: expected comma-separated columns; "
+            f"found fields separated by {sep!r}"
+        )
     headerless = len(header) == 3 and all(_is_number(h) for h in header)
     if headerless:
         index, ignored = {c: j for j, c in enumerate(GAIN_COLUMNS)}, ()
@@ -609,8 +614,13 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
 
 def _plain(x: Any) -> Any:
     """JSON-safe plain Python values; non-finite floats become None (JSON null)."""
+    t = type(x)
+    if t is float:
+        return x if x - x == 0.0 else None  # inf - inf and nan - nan are nan
+    if t is str or t is int or t is bool or x is None:
+        return x
     if isinstance(x, Mapping):
-        return {str(k): _plain(v) for k, v in x.items()}
+        return {k if type(k) is str else str(k): _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
     if isinstance(x, np.ndarray):
@@ -628,7 +638,7 @@ def _plain(x: Any) -> Any:
 def _flatten(rec: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in rec.items():
-        if isinstance(v, Mapping):
+        if type(v) is dict or isinstance(v, Mapping):
             out.update(_flatten(v, f"{prefix}{k}_"))
         else:
             out[f"{prefix}{k}"] = v
@@ -673,9 +683,9 @@ _TABLE_COLUMNS: list[tuple[str, str, str]] = [
 ]
 
 
-def _get(rec: Mapping[str, Any], dotted: str) -> Any:
+def _get(rec: Mapping[str, Any], path: tuple[str, ...]) -> Any:
     v: Any = rec
-    for part in dotted.split("."):
+    for part in path:
         if not isinstance(v, Mapping) or part not in v:
             return _MISSING
         v = v[part]
@@ -731,7 +741,13 @@ def format_results(
         doc["results"] = recs
         if summary is not None:
             doc["summary"] = _plain(summary)
-        return json.dumps(doc, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
+        # One result per line: readable, grep-able, and fast (C encoder; indent= is not).
+        dump = json.JSONEncoder(ensure_ascii=False, allow_nan=False).encode
+        parts = [f" {json.dumps(k)}: {dump(v)}" for k, v in doc.items() if k != "results"]
+        rows = ",\n".join("  " + dump(r) for r in recs)
+        results = f' "results": [\n{rows}\n ]' if recs else ' "results": []'
+        parts.insert(1 if params is not None else 0, results)
+        return "{\n" + ",\n".join(parts) + "\n}\n"
     if fmt == "csv":
         flat = [_flatten(r) for r in recs]
         extra = {k: v for k, v in _plain(params or {}).items() if not isinstance(v, Mapping)}
@@ -749,7 +765,8 @@ def format_results(
             w.writerow([_cell(row.get(k)) for k in header])
         return buf.getvalue()
     # table
-    cols = [c for c in _TABLE_COLUMNS if any(_get(r, c[1]) is not _MISSING for r in recs)]
+    paths = [(h, tuple(key.split(".")), spec) for h, key, spec in _TABLE_COLUMNS]
+    cols = [c for c in paths if any(_get(r, c[1]) is not _MISSING for r in recs)]
     body = [
         [_fmt_num(v, spec) if (v := _get(r, key)) is not _MISSING else "" for _, key, spec in cols]
         for r in recs

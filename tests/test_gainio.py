@@ -112,6 +112,7 @@ def test_csv_bom_headerless_case_and_string_ids(tmp_path):
     ("t,k_x,k_v,k_a\nnan,1,1,1\n", r"line 2, column 't': expected a finite number"),
     ("k_x,k_v,k_a\n1,1\n", r"line 2: expected 3 comma-separated fields \(k_x,k_v,k_a\); found 2"),
     ("1,2,3,4\n", r"line 1: expected a header naming the columns"),
+    ("k_x;k_v;k_a\n1;1;1\n", r"line 1: expected comma-separated columns; found fields separated by ';'"),
     ("vehicle,k_x,k_v,k_a\n,1,1,1\n", r"line 2, column 'vehicle': expected a vehicle id"),
 ])
 def test_csv_bad(tmp_path, text, match):
@@ -307,6 +308,8 @@ def test_format_json_is_strict_json():
     assert list(doc) == ["params", "results", "summary"]
     assert doc["results"][1]["sup_gain"] is None and doc["results"][1]["margin"] is None
     assert doc["results"][0]["taylor_derived"] == {"verdict": "stable", "psi3": 0.7}
+    assert text.splitlines()[3].startswith('  {"t": 0.5,')  # one result per line
+    assert json.loads(format_results([], "json")) == {"results": []}
 
 
 def test_format_csv_flattens_and_repeats_params():
