@@ -10,7 +10,7 @@ from stringstab.cli import main
 
 def test_simulate_tiny_run(tmp_path, capsys):
     out = tmp_path / "sim"
-    rc = main(["simulate", "--leader", "us06", "--duration", "60", "--followers", "3",
+    rc = main(["simulate", "--leader", "us06", "--duration", "50", "--hold", "10", "--followers", "3",
                "--gains", "1.2,0.5,0.6", "--tau", "0.1", "--delta", "0.2", "--out", str(out)])
     assert rc == 0
     assert sorted(p.name for p in out.iterdir()) == ["damping.png", "metrics.json", "platoon.png",
@@ -50,6 +50,7 @@ def test_simulate_csv_leader_cacc_kinematic(tmp_path):
         (["--delta", "-1"], "delta"),
         (["--followers", "0"], "--followers"),
         (["--dt", "0"], "--dt"),
+        (["--hold", "-1"], "--hold"),
         (["--leader", "sinusoid:omega=-1"], "omega must be"),
         (["--controller", "idm", "--gains", "1,1,1"], "apply to --controller linear"),
         (["--leader", "BADCSV"], "expected columns 't, v' or 't, v, a'"),

@@ -53,6 +53,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--length", type=float, default=5.0, help="vehicle length, m (default 5)")
     p.add_argument("--dt", type=float, default=0.1, help="simulation step, s (default 0.1)")
     p.add_argument("--duration", type=float, default=None, help="keep only the first seconds of the leader")
+    p.add_argument("--hold", type=float, default=0.0, metavar="SECONDS",
+                   help="then let the leader hold its final speed this long (lets the platoon settle)")
     p.add_argument("--model", choices=("lag", "kinematic"), default="lag",
                    help="third-order model with exact ZOH (default) or the paper's eqs 1-2")
     p.add_argument("--ttc-star", type=float, default=3.0, help="TTC* threshold, s (default 3)")
@@ -133,7 +135,9 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise StringStabError(f"--out must be a directory; {str(out)!r} is a file")
-    leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration)
+    if not (math.isfinite(args.hold) and args.hold >= 0):
+        raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {args.hold!r}")
+    leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
     controller = _controller(args, headway)
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length)

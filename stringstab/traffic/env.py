@@ -31,7 +31,7 @@ the (simple) API.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, TypeGuard
 
 import gymnasium as gym
 import numpy as np
@@ -70,6 +70,11 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
                      obs.pred_accel_delayed / scales[2]], axis=-1)
 
 
+def _is_pair(x: Any) -> TypeGuard[FollowingPair]:
+    # duck typing (see stringstab.traffic.platoon._is_trajectory)
+    return hasattr(x, "leader") and hasattr(x, "follower") and hasattr(x, "gap")
+
+
 class _Core:
     """``n`` independent leader–follower episodes over a shared list of leaders."""
 
@@ -82,12 +87,12 @@ class _Core:
         items = list(leaders)
         if not items:
             raise StringStabError("the environment needs at least one leader trajectory or pair")
-        trs = []
+        trs: list[Trajectory] = []
         for it in items:
-            if isinstance(it, FollowingPair):
+            if _is_pair(it):
                 trs.append(it.leader)
-            elif isinstance(it, Trajectory):
-                trs.append(it)
+            elif hasattr(it, "speed") and hasattr(it, "dt"):
+                trs.append(it)  # type: ignore[arg-type]
             else:
                 raise StringStabError(f"leaders must be Trajectory or FollowingPair; got {type(it).__name__}")
         dts = {tr.dt for tr in trs}
@@ -115,7 +120,7 @@ class _Core:
             self.LX[j, m:], self.LV[j, m:] = x[-1], v[-1]
         init_gap, init_speed = [], []
         for it, tr in zip(items, trs):
-            if isinstance(it, FollowingPair):
+            if _is_pair(it):
                 init_gap.append(float(it.gap[0]))
                 init_speed.append(float(it.follower.speed[0]))
             else:

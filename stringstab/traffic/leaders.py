@@ -135,6 +135,29 @@ class Trajectory:
         """Sample times k·dt, s."""
         return np.asarray(np.arange(self.n_steps) * self.dt, dtype=np.float64)
 
+    def hold(self, seconds: float) -> Trajectory:
+        """This trajectory followed by ``seconds`` at its final speed (zero acceleration).
+
+        Lets a long platoon settle before its damping ratios are measured (eq 29 sums over the
+        whole run).
+
+        Examples
+        --------
+        >>> tr = from_speed([0, 1], [10.0, 12.0], dt=0.5).hold(1.0)
+        >>> tr.speed.tolist(), tr.accel.tolist()
+        ([10.0, 11.0, 12.0, 12.0, 12.0], [2.0, 2.0, 0.0, 0.0, 0.0])
+        """
+        n = round(float(seconds) / self.dt)
+        if n < 0:
+            raise StringStabError(f"hold needs seconds >= 0; got {seconds!r}")
+        v_end = self.speed[-1]
+        x_tail = self.position[-1] + v_end * self.dt * np.arange(1, n + 1)
+        accel = self.accel.copy()
+        if n:
+            accel[-1] = 0.0
+        return Trajectory(self.dt, np.r_[self.position, x_tail], np.r_[self.speed, np.full(n, v_end)],
+                          np.r_[accel, np.zeros(n)], self.name, dict(self.meta))
+
     def window(self, start: int, stop: int | None = None) -> Trajectory:
         """Samples ``start:stop``, re-timed to start at t = 0."""
         sl = slice(start, stop)

@@ -400,11 +400,20 @@ class PlatoonResult:
         return platoon_metrics(self, ttc_star=ttc_star, certificate=certificate)
 
 
+def _is_trajectory(x: Any) -> bool:
+    # duck typing rather than isinstance: a module re-imported (e.g. by doctest collection)
+    # defines a second Trajectory class, and user objects with the same fields work too
+    return all(hasattr(x, a) for a in ("dt", "position", "speed", "accel", "n_steps"))
+
+
 def _stack_leaders(leader: Trajectory | Sequence[Trajectory]) -> tuple[list[Trajectory], bool]:
-    if isinstance(leader, Trajectory):
-        return [leader], False
-    leaders = list(leader)
-    if not leaders or not all(isinstance(tr, Trajectory) for tr in leaders):
+    if _is_trajectory(leader):
+        return [leader], False  # type: ignore[list-item]
+    try:
+        leaders = list(leader)  # type: ignore[arg-type]
+    except TypeError:
+        leaders = []
+    if not leaders or not all(_is_trajectory(tr) for tr in leaders):
         raise StringStabError("leader must be a Trajectory or a non-empty sequence of Trajectory")
     dts = {tr.dt for tr in leaders}
     ns = {tr.n_steps for tr in leaders}
@@ -478,8 +487,11 @@ def simulate(
     ((4, 201), False)
     """
     leaders, batched = _stack_leaders(leader)
-    if not isinstance(controller, Controller):
-        raise StringStabError(f"controller must be a stringstab Controller; got {type(controller).__name__}")
+    if not all(callable(getattr(controller, m, None)) for m in ("command", "equilibrium_gap", "gains")):
+        raise StringStabError(
+            f"controller must be a stringstab Controller (command, equilibrium_gap, gains); "
+            f"got {type(controller).__name__}"
+        )
     try:
         N = int(n_followers)
     except (TypeError, ValueError) as e:
