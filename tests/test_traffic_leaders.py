@@ -206,6 +206,10 @@ def test_ngsim_missing_columns(tmp_path):
     p = _write(tmp_path / "x.csv", "Vehicle_ID,Frame_ID,Local_Y\n1,1,1\n")
     with pytest.raises(StringStabError, match=r"missing columns \['v_Vel', 'v_Acc', 'Preceding'\]"):
         load_ngsim_pairs(p)
+    p = _write(tmp_path / "y.csv", "Vehicle_ID,Frame_ID,Local_Y,v_Vel,v_Acc,Preceding\n1,1,1,1,0,0\n")
+    assert load_ngsim_pairs(p) == []
+    with pytest.raises(StringStabError, match="no Location column"):
+        load_ngsim_pairs(p, location="i-80")
 
 
 def test_train_test_split():

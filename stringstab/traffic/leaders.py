@@ -822,6 +822,10 @@ def load_ngsim_pairs(
     arr = np.asarray(num)
     loc_arr = np.asarray(locs)
     if location is not None:
+        if loc_i is None:
+            raise StringStabError(
+                f"NGSIM file {str(p)!r} has no Location column; cannot select location {location!r}"
+            )
         keep = loc_arr == location.strip().lower()
         arr, loc_arr = arr[keep], loc_arr[keep]
     has_len = "v_Length" in cols

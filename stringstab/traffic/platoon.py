@@ -332,7 +332,8 @@ class PlatoonResult:
     command : array (P, N, T) or None
         Limited desired accelerations u.
     gains : array (P, N, T, 3) or (P, N, 1, 3) or None
-        The eq-4 gains in force (one column when constant), None if not an eq-4 controller.
+        The eq-4 gains in force (one column when constant); None if the controller is not of
+        the eq-4 form, or is time-varying and the run was not recorded.
     collided : bool array (P, N)
         Followers that ever had gap ≤ 0.
     collision_events : int array (P, N)
