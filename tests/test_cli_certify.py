@@ -315,3 +315,16 @@ def test_demo_certify_step(capsys, tmp_path):
         assert (tmp_path / "certify" / name).stat().st_size > 0
     bad = next(r for r in summary["triples"] if r["K"] == [0.9, -0.5, 1.1])
     assert bad == {"K": [0.9, -0.5, 1.1], "verdict": "not_certified", "taylor_printed": "stable"}
+
+
+def test_docs_example_is_what_the_tool_prints(capsys):
+    """The first console example of docs/certify.md is the tool's actual output."""
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "certify.md").read_text()
+    block = doc.split("```console\n", 1)[1].split("```", 1)[0].splitlines()
+    assert block[0] == "$ stringstab certify 0.9,-0.5,1.1 1.3,0,0.6 -0.5,1,1"
+    shown = block[1:block.index("$ echo $?")]
+    code, out, _ = _run(capsys, "0.9,-0.5,1.1", "1.3,0,0.6", "-0.5,1,1")
+    assert out.splitlines() == shown
+    assert str(code) == block[block.index("$ echo $?") + 1]
