@@ -34,10 +34,11 @@ def gamma_jw(
     >>> abs(gamma_jw(0.0, 1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1))
     np.float64(1.0)
     """
-    w = np.asarray(omega, dtype=float)
-    jw = 1j * w
-    num = k_x + np.multiply(k_v, jw) + np.multiply(k_a, jw**2) * np.exp(-np.multiply(delta, jw))
-    den = np.multiply(tau, jw**3) + jw**2 + np.multiply(np.add(k_v, np.multiply(headway, k_x)), jw) + k_x
+    jw = 1j * np.asarray(omega, dtype=float)
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
+    t, d, h = (np.asarray(p, dtype=float) for p in (tau, delta, headway))
+    num = kx + kv * jw + ka * jw**2 * np.exp(-d * jw)
+    den = t * jw**3 + jw**2 + (kv + h * kx) * jw + kx
     return np.asarray(num / den)
 
 
