@@ -107,11 +107,35 @@ def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
     return summary
 
 
+def _step_region(out: Path, log: Log) -> dict[str, Any]:
+    """A coarse 121 × 121 slice over (k_x, k_v) at k_a = 0.5: class, comparison and sup|Γ| maps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from .gainio import read_gains
+    from .plots import save_figures
+    from .regions import region_map
+
+    g = np.linspace(-2.0, 2.0, 121)
+    rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1,
+                      progress=False)
+    rollout = read_gains(Path(__file__).parent / "data" / "examples" / "gain_rollout.csv")
+    files = [rmap.save_npz(out / "region.npz").name]
+    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=rollout, dpi=110)]
+    for line in rmap.report().splitlines():
+        log(line)
+    return {"files": files, "class_shares": rmap.class_shares(),
+            "disagreements": rmap.disagreements()}
+
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
     ("certify", _step_certify),
     ("simulate", _step_simulate),
+    ("region", _step_region),
 ]
 
 

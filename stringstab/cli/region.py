@@ -1,0 +1,231 @@
+"""``stringstab region``: maps of where the gains K = [k_x, k_v, k_a] are string stable.
+
+Parses the grid, calls :func:`stringstab.regions.region_map`, saves the data
+(:meth:`~stringstab.regions.RegionMap.save_npz`, and ``save_csv`` for a 2-D
+slice) and the figures (:func:`stringstab.plots.save_figures`), and prints the
+class shares per method and the disagreements.  Bad input: a one-line error,
+exit code 2 and nothing written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import StringStabError
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ..regions import GAIN_NAMES, METHODS
+
+__all__ = ["add_parser", "run"]
+
+DEFAULT_RANGE = (-2.0, 2.0)
+DEFAULT_N_2D = 201
+DEFAULT_N_3D = 61
+
+_EPILOG = f"""\
+examples:
+  stringstab region --x k_x --y k_v --fix k_a=0.5 --range -2,2 --n 401 --out maps/
+  stringstab region --x k_x --y k_a --fix k_v=0.5 --method exact,printed --tau 0.2
+  stringstab region --3d --n 81 --method exact --out maps3d/
+  stringstab region --fix k_a=0.3 --range k_x=0,1.5 --range k_v=-1,1 --overlay rollout.csv
+
+outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
+in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
+<prefix>_compare, <prefix>_sup_gain, <prefix>_overlay (2-D) or
+<prefix>_slices_<method>, <prefix>_3d_<method> (3-D).
+classes: exact = not internally stable / not certified / inconclusive / certified;
+taylor, printed = not internally stable / type III / type IV / type I / type II.
+defaults: range {DEFAULT_RANGE[0]:g},{DEFAULT_RANGE[1]:g}, n {DEFAULT_N_2D} (2-D) or {DEFAULT_N_3D} (3-D),
+tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/regions.md.
+"""
+
+# "-2,2" is a value, not an option
+_NEGATIVE = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``region``."""
+    p = sub.add_parser(
+        "region",
+        help="map the string-stable gains on a 2-D slice or a 3-D grid (figures + data)",
+        description=(
+            "Evaluate a grid of gain triples K = [k_x, k_v, k_a] with the exact certificate and "
+            "the Taylor Proposition 1 (derived and printed Ψ), and write class maps, a map of "
+            "where the methods disagree, a heat map of sup|Γ(jω)|, and the data."
+        ),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p._negative_number_matcher = _NEGATIVE  # type: ignore[attr-defined]
+    p.add_argument("--x", default="k_x", metavar="GAIN", help="gain on the first axis (default k_x)")
+    p.add_argument("--y", default="k_v", metavar="GAIN", help="gain on the second axis (default k_v)")
+    p.add_argument("--fix", metavar="GAIN=V",
+                   help="value of the third gain for a 2-D slice, e.g. k_a=0.5 (required without --3d)")
+    p.add_argument("--3d", dest="three_d", action="store_true",
+                   help="map the volume over all three gains (axes --x, --y, then the third)")
+    p.add_argument("--range", action="append", metavar="[GAIN=]LO,HI",
+                   help="grid range of every axis, or of one gain (repeatable); default -2,2")
+    p.add_argument("--n", metavar="N[,N2[,N3]]",
+                   help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
+    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
+                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
+    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
+                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
+    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
+                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    p.add_argument("--method", default=",".join(METHODS), metavar="M[,M...]",
+                   help="methods among exact, taylor, printed (default: all three)")
+    p.add_argument("--overlay", metavar="FILE",
+                   help="gain trajectory (.csv/.json/.npz as for certify) drawn on the 2-D map")
+    p.add_argument("--out", "-o", default="maps", metavar="DIR", help="output directory (default: maps)")
+    p.add_argument("--prefix", default="region", metavar="NAME", help="file name stem (default: region)")
+    p.add_argument("--format", default="png,pdf", metavar="F[,F...]",
+                   help="figure formats among png, pdf, svg (default: png,pdf)")
+    p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
+    p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
+    p.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+    p.set_defaults(func=run)
+
+
+# --------------------------------------------------------------------------- parsing
+def _number(text: str, what: str) -> float:
+    try:
+        v = float(text)
+    except ValueError as e:
+        raise StringStabError(f"{what} must be a number; got {text!r}") from e
+    if not math.isfinite(v):
+        raise StringStabError(f"{what} must be finite; got {text!r}")
+    return v
+
+
+def _int(text: str, what: str, low: int) -> int:
+    try:
+        v = int(text)
+    except ValueError as e:
+        raise StringStabError(f"{what} must be an integer >= {low}; got {text!r}") from e
+    if v < low:
+        raise StringStabError(f"{what} must be an integer >= {low}; got {text!r}")
+    return v
+
+
+def _gain(text: str, what: str) -> str:
+    if text not in GAIN_NAMES:
+        raise StringStabError(f"{what} must be one of {', '.join(GAIN_NAMES)}; got {text!r}")
+    return text
+
+
+def _pair(text: str, what: str) -> tuple[float, float]:
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise StringStabError(f"{what} must be LO,HI (two numbers); got {text!r}")
+    lo, hi = (_number(s.strip(), what) for s in parts)
+    if not lo < hi:
+        raise StringStabError(f"{what} must have LO < HI; got {text!r}")
+    return lo, hi
+
+
+def _ranges(items: list[str] | None, names: list[str]) -> dict[str, tuple[float, float]]:
+    """Ranges per axis gain: ``LO,HI`` items apply to all axes, ``GAIN=LO,HI`` items override."""
+    items = items or []
+    out = dict.fromkeys(names, DEFAULT_RANGE)
+    for item in items:
+        if "=" not in item:
+            out = dict.fromkeys(names, _pair(item, "--range"))
+    for item in items:
+        if "=" in item:
+            g, _, rest = item.partition("=")
+            g = _gain(g.strip(), f"--range {item!r}: the gain")
+            if g not in names:
+                raise StringStabError(f"--range {item!r}: {g} is not on an axis (axes: {', '.join(names)})")
+            out[g] = _pair(rest, f"--range {g}")
+    return out
+
+
+def _sizes(text: str | None, k: int, default: int) -> list[int]:
+    if text is None:
+        return [default] * k
+    parts = text.split(",")
+    if len(parts) not in (1, k):
+        raise StringStabError(f"--n must be N or {k} comma-separated counts; got {text!r}")
+    ns = [_int(s.strip(), "--n", 2) for s in parts]
+    return ns * k if len(ns) == 1 else ns
+
+
+def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, float]]:
+    x = _gain(args.x, "--x")
+    y = _gain(args.y, "--y")
+    if x == y:
+        raise StringStabError(f"--x and --y must be different gains; got {x} twice")
+    third = next(g for g in GAIN_NAMES if g not in (x, y))
+    fixed: dict[str, float] = {}
+    if args.three_d:
+        if args.fix is not None:
+            raise StringStabError(f"--3d maps all three gains; got --fix {args.fix}")
+        names = [x, y, third]
+    else:
+        if args.fix is None:
+            raise StringStabError(f"expected --fix {third}=VALUE (the gain not on --x/--y) or --3d; got neither")
+        g, sep, v = args.fix.partition("=")
+        if not sep:
+            raise StringStabError(f"--fix must be GAIN=VALUE, e.g. {third}=0.5; got {args.fix!r}")
+        g = _gain(g.strip(), "--fix gain")
+        if g != third:
+            raise StringStabError(f"--fix must fix {third} (the gain not on --x/--y); got {g}")
+        fixed = {g: _number(v.strip(), f"--fix {g}")}
+        names = [x, y]
+    ranges = _ranges(args.range, names)
+    sizes = _sizes(args.n, len(names), DEFAULT_N_3D if args.three_d else DEFAULT_N_2D)
+    axes = {g: np.linspace(*ranges[g], n) for g, n in zip(names, sizes)}
+    return axes, fixed
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``region``; returns 0, or raises StringStabError (exit 2) before writing anything."""
+    from ..plots import FIGURE_FORMATS
+    from ..regions import region_map
+
+    axes, fixed = _grid(args)
+    tau, delta, headway = check_params(args.tau, args.delta, args.headway)
+    formats = [f.strip() for f in args.format.split(",")]
+    for f in formats:
+        if f not in FIGURE_FORMATS:
+            raise StringStabError(f"--format must be among {', '.join(FIGURE_FORMATS)}; got {f!r}")
+    dpi = _int(args.dpi, "--dpi", 10)
+    workers = None if args.workers is None else _int(args.workers, "--workers", 1)
+    if not args.prefix or "/" in args.prefix or args.prefix.startswith("."):
+        raise StringStabError(f"--prefix must be a plain file name stem; got {args.prefix!r}")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise StringStabError(f"--out {args.out}: expected a directory; found a file")
+    gains = None
+    if args.overlay is not None:
+        if args.three_d:
+            raise StringStabError("--overlay draws on a 2-D map; got --3d")
+        from ..gainio import read_gains
+
+        gains = read_gains(args.overlay)
+
+    # region_map validates the methods before computing anything
+    rmap = region_map(axes, fixed or None, tau=tau, delta=delta, headway=headway, methods=args.method,
+                      workers=workers, progress=False if args.no_progress else None)
+
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    from ..plots import save_figures
+
+    out.mkdir(parents=True, exist_ok=True)
+    written = [rmap.save_npz(out / f"{args.prefix}.npz")]
+    if rmap.ndim == 2:
+        written.append(rmap.save_csv(out / f"{args.prefix}.csv"))
+    written += save_figures(rmap, out, prefix=args.prefix, formats=formats, gains=gains, dpi=dpi)
+    print(rmap.report())
+    print(f"wrote {len(written)} files to {out}: " + ", ".join(p.name for p in written))
+    return 0

@@ -1,0 +1,924 @@
+"""Figures of stability-region maps (:mod:`stringstab.regions`), with matplotlib.
+
+Every function takes ``ax=None`` (or ``axes=None`` / ``fig=None`` for
+multi-panel figures), draws into it or into a new figure, and returns a dict
+of what it drew (``"ax"`` plus the artists: ``"image"``, ``"legend"``,
+``"contour"``, ...), so figures can be composed and tested.
+
+Colours are the Okabe-Ito palette (safe for the common colour-vision
+deficiencies); marker shapes repeat the information of marker colours.
+
+=========================  ===================================================
+function                   shows
+=========================  ===================================================
+:func:`plot_class_map`     classes of one method (types, or exact verdicts)
+:func:`plot_comparison`    where exact, taylor and printed agree and disagree
+:func:`plot_sup_gain`      sup_ω |Γ(jω)| (log scale), with the certified boundary
+:func:`plot_slices`        a 3-D map as a montage of slices over one gain
+:func:`plot_region_3d`     the boundary of the certified region in 3-D
+:func:`plot_facets`        one class map per τ (or δ): how the region shrinks
+:func:`plot_boundaries`    the certified boundaries of several maps on one axes
+:func:`plot_trajectory`    a policy's gain trajectory over a map, by verdict
+=========================  ===================================================
+
+References
+----------
+M. Okabe and K. Ito, "Color Universal Design (CUD)", 2008,
+https://jfly.uni-koeln.de/color/.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from itertools import product
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import StringStabError
+from .regions import METHODS, RegionMap
+
+__all__ = [
+    "CLASS_COLORS",
+    "FIGURE_FORMATS",
+    "GAIN_LABELS",
+    "plot_boundaries",
+    "plot_class_map",
+    "plot_comparison",
+    "plot_facets",
+    "plot_region_3d",
+    "plot_slices",
+    "plot_sup_gain",
+    "plot_trajectory",
+    "save_figures",
+]
+
+#: Okabe-Ito colours.
+_OI = {
+    "orange": "#E69F00", "sky": "#56B4E9", "green": "#009E73", "yellow": "#F0E442",
+    "blue": "#0072B2", "vermillion": "#D55E00", "purple": "#CC79A7", "black": "#000000",
+    "grey": "#BBBBBB",
+}
+#: Colour of each class of :data:`stringstab.regions.TYPE_CLASSES` / ``EXACT_CLASSES``.
+CLASS_COLORS: dict[str, str] = {
+    "not internally stable": _OI["grey"],
+    "type III": _OI["vermillion"],
+    "type IV": _OI["orange"],
+    "type I": _OI["blue"],
+    "type II": _OI["sky"],
+    "not certified": _OI["vermillion"],
+    "inconclusive": _OI["black"],
+    "certified": _OI["blue"],
+}
+#: Axis labels of the gains, with units (u = k_x Δp + k_v Δv + k_a a in m/s²).
+GAIN_LABELS: dict[str, str] = {
+    "k_x": r"$k_x$ (s$^{-2}$)",
+    "k_v": r"$k_v$ (s$^{-1}$)",
+    "k_a": r"$k_a$ (–)",
+}
+#: File formats :func:`save_figures` can write.
+FIGURE_FORMATS: tuple[str, ...] = ("png", "pdf", "svg")
+_METHOD_TITLES = {
+    "exact": "exact certificate",
+    "taylor": "Taylor Prop. 1 (derived Ψ) types",
+    "printed": "Taylor Prop. 1 (printed Ψ) types",
+}
+_AGREE_STABLE = "#BFE1F5"  # light tint of sky blue
+_AGREE_UNSTABLE = "#E4E4E4"
+_UNSAFE = [_OI["vermillion"], _OI["purple"], _OI["orange"]]
+_CONSERVATIVE = [_OI["blue"], _OI["green"], _OI["yellow"]]
+_VERDICT_MARKERS = {
+    "certified": dict(marker="o", facecolor="white", edgecolor="black"),
+    "not_certified": dict(marker="X", facecolor="black", edgecolor="white"),
+    "inconclusive": dict(marker="D", facecolor=_OI["yellow"], edgecolor="black"),
+}
+
+
+# --------------------------------------------------------------------------- helpers
+def _plt() -> Any:
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _new_ax(ax: Any, figsize: tuple[float, float] = (6.4, 7.0)) -> Any:
+    if ax is not None:
+        return ax
+    fig = _plt().figure(figsize=figsize, layout="constrained")
+    return fig.add_subplot()
+
+
+def _need_2d(rmap: RegionMap, what: str) -> None:
+    if not isinstance(rmap, RegionMap):
+        raise StringStabError(f"{what} needs a RegionMap; got {type(rmap).__name__}")
+    if rmap.ndim != 2:
+        raise StringStabError(
+            f"{what} draws a 2-D map; got a {rmap.ndim}-D map (use RegionMap.slice or plot_slices)"
+        )
+
+
+def _uniform(a: npt.NDArray[np.float64]) -> bool:
+    d = np.diff(a)
+    return bool(np.allclose(d, d[0], rtol=1e-6, atol=0.0))
+
+
+def _draw_field(ax: Any, rmap: RegionMap, values: np.ndarray, **kw: Any) -> Any:
+    """Draw a 2-D field over the map's axes (imshow on a uniform grid, else pcolormesh)."""
+    x, y = rmap.axes.values()
+    if _uniform(x) and _uniform(y):
+        dx, dy = (x[1] - x[0]) / 2, (y[1] - y[0]) / 2
+        return ax.imshow(
+            np.asarray(values).T, origin="lower", extent=(x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy),
+            aspect="auto", interpolation="nearest", **kw,
+        )
+    return ax.pcolormesh(x, y, np.asarray(values).T, shading="nearest", **kw)
+
+
+def _label_axes(ax: Any, rmap: RegionMap) -> None:
+    xn, yn = rmap.axis_names
+    ax.set_xlabel(GAIN_LABELS[xn])
+    ax.set_ylabel(GAIN_LABELS[yn])
+    ax.set_box_aspect(1.0)
+
+
+def _categorical(colors: Sequence[str]) -> tuple[Any, Any]:
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    cmap = ListedColormap(list(colors))
+    norm = BoundaryNorm(np.arange(len(colors) + 1) - 0.5, len(colors))
+    return cmap, norm
+
+
+def _pct(count: int, n: int) -> str:
+    share = 100.0 * count / n if n else float("nan")
+    if 0 < share < 0.1:
+        return "<0.1 %"
+    return f"{share:.1f} %"
+
+
+def _legend(ax: Any, handles: list[Any], title: str | None = None, ncol: int = 2) -> Any:
+    """A legend under the axes (below the x label), so it never covers the map."""
+    return ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.12),
+                     ncol=ncol, frameon=False, fontsize="small", title_fontsize="small",
+                     columnspacing=1.2, handlelength=1.6)
+
+
+def _patch(color: str, label: str) -> Any:
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor=color, edgecolor="#555555", linewidth=0.5, label=label)
+
+
+# --------------------------------------------------------------------------- class map
+def plot_class_map(
+    rmap: RegionMap, method: str = "exact", *, ax: Any = None, legend: bool = True,
+    title: bool = True,
+) -> dict[str, Any]:
+    """Draw a 2-D map coloured by the classes of one method.
+
+    ``exact``: not internally stable / not certified / inconclusive /
+    certified.  ``taylor``, ``printed``: not internally stable / type III /
+    type IV / type I / type II of that method's Ψ (IDL §3.3); see
+    :meth:`stringstab.regions.RegionMap.classes`.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        A 2-D map.
+    method : {"exact", "taylor", "printed"}
+        Whose classes to show (must be in ``rmap.methods``).
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    legend, title : bool
+        Draw the legend (classes with their shares, right of the axes) and the title.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``image`` (the AxesImage or QuadMesh), ``legend`` (or None) and
+        ``handles`` (one legend patch per class).
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 2-D or ``method`` was not evaluated.
+
+    Examples
+    --------
+    >>> from stringstab.regions import region_map
+    >>> m = region_map({"k_x": np.linspace(-2, 2, 21), "k_v": np.linspace(-2, 2, 21)},
+    ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods="taylor")
+    >>> out = plot_class_map(m, "taylor")
+    >>> sorted(out)
+    ['ax', 'handles', 'image', 'legend']
+    >>> import matplotlib.pyplot as plt; plt.close("all")
+    """
+    _need_2d(rmap, "plot_class_map")
+    names = rmap.class_names(method)
+    ax = _new_ax(ax)
+    codes = rmap.classes(method)
+    colors = [CLASS_COLORS[n] for n in names]
+    cmap, norm = _categorical(colors)
+    im = _draw_field(ax, rmap, codes, cmap=cmap, norm=norm)
+    _label_axes(ax, rmap)
+    counts = np.bincount(codes.ravel(), minlength=len(names))
+    handles = [_patch(c, f"{n} ({_pct(k, rmap.size)})") for n, c, k in zip(names, colors, counts)]
+    leg = _legend(ax, handles, title=f"{rmap.size:,} grid points") if legend else None
+    if title:
+        ax.set_title(f"{_METHOD_TITLES[method]}\n{rmap.title()}", fontsize="medium")
+    return {"ax": ax, "image": im, "legend": leg, "handles": handles}
+
+
+# --------------------------------------------------------------------------- comparison
+def _comparison_codes(
+    rmap: RegionMap, methods: Sequence[str]
+) -> tuple[np.ndarray, list[str], list[str], list[bool]]:
+    """Category per point, with labels, colours and whether each is a disagreement."""
+    short = {"exact": "exact", "taylor": "taylor", "printed": "printed"}
+    stable = [rmap.stable(m) for m in methods]
+    inc = np.zeros(rmap.shape, dtype=bool)
+    for m in methods:
+        inc |= rmap.verdict[m] == 2
+    labels = [f"all {len(methods)} say string stable" if len(methods) > 2 else "both say string stable",
+              f"all {len(methods)} say not string stable" if len(methods) > 2 else "both say not string stable"]
+    colors = [_AGREE_STABLE, _AGREE_UNSTABLE]
+    disagree = [False, False]
+    codes = np.full(rmap.shape, -1, dtype=np.int8)
+    codes[np.logical_and.reduce(stable)] = 0
+    codes[np.logical_and.reduce([~s for s in stable])] = 1
+    n_unsafe = n_cons = 0
+    # reference (first method) says not stable but another says stable: unsafe first
+    for ref in (False, True):
+        for rest in product((True, False) if not ref else (False, True), repeat=len(methods) - 1):
+            if all(r == ref for r in rest):
+                continue
+            pattern = (ref, *rest)
+            mask = np.ones(rmap.shape, dtype=bool)
+            for s, want in zip(stable, pattern):
+                mask &= s if want else ~s
+            codes[mask] = len(labels)
+            labels.append(" · ".join(f"{short[m]} {'✓' if w else '✗'}" for m, w in zip(methods, pattern)))
+            if ref:
+                colors.append(_CONSERVATIVE[n_cons % 3])
+                n_cons += 1
+            else:
+                colors.append(_UNSAFE[n_unsafe % 3])
+                n_unsafe += 1
+            disagree.append(True)
+    codes[inc] = len(labels)
+    labels.append("exact inconclusive")
+    colors.append(CLASS_COLORS["inconclusive"])
+    disagree.append(False)
+    return codes, labels, colors, disagree
+
+
+def plot_comparison(
+    rmap: RegionMap, methods: Sequence[str] | None = None, *, ax: Any = None,
+    legend: bool = True, title: bool = True,
+) -> dict[str, Any]:
+    """Draw where methods agree and disagree on string stability, counting each case.
+
+    Each point is coloured by the pattern of verdicts (✓ = says string stable:
+    exact certified, or Hurwitz and Proposition 1).  Agreement is drawn in
+    light tints; each disagreement pattern in a strong colour: warm colours
+    where the first method (the reference, normally ``exact``) says *not*
+    stable but another says stable (unsafe), cool colours the reverse
+    (conservative).  The legend gives the count of points of every pattern
+    present and the number of disagreeing points in its title.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        A 2-D map.
+    methods : sequence of str, optional
+        Two or three evaluated methods, reference first; default all of the map's
+        methods in the order exact, taylor, printed.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    legend, title : bool
+        Draw the legend and the title.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``image``, ``legend``, ``counts`` (label → number of points)
+        and ``disagreements`` (total number of disagreeing points).
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 2-D or fewer than two evaluated methods are given.
+    """
+    _need_2d(rmap, "plot_comparison")
+    ms = [m for m in METHODS if m in rmap.methods] if methods is None else list(methods)
+    if len(ms) < 2 or len(set(ms)) != len(ms):
+        raise StringStabError(f"plot_comparison needs 2 or 3 distinct evaluated methods; got {ms}")
+    for m in ms:
+        if m not in rmap.methods:
+            raise StringStabError(f"method {m!r} was not evaluated in this map (methods {list(rmap.methods)})")
+    ax = _new_ax(ax)
+    codes, labels, colors, disagree = _comparison_codes(rmap, ms)
+    cmap, norm = _categorical(colors)
+    im = _draw_field(ax, rmap, codes, cmap=cmap, norm=norm)
+    _label_axes(ax, rmap)
+    counts_arr = np.bincount(codes.ravel(), minlength=len(labels))
+    counts = {lab: int(c) for lab, c in zip(labels, counts_arr)}
+    n_dis = int(sum(c for c, d in zip(counts_arr, disagree) if d))
+    handles = [
+        _patch(col, f"{lab} (n = {c:,})")
+        for lab, col, c, d in zip(labels, colors, counts_arr, disagree)
+        if c > 0 or not d
+    ]
+    leg = _legend(ax, handles, title=f"disagreements: {n_dis:,} of {rmap.size:,} points") if legend else None
+    if title:
+        ax.set_title(f"{' vs '.join(ms)}: where the verdicts differ\n{rmap.title()}", fontsize="medium")
+    return {"ax": ax, "image": im, "legend": leg, "counts": counts, "disagreements": n_dis}
+
+
+# --------------------------------------------------------------------------- sup gain
+def plot_sup_gain(
+    rmap: RegionMap, *, ax: Any = None, vmax: float | None = None, colorbar: bool = True,
+    title: bool = True, cmap: str = "cividis",
+) -> dict[str, Any]:
+    """Heat map of ‖Γ‖_{H∞} = sup_ω |Γ(jω)| on a log colour scale, with the ≤ 1 boundary.
+
+    Points where Γ is not internally stable (‖Γ‖∞ = ∞) are drawn in light
+    grey.  The boundary of the certified region (sup|Γ| ≤ 1) is drawn as a
+    solid line; certified points have sup|Γ| = |Γ(0)| = 1 exactly, the bottom
+    of the colour scale.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        A 2-D map evaluated with ``exact``.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    vmax : float, optional
+        Top of the colour scale (larger values saturate); default the 99th
+        percentile of the finite values, at least 1.1.
+    colorbar, title : bool
+        Draw the colour bar and the title.
+    cmap : str
+        A perceptually uniform matplotlib colour map.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``image``, ``contour`` (the boundary, or None when the region
+        is empty or everything), ``colorbar`` and ``legend``.
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 2-D or has no exact verdicts.
+    """
+    _need_2d(rmap, "plot_sup_gain")
+    if rmap.sup_gain is None:
+        raise StringStabError(f"plot_sup_gain needs a map evaluated with 'exact'; got methods {list(rmap.methods)}")
+    import matplotlib as mpl
+    from matplotlib.colors import LogNorm
+    from matplotlib.lines import Line2D
+
+    ax = _new_ax(ax)
+    sup = np.asarray(rmap.sup_gain, dtype=float)
+    finite = np.isfinite(sup)
+    if vmax is None:
+        vmax = float(np.percentile(sup[finite], 99)) if finite.any() else 10.0
+        vmax = max(vmax, 1.1)
+    cm = mpl.colormaps[cmap].with_extremes(bad="#E4E4E4")
+    im = _draw_field(ax, rmap, np.ma.masked_invalid(np.where(finite, sup, np.nan)),
+                     cmap=cm, norm=LogNorm(vmin=1.0, vmax=vmax))
+    cert = rmap.stable("exact").astype(float)
+    contour = None
+    handles = [_patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)")]
+    if 0 < cert.sum() < cert.size:
+        x, y = rmap.axes.values()
+        contour = ax.contour(x, y, cert.T, levels=[0.5], colors=[_OI["vermillion"]], linewidths=1.6)
+        handles.append(Line2D([], [], color=_OI["vermillion"], lw=1.6,
+                              label=f"boundary of sup|Γ| ≤ 1 (certified, {_pct(int(cert.sum()), cert.size)})"))
+    leg = _legend(ax, handles, ncol=1)
+    cb = None
+    if colorbar:
+        cb = ax.figure.colorbar(im, ax=ax, extend="max", label=r"$\sup_\omega |\Gamma(j\omega)|$")
+    _label_axes(ax, rmap)
+    if title:
+        ax.set_title(f"sup|Γ(jω)| (exact delay)\n{rmap.title()}", fontsize="medium")
+    return {"ax": ax, "image": im, "contour": contour, "colorbar": cb, "legend": leg}
+
+
+# --------------------------------------------------------------------------- 3-D
+def plot_slices(
+    rmap: RegionMap, method: str = "exact", *, gain: str | None = None, n: int = 9,
+    fig: Any = None, ncols: int | None = None,
+) -> dict[str, Any]:
+    """A 3-D map as a montage of 2-D class maps over one gain.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        A 3-D map.
+    method : {"exact", "taylor", "printed"}
+        Whose classes to show.
+    gain : str, optional
+        The gain to slice along; default the map's last axis.
+    n : int
+        Number of slices, evenly spaced over that gain's grid (at most its size).
+    fig : matplotlib Figure, optional
+        Where to draw; a new figure when None.
+    ncols : int, optional
+        Panels per row; default ⌈√n⌉.
+
+    Returns
+    -------
+    dict
+        ``fig``, ``axes`` (list), ``images`` (list), ``values`` (the slice
+        coordinates) and ``legend``.
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 3-D, ``gain`` is not an axis or ``n < 1``.
+    """
+    if rmap.ndim != 3:
+        raise StringStabError(f"plot_slices needs a 3-D map; got a {rmap.ndim}-D map")
+    gain = gain or rmap.axis_names[-1]
+    if gain not in rmap.axes:
+        raise StringStabError(f"gain must be one of {list(rmap.axes)}; got {gain!r}")
+    if n < 1:
+        raise StringStabError(f"n must be >= 1 slices; got {n}")
+    coords = rmap.axes[gain]
+    idx = np.unique(np.round(np.linspace(0, coords.size - 1, min(n, coords.size))).astype(int))
+    ncols = ncols or int(np.ceil(np.sqrt(idx.size)))
+    nrows = int(np.ceil(idx.size / ncols))
+    if fig is None:
+        fig = _plt().figure(figsize=(2.5 * ncols + 2.6, 2.4 * nrows + 0.7), layout="constrained")
+    axs = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
+    images, used = [], []
+    handles: list[Any] = []
+    for k, ax in zip(idx, axs):
+        sl = rmap.slice(gain, float(coords[k]))
+        out = plot_class_map(sl, method, ax=ax, legend=False, title=False)
+        images.append(out["image"])
+        used.append(ax)
+        handles = out["handles"]
+        share = sl.stable(method).mean()
+        word = "certified" if method == "exact" else "stable"
+        ax.set_title(f"{gain} = {coords[k]:.3g}: {100 * share:.1f} % {word}", fontsize="small")
+        ax.label_outer()
+    for ax in axs[idx.size:]:
+        ax.set_visible(False)
+    names = rmap.class_names(method)
+    handles = [_patch(CLASS_COLORS[c], c) for c in names]
+    leg = fig.legend(handles=handles, loc="outside right upper", frameon=False, fontsize="small")
+    fig.suptitle(f"{_METHOD_TITLES[method]}, slices over {gain}\n{rmap.title()}", fontsize="medium")
+    return {"fig": fig, "axes": used, "images": images, "values": coords[idx], "legend": leg}
+
+
+def plot_region_3d(
+    rmap: RegionMap, method: str = "exact", *, ax: Any = None, kind: str = "surface",
+    max_points: int = 40_000, title: bool = True,
+) -> dict[str, Any]:
+    """The string-stable region of a 3-D map, drawn in 3-D.
+
+    ``kind="surface"`` (default): for every grid point of the first two axis
+    gains, the lowest and the highest value of the third (the map's last axis)
+    at which the method says string stable; the two surfaces enclose the
+    region, and are its exact boundary where the stable set of each such
+    column is one interval (``n_gapped`` counts the columns where it is not).
+    ``kind="points"``: every stable grid point with a neighbour that is not
+    (the boundary voxels), coloured by the third gain, thinned evenly to
+    ``max_points``.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        A 3-D map.
+    method : {"exact", "taylor", "printed"}
+        Whose verdict defines the region.
+    ax : mpl_toolkits.mplot3d Axes3D, optional
+        A 3-D axes; a new figure when None.
+    kind : {"surface", "points"}
+        What to draw.
+    max_points : int
+        With ``kind="points"``, at most this many points are drawn.
+    title : bool
+        Draw the title.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``artists`` (the surfaces or the scatter; empty when the region
+        is empty), ``n_gapped`` (surface) or ``n_boundary`` (points), and
+        ``legend`` or ``colorbar``.
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 3-D or ``kind`` is unknown.
+    """
+    if rmap.ndim != 3:
+        raise StringStabError(f"plot_region_3d needs a 3-D map; got a {rmap.ndim}-D map")
+    if kind not in ("surface", "points"):
+        raise StringStabError(f"kind must be 'surface' or 'points'; got {kind!r}")
+    st = rmap.stable(method)
+    if ax is None:
+        fig = _plt().figure(figsize=(7.2, 6.4), layout="constrained")
+        ax = fig.add_subplot(projection="3d")
+    names = rmap.axis_names
+    a0, a1, a2 = rmap.axes.values()
+    out: dict[str, Any] = {"ax": ax, "artists": []}
+    if kind == "surface":
+        from matplotlib.patches import Patch
+
+        anyst = st.any(axis=2)
+        lo_i = np.argmax(st, axis=2)
+        hi_i = a2.size - 1 - np.argmax(st[:, :, ::-1], axis=2)
+        lower = np.where(anyst, a2[lo_i], np.nan)
+        upper = np.where(anyst, a2[hi_i], np.nan)
+        n_gapped = int(np.count_nonzero(anyst & (st.sum(axis=2) < hi_i - lo_i + 1)))
+        X, Y = np.meshgrid(a0, a1, indexing="ij")
+        stride = max(1, int(np.ceil(max(a0.size, a1.size) / 80)))
+        handles = []
+        if anyst.any():
+            for Z, col, lab in ((lower, _OI["blue"], f"lowest {names[2]}"),
+                                (upper, _OI["orange"], f"highest {names[2]}")):
+                surf = ax.plot_surface(X, Y, np.ma.masked_invalid(Z), color=col, rstride=stride,
+                                       cstride=stride, linewidth=0.15, edgecolor="#333333",
+                                       alpha=0.85, shade=True)
+                out["artists"].append(surf)
+                handles.append(Patch(facecolor=col, edgecolor="#333333", label=lab))
+        out["n_gapped"] = n_gapped
+        out["legend"] = ax.legend(handles=handles, loc="upper left", fontsize="small",
+                                  title=f"stable {names[2]} range over ({names[0]}, {names[1]})",
+                                  title_fontsize="small") if handles else None
+    else:
+        pad = np.pad(st, 1, mode="constant", constant_values=False)
+        inner = np.ones_like(st)
+        for axis in range(3):
+            for shift in (-1, 1):
+                inner &= np.roll(pad, shift, axis=axis)[1:-1, 1:-1, 1:-1]
+        i, j, k = np.nonzero(st & ~inner)
+        nb = i.size
+        if nb > max_points:
+            keep = np.linspace(0, nb - 1, max_points).astype(int)
+            i, j, k = i[keep], j[keep], k[keep]
+        out["n_boundary"] = int(nb)
+        out["colorbar"] = None
+        if nb:
+            sc = ax.scatter(a0[i], a1[j], a2[k], c=a2[k], cmap="cividis", s=6, depthshade=False,
+                            linewidths=0)
+            out["artists"].append(sc)
+            out["colorbar"] = ax.figure.colorbar(sc, ax=ax, shrink=0.6, pad=0.1,
+                                                 label=GAIN_LABELS[names[2]])
+    for setter, a in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), (a0, a1, a2)):
+        setter(a[0], a[-1])
+    ax.set_xlabel(GAIN_LABELS[names[0]])
+    ax.set_ylabel(GAIN_LABELS[names[1]])
+    ax.set_zlabel(GAIN_LABELS[names[2]])
+    ax.view_init(elev=22, azim=-125)
+    if title:
+        what = "certified" if method == "exact" else f"{method}-stable"
+        ax.set_title(f"the {what} region ({100 * st.mean():.1f} % of the box)\n{rmap.title()}",
+                     fontsize="medium")
+    return out
+
+
+# --------------------------------------------------------------------------- several maps
+def _param_label(rmap: RegionMap, vary: Sequence[str]) -> str:
+    p = rmap.params.as_dict()
+    sym = {"tau": "τ", "delta": "δ", "headway": "T*"}
+    return ", ".join(f"{sym[k]} = {p[k]:g} s" for k in vary)
+
+
+def _varying(maps: Sequence[RegionMap]) -> list[str]:
+    keys = ["tau", "delta", "headway"]
+    vary = [k for k in keys if len({m.params.as_dict()[k] for m in maps}) > 1]
+    return vary or ["tau"]
+
+
+def _check_same_axes(maps: Sequence[RegionMap], what: str) -> None:
+    if not maps:
+        raise StringStabError(f"{what} needs at least one map; got none")
+    for m in maps:
+        _need_2d(m, what)
+    first = maps[0]
+    for m in maps[1:]:
+        if m.axis_names != first.axis_names or m.fixed != first.fixed:
+            raise StringStabError(
+                f"{what} needs maps over the same gains and fixed gain; got {first.axis_names} "
+                f"{first.fixed} and {m.axis_names} {m.fixed}"
+            )
+
+
+def plot_facets(
+    maps: Sequence[RegionMap], method: str = "exact", *, axes: Sequence[Any] | None = None,
+    kind: str = "class",
+) -> dict[str, Any]:
+    """One panel per map (e.g. per τ or δ), side by side, to show how the region changes.
+
+    Parameters
+    ----------
+    maps : sequence of RegionMap
+        2-D maps over the same gains (and fixed gain), differing in τ, δ or T*.
+    method : {"exact", "taylor", "printed"}
+        Whose classes to show (``kind="class"``).
+    axes : sequence of Axes, optional
+        One axes per map; a new one-row figure when None.
+    kind : {"class", "sup_gain"}
+        Class maps, or heat maps of sup|Γ| (then ``method`` is ignored).
+
+    Returns
+    -------
+    dict
+        ``fig``, ``axes``, ``images``, ``legend`` (a shared legend or colour bar
+        owner) and ``shares`` (share of stable points per map).
+
+    Raises
+    ------
+    StringStabError
+        If the maps differ in their axes, ``axes`` has the wrong length or
+        ``kind`` is unknown.
+    """
+    _check_same_axes(maps, "plot_facets")
+    if kind not in ("class", "sup_gain"):
+        raise StringStabError(f"kind must be 'class' or 'sup_gain'; got {kind!r}")
+    vary = _varying(maps)
+    if axes is None:
+        fig = _plt().figure(figsize=(3.4 * len(maps) + 2.4, 3.9), layout="constrained")
+        axes = list(fig.subplots(1, len(maps), sharex=True, sharey=True, squeeze=False).ravel())
+    else:
+        axes = list(axes)
+        if len(axes) != len(maps):
+            raise StringStabError(f"expected one axes per map ({len(maps)}); got {len(axes)}")
+        fig = axes[0].figure
+    images, shares = [], []
+    vmax = None
+    if kind == "sup_gain":
+        fin = np.concatenate([m.sup_gain[np.isfinite(m.sup_gain)] for m in maps if m.sup_gain is not None])
+        vmax = max(float(np.percentile(fin, 99)), 1.1) if fin.size else 10.0
+    for i, (m, ax) in enumerate(zip(maps, axes)):
+        if kind == "class":
+            out = plot_class_map(m, method, ax=ax, legend=False, title=False)
+            share = float(m.stable(method).mean())
+        else:
+            out = plot_sup_gain(m, ax=ax, vmax=vmax, colorbar=False, title=False)
+            share = float(m.stable("exact").mean())
+            out["legend"].remove()
+        images.append(out["image"])
+        shares.append(share)
+        word = "certified" if (kind == "sup_gain" or method == "exact") else "stable"
+        ax.set_title(f"{_param_label(m, vary)}\n{100 * share:.1f} % {word}", fontsize="medium")
+        if i:
+            ax.set_ylabel("")
+    if kind == "class":
+        names = maps[0].class_names(method)
+        leg = fig.legend(handles=[_patch(CLASS_COLORS[c], c) for c in names],
+                         loc="outside right upper", frameon=False, fontsize="small")
+    else:
+        from matplotlib.lines import Line2D
+
+        fig.colorbar(images[-1], ax=axes, extend="max", shrink=0.9,
+                     label=r"$\sup_\omega |\Gamma(j\omega)|$")
+        leg = fig.legend(handles=[_patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)"),
+                                  Line2D([], [], color=_OI["vermillion"], lw=1.6,
+                                         label="boundary of sup|Γ| ≤ 1 (certified)")],
+                         loc="outside lower center", ncol=2, frameon=False, fontsize="small")
+    fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
+    p = maps[0].params.as_dict()
+    const = ", ".join(f"{s} = {p[k]:g} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
+                      if k not in vary)
+    what = _METHOD_TITLES[method] if kind == "class" else "sup|Γ(jω)|"
+    fig.suptitle(f"{what}; {fixed}; {const}", fontsize="medium")
+    return {"fig": fig, "axes": axes, "images": images, "legend": leg, "shares": shares}
+
+
+def plot_boundaries(
+    maps: Sequence[RegionMap], method: str = "exact", *, ax: Any = None, title: bool = True,
+) -> dict[str, Any]:
+    """The boundaries of the string-stable regions of several maps on one axes.
+
+    Parameters
+    ----------
+    maps : sequence of RegionMap
+        2-D maps over the same gains, differing in τ, δ or T*.
+    method : {"exact", "taylor", "printed"}
+        Whose verdict defines each region.
+    ax : matplotlib Axes, optional
+        Where to draw; a new figure when None.
+    title : bool
+        Draw the title.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``contours`` (one ContourSet or None per map), ``legend`` and
+        ``shares``.
+    """
+    _check_same_axes(maps, "plot_boundaries")
+    from matplotlib.lines import Line2D
+
+    ax = _new_ax(ax, figsize=(6.4, 7.4))
+    vary = _varying(maps)
+    colors = [_OI["blue"], _OI["vermillion"], _OI["green"], _OI["purple"], _OI["orange"], _OI["sky"]]
+    styles = ["-", "--", "-.", ":"]
+    contours, handles, shares = [], [], []
+    for i, m in enumerate(maps):
+        st = m.stable(method)
+        share = float(st.mean())
+        shares.append(share)
+        col, ls = colors[i % len(colors)], styles[i % len(styles)]
+        cs = None
+        if 0 < st.sum() < st.size:
+            x, y = m.axes.values()
+            cs = ax.contour(x, y, st.T.astype(float), levels=[0.5], colors=[col], linestyles=[ls],
+                            linewidths=1.8)
+        contours.append(cs)
+        handles.append(Line2D([], [], color=col, ls=ls, lw=1.8,
+                              label=f"{_param_label(m, vary)} ({100 * share:.1f} % inside)"))
+    x, y = maps[0].axes.values()
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(y[0], y[-1])
+    ax.grid(True, lw=0.4, alpha=0.5)
+    _label_axes(ax, maps[0])
+    word = "certified" if method == "exact" else f"{method}-stable"
+    leg = _legend(ax, handles, title=f"boundary of the {word} region", ncol=1)
+    if title:
+        fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
+        p = maps[0].params.as_dict()
+        const = ", ".join(f"{s} = {p[k]:g} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
+                          if k not in vary)
+        sym = {"tau": "τ", "delta": "δ", "headway": "T*"}
+        ax.set_title(f"boundary of the {word} region for several {', '.join(sym[v] for v in vary)}\n"
+                     f"{fixed}; {const}", fontsize="medium")
+    return {"ax": ax, "contours": contours, "legend": leg, "shares": shares}
+
+
+# --------------------------------------------------------------------------- trajectory
+def plot_trajectory(
+    rmap: RegionMap, gains: Any, *, ax: Any = None, verdicts: Sequence[str] | None = None,
+    legend: bool = True,
+) -> dict[str, Any]:
+    """Overlay a gain trajectory (e.g. from a policy rollout) on a 2-D map.
+
+    The trajectory is projected on the map's two axis gains; each point is
+    marked by the exact verdict of *its own* triple (its own third gain, the
+    map's τ, δ, T*), which need not equal the map's fixed gain.  Points of one
+    vehicle are joined in order; the first point of each is labelled.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The 2-D map it is drawn over (gives the axes and the parameters).
+    gains : GainTable or array_like of shape (n, 3)
+        The triples k_x, k_v, k_a in time order (a
+        :class:`stringstab.gainio.GainTable`, e.g. from
+        :func:`stringstab.gainio.read_gains`, adds ``t`` and ``vehicle``).
+    ax : matplotlib Axes, optional
+        Usually the axes of a class map; a new figure when None.
+    verdicts : sequence of str, optional
+        Precomputed verdicts per row; default
+        :func:`stringstab.certificate.certify_batch` on each triple.
+    legend : bool
+        Add the trajectory's legend (next to an existing one, under the axes).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``lines`` (one per vehicle), ``markers`` (verdict → the
+        PathCollection), ``verdicts`` (list) and ``legend``.
+
+    Raises
+    ------
+    StringStabError
+        If ``rmap`` is not 2-D or the gains are not n × 3.
+    """
+    _need_2d(rmap, "plot_trajectory")
+    from .gainio import GainTable
+
+    if isinstance(gains, GainTable):
+        K = gains.K
+        vehicle = gains.vehicle
+    else:
+        K = np.asarray(gains, dtype=float)
+        vehicle = None
+        if K.ndim != 2 or K.shape[1] != 3 or K.shape[0] == 0:
+            raise StringStabError(f"gains must be an (n, 3) array of k_x, k_v, k_a; got shape {K.shape}")
+    if verdicts is None:
+        from .certificate import certify_batch
+
+        p = rmap.params
+        verdicts = certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta,
+                                 headway=p.headway).verdict.tolist()
+    verdicts = list(verdicts)
+    if len(verdicts) != K.shape[0]:
+        raise StringStabError(f"expected one verdict per gain triple ({K.shape[0]}); got {len(verdicts)}")
+    ax = _new_ax(ax)
+    col = {"k_x": 0, "k_v": 1, "k_a": 2}
+    xn, yn = rmap.axis_names
+    x, y = K[:, col[xn]], K[:, col[yn]]
+    groups = [np.arange(K.shape[0])] if vehicle is None else [
+        np.flatnonzero(vehicle == v) for v in dict.fromkeys(vehicle.tolist())
+    ]
+    lines = []
+    for g in groups:
+        (ln,) = ax.plot(x[g], y[g], color="#333333", lw=1.0, zorder=3)
+        lines.append(ln)
+        if vehicle is not None:
+            ax.annotate(f"veh {vehicle[g[0]]}", (x[g[0]], y[g[0]]), xytext=(4, 4),
+                        textcoords="offset points", fontsize="x-small", zorder=5)
+    v_arr = np.asarray(verdicts)
+    markers = {}
+    for name, style in _VERDICT_MARKERS.items():
+        sel = v_arr == name
+        if sel.any():
+            markers[name] = ax.scatter(
+                x[sel], y[sel], marker=style["marker"], s=40, facecolors=style["facecolor"],
+                edgecolors=style["edgecolor"], linewidths=0.8, zorder=4,
+                label=f"policy gains: {name.replace('_', ' ')} (n = {int(sel.sum())})",
+            )
+    leg = None
+    if legend:
+        handles = list(markers.values())
+        title = "gain trajectory: exact verdict of each point's own K"
+        old = ax.get_legend()
+        if old is not None:  # extend the map's legend rather than cover the map
+            handles = [*old.legend_handles, *handles]
+            for h, t in zip(old.legend_handles, old.get_texts()):
+                h.set_label(t.get_text())
+            title = f"{old.get_title().get_text()}; {title}"
+        leg = _legend(ax, handles, title=title)
+    return {"ax": ax, "lines": lines, "markers": markers, "verdicts": verdicts, "legend": leg}
+
+
+# --------------------------------------------------------------------------- files
+def save_figures(
+    rmap: RegionMap, out: str | Path, *, prefix: str = "region",
+    formats: Sequence[str] = ("png", "pdf"), gains: Any = None, dpi: int = 150,
+) -> list[Path]:
+    """Draw the standard figures of a map and save each in every format.
+
+    2-D map: ``<prefix>_class_<method>`` for each method,
+    ``<prefix>_compare`` (two or more methods), ``<prefix>_sup_gain``
+    (``exact``) and, with ``gains``, ``<prefix>_overlay`` (the trajectory over
+    the class map of the first method).  3-D map: ``<prefix>_slices_<method>``
+    and ``<prefix>_3d_<method>`` for each method.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The map.
+    out : path
+        An existing directory.
+    prefix : str
+        File name stem.
+    formats : sequence of str
+        Among :data:`FIGURE_FORMATS`.
+    gains : GainTable or array_like, optional
+        A gain trajectory to overlay (2-D maps only).
+    dpi : int
+        Resolution of raster formats.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown format, or ``gains`` with a 3-D map.
+    """
+    for f in formats:
+        if f not in FIGURE_FORMATS:
+            raise StringStabError(f"figure formats must be among {list(FIGURE_FORMATS)}; got {f!r}")
+    if gains is not None and rmap.ndim != 2:
+        raise StringStabError(f"a gain trajectory can be overlaid on a 2-D map only; got a {rmap.ndim}-D map")
+    plt = _plt()
+    out = Path(out)
+    written: list[Path] = []
+
+    def save(fig: Any, stem: str) -> None:
+        for f in formats:
+            path = out / f"{prefix}_{stem}.{f}"
+            fig.savefig(path, dpi=dpi)
+            written.append(path)
+        plt.close(fig)
+
+    if rmap.ndim == 2:
+        for m in rmap.methods:
+            save(plot_class_map(rmap, m)["ax"].figure, f"class_{m}")
+        if len(rmap.methods) >= 2:
+            save(plot_comparison(rmap)["ax"].figure, "compare")
+        if "exact" in rmap.methods:
+            save(plot_sup_gain(rmap)["ax"].figure, "sup_gain")
+        if gains is not None:
+            ax = plot_class_map(rmap, rmap.methods[0])["ax"]
+            plot_trajectory(rmap, gains, ax=ax)
+            save(ax.figure, "overlay")
+    else:
+        for m in rmap.methods:
+            save(plot_slices(rmap, m)["fig"], f"slices_{m}")
+            save(plot_region_3d(rmap, m)["ax"].figure, f"3d_{m}")
+    return written
