@@ -816,7 +816,11 @@ def write_results(
     """
     text = format_results(records, fmt, params=params, summary=summary)
     if not isinstance(dest, (str, os.PathLike)):
-        dest.write(text)
+        try:
+            dest.write(text)
+        except UnicodeEncodeError:  # e.g. an ASCII terminal: Γ, ω, ‖ become '?'
+            enc = getattr(dest, "encoding", None) or "ascii"
+            dest.write(text.encode(enc, "replace").decode(enc))
         return
     path = Path(dest)
     try:

@@ -342,3 +342,12 @@ def test_write_results_atomic(tmp_path):
     buf = io.StringIO()
     write_results(RECORDS, buf, "csv")
     assert buf.getvalue().startswith("t,k_x,k_v,k_a,hurwitz")
+
+
+def test_write_results_to_an_ascii_stream():
+    raw = io.BytesIO()
+    stream = io.TextIOWrapper(raw, encoding="ascii")
+    write_results(RECORDS, stream, "table", params=PARAMS)
+    stream.flush()
+    text = raw.getvalue().decode("ascii")
+    assert "sup|?|" in text and "not_certified" in text
