@@ -130,12 +130,52 @@ def _step_region(out: Path, log: Log) -> dict[str, Any]:
             "disagreements": rmap.disagreements()}
 
 
+#: Uncertified triples repaired by the tune step (the first three are from DEMO_TRIPLES).
+TUNE_TRIPLES = ["0.9,-0.5,1.1", "0.2,0.7,0", "-0.5,1,1", "1,-1.2,0.5", "0.3,0.2,0.5",
+                "1.6,-0.9,0.6", "0.5,0.3,1.2"]
+
+
+def _step_tune(out: Path, log: Log) -> dict[str, Any]:
+    """Repair uncertified triples by region growing (IDL §3.3) and by projection; draw the moves."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .cli import main
+    from .gainio import parse_triple
+    from .tuning import plot_moves, project, region_growing
+
+    main(["tune", *TUNE_TRIPLES, "--method", "both", "--format", "json",
+          "--out", str(out / "tune.json")])
+    main(["tune", *TUNE_TRIPLES, "--method", "both", "--out", str(out / "tune.txt")])
+    doc = json.loads((out / "tune.json").read_text())
+    for r in doc["results"]:
+        log(
+            f"{r['method']:>14}: K0=({r['k_x_in']:g}, {r['k_v_in']:g}, {r['k_a_in']:g}) -> "
+            f"({r['k_x']:.4g}, {r['k_v']:.4g}, {r['k_a']:.4g}), moved {r['distance']:.4g}, "
+            f"{'certified' if r['certified'] else 'NOT certified'} ({r['status']})"
+        )
+    p = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
+    results = []
+    for t in TUNE_TRIPLES:
+        K = parse_triple(t)
+        results += [region_growing(K, **p), project(K, **p)]
+    drawn = plot_moves(results, **p, k_a=0.6, n=101)
+    fig = drawn["ax"].figure
+    fig.tight_layout()
+    fig.savefig(out / "tune_moves.png", dpi=110)
+    plt.close(fig)
+    return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": doc["summary"]}
+
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
     ("certify", _step_certify),
     ("simulate", _step_simulate),
     ("region", _step_region),
+    ("tune", _step_tune),
 ]
 
 

@@ -493,13 +493,15 @@ def _g_coeffs(K: Array, p: Params) -> tuple[float, float, float, float, float]:
     return float(t2), float(a), float(b), float(cx), float(cv)
 
 
-def _g_dips(K: Array, p: Params, threshold: float, n: int = 384) -> tuple[float, list[float]]:
+def _g_dips(K: Array, p: Params, threshold: float, n: int = 384,
+            max_minima: int = 12) -> tuple[float, list[float]]:
     """Cheap scan of g(·; K): (minimum found, refined local minimisers with g < threshold).
 
     A dense grid on [0, Ω_F], Ω_F Fujiwara's bound beyond which g > 0 (see
-    :func:`stringstab.certificate.tail_bound`), then each local minimum below
-    ``threshold`` is zoomed into (a 9-point grid, shrunk ×4, five times).  Used
-    only to pick frequencies and to detect violations, never to certify.
+    :func:`stringstab.certificate.tail_bound`), then the ``max_minima`` lowest
+    local minima of the grid are zoomed into (a 9-point grid, shrunk ×4, six
+    times) and those below ``threshold`` returned.  Used only to pick
+    frequencies and to detect violations, never to certify.
     """
     t2, a, b, cx, cv = _g_coeffs(K, p)
     A = max(-a, 0.0) / t2
@@ -515,16 +517,16 @@ def _g_dips(K: Array, p: Params, threshold: float, n: int = 384) -> tuple[float,
     W = np.linspace(0.0, om_max, n)
     Gv = g(W)
     gmin = float(Gv.min())
-    # local minima (including the end point ω = 0)
+    # local minima of the grid (including the end point ω = 0), the lowest first; a dip
+    # narrower than the grid spacing can hide between samples, so all are refined
     left = np.concatenate([[np.inf], Gv[:-1]])
     right = np.concatenate([Gv[1:], [np.inf]])
-    idx = np.flatnonzero((Gv <= left) & (Gv <= right) & (Gv < threshold))
-    if idx.size == 0:
-        return gmin, []
+    idx = np.flatnonzero((Gv <= left) & (Gv <= right))
+    idx = idx[np.argsort(Gv[idx])[:max_minima]]
     centres = W[idx]
     half = np.full(idx.size, om_max / (n - 1))
     v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(5):
+    for _ in range(6):
         Wl = np.maximum(centres[:, None] + half[:, None] * v[None, :], 0.0)
         Gl = g(Wl)
         jl = np.argmin(Gl, axis=1)
@@ -728,8 +730,11 @@ class Projector:
                 if cert.certified:
                     best = (x, cert)
                     break
-                if math.isfinite(cert.peak_omega):
-                    new = [float(cert.peak_omega)]
+                # a violation the coarse scan missed: look closer (the certificate's
+                # peak_omega can be 0 when |Γ| exceeds 1 only by ~1e-6)
+                _, new = _g_dips(x, p, threshold=0.5 * self.eps, n=8192)
+                if math.isfinite(cert.peak_omega) and cert.peak_omega > 0:
+                    new.append(float(cert.peak_omega))
             # each new frequency comes with two neighbours ±_CLUSTER: the dip moves as K moves
             new = [o * f for o in new for f in (1.0, 1.0 - _CLUSTER, 1.0 + _CLUSTER)]
             grown = _dedupe([*omegas, *new])
@@ -974,6 +979,8 @@ def plot_moves(
         ax.text(x1, y1, f" {r.k[2]:.2f}", fontsize=7, color=c)
     ax.set_xlabel("k_x")
     ax.set_ylabel("k_v")
-    ax.set_title(f"repairs on the certified region (shaded) at k_a = {k_a:g}")
+    ax.set_title(f"repairs K0 → K over the certified region (shaded) at k_a = {k_a:g}\n"
+                 "arrows projected on (k_x, k_v); label: output k_a; ■ certified, × not",
+                 fontsize=9)
     ax.legend(loc="lower right", fontsize=8)
     return {"ax": ax, "region": region, "arrows": arrows}
