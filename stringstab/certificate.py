@@ -161,6 +161,8 @@ class _Exact:
     omega_max: Array
     worst_omega: Array
     n_evals: npt.NDArray[np.int64]
+    grid_omega: Array  # (n, n_grid + 1) initial grid
+    grid_g: Array  # g on that grid
 
 
 def _exact_chunk(
@@ -243,7 +245,7 @@ def _exact_chunk(
     verdict = np.full(n, _CERT, dtype=np.int8)
     verdict[inconclusive] = _INC
     verdict[violated] = _NOT
-    return _Exact(verdict, margin, Om, worst, n_evals)
+    return _Exact(verdict, margin, Om, worst, n_evals, W, G)
 
 
 # ---------------------------------------------------------------------------
@@ -267,31 +269,37 @@ def _gain2(w: Array, kx: Array, kv: Array, ka: Array, tau: float, delta: float,
 
 def _peak(
     kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float, Om: Array,
-    n_grid: int = 96,
+    W: Array, G: Array,
 ) -> tuple[Array, Array]:
-    """sup_ω |Γ(jω)| on [0, Ω] and where: grid + resonance candidates + local refinement."""
+    """sup_ω |Γ(jω)| on [0, Ω] and where it is attained (reporting only).
+
+    Starts from the branch-and-bound grid (|Γ|² = 1 − ω² g/|D|², no new
+    evaluations), adds the minimisers of |D(jω)|² (a cubic in x = ω², so they
+    are roots of a quadratic: the resonance frequencies) and refines locally.
+    """
     n = kx.size
-    u = np.linspace(0.0, 1.0, n_grid + 1)
-    W = Om[:, None] * u[None, :]
-    # add the minimisers of |D(jω)|² (a cubic in x = ω²): near-resonance frequencies
+    rows = np.arange(n)
     c = kv + headway * kx
+    w2 = W * W
+    D2 = (col(kx) - w2) ** 2 + w2 * (col(c) - tau * w2) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        G2 = np.where(D2 > 0, 1.0 - w2 * G / D2, np.inf)
+    G2[:, 0] = np.where(kx != 0, 1.0, np.inf)  # Γ(0) = k_x/k_x
     qa, qb, qc = 3.0 * tau * tau, 2.0 * (1.0 - 2.0 * tau * c), c * c - 2.0 * kx
     disc = qb * qb - 4.0 * qa * qc
     sq = np.sqrt(np.maximum(disc, 0.0))
-    extra = []
-    for sign in (1.0, -1.0):
-        x = (-qb + sign * sq) / (2.0 * qa)
-        extra.append(np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0))
-    W = np.concatenate([W, np.stack(extra, axis=1)], axis=1)
-    G2 = _gain2(W, col(kx), col(kv), col(ka), tau, delta, headway)
-    G2 = np.where(np.isnan(G2), np.inf, G2)
-    rows = np.arange(n)
-    j = np.argmax(G2, axis=1)
-    best_w = W[rows, j]
-    best = G2[rows, j]
-    # local refinement around the best sample (the grid spacing, then /5 each round)
-    half = Om / n_grid
-    v = np.linspace(-1.0, 1.0, 11)
+    extra = np.stack([np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0)
+                      for x in ((-qb + sq) / (2.0 * qa), (-qb - sq) / (2.0 * qa))], axis=1)
+    Ge = _gain2(extra, col(kx), col(kv), col(ka), tau, delta, headway)
+    Wall = np.concatenate([W, extra], axis=1)
+    Gall = np.concatenate([G2, Ge], axis=1)
+    Gall = np.where(np.isnan(Gall), np.inf, Gall)
+    j = np.argmax(Gall, axis=1)
+    best_w = Wall[rows, j]
+    best = Gall[rows, j]
+    # local refinement around the best sample: grid spacing, then /4 each round
+    half = Om / (W.shape[1] - 1)
+    v = np.linspace(-1.0, 1.0, 9)
     for _ in range(8):
         Wl = np.maximum(best_w[:, None] + half[:, None] * v[None, :], 0.0)
         Gl = _gain2(Wl, col(kx), col(kv), col(ka), tau, delta, headway)
@@ -301,7 +309,7 @@ def _peak(
         upd = gl > best
         best = np.where(upd, gl, best)
         best_w = np.where(upd, Wl[rows, jl], best_w)
-        half = half / 5.0
+        half = half / 4.0
     return np.sqrt(best), best_w
 
 
@@ -531,7 +539,15 @@ def certify_batch(
                           n_grid=n_grid, max_rounds=max_rounds, split=4,
                           max_intervals=max_intervals, refine=~hz_fail[sl])
         verdict[sl], margin[sl], omega_max[sl], n_evals[sl] = ex.verdict, ex.margin, ex.omega_max, ex.n_evals
-        sup[sl], peak_w[sl] = _peak(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway, ex.omega_max)
+        # certified ⇒ sup |Γ| = 1 at ω = 0: only the others need a peak search
+        need = ex.verdict != _CERT
+        sup[sl], peak_w[sl] = 1.0, 0.0
+        if need.any():
+            idx = np.arange(sl.start, sl.stop)[need]
+            sup[idx], peak_w[idx] = _peak(
+                kx[idx], kv[idx], ka[idx], p.tau, p.delta, p.headway, ex.omega_max[need],
+                ex.grid_omega[need], ex.grid_g[need],
+            )
 
     verdict[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
     # certified ⇒ sup |Γ| = 1 exactly, at ω = 0 (Γ(0) = 1 for k_x ≠ 0)
