@@ -10,17 +10,39 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
+from .certificate import Certificate, CertificateBatch, certify, certify_batch, certify_pade
+from .criteria import hurwitz, stability_type, taylor_criteria
 from .errata import Erratum, errata
 from .errors import StringStabError
+from .frequency import gain, gamma_jw, margin_g
+from .gainio import GainTable, parse_triple, read_gains
 from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Params
+
+# The simulator (stringstab.traffic, stringstab.metrics), the region maps
+# (stringstab.regions, stringstab.plots) and the gain repair (stringstab.tuning)
+# are imported on demand: they pull in gymnasium, matplotlib and CasADi.
 
 __all__ = [
     "DEFAULT_DELTA",
     "DEFAULT_HEADWAY",
     "DEFAULT_TAU",
+    "Certificate",
+    "CertificateBatch",
     "Erratum",
+    "GainTable",
     "Params",
     "StringStabError",
     "__version__",
+    "certify",
+    "certify_batch",
+    "certify_pade",
     "errata",
+    "gain",
+    "gamma_jw",
+    "hurwitz",
+    "margin_g",
+    "parse_triple",
+    "read_gains",
+    "stability_type",
+    "taylor_criteria",
 ]

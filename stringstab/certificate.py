@@ -560,19 +560,25 @@ def certify_batch(
     pade_rows = None
     if method == "pade":
         pade_rows = []
+        disagree = []
         for i in range(n):
             pr = certify_pade(kx[i], kv[i], ka[i], tau=p.tau, delta=p.delta, headway=p.headway,
                               order=pade_order)
             row = pr.as_dict()
             row["agrees"] = pr.verdict == names[i] or names[i] == "inconclusive"
             if not row["agrees"]:
-                warnings.warn(
-                    f"Padé({pade_order}) cross-check disagrees for K=({kx[i]}, {kv[i]}, {ka[i]}): "
-                    f"exact {names[i]} (sup {hinf[i]:.6g}), python-control {pr.verdict} "
-                    f"(norm {pr.hinf:.6g})",
-                    stacklevel=2,
+                disagree.append(
+                    f"K=({kx[i]:g}, {kv[i]:g}, {ka[i]:g}): exact {names[i]} (sup {hinf[i]:.9g}), "
+                    f"Padé {pr.verdict} (norm {pr.hinf:.9g})"
                 )
             pade_rows.append(row)
+        if disagree:
+            more = f" and {len(disagree) - 3} more" if len(disagree) > 3 else ""
+            warnings.warn(
+                f"Padé({pade_order}) cross-check disagrees with the exact certificate on "
+                f"{len(disagree)} of {n} triples: " + "; ".join(disagree[:3]) + more,
+                stacklevel=2,
+            )
     return CertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, hurwitz=np.asarray(hz_sure),
         hurwitz_margin=hz_margin, verdict=names, type=np.array([TYPE_NAMES[int(t)] for t in td.type]) if n else np.array([], dtype=str),
