@@ -36,7 +36,7 @@ P = dict(tau=0.1, delta=0.2, headway=1.1)
 
 def _load() -> str:
     try:
-        return "load %.2f" % os.getloadavg()[0]
+        return f"load {os.getloadavg()[0]:.2f}"
     except OSError:  # pragma: no cover
         return "load ?"
 
