@@ -551,7 +551,8 @@ def plot_region_3d(
                 handles.append(Patch(facecolor=col, edgecolor="#333333", label=lab))
         out["n_gapped"] = n_gapped
         out["legend"] = ax.legend(handles=handles, loc="upper left", fontsize="small",
-                                  title=f"stable {names[2]} range over ({names[0]}, {names[1]})",
+                                  title=f"{'certified' if method == 'exact' else 'stable'} {names[2]} "
+                                        f"range over ({names[0]}, {names[1]})",
                                   title_fontsize="small") if handles else None
     else:
         pad = np.pad(st, 1, mode="constant", constant_values=False)
@@ -758,7 +759,7 @@ def plot_boundaries(
 # --------------------------------------------------------------------------- trajectory
 def plot_trajectory(
     rmap: RegionMap, gains: Any, *, ax: Any = None, verdicts: Sequence[str] | None = None,
-    legend: bool = True,
+    legend: bool = True, label: str = "policy gains",
 ) -> dict[str, Any]:
     """Overlay a gain trajectory (e.g. from a policy rollout) on a 2-D map.
 
@@ -781,7 +782,9 @@ def plot_trajectory(
         Precomputed verdicts per row; default
         :func:`stringstab.certificate.certify_batch` on each triple.
     legend : bool
-        Add the trajectory's legend (next to an existing one, under the axes).
+        Add the trajectory's entries to the axes' legend (under the axes).
+    label : str
+        What the points are, in the legend ("policy gains: certified (n = 12)").
 
     Returns
     -------
@@ -836,12 +839,12 @@ def plot_trajectory(
             markers[name] = ax.scatter(
                 x[sel], y[sel], marker=style["marker"], s=40, facecolors=style["facecolor"],
                 edgecolors=style["edgecolor"], linewidths=0.8, zorder=4,
-                label=f"policy gains: {name.replace('_', ' ')} (n = {int(sel.sum())})",
+                label=f"{label}: {name.replace('_', ' ')} (n = {int(sel.sum())})",
             )
     leg = None
     if legend:
         handles = list(markers.values())
-        title = "gain trajectory: exact verdict of each point's own K"
+        title = "markers: exact verdict of each point's own K"
         old = ax.get_legend()
         if old is not None:  # extend the map's legend rather than cover the map
             handles = [*old.legend_handles, *handles]
