@@ -862,6 +862,11 @@ def save_figures(
 ) -> list[Path]:
     """Draw the standard figures of a map and save each in every format.
 
+    Each file carries the tool version and :meth:`RegionMap.metadata` (τ, δ,
+    T*, axes, methods) as JSON in its own metadata: PNG ``Software`` and
+    ``Description`` text chunks, PDF ``Creator`` and ``Subject``, SVG
+    ``Creator`` and ``Description``.
+
     2-D map: ``<prefix>_class_<method>`` for each method,
     ``<prefix>_compare`` (two or more methods), ``<prefix>_sup_gain``
     (``exact``) and, with ``gains``, ``<prefix>_overlay`` (the trajectory over
@@ -902,10 +907,20 @@ def save_figures(
     out = Path(out)
     written: list[Path] = []
 
+    import json
+
+    meta = json.dumps(rmap.metadata(), ensure_ascii=False)
+    software = f"stringstab {rmap.version}"
+    file_meta = {
+        "png": {"Software": software, "Description": meta},
+        "pdf": {"Creator": software, "Subject": meta},
+        "svg": {"Creator": software, "Description": meta},
+    }
+
     def save(fig: Any, stem: str) -> None:
         for f in formats:
             path = out / f"{prefix}_{stem}.{f}"
-            fig.savefig(path, dpi=dpi)
+            fig.savefig(path, dpi=dpi, metadata=file_meta[f])
             written.append(path)
         plt.close(fig)
 

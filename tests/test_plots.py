@@ -1,5 +1,7 @@
 """Plot functions draw into the axes they are given and return what they drew."""
 
+import json
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -141,5 +143,12 @@ def test_save_figures_writes_each_format(tmp_path, m2):
     assert "region_compare.svg" in names and "region_sup_gain.png" in names
     assert len(names) == 2 * (3 + 2)
     assert all(p.stat().st_size > 0 for p in written)
+    from PIL import Image
+
+    info = Image.open(tmp_path / "region_compare.png").info
+    assert info["Software"] == f"stringstab {m2.version}"
+    meta = json.loads(info["Description"])
+    assert meta["params"] == {"tau": 0.1, "delta": 0.2, "headway": 1.1} and meta["fixed"] == {"k_x": 0.9}
+    assert m2.version in (tmp_path / "region_sup_gain.svg").read_text()
     with pytest.raises(StringStabError, match="formats"):
         plots.save_figures(m2, tmp_path, formats=("gif",))
