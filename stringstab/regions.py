@@ -747,6 +747,8 @@ def region_map(
     if int(workers) < 1:
         raise StringStabError(f"workers must be >= 1; got {workers!r}")
     workers = min(int(workers), len(blocks))
+    if multiprocessing.current_process().daemon:  # e.g. inside another pool: no children allowed
+        workers = 1
     if progress is None:
         progress = seconds / workers > 5.0
     spec = _Spec(names, internal, p, ms)  # type: ignore[arg-type]

@@ -176,6 +176,21 @@ def test_worker_processes_give_the_same_map():
         assert_array_equal(a, b)
 
 
+def _map_in_a_daemon(axes):
+    return region_map(axes, **P, workers=2, block=37).verdict["exact"]
+
+
+def test_map_inside_a_daemonic_worker_runs_in_one_process():
+    import multiprocessing
+
+    axes = {"k_x": np.linspace(-0.5, 2, 6), "k_v": np.linspace(-1, 2, 5)}
+    fixed_axes = {**axes, "k_a": np.array([0.2, 0.9])}
+    # multiprocessing.Pool workers are daemonic and may not start processes of their own
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        got = pool.apply_async(_map_in_a_daemon, (fixed_axes,)).get(timeout=60)
+    assert_array_equal(got, region_map(fixed_axes, **P, workers=1).verdict["exact"])
+
+
 @pytest.mark.parametrize("shape,target", [((7, 5, 3), 10), ((3, 40, 2), 9), ((1, 1, 1), 5), ((50, 1, 1), 7)])
 def test_blocks_cover_the_grid_once(shape, target):
     seen = np.zeros(shape, dtype=int)
