@@ -430,11 +430,13 @@ def region_growing(
 # Projection: the nearest certified gains (CasADi / IPOPT, exchange method)
 # ---------------------------------------------------------------------------
 #: Frequency-slot capacities of the prebuilt NLPs (the smallest that fits is used).
-_SLOTS = (6, 16, 40)
+_SLOTS = (12, 24, 48)
 #: Fixed frequencies (rad/s) in every first solve, besides ω = 0 and the dips of g(·; K0).
-_LADDER: tuple[float, ...] = tuple(float(v) for v in np.geomspace(0.1, 5.0, 8))
+_LADDER: tuple[float, ...] = tuple(float(v) for v in np.geomspace(0.2, 5.0, 16))
 #: Relative offset of the two neighbours added with every exchanged frequency.
 _CLUSTER = 0.05
+#: Multipliers of the violating frequencies of K0 in the first solve.
+_K0_CLUSTER = (1.0, 0.95, 0.9)
 
 
 def _import_casadi() -> Any:
@@ -688,6 +690,8 @@ class Projector:
                                "already certified by the exact certificate; returned unchanged")
             if math.isfinite(cert0.peak_omega):
                 dips = [*dips, float(cert0.peak_omega)]
+        # the dips of the solution lie a little below those of K0, as a rule
+        dips = [o * f for o in dips for f in _K0_CLUSTER]
 
         # Starting point: the nearest certified map point, the previous solution or warm_start.
         M = self._map()
@@ -724,7 +728,7 @@ class Projector:
             if not np.all(np.isfinite(x)):
                 break
             # exchange: first the cheap scan, then the exact certificate
-            _, new = _g_dips(x, p, threshold=0.5 * self.eps)
+            _, new = _g_dips(x, p, threshold=0.0)
             if not new and _hurwitz_ok(x, p):
                 cert = certify(*x, tau=p.tau, delta=p.delta, headway=p.headway)
                 if cert.certified:
@@ -732,7 +736,7 @@ class Projector:
                     break
                 # a violation the coarse scan missed: look closer (the certificate's
                 # peak_omega can be 0 when |Γ| exceeds 1 only by ~1e-6)
-                _, new = _g_dips(x, p, threshold=0.5 * self.eps, n=8192)
+                _, new = _g_dips(x, p, threshold=0.0, n=8192)
                 if math.isfinite(cert.peak_omega) and cert.peak_omega > 0:
                     new.append(float(cert.peak_omega))
             # each new frequency comes with two neighbours ±_CLUSTER: the dip moves as K moves
@@ -834,11 +838,13 @@ def project(
 
     where g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.frequency.margin_g`;
     g(0) = Ψ3), so g(ω_j) ≥ ε is |D(jω_j)|² − |N(jω_j)|² ≥ ε ω_j².  The frequency
-    set starts as {0} plus the violating local minima of g(·; K0) (and the
-    certificate's worst frequency of K0), and is refined by *exchange*: after
-    each solve the local minima of g(·; K) below ε/2 found by a dense scan are
-    added; when there are none, the exact certificate is asked, and if it does
-    not certify, its worst frequency is added.  The loop ends when the
+    set starts as {0}, a fixed ladder of 16 frequencies (0.2 to 5 rad/s,
+    geometric) and the violating local minima of g(·; K0) (each also at 0.95
+    and 0.9 times itself), and is refined by *exchange*: after each solve the
+    local minima of g(·; K) below 0 found by a dense scan are added, each with
+    neighbours at ±5 %; when there are none, the exact certificate is asked,
+    and if it does not certify, a finer scan and the certificate's
+    ``peak_omega`` give the frequencies to add.  The loop ends when the
     certificate certifies K (or after ``max_exchange`` solves).
 
     The first solve starts from the nearest point (weighted distance) of a
@@ -850,7 +856,7 @@ def project(
     than the nearest certified grid point.
 
     The NLP is built once per process for each of a few frequency-slot
-    capacities (6, 16, 40), with K0, the weights, τ, δ, T* and the frequencies
+    capacities (12, 24, 48), with K0, the weights, τ, δ, T* and the frequencies
     as parameters; unused slots are disabled by a lower bound of −∞.
 
     Parameters
