@@ -205,15 +205,13 @@ def _exact_chunk(
     for _ in range(max_rounds):
         if tri.size == 0:
             break
-        if tri.size > max_intervals:  # budget: give up on the triples with most intervals
-            counts = np.bincount(tri, minlength=n)
-            order = np.argsort(counts, kind="stable")  # fewest intervals first
-            keep_budget = np.cumsum(counts[order]) <= max_intervals
-            drop = np.zeros(n, dtype=bool)
-            drop[order[~keep_budget]] = True
-            drop &= counts > 0
-            inconclusive |= drop
-            sel = ~drop[tri]
+        # budget, per triple (so a verdict never depends on the other triples
+        # of its chunk): too many undecided intervals → inconclusive
+        counts = np.bincount(tri, minlength=n)
+        over = counts > max_intervals
+        if over.any():
+            inconclusive |= over
+            sel = ~over[tri]
             tri, L, R = tri[sel], L[sel], R[sel]
             if tri.size == 0:
                 break
@@ -468,7 +466,7 @@ def certify_batch(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
     *, tau: float, delta: float, headway: float, method: str = "exact",
     pade_order: int = 5, progress: bool = False, chunk: int = 4096,
-    n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 200_000,
+    n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 1024,
 ) -> CertificateBatch:
     """Certify many gain triples at once (exact delay, sound; see the module docstring).
 
@@ -490,7 +488,8 @@ def certify_batch(
         Triples per vectorised chunk (bounds memory).
     n_grid, max_rounds, max_intervals : int
         Initial intervals on [0, Ω], refinement rounds, and the cap on undecided
-        intervals per chunk before the worst triples are declared inconclusive.
+        intervals *per triple* beyond which that triple is declared inconclusive
+        (per triple, so a verdict never depends on the rest of the batch).
 
     Returns
     -------

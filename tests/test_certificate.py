@@ -197,3 +197,15 @@ def test_pade_method_reports_both_and_warns_on_disagreement():
     assert row["verdict"] == "certified" and "pade" in row
     if not row["pade"]["agrees"]:
         assert any("disagrees" in str(w.message) for w in rec)
+
+
+def test_verdicts_do_not_depend_on_chunking():
+    """Budgets are per triple: hard boundary triples get the same verdict alone or batched."""
+    kx = np.array([0.5, 1.2, 0.8, 1.5])
+    kv = np.array([0.3, 0.1, 1.0, -0.2])
+    ka = (2 - kx * 1.1**2 - 2 * kv * 1.1) / 2  # Ψ3 = 0 exactly: the hardest case
+    KX, KV, KA = (np.concatenate([v, v]) for v in (kx, kv, ka))
+    KA[4:] += 1e-9
+    big = certify_batch(KX, KV, KA, tau=0.1, delta=0.2, headway=1.1)
+    one = certify_batch(KX, KV, KA, tau=0.1, delta=0.2, headway=1.1, chunk=1)
+    assert big.verdict.tolist() == one.verdict.tolist()
