@@ -209,3 +209,26 @@ def test_verdicts_do_not_depend_on_chunking():
     big = certify_batch(KX, KV, KA, tau=0.1, delta=0.2, headway=1.1)
     one = certify_batch(KX, KV, KA, tau=0.1, delta=0.2, headway=1.1, chunk=1)
     assert big.verdict.tolist() == one.verdict.tolist()
+
+
+def test_witness_of_a_tiny_violation_is_reported():
+    """|Γ| exceeds 1 by ~2e-6 in a narrow band: sup_gain and peak_omega must show it."""
+    K = (1.77510761, 1.24315872, -1.07339563)
+    c = certify(*K, tau=0.1, delta=0.2, headway=1.1)
+    assert c.verdict == "not_certified" and c.margin < 0
+    s = 1j * c.peak_omega
+    G = (K[0] + K[1] * s + K[2] * s**2 * np.exp(-0.2 * s)) / (0.1 * s**3 + s**2 + (K[1] + 1.1 * K[0]) * s + K[0])
+    assert abs(G) > 1.0 and c.sup_gain > 1.0
+    assert_allclose(c.sup_gain, abs(G), rtol=1e-12)
+
+
+def test_check_gives_the_same_verdicts_as_certify_batch():
+    from stringstab.certificate import check
+
+    rng = np.random.default_rng(11)
+    K = rng.uniform(-2, 2, (500, 3))
+    K[:50, 2] = (2 - K[:50, 0] * 1.1**2 - 2 * K[:50, 1] * 1.1) / 2  # Ψ3 = 0: hard cases
+    a = certify_batch(*K.T, tau=0.1, delta=0.2, headway=1.1)
+    b = check(*K.T, tau=0.1, delta=0.2, headway=1.1)
+    assert a.verdict.tolist() == b.verdict.tolist()
+    assert_allclose(a.margin, b.margin, rtol=0, atol=0)
