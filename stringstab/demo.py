@@ -156,12 +156,13 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
             f"({r['k_x']:.4g}, {r['k_v']:.4g}, {r['k_a']:.4g}), moved {r['distance']:.4g}, "
             f"{'certified' if r['certified'] else 'NOT certified'} ({r['status']})"
         )
-    p = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
+    tau, delta, headway = 0.1, 0.2, 1.1
     results = []
     for t in TUNE_TRIPLES:
         K = parse_triple(t)
-        results += [region_growing(K, **p), project(K, **p)]
-    drawn = plot_moves(results, **p, k_a=0.6, n=101)
+        results += [region_growing(K, tau=tau, delta=delta, headway=headway),
+                    project(K, tau=tau, delta=delta, headway=headway)]
+    drawn = plot_moves(results, tau=tau, delta=delta, headway=headway, k_a=0.6, n=101)
     fig = drawn["ax"].figure
     fig.tight_layout()
     fig.savefig(out / "tune_moves.png", dpi=110)

@@ -341,7 +341,8 @@ def _read_csv(text: str, source: str) -> GainTable:
         )
     headerless = len(header) == 3 and all(_is_number(h) for h in header)
     if headerless:
-        index, ignored = {c: j for j, c in enumerate(GAIN_COLUMNS)}, ()
+        index = {c: j for j, c in enumerate(GAIN_COLUMNS)}
+        ignored: tuple[str, ...] = ()
         body = list(zip(lines, records))
     else:
         if all(_is_number(h) for h in header):
@@ -581,12 +582,13 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
 
     path = Path(source)
     name = str(source)
-    kind = fmt or _INPUT_FORMATS.get(path.suffix.lower())
-    if kind is None:
+    kind_or_none = fmt or _INPUT_FORMATS.get(path.suffix.lower())
+    if kind_or_none is None:
         raise StringStabError(
             f"{name}: unsupported file extension {path.suffix or '(none)'!r}; "
             "expected .csv, .json or .npz"
         )
+    kind = kind_or_none
     if not path.exists():
         raise StringStabError(f"{name}: no such file; expected a readable {kind.upper()} file")
     if path.is_dir():
@@ -772,14 +774,14 @@ def format_results(
         for r in recs
     ]
     widths = [max([len(h), *(len(row[j]) for row in body)]) for j, (h, _, _) in enumerate(cols)]
-    lines = []
+    lines: list[str] = []
     if params is not None:
         lines.append(
             "# " + ", ".join(f"{k} = {_fmt_num(v, 'g')}" for k, v in _plain(params).items())
         )
     lines.append("  ".join(h.ljust(wd) for (h, _, _), wd in zip(cols, widths)).rstrip())
-    for row in body:
-        lines.append("  ".join(c.ljust(wd) for c, wd in zip(row, widths)).rstrip())
+    for cells in body:
+        lines.append("  ".join(c.ljust(wd) for c, wd in zip(cells, widths)).rstrip())
     if summary is not None:
         s = _plain(summary)
         lines.append(
