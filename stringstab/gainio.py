@@ -55,6 +55,7 @@ __all__ = [
     "parse_triple",
     "read_gains",
     "write_results",
+    "write_text",
 ]
 
 #: The three gain columns, in the order of K = [k_x, k_v, k_a] (IDL eq 4).
@@ -816,7 +817,17 @@ def write_results(
     StringStabError
         On an unknown format or when the file cannot be written.
     """
-    text = format_results(records, fmt, params=params, summary=summary)
+    write_text(format_results(records, fmt, params=params, summary=summary), dest)
+
+
+def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
+    """Write text to a path atomically (temporary file + rename) or to a text stream.
+
+    Raises
+    ------
+    StringStabError
+        When the file cannot be written.
+    """
     if not isinstance(dest, (str, os.PathLike)):
         try:
             dest.write(text)

@@ -9,15 +9,15 @@ not (``not_certified`` or ``inconclusive``), 2 on bad input (nothing printed).
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 import warnings
 from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
-from ..gainio import FORMATS, GainTable, parse_triple, read_gains, write_results
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ..gainio import FORMATS, write_results
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from ._common import add_gain_arguments, add_model_arguments, gains_from_args, model_params
 
 __all__ = ["PROGRESS_ROWS", "add_parser", "run"]
 
@@ -41,10 +41,6 @@ defaults: tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY
 Table 2; tau from Zhou et al. 2020). See docs/certify.md.
 """
 
-# argparse (< 3.13) reads "-0.5,1,1" as an unknown option; treat anything that
-# starts like a negative number (or -inf/-nan, rejected later with a clear
-# message) as a positional.
-_NEGATIVE = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
 def add_parser(sub: Any) -> None:
@@ -62,19 +58,8 @@ def add_parser(sub: Any) -> None:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p._negative_number_matcher = _NEGATIVE  # type: ignore[attr-defined]
-    p.add_argument(
-        "triples", nargs="*", metavar="K_X,K_V,K_A",
-        help="gain triples, e.g. 0.9,-0.5,1.1 (or use --file)",
-    )
-    p.add_argument("--file", "-f", metavar="F",
-                   help="read triples from a .csv, .json or .npz file ('-' reads CSV/JSON from stdin)")
-    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
-                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
-    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
-                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
-    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
-                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    add_gain_arguments(p)
+    add_model_arguments(p)
     p.add_argument("--method", choices=("exact", "pade"), default="exact",
                    help="exact: the sound certificate (default); pade: the same, plus "
                         "python-control's Padé + norm('inf') numbers, warning where they disagree")
@@ -87,20 +72,6 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _gains(args: argparse.Namespace) -> GainTable:
-    if args.triples and args.file:
-        raise StringStabError(
-            f"expected gain triples or --file, not both; got {len(args.triples)} triple(s) "
-            f"and --file {args.file}"
-        )
-    if args.file:
-        return read_gains(args.file)
-    if not args.triples:
-        raise StringStabError("expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none")
-    triples = [
-        parse_triple(t, where=f"triple {i + 1} {t!r}") for i, t in enumerate(args.triples)
-    ]
-    return GainTable.from_triples(triples, source="<command line>")
 
 
 def _pade_order(text: str) -> int:
@@ -136,7 +107,7 @@ def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input."""
-    tau, delta, headway = check_params(args.tau, args.delta, args.headway)
+    tau, delta, headway = model_params(args)
     order = _pade_order(args.pade_order)
     if args.out:
         out = Path(args.out)
@@ -144,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
             raise StringStabError(
                 f"--out {args.out}: expected a file path in an existing directory"
             )
-    table = _gains(args)
+    table = gains_from_args(args)
 
     from ..certificate import certify_batch
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -19,8 +18,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ..regions import GAIN_NAMES, METHODS
+from ._common import add_model_arguments, model_params
 
 __all__ = ["add_parser", "run"]
 
@@ -45,8 +45,6 @@ defaults: range {DEFAULT_RANGE[0]:g},{DEFAULT_RANGE[1]:g}, n {DEFAULT_N_2D} (2-D
 tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/regions.md.
 """
 
-# "-2,2" is a value, not an option
-_NEGATIVE = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
 def add_parser(sub: Any) -> None:
@@ -62,7 +60,6 @@ def add_parser(sub: Any) -> None:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p._negative_number_matcher = _NEGATIVE  # type: ignore[attr-defined]
     p.add_argument("--x", default="k_x", metavar="GAIN", help="gain on the first axis (default k_x)")
     p.add_argument("--y", default="k_v", metavar="GAIN", help="gain on the second axis (default k_v)")
     p.add_argument("--fix", metavar="GAIN=V",
@@ -73,12 +70,7 @@ def add_parser(sub: Any) -> None:
                    help="grid range of every axis, or of one gain (repeatable); default -2,2")
     p.add_argument("--n", metavar="N[,N2[,N3]]",
                    help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
-    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
-                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
-    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
-                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
-    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
-                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    add_model_arguments(p)
     p.add_argument("--method", default=",".join(METHODS), metavar="M[,M...]",
                    help="methods among exact, taylor, printed (default: all three)")
     p.add_argument("--overlay", metavar="FILE",
@@ -191,7 +183,7 @@ def run(args: argparse.Namespace) -> int:
     from ..regions import region_map
 
     axes, fixed = _grid(args)
-    tau, delta, headway = check_params(args.tau, args.delta, args.headway)
+    tau, delta, headway = model_params(args)
     formats = [f.strip() for f in args.format.split(",")]
     for f in formats:
         if f not in FIGURE_FORMATS:

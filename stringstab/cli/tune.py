@@ -11,18 +11,16 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
-import re
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import StringStabError
-from ..gainio import FORMATS, GainTable, format_results, parse_triple, read_gains
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ..gainio import FORMATS, format_results, write_text
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from ._common import add_gain_arguments, add_model_arguments, gains_from_args, model_params
 
 __all__ = ["add_parser", "run"]
 
@@ -48,8 +46,6 @@ exit status: 0 every output certified; 1 some output not certified;
 defaults: tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/tuning.md.
 """
 
-# Read "-0.5,1,1" as a positional, not an unknown option (as `certify` does).
-_NEGATIVE = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
 def add_parser(sub: Any) -> None:
@@ -67,19 +63,10 @@ def add_parser(sub: Any) -> None:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p._negative_number_matcher = _NEGATIVE  # type: ignore[attr-defined]
-    p.add_argument("triples", nargs="*", metavar="K_X,K_V,K_A",
-                   help="gain triples, e.g. 0.9,-0.5,1.1 (or use --file)")
-    p.add_argument("--file", "-f", metavar="F",
-                   help="read triples from a .csv, .json or .npz file ('-' reads CSV/JSON from stdin)")
+    add_gain_arguments(p)
     p.add_argument("--method", "-m", choices=_METHODS, default="projection",
                    help="repair method (default: projection)")
-    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
-                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
-    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
-                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
-    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
-                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    add_model_arguments(p)
     p.add_argument("--bounds", default="-2,2", metavar="LO,HI",
                    help="bounds on every gain (default: -2,2, IDL Table 2)")
     p.add_argument("--weights", default="1,1,1", metavar="WX,WV,WA",
@@ -137,18 +124,6 @@ def _integer(text: str | None, option: str) -> int | None:
     return n
 
 
-def _gains(args: argparse.Namespace) -> GainTable:
-    if args.triples and args.file:
-        raise StringStabError(
-            f"expected gain triples or --file, not both; got {len(args.triples)} triple(s) "
-            f"and --file {args.file}"
-        )
-    if args.file:
-        return read_gains(args.file)
-    if not args.triples:
-        raise StringStabError("expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none")
-    triples = [parse_triple(t, where=f"triple {i + 1} {t!r}") for i, t in enumerate(args.triples)]
-    return GainTable.from_triples(triples, source="<command line>")
 
 
 _TABLE = [
@@ -191,27 +166,6 @@ def _table(records: list[dict[str, Any]], params: dict[str, Any], summary: dict[
     return "\n".join(lines) + "\n"
 
 
-def _write(text: str, dest: str | None) -> None:
-    if dest is None:
-        sys.stdout.write(text)
-        return
-    path = Path(dest)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as e:
-        raise StringStabError(f"{dest}: cannot write the output file ({e.strerror or e})") from e
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        mask = os.umask(0o022)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise StringStabError(f"{dest}: cannot write the output file ({e.strerror or e})") from e
-
-
 def _summary(records: list[dict[str, Any]], methods: list[str]) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for m in methods:
@@ -230,7 +184,7 @@ def _summary(records: list[dict[str, Any]], methods: list[str]) -> dict[str, dic
 
 def run(args: argparse.Namespace) -> int:
     """Run ``tune``; returns 0 (every output certified), 1 (some not) or raises on bad input."""
-    tau, delta, headway = check_params(args.tau, args.delta, args.headway)
+    tau, delta, headway = model_params(args)
     lo, hi = _numbers(args.bounds, 2, "--bounds")
     if not lo < hi:
         raise StringStabError(f"--bounds expects LO,HI with LO < HI; got {args.bounds!r}")
@@ -252,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
         out = Path(args.out)
         if out.is_dir() or not out.resolve().parent.is_dir():
             raise StringStabError(f"--out {args.out}: expected a file path in an existing directory")
-    table = _gains(args)
+    table = gains_from_args(args)
 
     from ..tuning import Projector, region_growing
 
@@ -292,7 +246,7 @@ def run(args: argparse.Namespace) -> int:
         text = format_results(records, "csv", params=flat)
     else:
         text = format_results(records, "json", params=params, summary=summary)
-    _write(text, args.out)
+    write_text(text, args.out if args.out else sys.stdout)
     if args.out:
         n_cert = sum(r["certified"] for r in records)
         print(f"stringstab tune: {n_cert} of {len(records)} outputs certified; "
