@@ -4,7 +4,9 @@ In the IDL strategy every action K = [k_x, k_v, k_a] proposed by the agent goes
 through a *parameter tuning* step that replaces gains that are not string
 stable by nearby gains that are (IDL paper §3.3).  Two methods are offered;
 both report whether their output is certified by the exact certificate
-(:func:`stringstab.certificate.certify`), never by a Taylor formula alone.
+(:func:`stringstab.certificate.certify`, or its verdict-only form
+:func:`stringstab.certificate.check`: the same sound decision), never by a
+Taylor formula alone.
 
 :func:`region_growing`
     The paper's region-growing grid search (§3.3, Steps 1-6) as written: its
@@ -41,7 +43,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .certificate import Certificate, certify, certify_batch
+from .certificate import Certificate, certify, certify_batch, check
 from .criteria import TYPE_NAMES, taylor_criteria
 from .errors import StringStabError
 from .frequency import margin_g_coefficients
@@ -205,13 +207,42 @@ def _triple(k: Array) -> tuple[float, float, float]:
     return float(k[0]), float(k[1]), float(k[2])
 
 
-def _result(method: str, K0: Array, K: Array, cert: Certificate, status: str, w: Array,
+@dataclass(frozen=True)
+class _Verdict:
+    """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
+
+    Built from a full :class:`~stringstab.certificate.Certificate` or, in the
+    projection's fast path, from :func:`stringstab.certificate.check` (the same
+    sound decision without the reporting extras).  A certified triple has
+    ‖Γ‖_{H∞} = 1 exactly (Γ(0) = 1 and |Γ(jω)| ≤ 1), which is what
+    :func:`~stringstab.certificate.certify` reports for it too, so no peak
+    search is needed; for any other verdict the full certificate is computed.
+    """
+
+    verdict: str
+    sup_gain: float
+
+    @property
+    def certified(self) -> bool:
+        return self.verdict == "certified"
+
+    @classmethod
+    def of(cls, cert: Certificate) -> _Verdict:
+        return cls(cert.verdict, float(cert.sup_gain))
+
+
+#: The verdict of a triple that :func:`stringstab.certificate.check` certified.
+_CERTIFIED = _Verdict("certified", 1.0)
+
+
+def _result(method: str, K0: Array, K: Array, cert: Certificate | _Verdict, status: str, w: Array,
             iterations: int, t0: float, message: str, **details: Any) -> TuneResult:
+    v = cert if isinstance(cert, _Verdict) else _Verdict.of(cert)
     return TuneResult(
-        method=method, k_in=_triple(K0), k=_triple(K), certified=cert.certified,
-        verdict=cert.verdict, status=status, distance=float(_wdist(K, K0, w)),
+        method=method, k_in=_triple(K0), k=_triple(K), certified=v.certified,
+        verdict=v.verdict, status=status, distance=float(_wdist(K, K0, w)),
         iterations=iterations, seconds=time.perf_counter() - t0, message=message,
-        sup_gain=cert.sup_gain, details=details,
+        sup_gain=v.sup_gain, details=details,
     )
 
 
@@ -429,14 +460,17 @@ def region_growing(
 # ---------------------------------------------------------------------------
 # Projection: the nearest certified gains (CasADi / IPOPT, exchange method)
 # ---------------------------------------------------------------------------
-#: Frequency-slot capacities of the prebuilt NLPs (the smallest that fits is used).
-_SLOTS = (12, 24, 48)
+#: Frequency-slot capacities of the NLPs, each built on first use (the smallest that fits is
+#: used: an unused slot costs IPOPT about as much per iteration as a used one).
+_SLOTS = (4, 6, 8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48)
 #: Fixed frequencies (rad/s) in every first solve, besides ω = 0 and the dips of g(·; K0).
 _LADDER: tuple[float, ...] = tuple(float(v) for v in np.geomspace(0.2, 5.0, 16))
 #: Relative offset of the two neighbours added with every exchanged frequency.
 _CLUSTER = 0.05
 #: Multipliers of the violating frequencies of K0 in the first solve.
 _K0_CLUSTER = (1.0, 0.95, 0.9)
+#: Multipliers of the predicted dips of the solution (:func:`_predict_dips`) in the first solve.
+_PRED_CLUSTER = (1.0, 0.98, 1.02)
 
 
 def _import_casadi() -> Any:
@@ -539,6 +573,57 @@ def _g_dips(K: Array, p: Params, threshold: float, n: int = 384,
     return gmin, [float(c) for c, gv in zip(centres, gl) if gv < threshold]
 
 
+def _g_and_grad(om: Array, K: Array, p: Params) -> tuple[Array, Array]:
+    """g(ω; K) and its gradient in K (rows: frequencies), g as in :func:`_nlp`."""
+    kx, kv, ka = float(K[0]), float(K[1]), float(K[2])
+    tau, d, T = p.tau, p.delta, p.headway
+    c = kv + T * kx
+    a = 1.0 - 2.0 * tau * c - ka * ka
+    b = c * c - 2.0 * kx - kv * kv
+    w2 = om * om
+    co, si = np.cos(d * om), np.sin(d * om)
+    g = tau * tau * w2 * w2 + a * w2 + b + 2.0 * kx * ka * co - 2.0 * kv * ka * om * si
+    grad = np.stack([
+        -2.0 * tau * T * w2 + 2.0 * c * T - 2.0 + 2.0 * ka * co,
+        -2.0 * tau * w2 + 2.0 * c - 2.0 * kv - 2.0 * ka * om * si,
+        -2.0 * ka * w2 + 2.0 * kx * co - 2.0 * kv * om * si,
+    ], axis=1)
+    return g, grad
+
+
+def _predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
+                  rounds: int = 2) -> list[float]:
+    """Predicted dips of the repaired gains: a frequency-selection heuristic, never a proof.
+
+    For each violating dip ω of g(·; K0), the nearest point of the linearised
+    constraint g(ω; K) ≥ ε is taken (a Gauss-Newton step from K0) and the dip
+    of g at that point is followed by a local grid search on [0.7ω, 1.05ω]
+    (the dip moves down in frequency as the gains are repaired, by up to
+    ~20 % in the benchmark); twice.  The frequencies returned only seed the
+    NLP's frequency set; the exact certificate decides.
+    """
+    out: list[float] = []
+    v = np.linspace(0.7, 1.05, 36)
+    z = np.linspace(-1.0, 1.0, 9)
+    for om in dips:
+        x = K0
+        for _ in range(rounds):
+            g, gr = _g_and_grad(np.array([om]), x, p)
+            gr = gr[0]
+            den = float(gr @ (gr / w))
+            if not den > 0:
+                break
+            lam = (eps - float(g[0]) - float(gr @ (K0 - x))) / den
+            x = K0 + lam * gr / w
+            W = om * v
+            j = int(np.argmin(_g_and_grad(W, x, p)[0]))
+            Wl = np.maximum(W[j] + om * (v[1] - v[0]) * z, 0.0)
+            om = float(Wl[int(np.argmin(_g_and_grad(Wl, x, p)[0]))])
+        if om > 0:
+            out.append(om)
+    return out
+
+
 def _hurwitz_ok(K: Array, p: Params) -> bool:
     return bool(K[0] > 0 and K[1] + (p.headway - p.tau) * K[0] > 0)
 
@@ -582,8 +667,10 @@ class Projector:
       is nearer to the new K0 than the nearest point of the certified map, the
       solve is warm-started from it with its frequencies.
 
-    Every output reported certified has been certified by
-    :func:`stringstab.certificate.certify` (a cache hit returns gains that were).
+    Every output reported certified has been certified by the exact
+    certificate, :func:`stringstab.certificate.check` (the verdicts of
+    :func:`~stringstab.certificate.certify` without its reporting extras; a
+    cache hit returns gains that were).
 
     Parameters
     ----------
@@ -632,7 +719,7 @@ class Projector:
         self.max_exchange = int(max_exchange)
         self.cache_size = int(cache_size)
         self.cache_decimals = int(cache_decimals)
-        self._cache: OrderedDict[tuple[float, ...], tuple[Array, Certificate]] = OrderedDict()
+        self._cache: OrderedDict[tuple[float, ...], tuple[Array, _Verdict]] = OrderedDict()
         self._last: tuple[Array, list[float]] | None = None
         self.stats = {"calls": 0, "cache_hits": 0, "warm_starts": 0, "fallbacks": 0}
 
@@ -662,6 +749,17 @@ class Projector:
         st = solver.stats()
         return np.asarray(sol["x"], dtype=float).ravel(), str(st["return_status"]), int(st["iter_count"])
 
+    def _check(self, K: Array) -> tuple[str, bool, float]:
+        """The exact certificate's verdict on K (:func:`stringstab.certificate.check`).
+
+        Returns (verdict, internally stable, witness frequency: where the
+        smallest g(ω) was found; |Γ(jω)| > 1 there when K is internally stable
+        and not certified).
+        """
+        p = self.params
+        c = check(K[0], K[1], K[2], tau=p.tau, delta=p.delta, headway=p.headway)
+        return str(c.verdict[0]), bool(c.hurwitz[0]), float(c.witness_omega[0])
+
     def __call__(self, K0: Sequence[float] | Array, *, warm_start: Sequence[float] | None = None,
                  use_state: bool = True) -> TuneResult:
         """Repair one triple K0 (see :func:`project` for the algorithm)."""
@@ -674,24 +772,27 @@ class Projector:
         key = tuple(np.round(k0, self.cache_decimals).tolist())
         if use_state and self.cache_size and key in self._cache:
             self._cache.move_to_end(key)
-            kc, cc = self._cache[key]
+            kc, vc = self._cache[key]
             self.stats["cache_hits"] += 1
             status = "unchanged" if np.array_equal(kc, k0) else "repaired"
-            return _result(method, k0, kc if status == "repaired" else k0, cc, status, w, 0, t0,
+            return _result(method, k0, kc if status == "repaired" else k0, vc, status, w, 0, t0,
                            "cache hit: gains certified on an earlier call", cache_hit=True)
 
         # Is K0 already certified?  Skip the certificate when a violation is found cheaply.
         bad, dips = _surely_uncertifiable(k0, p)
         if not bad:
-            cert0 = certify(*k0, tau=p.tau, delta=p.delta, headway=p.headway)
-            if cert0.certified:
-                self._remember(key, k0, cert0, use_state)
-                return _result(method, k0, k0, cert0, "unchanged", w, 0, t0,
+            verdict0, hz0, wit0 = self._check(k0)
+            if verdict0 == "certified":
+                self._remember(key, k0, use_state)
+                return _result(method, k0, k0, _CERTIFIED, "unchanged", w, 0, t0,
                                "already certified by the exact certificate; returned unchanged")
-            if math.isfinite(cert0.peak_omega):
-                dips = [*dips, float(cert0.peak_omega)]
-        # the dips of the solution lie a little below those of K0, as a rule
+            if hz0 and wit0 > 0:
+                dips = [*dips, wit0]
+        # the dips of the solution lie a little below those of K0, as a rule; where they
+        # go is predicted from the linearised constraint at each dip
+        pred = _predict_dips(k0, dips, p, w, self.eps)
         dips = [o * f for o in dips for f in _K0_CLUSTER]
+        dips += [o * f for o in pred for f in _PRED_CLUSTER]
 
         # Starting point: the nearest certified map point, the previous solution or warm_start.
         M = self._map()
@@ -715,7 +816,7 @@ class Projector:
             start = "input"
         omegas = _dedupe(omegas)
 
-        best: tuple[Array, Certificate] | None = None
+        best: Array | None = None
         n_solves = ipopt_iters = 0
         statuses: list[str] = []
         x = x0
@@ -727,18 +828,14 @@ class Projector:
             statuses.append(status)
             if not np.all(np.isfinite(x)):
                 break
-            # exchange: first the cheap scan, then the exact certificate
-            _, new = _g_dips(x, p, threshold=0.0)
-            if not new and _hurwitz_ok(x, p):
-                cert = certify(*x, tau=p.tau, delta=p.delta, headway=p.headway)
-                if cert.certified:
-                    best = (x, cert)
-                    break
-                # a violation the coarse scan missed: look closer (the certificate's
-                # peak_omega can be 0 when |Γ| exceeds 1 only by ~1e-6)
-                _, new = _g_dips(x, p, threshold=0.0, n=8192)
-                if math.isfinite(cert.peak_omega) and cert.peak_omega > 0:
-                    new.append(float(cert.peak_omega))
+            # the exact certificate's verdict; when it does not certify, its witness
+            # frequency (|Γ| > 1 there) and the violating dips of a cheap scan are added
+            verdict, hz, wit = self._check(x)
+            if verdict == "certified":
+                best = x
+                break
+            new = [wit] if hz and wit > 0 else []
+            new += _g_dips(x, p, threshold=0.0)[1]
             # each new frequency comes with two neighbours ±_CLUSTER: the dip moves as K moves
             new = [o * f for o in new for f in (1.0, 1.0 - _CLUSTER, 1.0 + _CLUSTER)]
             grown = _dedupe([*omegas, *new])
@@ -747,37 +844,35 @@ class Projector:
             omegas = grown
 
         fallback = False
-        if im >= 0 and (best is None or float(_wdist(best[0], k0, w)) > float(dm[im])):
+        if im >= 0 and (best is None or float(_wdist(best, k0, w)) > float(dm[im])):
             # the nearest certified map point is nearer (or the exchange failed): use it
-            cm = certify(*M[im], tau=p.tau, delta=p.delta, headway=p.headway)
-            if cm.certified:
-                best = (M[im].copy(), cm)
+            if self._check(M[im])[0] == "certified":
+                best = M[im].copy()
                 fallback = True
                 self.stats["fallbacks"] += 1
         if best is None:
-            cx = certify(*x, tau=p.tau, delta=p.delta, headway=p.headway) if np.all(np.isfinite(x)) \
-                else certify(*k0, tau=p.tau, delta=p.delta, headway=p.headway)
-            return _result(method, k0, x if np.all(np.isfinite(x)) else k0, cx, "failed", w,
-                           n_solves, t0,
+            xf = x if np.all(np.isfinite(x)) else k0
+            cx = certify(*xf, tau=p.tau, delta=p.delta, headway=p.headway)  # full report
+            return _result(method, k0, xf, cx, "failed", w, n_solves, t0,
                            f"no certified point found after {n_solves} solve(s) "
                            f"(IPOPT: {statuses[-1] if statuses else 'not run'})",
                            start=start, frequencies=omegas, ipopt_iterations=ipopt_iters,
                            ipopt_status=statuses)
-        xb, cb = best
-        self._remember(key, xb, cb, use_state)
+        self._remember(key, best, use_state)
         if use_state:
-            self._last = (xb, [o for o in omegas if o > 0])
+            self._last = (best, [o for o in omegas if o > 0])
         msg = (f"nearest certified point of the {len(M)}-point certified map (the NLP solution "
                "was not nearer)" if fallback else
                f"nearest certified point: {n_solves} solve(s), {len(omegas)} frequencies")
-        return _result(method, k0, xb, cb, "repaired", w, n_solves, t0, msg,
+        return _result(method, k0, best, _CERTIFIED, "repaired", w, n_solves, t0, msg,
                        start=start, fallback=fallback, frequencies=omegas,
                        ipopt_iterations=ipopt_iters, ipopt_status=statuses)
 
-    def _remember(self, key: tuple[float, ...], k: Array, cert: Certificate, use_state: bool) -> None:
+    def _remember(self, key: tuple[float, ...], k: Array, use_state: bool) -> None:
+        """Cache gains that the exact certificate certified."""
         if not (use_state and self.cache_size):
             return
-        self._cache[key] = (k, cert)
+        self._cache[key] = (k, _CERTIFIED)
         if len(self._cache) > self.cache_size:
             self._cache.popitem(last=False)
 
@@ -839,13 +934,16 @@ def project(
     where g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.frequency.margin_g`;
     g(0) = Ψ3), so g(ω_j) ≥ ε is |D(jω_j)|² − |N(jω_j)|² ≥ ε ω_j².  The frequency
     set starts as {0}, a fixed ladder of 16 frequencies (0.2 to 5 rad/s,
-    geometric) and the violating local minima of g(·; K0) (each also at 0.95
-    and 0.9 times itself), and is refined by *exchange*: after each solve the
-    local minima of g(·; K) below 0 found by a dense scan are added, each with
-    neighbours at ±5 %; when there are none, the exact certificate is asked,
-    and if it does not certify, a finer scan and the certificate's
-    ``peak_omega`` give the frequencies to add.  The loop ends when the
-    certificate certifies K (or after ``max_exchange`` solves).
+    geometric), the violating local minima of g(·; K0) (each also at 0.95
+    and 0.9 times itself) and, for each of them, the predicted dip of the
+    repaired gains (the dip of g at the nearest point of the linearised
+    constraint, followed twice; each also at 0.98 and 1.02 times itself).  It
+    is refined by *exchange*: after each solve the exact certificate
+    (:func:`stringstab.certificate.check`) is asked; if it does not certify
+    K, its witness frequency (where |Γ(jω)| > 1) and the local minima of
+    g(·; K) below 0 found by a dense scan are added, each with neighbours at
+    ±5 %.  The loop ends when the certificate certifies K, when nothing new
+    can be added, or after ``max_exchange`` solves.
 
     The first solve starts from the nearest point (weighted distance) of a
     precomputed map of certified gains (a 21³ grid over the bounds, certified
@@ -855,9 +953,10 @@ def project(
     which is certified, is returned instead, so the result is never further
     than the nearest certified grid point.
 
-    The NLP is built once per process for each of a few frequency-slot
-    capacities (12, 24, 48), with K0, the weights, τ, δ, T* and the frequencies
-    as parameters; unused slots are disabled by a lower bound of −∞.
+    The NLP is built once per process for each frequency-slot capacity
+    (4, 6, ..., 16, 20, ..., 32, 40, 48; each on first use), with K0, the
+    weights, τ, δ, T* and the frequencies as parameters; the smallest that
+    fits is used and unused slots are disabled by a lower bound of −∞.
 
     Parameters
     ----------

@@ -194,6 +194,23 @@ def test_projection_output_passes_fine_sweep(K):
     assert_allclose(r.distance, np.linalg.norm(np.subtract(r.k, K)), rtol=1e-12)
 
 
+@pytest.mark.parametrize("K", REPAIR + CERTIFIED)
+def test_projection_reports_what_certify_reports(K):
+    # the projection decides with check() and builds its report from it; the
+    # verdict and sup |Γ| it reports must be those of the full certificate
+    r = project(K, **P)
+    c = certify(*r.k, **P)
+    assert (r.verdict, r.certified) == (c.verdict, c.certified)
+    assert r.sup_gain == c.sup_gain
+
+
+def test_projection_one_solve_near_the_boundary():
+    # the paper's example: the dip of the repaired gains (predicted from the
+    # linearised constraint) is in the first frequency set, so one solve suffices
+    r = project((0.9, -0.5, 1.1), **P)
+    assert r.certified and r.iterations == 1 and sweep_ok(r.k, **P)
+
+
 @pytest.mark.parametrize("K", [(0.9, -0.5, 1.1), (0.2, 0.7, 0.0), (1.0, -1.2, 0.5)])
 def test_projection_no_further_than_region_growing(K):
     rg = region_growing(K, **P)
