@@ -23,7 +23,7 @@ that is sound by construction:
 2. **Body.**  On each grid interval [l, r] ⊂ [0, Ω] of width h,
    g ≥ min(g(l), g(r)) − M h²/8 with the explicit bound
    M = 12τ²r² + 2|a| + |2k_xk_a|δ² + |2k_vk_a|(2δ + δ²r) ≥ |g''| on [l, r].
-   Intervals whose lower bound is not positive are split (×4) and re-checked,
+   Intervals whose lower bound is not positive are split (×4 to ×64, by need) and re-checked,
    vectorised over every undecided interval of every triple.
 3. **Round-off.**  Every comparison carries a slack of 10⁻¹³ times the sum of
    the absolute values of the terms of g (hundreds of ulps).
@@ -170,7 +170,7 @@ class _Exact:
 
 def _exact_chunk(
     kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float,
-    *, n_grid: int, max_rounds: int, split: int, max_intervals: int,
+    *, n_grid: int, max_rounds: int, split_min: int, max_intervals: int,
     refine: npt.NDArray[np.bool_] | None = None,
 ) -> _Exact:
     n = kx.size
@@ -203,6 +203,9 @@ def _exact_chunk(
     tri, k = np.nonzero(undecided)
     L = W[tri, k]
     R = W[tri, k + 1]
+    # what an interval needs: min(g(l), g(r)) against its curvature bound
+    gap = np.minimum(Gl, Gr)[tri, k] - slack[tri, k]
+    Mi = M[tri, k]
     inconclusive = np.zeros(n, dtype=bool)
 
     for _ in range(max_rounds):
@@ -215,9 +218,17 @@ def _exact_chunk(
         if over.any():
             inconclusive |= over
             sel = ~over[tri]
-            tri, L, R = tri[sel], L[sel], R[sel]
+            tri, L, R, gap, Mi = tri[sel], L[sel], R[sel], gap[sel], Mi[sel]
             if tri.size == 0:
                 break
+        # adaptive split: enough pieces that M h²/8 ≤ gap/2 where the endpoints
+        # are clearly positive (one round instead of several near a shallow dip);
+        # the bound is re-checked on every piece, so this only saves rounds
+        with np.errstate(divide="ignore", invalid="ignore"):
+            need = np.where(gap > 0, (R - L) * np.sqrt(Mi / (4.0 * gap)), split_min)
+        split = int(min(max(split_min, 2 ** math.ceil(math.log2(max(float(np.max(need)), 1.0)))), 64))
+        while split > split_min and tri.size * split > 2_000_000:
+            split //= 2
         v = np.linspace(0.0, 1.0, split + 1)
         Wn = L[:, None] + (R - L)[:, None] * v[None, :]
         Gn, En = _g_and_scale(
@@ -239,6 +250,8 @@ def _exact_chunk(
         lowern = np.minimum(Gn[:, :-1], Gn[:, 1:]) - Mn * hn * hn / 8.0 - np.maximum(En[:, :-1], En[:, 1:])
         und = (lowern < 0) & ~violated[tri][:, None]
         ii, kk = np.nonzero(und)
+        gap = (np.minimum(Gn[:, :-1], Gn[:, 1:]) - np.maximum(En[:, :-1], En[:, 1:]))[ii, kk]
+        Mi = Mn[ii, kk]
         tri, L, R = tri[ii], Wn[ii, kk], Wn[ii, kk + 1]
     if tri.size:
         inconclusive[np.unique(tri)] = True
@@ -521,7 +534,7 @@ def check(
     kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
     hz_sure, hz_fail = _hurwitz_bands(kx, kv, p)
     ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
-                      max_rounds=max_rounds, split=4, max_intervals=max_intervals,
+                      max_rounds=max_rounds, split_min=4, max_intervals=max_intervals,
                       refine=~hz_fail)
     v = ex.verdict.copy()
     v[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
@@ -598,7 +611,7 @@ def certify_batch(
     for s0 in starts:
         sl = slice(s0, min(s0 + chunk, n))
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
-                          n_grid=n_grid, max_rounds=max_rounds, split=4,
+                          n_grid=n_grid, max_rounds=max_rounds, split_min=4,
                           max_intervals=max_intervals, refine=~hz_fail[sl])
         verdict[sl], margin[sl], omega_max[sl], n_evals[sl] = ex.verdict, ex.margin, ex.omega_max, ex.n_evals
         # certified ⇒ sup |Γ| = 1 at ω = 0: only the others need a peak search
