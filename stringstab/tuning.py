@@ -17,7 +17,10 @@ Taylor formula alone.
     The certified gains nearest to K0 in a weighted Euclidean distance, solved
     with CasADi/IPOPT under the internal-stability conditions with a margin
     and the exact frequency condition g(ω_j) ≥ ε on a finite set of
-    frequencies, refined by exchange until the exact certificate certifies.
+    frequencies, refined by exchange until the exact certificate certifies;
+    first, a Newton predictor on the KKT system of a small active set
+    (usually one constraint) answers without IPOPT when the exact
+    certificate certifies its point.
 
 Both return a :class:`TuneResult`.  Gains that the exact certificate already
 certifies are returned unchanged, without any search or solve.
@@ -97,7 +100,8 @@ class TuneResult:
         Weighted Euclidean distance ‖K − K0‖_W = sqrt(Σ w_i (K_i − K0_i)²).
     iterations : int
         Region growing: the index k of the last region R_k searched.
-        Projection: the number of NLP solves (exchange iterations).
+        Projection: the number of NLP solves (exchange iterations); an output of
+        the Newton predictor counts as one solve (``details["predictor"]``).
     seconds : float
         Wall-clock time of the call.
     message : str
@@ -624,6 +628,107 @@ def _predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
     return out
 
 
+def _g_full(om: float, K: Array, p: Params) -> tuple[float, Array, float, Array, float, Array]:
+    """g(ω; K) with the derivatives the KKT Newton step needs (scalar ω).
+
+    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g), g as in :func:`_nlp`.
+    """
+    kx, kv, ka = float(K[0]), float(K[1]), float(K[2])
+    tau, d, T = p.tau, p.delta, p.headway
+    c = kv + T * kx
+    a = 1.0 - 2.0 * tau * c - ka * ka
+    b = c * c - 2.0 * kx - kv * kv
+    w2 = om * om
+    co, si = math.cos(d * om), math.sin(d * om)
+    g = tau * tau * w2 * w2 + a * w2 + b + 2.0 * kx * ka * co - 2.0 * kv * ka * om * si
+    gk = np.array([
+        -2.0 * tau * T * w2 + 2.0 * c * T - 2.0 + 2.0 * ka * co,
+        -2.0 * tau * w2 + 2.0 * c - 2.0 * kv - 2.0 * ka * om * si,
+        -2.0 * ka * w2 + 2.0 * kx * co - 2.0 * kv * om * si,
+    ])
+    s1 = si + d * om * co  # d(ω sin δω)/dω
+    gw = (4.0 * tau * tau * w2 * om + 2.0 * a * om - 2.0 * kx * ka * d * si
+          - 2.0 * kv * ka * s1)
+    gwk = np.array([
+        -4.0 * tau * T * om - 2.0 * ka * d * si,
+        -4.0 * tau * om - 2.0 * ka * s1,
+        -4.0 * ka * om - 2.0 * kx * d * si - 2.0 * kv * s1,
+    ])
+    gww = (12.0 * tau * tau * w2 + 2.0 * a - 2.0 * kx * ka * d * d * co
+           - 2.0 * kv * ka * (2.0 * d * co - d * d * om * si))
+    gkk = np.array([
+        [2.0 * T * T, 2.0 * T, 2.0 * co],
+        [2.0 * T, 0.0, -2.0 * om * si],
+        [2.0 * co, -2.0 * om * si, -2.0 * w2],
+    ])
+    return g, gk, gw, gwk, gww, gkk
+
+
+def _kkt_newton(K0: Array, cons: list[tuple[Any, ...]], p: Params, w: Array, eps: float,
+                x: Array, lam: Array, max_iter: int = 25) -> tuple[Array, Array, list[float]] | None:
+    """Newton's method on the KKT system of min ½‖K − K0‖²_W with the constraints ``cons`` active.
+
+    Each constraint is ``("lin", a, m)`` (a·K = m: a bound or an internal-stability margin),
+    ``("g0",)`` (g(0; K) = Ψ3 = ε) or ``("dip", ω)`` (g(ω; K) = ε at a dip ω of g(·; K):
+    ∂g/∂ω = 0, ω a variable started at the given value; at the optimum of the semi-infinite
+    problem the active dip is a minimiser in ω).  Unknowns: K, one multiplier per
+    constraint and the dip frequencies.  Started from (x, lam); returns (K, λ, the
+    constraints' frequencies) once the Newton step is below 1e-9 and the residual below
+    1e-10, or None when it does not converge in ``max_iter`` steps (or a dip leaves ω > 0).
+    """
+    nc = len(cons)
+    free = [i for i, c in enumerate(cons) if c[0] == "dip"]
+    om = [float(c[1]) if c[0] == "dip" else 0.0 for c in cons]
+    n = 3 + nc + len(free)
+    lam = np.array(lam, dtype=float)
+    J = np.zeros((n, n))
+    r = np.zeros(n)
+    converged = False
+    for it in range(max_iter + 1):
+        J[:] = 0.0
+        J[:3, :3] = np.diag(w)
+        r[:3] = w * (x - K0)
+        for i, c in enumerate(cons):
+            if c[0] == "lin":
+                gk = c[1]
+                val = float(gk @ x) - c[2]
+            else:
+                val, gk, gw, gwk, gww, gkk = _g_full(om[i], x, p)
+                val -= eps
+                J[:3, :3] -= lam[i] * gkk
+            r[:3] -= lam[i] * gk
+            J[:3, 3 + i] = -gk
+            J[3 + i, :3] = gk
+            r[3 + i] = val
+            if c[0] == "dip":
+                k = 3 + nc + free.index(i)
+                J[:3, k] = -lam[i] * gwk
+                J[3 + i, k] = gw
+                J[k, :3] = gwk
+                J[k, k] = gww
+                r[k] = gw
+        if converged:
+            if float(np.max(np.abs(r))) <= 1e-10:
+                return x, lam, om
+            return None
+        if it == max_iter:
+            return None
+        try:
+            s = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(s)):
+            return None
+        x = x + s[:3]
+        lam = lam + s[3: 3 + nc]
+        for j, i in enumerate(free):
+            om[i] += float(s[3 + nc + j])
+            if not om[i] > 0:
+                return None
+        converged = float(np.max(np.abs(s))) <= 1e-9
+    return None  # pragma: no cover
+
+
 def _hurwitz_ok(K: Array, p: Params) -> bool:
     return bool(K[0] > 0 and K[1] + (p.headway - p.tau) * K[0] > 0)
 
@@ -692,6 +797,8 @@ class Projector:
         Entries of the LRU cache (0 disables it).
     cache_decimals : int
         Decimals of the cache key.
+    predictor : bool
+        Try the Newton predictor before IPOPT (see :func:`project`).
     """
 
     def __init__(
@@ -707,6 +814,7 @@ class Projector:
         max_exchange: int = 25,
         cache_size: int = 4096,
         cache_decimals: int = 6,
+        predictor: bool = True,
     ) -> None:
         self.params = Params(tau, delta, headway)
         self.weights = _as_weights(weights)
@@ -721,7 +829,9 @@ class Projector:
         self.cache_decimals = int(cache_decimals)
         self._cache: OrderedDict[tuple[float, ...], tuple[Array, _Verdict]] = OrderedDict()
         self._last: tuple[Array, list[float]] | None = None
-        self.stats = {"calls": 0, "cache_hits": 0, "warm_starts": 0, "fallbacks": 0}
+        self.predictor = bool(predictor)
+        self.stats = {"calls": 0, "cache_hits": 0, "warm_starts": 0, "fallbacks": 0,
+                      "predicted": 0}
 
     # -- the certified map (starting points, fallbacks) -------------------------------
     def _map(self) -> Array:
@@ -820,7 +930,16 @@ class Projector:
         n_solves = ipopt_iters = 0
         statuses: list[str] = []
         x = x0
-        for _ in range(self.max_exchange):
+        predicted = False
+        active: list[str] = []
+        if self.predictor:
+            kp = self._predict(k0, pred, omegas)
+            if kp is not None:
+                (best, active), predicted = kp, True
+                x = best
+                n_solves = 1
+                self.stats["predicted"] += 1
+        for _ in range(0 if predicted else self.max_exchange):
             omegas = self._fit_slots(omegas, x)
             x, status, its = self._solve(k0, x, omegas)
             n_solves += 1
@@ -863,10 +982,99 @@ class Projector:
             self._last = (best, [o for o in omegas if o > 0])
         msg = (f"nearest certified point of the {len(M)}-point certified map (the NLP solution "
                "was not nearer)" if fallback else
+               "nearest certified point: Newton's method on the KKT system with active "
+               f"{'; '.join(active)} (no IPOPT solve)" if predicted else
                f"nearest certified point: {n_solves} solve(s), {len(omegas)} frequencies")
         return _result(method, k0, best, _CERTIFIED, "repaired", w, n_solves, t0, msg,
-                       start=start, fallback=fallback, frequencies=omegas,
+                       start=start, fallback=fallback, predictor=predicted and not fallback,
+                       active=active, frequencies=omegas,
                        ipopt_iterations=ipopt_iters, ipopt_status=statuses)
+
+    def _predict(self, k0: Array, pred: list[float],
+                 omegas: list[float]) -> tuple[Array, list[str]] | None:
+        """The NLP's solution by Newton's method on a small active set, without IPOPT, or None.
+
+        The active set starts with the constraint most violated at K0 (relative
+        to its gradient's length): an internal-stability margin, a bound, Ψ3 ≥ ε
+        (ω = 0) or g ≥ ε at a predicted dip of the repaired gains (its
+        frequency a variable: the dip of g at the solution).  After each
+        :func:`_kkt_newton` solve the most violated remaining constraint (the
+        margins, the bounds, and g ≥ ε at every frequency of the first NLP's set)
+        is added, at most three in all.  The point is returned only when every
+        multiplier is positive, nothing is violated (by more than 1e-10 in g)
+        and the exact certificate certifies it, with the names of the active
+        constraints; otherwise None (IPOPT decides).
+        """
+        p, w, eps = self.params, self.weights, self.eps
+        lo, hi = self.bounds
+        m = self.hurwitz_margin
+        eye = np.eye(3)
+        lins = [(eye[0], m, "k_x >= m"), (np.array([p.headway - p.tau, 1.0, 0.0]), m,
+                                          "k_v + (T* - tau) k_x >= m")]
+        lins += [(eye[i], lo, f"{_GAIN_NAMES[i]} >= lo") for i in range(3)]
+        lins += [(-eye[i], -hi, f"{_GAIN_NAMES[i]} <= hi") for i in range(3)]
+        om_arr = np.asarray([o for o in omegas if o > 0], dtype=float)
+
+        def most_violated(x: Array, dips: Array) -> tuple[Any, ...] | None:
+            worst = 0.0
+            pick: tuple[Any, ...] | None = None
+            for a, mm, name in lins:
+                v = float(a @ x) - mm
+                if v < -1e-12:
+                    d = -v / math.sqrt(float(a @ (a / w)))
+                    if d > worst:
+                        worst, pick = d, ("lin", a, mm, name)
+            om = np.concatenate([[0.0], dips])
+            gv, gk = _g_and_grad(om, x, p)
+            viol = eps - gv - 1e-10
+            nrm = np.sqrt(np.sum(gk * gk / w, axis=1))
+            for j in np.flatnonzero(viol > 0):
+                d = float(viol[j]) / max(float(nrm[j]), 1e-300)
+                if d > worst:
+                    worst, pick = d, (("g0",) if j == 0 else ("dip", float(om[j])))
+            return pick
+
+        first = most_violated(k0, np.asarray(pred, dtype=float))
+        if first is None:
+            return None
+        cons: list[tuple[Any, ...]] = [first]
+        x, lam = k0, np.zeros(1)
+        for _ in range(6):
+            sol = _kkt_newton(k0, cons, p, w, eps, x, lam)
+            if sol is None:
+                return None
+            x, lam, oms = sol
+            cons = [("dip", o) if c[0] == "dip" else c for c, o in zip(cons, oms)]
+            if not np.all(lam > 0):
+                if len(cons) == 1:
+                    return None
+                j = int(np.argmin(lam))  # not active at the solution: drop the most negative
+                del cons[j]
+                lam = np.delete(lam, j)
+                continue
+            x = np.clip(x, lo, hi)  # a bound is met to rounding
+            nxt = most_violated(x, om_arr)
+            if nxt is None:
+                verdict, hz, wit = self._check(x)
+                if verdict == "certified":
+                    return x, [c[3] if c[0] == "lin" else "psi3 >= eps" if c[0] == "g0" else
+                               f"g >= eps at the dip omega = {c[1]!r}" for c in cons]
+                if not hz:
+                    return None
+                extra = [wit] if wit > 0 else []
+            else:
+                extra = []
+            if nxt is None or nxt[0] == "dip":
+                # a violated frequency enters at its dip: a local minimiser of g(·; K) below ε
+                dips = np.asarray([*_g_dips(x, p, threshold=eps)[1], *extra], dtype=float)
+                nxt = most_violated(x, dips)
+                if nxt is None:
+                    return None
+            if len(cons) == 3:
+                return None
+            cons.append(nxt)
+            lam = np.append(lam, 0.0)
+        return None
 
     def _remember(self, key: tuple[float, ...], k: Array, use_state: bool) -> None:
         """Cache gains that the exact certificate certified."""
@@ -903,10 +1111,10 @@ def _dedupe(omegas: list[float], rtol: float = 1e-6) -> list[float]:
 @lru_cache(maxsize=64)
 def _default_projector(tau: float, delta: float, headway: float, weights: tuple[float, ...],
                        bounds: tuple[float, float], hurwitz_margin: float, eps: float,
-                       max_exchange: int) -> Projector:
+                       max_exchange: int, predictor: bool = True) -> Projector:
     return Projector(tau=tau, delta=delta, headway=headway, weights=weights, bounds=bounds,
                      hurwitz_margin=hurwitz_margin, eps=eps, max_exchange=max_exchange,
-                     cache_size=0)
+                     cache_size=0, predictor=predictor)
 
 
 def project(
@@ -921,6 +1129,7 @@ def project(
     eps: float = 1e-4,
     warm_start: Sequence[float] | None = None,
     max_exchange: int = 25,
+    predictor: bool = True,
 ) -> TuneResult:
     """The certified gains nearest to K0: min ‖K − K0‖_W subject to string stability.
 
@@ -958,6 +1167,18 @@ def project(
     weights, τ, δ, T* and the frequencies as parameters; the smallest that
     fits is used and unused slots are disabled by a lower bound of −∞.
 
+    Before any IPOPT solve, a *predictor* (``predictor=True``) solves the
+    problem by Newton's method on its KKT system with a small active set:
+    it starts with the constraint most violated at K0 relative to its
+    gradient (a margin, a bound, Ψ3 = g(0) ≥ ε, or g ≥ ε at a predicted dip,
+    the dip's frequency being a variable with ∂g/∂ω = 0, so that g ≥ ε holds
+    at the dip itself), adds after each solve the constraint then most
+    violated (at most three), and drops one whose multiplier turns negative.
+    Its point is returned when every multiplier is positive, every
+    constraint of the first NLP holds (the margins, the bounds, g ≥ ε on its
+    frequency set) and the exact certificate certifies it; otherwise the
+    IPOPT path above runs unchanged (and the map fallback applies to both).
+
     Parameters
     ----------
     K0 : sequence of 3 floats
@@ -976,6 +1197,8 @@ def project(
         Starting point of the first solve instead of the certified map.
     max_exchange : int
         Maximum number of solves.
+    predictor : bool
+        Try the Newton predictor before IPOPT (default); False: IPOPT only.
 
     Returns
     -------
@@ -1003,7 +1226,7 @@ def project(
     proj = _default_projector(
         p.tau, p.delta, p.headway, tuple(float(v) for v in _as_weights(weights)),
         _as_bounds(bounds), _positive("hurwitz_margin", hurwitz_margin, allow_zero=True),
-        _positive("eps", eps), max_exchange,
+        _positive("eps", eps), max_exchange, bool(predictor),
     )
     return proj(K0, warm_start=warm_start, use_state=False)
 
