@@ -303,9 +303,14 @@ def test_projection_warm_start_and_fast_path():
     a = pr((0.9, -0.5, 1.1))
     hit = pr((0.9, -0.5, 1.1))
     assert hit.details.get("cache_hit") and hit.k == a.k and hit.certified
-    near = pr((0.9, -0.49, 1.1))
+    near = pr((0.9, -0.49, 1.1))  # no warm start from the previous output by default
+    assert near.details["start"] == "map" and near.certified and sweep_ok(near.k, **P)
+    assert pr.stats["cache_hits"] == 1 and pr.stats["warm_starts"] == 0
+    pw = Projector(**P, warm_from_previous=True)
+    pw((0.9, -0.5, 1.1))
+    near = pw((0.9, -0.49, 1.1))
     assert near.details["start"] == "previous" and near.certified and sweep_ok(near.k, **P)
-    assert pr.stats["cache_hits"] == 1 and pr.stats["warm_starts"] == 1
+    assert pw.stats["warm_starts"] == 1
     ws = project((0.9, -0.5, 1.1), **P, warm_start=a.k)
     assert ws.details["start"] == "warm_start" and ws.certified
     assert_allclose(ws.k, a.k, atol=1e-5)
