@@ -165,7 +165,7 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     drawn = plot_moves(results, tau=tau, delta=delta, headway=headway, k_a=0.6, n=101)
     fig = drawn["ax"].figure
     fig.tight_layout()
-    fig.savefig(out / "tune_moves.png", dpi=110)
+    fig.savefig(out / "tune_moves.png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": doc["summary"]}
 

@@ -920,7 +920,7 @@ def save_figures(
     def save(fig: Any, stem: str) -> None:
         for f in formats:
             path = out / f"{prefix}_{stem}.{f}"
-            fig.savefig(path, dpi=dpi, metadata=file_meta[f])
+            fig.savefig(path, dpi=dpi, metadata=file_meta[f], bbox_inches="tight", pad_inches=0.1)
             written.append(path)
         plt.close(fig)
 
