@@ -632,6 +632,10 @@ def _g_full(om: float, K: Array, p: Params) -> tuple[float, Array, float, Array,
     """g(ω; K) with the derivatives the KKT Newton step needs (scalar ω).
 
     Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g), g as in :func:`_nlp`.
+    Written out in scalar arithmetic on purpose (reusing the vectorised
+    :func:`_g_and_grad` costs ~0.5 ms of median repair latency);
+    ``tests/test_tuning.py::test_hand_derivatives_of_g_match_sympy`` checks every
+    term against SymPy's derivatives of the derived margin.
     """
     kx, kv, ka = float(K[0]), float(K[1]), float(K[2])
     tau, d, T = p.tau, p.delta, p.headway

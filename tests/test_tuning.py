@@ -367,3 +367,29 @@ def test_plot_moves():
     assert len(out["arrows"]) == 2
     assert out["ax"].get_xlabel() == "k_x"
     plt.close(out["ax"].figure)
+
+
+def test_hand_derivatives_of_g_match_sympy():
+    """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g equal SymPy's derivatives
+    of the derived margin (|D|² − |N|²)/ω² (stringstab.symbolic)."""
+    import sympy as sp
+
+    from stringstab import symbolic as S
+    from stringstab.params import Params
+    from stringstab.tuning import _g_full
+
+    g = S.margin_exact() / S.omega**2
+    K = list(S.GAINS)
+    exprs = [g, *[sp.diff(g, k) for k in K], sp.diff(g, S.omega),
+             *[sp.diff(g, S.omega, k) for k in K], sp.diff(g, S.omega, 2),
+             *[sp.diff(g, a, b) for a in K for b in K]]
+    f = sp.lambdify([*S.GAINS, *S.PARAMS, S.omega], exprs, "numpy")
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        k = rng.uniform(-2, 2, 3)
+        tau, delta, headway = rng.uniform(0.05, 0.6), rng.uniform(0, 0.5), rng.uniform(0.3, 2)
+        om = rng.uniform(0.05, 8)
+        ref = np.array(f(*k, tau, delta, headway, om), dtype=float)
+        val, gk, gw, gwk, gww, gkk = _g_full(om, k, Params(tau, delta, headway))
+        ours = np.concatenate([[val], gk, [gw], gwk, [gww], np.asarray(gkk).ravel()])
+        assert_allclose(ours, ref, rtol=1e-9, atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
