@@ -47,6 +47,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .errors import StringStabError
+from .params import positive
 
 __all__ = [
     "collision_count",
@@ -70,16 +71,6 @@ ArrayLike = npt.ArrayLike
 TTC_STAR = 3.0
 #: Lower speed bound v_min, m/s (IDL Table 2).
 V_MIN = 0.001
-
-
-def _dt(dt: Any) -> float:
-    try:
-        d = float(dt)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"dt must be a number > 0 s; got {dt!r}") from e
-    if not (math.isfinite(d) and d > 0):
-        raise StringStabError(f"dt must be a finite number > 0 s; got {dt!r}")
-    return d
 
 
 def time_to_collision(gap: ArrayLike, speed: ArrayLike, pred_speed: ArrayLike) -> Array:
@@ -138,7 +129,7 @@ def time_integrated_ttc(ttc: ArrayLike, dt: float, *, ttc_star: float = TTC_STAR
     >>> float(time_integrated_ttc([1.0, 2.0, 5.0, np.inf], 0.1))
     0.30000000000000004
     """
-    d = _dt(dt)
+    d = positive("dt", dt, unit=" s")
     x = np.asarray(ttc, dtype=np.float64)
     inside = (x >= 0) & (x <= ttc_star)
     return np.asarray(np.sum(np.where(inside, ttc_star - x, 0.0), axis=axis) * d)
@@ -154,7 +145,7 @@ def jerk_squared(accel: ArrayLike, dt: float, *, axis: int = -1) -> Array:
     >>> jerk_squared([0.0, 0.1, 0.3], 0.1).round(12).tolist()
     [1.0, 4.0]
     """
-    d = _dt(dt)
+    d = positive("dt", dt, unit=" s")
     return np.asarray((np.diff(np.asarray(accel, dtype=np.float64), axis=axis) / d) ** 2)
 
 

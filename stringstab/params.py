@@ -25,7 +25,15 @@ import numpy.typing as npt
 
 from .errors import StringStabError
 
-__all__ = ["DEFAULT_DELTA", "DEFAULT_HEADWAY", "DEFAULT_TAU", "Params", "as_gains", "check_params"]
+__all__ = [
+    "DEFAULT_DELTA",
+    "DEFAULT_HEADWAY",
+    "DEFAULT_TAU",
+    "Params",
+    "as_gains",
+    "check_params",
+    "positive",
+]
 
 DEFAULT_TAU = 0.1
 DEFAULT_DELTA = 0.2
@@ -56,6 +64,36 @@ class Params:
     def as_dict(self) -> dict[str, float]:
         """The parameters as a plain dict (for JSON and file metadata)."""
         return {"tau": float(self.tau), "delta": float(self.delta), "headway": float(self.headway)}
+
+
+def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "") -> float:
+    """``value`` as a float that is finite and > 0 (≥ 0 with ``allow_zero``).
+
+    The one check behind every step size, lag, margin and tolerance of the
+    toolkit; ``unit`` (e.g. ``" s"``) is appended to the expectation.
+
+    Raises
+    ------
+    StringStabError
+        Saying what was expected and what was found.
+
+    Examples
+    --------
+    >>> positive("dt", "0.1", unit=" s")
+    0.1
+    >>> positive("dt", 0, unit=" s")
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: dt must be a finite number > 0 s; got 0
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"{name} must be a number; got {value!r}") from e
+    if not (math.isfinite(x) and (x >= 0 if allow_zero else x > 0)):
+        op = ">=" if allow_zero else ">"
+        raise StringStabError(f"{name} must be a finite number {op} 0{unit}; got {value!r}")
+    return x
 
 
 def _finite(name: str, value: Any) -> float:

@@ -50,7 +50,7 @@ from .certificate import Certificate, certify, certify_batch, check
 from .criteria import TYPE_NAMES, taylor_criteria
 from .errors import StringStabError
 from .frequency import margin_g_coefficients
-from .params import Params
+from .params import Params, positive
 
 __all__ = [
     "METHODS",
@@ -188,17 +188,6 @@ def _as_weights(weights: Any) -> Array:
     if w.shape != (3,) or not np.all(np.isfinite(w)) or not np.all(w > 0):
         raise StringStabError(f"weights must be three finite numbers > 0; got {weights!r}")
     return w
-
-
-def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number; got {value!r}") from e
-    ok = x >= 0 if allow_zero else x > 0
-    if not (math.isfinite(x) and ok):
-        raise StringStabError(f"{name} must be a finite number {'>=' if allow_zero else '>'} 0; got {value!r}")
-    return x
 
 
 def _wdist(K: Array, K0: Array, w: Array) -> Array:
@@ -388,7 +377,7 @@ def region_growing(
     t0 = time.perf_counter()
     p = Params(tau, delta, headway)
     k0 = _as_k0(K0)
-    r0 = _positive("r0", r0)
+    r0 = positive("r0", r0)
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 1:
         raise StringStabError(f"grid must be an integer >= 1 (grid intervals per r0); got {grid!r}")
     G = int(grid)
@@ -831,8 +820,8 @@ class Projector:
         self.params = Params(tau, delta, headway)
         self.weights = _as_weights(weights)
         self.bounds = _as_bounds(bounds)
-        self.hurwitz_margin = _positive("hurwitz_margin", hurwitz_margin, allow_zero=True)
-        self.eps = _positive("eps", eps)
+        self.hurwitz_margin = positive("hurwitz_margin", hurwitz_margin, allow_zero=True)
+        self.eps = positive("eps", eps)
         if isinstance(max_exchange, bool) or not isinstance(max_exchange, (int, np.integer)) \
                 or max_exchange < 1:
             raise StringStabError(f"max_exchange must be an integer >= 1; got {max_exchange!r}")
@@ -1240,8 +1229,8 @@ def project(
     p = Params(tau, delta, headway)
     proj = _default_projector(
         p.tau, p.delta, p.headway, tuple(float(v) for v in _as_weights(weights)),
-        _as_bounds(bounds), _positive("hurwitz_margin", hurwitz_margin, allow_zero=True),
-        _positive("eps", eps), max_exchange, bool(predictor),
+        _as_bounds(bounds), positive("hurwitz_margin", hurwitz_margin, allow_zero=True),
+        positive("eps", eps), max_exchange, bool(predictor),
     )
     return proj(K0, warm_start=warm_start, use_state=False)
 

@@ -38,7 +38,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..params import DEFAULT_HEADWAY, as_gains
+from ..params import DEFAULT_HEADWAY, as_gains, positive
 
 __all__ = [
     "DEFAULT_STANDSTILL",
@@ -124,16 +124,6 @@ class Controller:
         return {"controller": type(self).__name__}
 
 
-def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number; got {value!r}") from e
-    if not math.isfinite(x) or x < 0 or (x == 0 and not allow_zero):
-        raise StringStabError(f"{name} must be a finite number {'>=' if allow_zero else '>'} 0; got {value!r}")
-    return x
-
-
 class LinearController(Controller):
     """The IDL linear law with fixed gains (IDL paper eqs 3-4).
 
@@ -159,8 +149,8 @@ class LinearController(Controller):
     def __init__(self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *,
                  headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL) -> None:
         self.k_x, self.k_v, self.k_a = as_gains(k_x, k_v, k_a)
-        self._headway = _positive("headway (T*)", headway, allow_zero=True)
-        self.standstill = _positive("standstill spacing l0", standstill, allow_zero=True)
+        self._headway = positive("headway (T*)", headway, allow_zero=True)
+        self.standstill = positive("standstill spacing l0", standstill, allow_zero=True)
         self._kxT = self.k_x * self._headway
         self._kxl = self.k_x * self.standstill
         self._K = np.stack([self.k_x, self.k_v, self.k_a], axis=-1)
@@ -211,8 +201,8 @@ class TimeVaryingLinearController(Controller):
 
     def __init__(self, schedule: npt.ArrayLike | Callable[[Observation], npt.ArrayLike], *,
                  headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL) -> None:
-        self._headway = _positive("headway (T*)", headway, allow_zero=True)
-        self.standstill = _positive("standstill spacing l0", standstill, allow_zero=True)
+        self._headway = positive("headway (T*)", headway, allow_zero=True)
+        self.standstill = positive("standstill spacing l0", standstill, allow_zero=True)
         self._fn: Callable[[Observation], npt.ArrayLike] | None
         if callable(schedule):
             self._fn, self._table = schedule, None
@@ -333,8 +323,8 @@ class CACCController(Controller):
                  t_system: float = DEFAULT_HEADWAY, r_min: float = DEFAULT_STANDSTILL,
                  speed_intended: float = 33.3) -> None:
         self.k_a, self.k_v, self.k_d, self.k = (float(k_a), float(k_v), float(k_d), float(k))
-        self.t_system = _positive("t_system", t_system, allow_zero=True)
-        self.r_min = _positive("r_min", r_min, allow_zero=True)
+        self.t_system = positive("t_system", t_system, allow_zero=True)
+        self.r_min = positive("r_min", r_min, allow_zero=True)
         self.speed_intended = float(speed_intended)
         self._K = np.array([self.k_d, self.k_v, self.k_a])
 
@@ -379,12 +369,12 @@ class IDMController(Controller):
     def __init__(self, *, desired_speed: float = 33.3, time_headway: float = 1.6,
                  min_gap: float = 2.0, max_accel: float = 0.73, comfortable_decel: float = 1.67,
                  exponent: float = 4.0) -> None:
-        self.v0 = _positive("desired_speed", desired_speed)
-        self.T = _positive("time_headway", time_headway, allow_zero=True)
-        self.s0 = _positive("min_gap", min_gap, allow_zero=True)
-        self.a = _positive("max_accel", max_accel)
-        self.b = _positive("comfortable_decel", comfortable_decel)
-        self.exponent = _positive("exponent", exponent)
+        self.v0 = positive("desired_speed", desired_speed)
+        self.T = positive("time_headway", time_headway, allow_zero=True)
+        self.s0 = positive("min_gap", min_gap, allow_zero=True)
+        self.a = positive("max_accel", max_accel)
+        self.b = positive("comfortable_decel", comfortable_decel)
+        self.exponent = positive("exponent", exponent)
         self._ab2 = 2.0 * math.sqrt(self.a * self.b)
 
     def command(self, obs: Observation) -> Array:

@@ -36,6 +36,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
+from ..params import positive
 
 __all__ = [
     "CYCLES",
@@ -169,16 +170,6 @@ class Trajectory:
 # construction helpers
 
 
-def _check_dt(dt: Any) -> float:
-    try:
-        d = float(dt)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"dt must be a number of seconds > 0; got {dt!r}") from e
-    if not (math.isfinite(d) and d > 0):
-        raise StringStabError(f"dt must be a finite number of seconds > 0; got {dt!r}")
-    return d
-
-
 def _grid(t0: float, t1: float, dt: float) -> Array:
     n = math.floor((t1 - t0) / dt + 1e-9) + 1
     return np.asarray(t0 + np.arange(n, dtype=np.float64) * dt, dtype=np.float64)
@@ -245,7 +236,7 @@ def from_speed(
     >>> tr.speed.tolist(), tr.accel.tolist(), tr.position.tolist()
     ([0.0, 0.5, 1.0, 1.0, 1.0], [1.0, 1.0, 0.0, 0.0, 0.0], [0.0, 0.125, 0.5, 1.0, 1.5])
     """
-    d = _check_dt(dt)
+    d = positive("dt", dt, unit=" s")
     tt = np.asarray(t, dtype=np.float64)
     vv = np.asarray(speed, dtype=np.float64)
     if tt.ndim != 1 or vv.shape != tt.shape:
@@ -311,7 +302,7 @@ def from_accel_segments(
     >>> tr.speed.tolist(), tr.accel.tolist()
     ([10.0, 10.0, 10.0, 9.0, 8.0], [0.0, 0.0, -2.0, -2.0, -2.0])
     """
-    d = _check_dt(dt)
+    d = positive("dt", dt, unit=" s")
     seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2)
     accs, durs = seg[:, 0], seg[:, 1]
     if not (np.isfinite(seg).all() and (durs >= 0).all()):
@@ -433,7 +424,7 @@ def sinusoid(
     >>> round(float(tr.accel.max()), 3)
     2.0
     """
-    d = _check_dt(dt)
+    d = positive("dt", dt, unit=" s")
     if not (math.isfinite(omega) and omega > 0):
         raise StringStabError(f"omega must be a finite number > 0 rad/s; got {omega!r}")
     if not (0 <= amplitude <= speed):
