@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_margin, taylor_criteria
+from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
 from .frequency import margin_g_coefficients
 from .params import Params, as_gains
@@ -483,10 +483,8 @@ class CertificateBatch:
 
 def _hurwitz_bands(kx: Array, kv: Array, p: Params) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
     """(surely Hurwitz, surely not Hurwitz); neither within 1e-12 of the boundary."""
-    c2 = kv + (p.headway - p.tau) * kx
-    s2 = np.abs(kv) + abs(p.headway - p.tau) * np.abs(kx)
-    hz_sure = (kx > 0) & (c2 > _HURWITZ_RTOL * s2)
-    hz_fail = (kx <= 0) | (c2 < -_HURWITZ_RTOL * s2)
+    hz_sure = hurwitz(kx, kv, tau=p.tau, headway=p.headway, rtol=_HURWITZ_RTOL)
+    hz_fail = ~hurwitz(kx, kv, tau=p.tau, headway=p.headway, rtol=-_HURWITZ_RTOL)
     return hz_sure, hz_fail
 
 
