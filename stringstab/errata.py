@@ -215,22 +215,20 @@ def _hurwitz_impact(printed_den: sp.Expr, params: dict[str, float]) -> dict[str,
 
 
 def _proposition1_row(params: dict[str, float]) -> Erratum:
-    from .printed import printed_psi
 
     p1, p2, p3, lam = sp.symbols("psi1 psi2 psi3 lambda_")
     printed_c = proposition1_conditions(p1, p2, p3, lam, printed=True)
     derived_c = proposition1_conditions(p1, p2, p3, lam, printed=False)
     # impact: verdict disagreement between printed logic on printed Ψ and
-    # corrected logic on derived Ψ, on the grid
+    # corrected logic on derived Ψ (criteria.taylor_criteria), on the grid
+    from .criteria import taylor_criteria
+
     kx, kv, ka = _grid()
-    args = (kx, kv, ka, params["tau"], params["delta"], params["headway"])
-    fp = sp.lambdify([*GAINS, *PARAMS], list(printed_psi()), modules="numpy")
-    fd = sp.lambdify([*GAINS, *PARAMS], list(derived_psi()), modules="numpy")
-    vp = [np.broadcast_to(np.asarray(v, float), kx.shape) for v in fp(*args)]
-    vd = [np.broadcast_to(np.asarray(v, float), kx.shape) for v in fd(*args)]
-    ok_p = ((vp[0] >= 0) & (vp[1] >= 0) & (vp[2] >= 0)) | (vp[3] <= 0)
-    ok_d = (vd[0] >= 0) & (vd[2] >= 0) & ((vd[1] >= 0) | (vd[3] <= 0))
-    ok_logic = (vd[0] >= 0) & (vd[2] >= 0) & ((vd[1] >= 0) | (vd[3] <= 0))
+    kw = {"tau": params["tau"], "delta": params["delta"], "headway": params["headway"]}
+    ok_p = taylor_criteria(kx, kv, ka, source="printed", **kw).stable
+    derived = taylor_criteria(kx, kv, ka, source="derived", **kw)
+    ok_d = derived.stable
+    vd = (derived.psi1, derived.psi2, derived.psi3, derived.lam)
     ok_printed_logic_on_derived = ((vd[0] >= 0) & (vd[1] >= 0) & (vd[2] >= 0)) | (vd[3] <= 0)
     return Erratum(
         equation="Proposition 1",
@@ -247,7 +245,7 @@ def _proposition1_row(params: dict[str, float]) -> Erratum:
             "params": params,
             "verdict_disagreement_printed_vs_derived": float(np.mean(ok_p != ok_d)),
             "verdict_disagreement_logic_only": float(
-                np.mean(ok_logic != ok_printed_logic_on_derived)
+                np.mean(ok_d != ok_printed_logic_on_derived)
             ),
         },
     )
