@@ -55,7 +55,7 @@ import numpy.typing as npt
 
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
-from .frequency import margin_g_coefficients
+from .frequency import gain_squared, margin_g_coefficients
 from .params import Params, as_gains
 
 __all__ = [
@@ -265,22 +265,6 @@ def _exact_chunk(
 # ---------------------------------------------------------------------------
 # Peak of |Γ(jω)| (for reporting; the verdict never depends on it)
 # ---------------------------------------------------------------------------
-def _gain2(w: Array, kx: Array, kv: Array, ka: Array, tau: float, delta: float,
-           headway: float) -> Array:
-    """|Γ(jω)|² in real arithmetic (inf where D(jω) = 0)."""
-    w2 = w * w
-    dw = delta * w
-    re_n = kx - ka * w2 * np.cos(dw)
-    im_n = kv * w + ka * w2 * np.sin(dw)
-    re_d = kx - w2
-    im_d = w * (kv + headway * kx - tau * w2)
-    num = re_n * re_n + im_n * im_n
-    den = re_d * re_d + im_d * im_d
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = num / den
-    return np.where(den > 0, out, np.inf)
-
-
 def _peak(
     kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float, Om: Array,
     W: Array, G: Array, worst: Array,
@@ -307,7 +291,7 @@ def _peak(
     extra = np.stack([np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0)
                       for x in ((-qb + sq) / (2.0 * qa), (-qb - sq) / (2.0 * qa))]
                      + [worst], axis=1)  # and the branch and bound's witness, min g
-    Ge = _gain2(extra, col(kx), col(kv), col(ka), tau, delta, headway)
+    Ge = gain_squared(extra, col(kx), col(kv), col(ka), tau=tau, delta=delta, headway=headway)
     Wall = np.concatenate([W, extra], axis=1)
     Gall = np.concatenate([G2, Ge], axis=1)
     Gall = np.where(np.isnan(Gall), np.inf, Gall)
@@ -319,7 +303,7 @@ def _peak(
     v = np.linspace(-1.0, 1.0, 9)
     for _ in range(8):
         Wl = np.maximum(best_w[:, None] + half[:, None] * v[None, :], 0.0)
-        Gl = _gain2(Wl, col(kx), col(kv), col(ka), tau, delta, headway)
+        Gl = gain_squared(Wl, col(kx), col(kv), col(ka), tau=tau, delta=delta, headway=headway)
         Gl = np.where(np.isnan(Gl), np.inf, Gl)
         jl = np.argmax(Gl, axis=1)
         gl = Gl[rows, jl]

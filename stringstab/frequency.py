@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["gain", "gamma_jw", "margin_g", "margin_g_coefficients"]
+__all__ = ["gain", "gain_squared", "gamma_jw", "margin_g", "margin_g_coefficients"]
 
 ArrayLike = npt.ArrayLike
 Array = npt.NDArray[np.float64]
@@ -48,6 +48,36 @@ def gain(
 ) -> Array:
     """|Γ(jω)|: the amplitude ratio of follower to predecessor acceleration at ω."""
     return np.abs(gamma_jw(omega, k_x, k_v, k_a, tau=tau, delta=delta, headway=headway))
+
+
+def gain_squared(
+    omega: ArrayLike, k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
+    *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
+) -> Array:
+    """|Γ(jω)|² = |N(jω)|²/|D(jω)|² in real arithmetic, ``inf`` where D(jω) = 0.
+
+    About twice as fast as ``gain(...)**2`` (no complex exponential); used by
+    the certificate's peak search.
+
+    Examples
+    --------
+    >>> round(float(gain_squared(1.0, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)), 6)
+    0.684342
+    """
+    w = np.asarray(omega, dtype=float)
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
+    t, d, h = (np.asarray(p, dtype=float) for p in (tau, delta, headway))
+    w2 = w * w
+    dw = d * w
+    re_n = kx - ka * w2 * np.cos(dw)
+    im_n = kv * w + ka * w2 * np.sin(dw)
+    re_d = kx - w2
+    im_d = w * (kv + h * kx - t * w2)
+    num = re_n * re_n + im_n * im_n
+    den = re_d * re_d + im_d * im_d
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = num / den
+    return np.asarray(np.where(den > 0, out, np.inf))
 
 
 def margin_g_coefficients(

@@ -151,12 +151,15 @@ def test_parse_substitutions_errors():
 @given(kx=gain, kv=gain, ka=gain, tau=lag, delta=delay, headway=hw, w=st.floats(0.01, 50))
 def test_numeric_frequency_module_matches_sympy(kx, kv, ka, tau, delta, headway, w):
     """stringstab.frequency (hand-vectorised) equals the SymPy derivation."""
-    from stringstab.frequency import gamma_jw, margin_g
+    from stringstab.frequency import gain_squared, gamma_jw, margin_g
 
     g = S.gamma()
     f = sp.lambdify([*S.GAINS, *S.PARAMS, S.s], g.expr, "numpy")
     assert_allclose(gamma_jw(w, kx, kv, ka, tau=tau, delta=delta, headway=headway),
                     f(kx, kv, ka, tau, delta, headway, 1j * w), rtol=1e-9, atol=1e-12)
+    G2 = abs(f(kx, kv, ka, tau, delta, headway, 1j * w)) ** 2
+    assert_allclose(gain_squared(w, kx, kv, ka, tau=tau, delta=delta, headway=headway), G2,
+                    rtol=1e-9, atol=1e-12)
     F = sp.lambdify([*S.GAINS, *S.PARAMS, S.omega], S.margin_exact() / S.omega**2, "numpy")
     ref = F(kx, kv, ka, tau, delta, headway, w)
     assert_allclose(margin_g(w, kx, kv, ka, tau=tau, delta=delta, headway=headway), ref,
