@@ -376,7 +376,7 @@ def test_hand_derivatives_of_g_match_sympy():
 
     from stringstab import symbolic as S
     from stringstab.params import Params
-    from stringstab.tuning import _g_full
+    from stringstab.tuning import _g_and_grad, _g_full
 
     g = S.margin_exact() / S.omega**2
     K = list(S.GAINS)
@@ -393,3 +393,6 @@ def test_hand_derivatives_of_g_match_sympy():
         val, gk, gw, gwk, gww, gkk = _g_full(om, k, Params(tau, delta, headway))
         ours = np.concatenate([[val], gk, [gw], gwk, [gww], np.asarray(gkk).ravel()])
         assert_allclose(ours, ref, rtol=1e-9, atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
+        gv, gk2 = _g_and_grad(np.array([om]), k, Params(tau, delta, headway))  # vectorised twin
+        assert_allclose(np.concatenate([gv, gk2[0]]), ref[:4], rtol=1e-9,
+                        atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
