@@ -39,6 +39,7 @@ __all__ = [
     "TaylorCriteria",
     "hurwitz",
     "hurwitz_margin",
+    "proposition1",
     "stability_type",
     "taylor_criteria",
 ]
@@ -168,10 +169,29 @@ def taylor_criteria(
     tau, delta, headway = check_params(tau, delta, headway)
     kx, kv, ka = as_gains(k_x, k_v, k_a)
     psi1, psi2, psi3, lam = lambdify_psi(source)(kx, kv, ka, tau, delta, headway)
-    if source == "derived":
-        stable = (psi1 >= 0) & (psi3 >= 0) & ((psi2 >= 0) | (lam <= 0))
-    else:
-        stable = ((psi1 >= 0) & (psi2 >= 0) & (psi3 >= 0)) | (lam <= 0)
     return TaylorCriteria(
-        source, psi1, psi2, psi3, lam, np.asarray(stable), stability_type(psi2, psi3, lam)
+        source, psi1, psi2, psi3, lam, proposition1(psi1, psi2, psi3, lam, source=source),
+        stability_type(psi2, psi3, lam),
     )
+
+
+def proposition1(
+    psi1: npt.ArrayLike, psi2: npt.ArrayLike, psi3: npt.ArrayLike, lam: npt.ArrayLike,
+    *, source: str = "derived",
+) -> npt.NDArray[np.bool_]:
+    """The Proposition-1 verdict from Ψ1, Ψ2, Ψ3, Λ (IDL eqs 12-15).
+
+    ``source="derived"``: the corrected logic Ψ1 ≥ 0 ∧ Ψ3 ≥ 0 ∧ (Ψ2 ≥ 0 ∨ Λ ≤ 0);
+    ``"printed"``: the printed (Ψ1, Ψ2, Ψ3 ≥ 0) ∨ Λ ≤ 0 (module docstring).
+
+    Examples
+    --------
+    >>> proposition1(-0.1, -1.0, -1.0, -1.0, source="printed"), proposition1(-0.1, -1.0, -1.0, -1.0)
+    (array(True), array(False))
+    """
+    p1, p2, p3, lm = (np.asarray(v, dtype=float) for v in (psi1, psi2, psi3, lam))
+    if source == "derived":
+        return np.asarray((p1 >= 0) & (p3 >= 0) & ((p2 >= 0) | (lm <= 0)))
+    if source == "printed":
+        return np.asarray(((p1 >= 0) & (p2 >= 0) & (p3 >= 0)) | (lm <= 0))
+    raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}")

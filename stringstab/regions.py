@@ -73,7 +73,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .criteria import TYPE_NAMES, hurwitz, stability_type
+from .criteria import TYPE_NAMES, hurwitz, proposition1, stability_type
 from .errors import StringStabError
 from .params import Params
 
@@ -170,13 +170,6 @@ def _psi_grid(
     return res[0], res[1], res[2], res[3]
 
 
-def _prop1(source: str, psi1: Array, psi2: Array, psi3: Array, lam: Array) -> npt.NDArray[np.bool_]:
-    """Proposition 1 with the logic of :func:`stringstab.criteria.taylor_criteria`."""
-    if source == "derived":
-        return (psi1 >= 0) & (psi3 >= 0) & ((psi2 >= 0) | (lam <= 0))
-    return ((psi1 >= 0) & (psi2 >= 0) & (psi3 >= 0)) | (lam <= 0)
-
-
 # --------------------------------------------------------------------------- blocks
 @dataclass(frozen=True)
 class _Spec:
@@ -210,7 +203,7 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
         psi1, psi2, psi3, lam = _psi_grid(source, spec.names, x0, x1, x2, p)
         out["type" if source == "derived" else "type_printed"] = stability_type(psi2, psi3, lam)
         if method in spec.methods:
-            ok = _prop1(source, psi1, psi2, psi3, lam)
+            ok = proposition1(psi1, psi2, psi3, lam, source=source)
             out[f"prop1_{method}"] = ok
             out[f"verdict_{method}"] = np.where(ok & hz, _STABLE, _UNSTABLE).astype(np.int8)
     if "exact" in spec.methods:
