@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import constants
 from .errors import StringStabError
 
 __all__ = [
@@ -35,9 +36,9 @@ __all__ = [
     "positive",
 ]
 
-DEFAULT_TAU = 0.1
-DEFAULT_DELTA = 0.2
-DEFAULT_HEADWAY = 1.1
+DEFAULT_TAU = constants.TAU
+DEFAULT_DELTA = constants.DELTA
+DEFAULT_HEADWAY = constants.HEADWAY
 
 
 @dataclass(frozen=True)

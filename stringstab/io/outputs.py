@@ -1,0 +1,356 @@
+"""Output files and folders that are checked before the work starts and written all-or-nothing.
+
+Three guarantees, for every command of the toolkit:
+
+1. **Checked first.**  :func:`check_output_file` and :func:`check_output_dir` (and
+   :class:`OutputDir`, which calls the latter) refuse, with one sentence, an output path whose
+   folder does not exist, a folder where a file is wanted and the reverse, and a place where
+   nothing can be written — *before* any computation, so a long run never ends in a traceback.
+   Writability is probed by creating (and removing) a temporary file, which is the only test that
+   is right for root, ACLs and read-only file systems alike.
+2. **Complete or absent.**  Files are written to a temporary name in the same folder and renamed
+   into place (``os.replace``, atomic on POSIX), so a reader never sees half a file.
+3. **One run per folder.**  An :class:`OutputDir` writes every file of a run into a staging folder
+   and moves them in only when the run succeeds, deleting the files its own earlier run (listed in
+   the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A failed run leaves the
+   previous outputs untouched; a folder written by a *different* command is refused; files the
+   toolkit did not write are never deleted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from ..errors import StringStabError
+
+__all__ = [
+    "MANIFEST",
+    "OutputDir",
+    "atomic_path",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "check_output_dir",
+    "check_output_file",
+]
+
+#: Name of the file in which an :class:`OutputDir` lists what it wrote.
+MANIFEST = ".stringstab-manifest.json"
+_STAGING_PREFIX = ".stringstab-staging-"
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _reason(e: OSError) -> str:
+    return e.strerror or str(e)
+
+
+def _probe_writable(folder: Path, what: str) -> None:
+    """Create and remove a temporary file in ``folder``; a clear error if that fails."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".stringstab-probe-", dir=folder)
+    except OSError as e:
+        raise StringStabError(
+            f"{what}: cannot write in the folder {str(folder)!r} ({_reason(e)}); "
+            "expected a folder you can write to"
+        ) from e
+    os.close(fd)
+    os.unlink(tmp)
+
+
+def check_output_file(path: str | os.PathLike[str], *, what: str = "output file") -> Path:
+    """Check that a file can be written at ``path``, before any work is done.
+
+    The parent folder must exist (it is not created: a mistyped folder name should be an error,
+    not a new folder) and be writable; ``path`` itself must not be a folder.
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    StringStabError
+        One sentence naming the path, what was expected and what was found.
+
+    Examples
+    --------
+    >>> check_output_file("/nonexistent-folder/x.json")
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: output file: the folder '/nonexistent-folder' of '/nonexistent-folder/x.json' does not exist; create it first or choose another path
+    """
+    p = Path(path)
+    if str(path) == "" or p.name in ("", ".", ".."):
+        raise StringStabError(f"{what}: expected a file name; got {str(path)!r}")
+    if p.is_dir():
+        raise StringStabError(f"{what}: expected a file; {str(p)!r} is a folder")
+    parent = p.parent
+    if not parent.exists():
+        raise StringStabError(
+            f"{what}: the folder {str(parent)!r} of {str(p)!r} does not exist; "
+            "create it first or choose another path"
+        )
+    if not parent.is_dir():
+        raise StringStabError(f"{what}: {str(parent)!r} in {str(p)!r} is a file, not a folder")
+    if p.exists() and not p.is_file():
+        raise StringStabError(f"{what}: expected a regular file; {str(p)!r} is something else")
+    _probe_writable(parent, what)
+    return p
+
+
+def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Path:
+    """Check that a folder can be written (or created, with its parents) at ``path``.
+
+    Nothing is created: the nearest existing ancestor must be a writable folder.
+
+    Raises
+    ------
+    StringStabError
+        When ``path`` (or an ancestor) is a file, or nothing can be written there.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "a-file"
+    >>> _ = f.write_text("x")
+    >>> check_output_dir(f)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: output folder: expected a folder; '...a-file' is a file
+    """
+    p = Path(path)
+    if str(path) == "":
+        raise StringStabError(f"{what}: expected a folder path; got ''")
+    if p.exists() and not p.is_dir():
+        raise StringStabError(f"{what}: expected a folder; {str(p)!r} is a file")
+    probe = p
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise StringStabError(f"{what}: {str(probe)!r} in {str(p)!r} is a file, not a folder")
+    _probe_writable(probe, what)
+    return p
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> Iterator[Path]:
+    """A temporary path beside ``path`` that is renamed onto it if the block succeeds.
+
+    For libraries that write to a file name themselves (``numpy.savez``, ``Figure.savefig``,
+    ``safetensors``): the temporary name keeps ``path``'s suffix, so format detection works.
+    If the block raises, the temporary file is removed and ``path`` is left as it was.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.npz"
+    >>> with atomic_path(target) as tmp:
+    ...     np.savez(tmp, x=np.arange(3))
+    >>> np.load(target)["x"].tolist()
+    [0, 1, 2]
+    """
+    p = Path(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=f".tmp{p.suffix}", dir=p.parent)
+    except OSError as e:
+        raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.chmod(tmp_path, 0o666 & ~_umask())
+        os.replace(tmp_path, p)
+    except OSError as e:
+        tmp_path.unlink(missing_ok=True)
+        raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str = "output file") -> Path:
+    """Write ``data`` to ``path`` atomically (temporary file + rename); returns the path."""
+    with atomic_path(path, what=what) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+    return Path(path)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "output file") -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically (temporary file + rename); returns the path.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = atomic_write_text(pathlib.Path(tempfile.mkdtemp()) / "r.txt", "Γ ≤ 1\\n")
+    >>> p.read_text(encoding="utf-8")
+    'Γ ≤ 1\\n'
+    """
+    return atomic_write_bytes(path, text.encode("utf-8"), what=what)
+
+
+class OutputDir:
+    """An output folder written all-or-nothing, replacing only its own earlier run.
+
+    Use as a context manager around the work.  The folder is checked on construction (before the
+    work); files are written with :meth:`path` (a staging path to hand to any writer),
+    :meth:`write_text`, :meth:`write_bytes` or :meth:`write_json`; on success they are moved in
+    and the manifest is updated, on failure the staging folder is removed and the folder is left
+    exactly as it was.
+
+    Parameters
+    ----------
+    path : path-like
+        The output folder (created, with its parents, when the run succeeds).
+    command : str
+        Who writes it (e.g. ``"region"``); a folder whose manifest names another command is
+        refused, so two different runs are never mixed in one folder.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> with OutputDir(root / "run", command="demo") as out:
+    ...     _ = out.write_text("a.txt", "first")
+    ...     _ = out.write_text("b.txt", "first")
+    >>> with OutputDir(root / "run", command="demo") as out:
+    ...     _ = out.write_text("a.txt", "second")
+    >>> sorted(p.name for p in (root / "run").iterdir() if not p.name.startswith("."))
+    ['a.txt']
+    >>> OutputDir(root / "run", command="region")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: output folder: '...run' holds the outputs of 'stringstab demo'; ...
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, command: str,
+                 what: str = "output folder") -> None:
+        self.root = check_output_dir(path, what=what)
+        self.command = command
+        self.what = what
+        self._staging: Path | None = None
+        self._written: list[str] = []
+        old = self._read_manifest()
+        if old is not None and old.get("command") != command:
+            raise StringStabError(
+                f"{what}: {str(self.root)!r} holds the outputs of 'stringstab {old.get('command')}'; "
+                f"expected an empty folder or one written by 'stringstab {command}'; "
+                "choose another folder"
+            )
+
+    # -- manifest ---------------------------------------------------------------------------
+    def _read_manifest(self) -> dict[str, Any] | None:
+        m = self.root / MANIFEST
+        if not m.is_file():
+            return None
+        try:
+            doc = json.loads(m.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None  # an unreadable manifest protects nothing; we will overwrite it
+        return doc if isinstance(doc, dict) else None
+
+    # -- context ------------------------------------------------------------------------------
+    def __enter__(self) -> OutputDir:
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+            self._staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.root))
+        except OSError as e:
+            raise StringStabError(
+                f"{self.what}: cannot create {str(self.root)!r} ({_reason(e)})"
+            ) from e
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        if exc_type is None:
+            self.commit()
+        else:
+            self.discard()
+
+    @property
+    def staging(self) -> Path:
+        if self._staging is None:
+            raise RuntimeError("OutputDir is used outside its 'with' block")
+        return self._staging
+
+    def path(self, name: str) -> Path:
+        """The staging path of output ``name`` (sub-folders allowed); hand it to any writer."""
+        rel = Path(name)
+        if rel.is_absolute() or ".." in rel.parts or name in ("", MANIFEST):
+            raise ValueError(f"output names are relative paths inside the folder; got {name!r}")
+        p = self.staging / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        if rel.as_posix() not in self._written:
+            self._written.append(rel.as_posix())
+        return p
+
+    def final(self, name: str) -> Path:
+        """Where output ``name`` will be once the run has succeeded."""
+        return self.root / name
+
+    def write_bytes(self, name: str, data: bytes) -> Path:
+        """Stage ``data`` as output ``name``; returns its final path."""
+        self.path(name).write_bytes(data)
+        return self.final(name)
+
+    def write_text(self, name: str, text: str) -> Path:
+        """Stage UTF-8 ``text`` as output ``name``; returns its final path."""
+        return self.write_bytes(name, text.encode("utf-8"))
+
+    def write_json(self, name: str, doc: Any) -> Path:
+        """Stage ``doc`` as JSON (:func:`~stringstab.io.plain.dumps_json`); returns its final path."""
+        from .plain import dumps_json
+
+        return self.write_text(name, dumps_json(doc))
+
+    @property
+    def written(self) -> list[str]:
+        """Names staged so far, in order."""
+        return list(self._written)
+
+    def discard(self) -> None:
+        """Drop everything staged; the folder is left as it was."""
+        if self._staging is not None:
+            shutil.rmtree(self._staging, ignore_errors=True)
+            self._staging = None
+
+    def commit(self) -> None:
+        """Move the staged files in, remove this command's stale files, update the manifest."""
+        staging = self.staging
+        old = self._read_manifest() or {}
+        new = [n for n in self._written if (staging / n).is_file()]
+        try:
+            mode = 0o666 & ~_umask()
+            for name in old.get("files", []):
+                if isinstance(name, str) and name not in new and ".." not in Path(name).parts:
+                    (self.root / name).unlink(missing_ok=True)
+            for name in new:
+                dest = self.root / name
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                os.chmod(staging / name, mode)
+                os.replace(staging / name, dest)
+            from .. import __version__
+
+            manifest = {"command": self.command, "version": __version__, "files": new}
+            atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
+                              what=self.what)
+        except OSError as e:
+            raise StringStabError(
+                f"{self.what}: cannot move the outputs into {str(self.root)!r} ({_reason(e)})"
+            ) from e
+        finally:
+            self.discard()
