@@ -1,4 +1,7 @@
-"""The I/O home: JSON-safe values and safe, all-or-nothing output files and folders.
+"""The I/O home: result tables, JSON-safe values and safe, all-or-nothing output files and folders.
+
+:mod:`~stringstab.io.results` writes every command's result columns (table, JSON, CSV,
+Parquet, NPZ) with one vectorised writer.
 
 Every command checks its output paths with :func:`check_output_file` or :class:`OutputDir`
 *before* it starts work, and writes through :func:`atomic_write_text`,
@@ -18,15 +21,35 @@ from .outputs import (
     check_output_file,
 )
 from .plain import dumps_json, to_plain
+from .results import (
+    BINARY_FORMATS,
+    RESULT_FORMATS,
+    TableColumn,
+    columns_from_records,
+    flatten_columns,
+    format_results,
+    render_table,
+    write_results,
+    write_text,
+)
 
 __all__ = [
+    "BINARY_FORMATS",
     "MANIFEST",
+    "RESULT_FORMATS",
     "OutputDir",
+    "TableColumn",
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
+    "columns_from_records",
     "dumps_json",
+    "flatten_columns",
+    "format_results",
+    "render_table",
     "to_plain",
+    "write_results",
+    "write_text",
 ]
