@@ -15,7 +15,7 @@ from .criteria import hurwitz, stability_type, taylor_criteria
 from .errata import Erratum, errata
 from .errors import StringStabError
 from .frequency import gain, gamma_jw, margin_g
-from .gainio import GainTable, parse_triple, read_gains
+from .io.gains import GainTable, parse_triple, read_gains
 from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Params
 
 # The simulator (stringstab.traffic, stringstab.metrics), the region maps

@@ -56,9 +56,11 @@ import numpy.typing as npt
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
 from .frequency import gain_squared, margin_g_coefficients
+from .io.results import TableColumn, columns_from_records, records_from_columns
 from .params import Params, as_gains
 
 __all__ = [
+    "TABLE_COLUMNS",
     "VERDICTS",
     "Certificate",
     "CertificateBatch",
@@ -454,15 +456,75 @@ class CertificateBatch:
             pade=None if self.pade is None else self.pade[i],
         )
 
+    # -- result rendering: the rows, columns and totals every output format is written from --
+    def columns(self) -> dict[str, Any]:
+        """The result columns, in the order and with the keys of :meth:`Certificate.as_dict`.
+
+        Groups (``taylor_derived``, ``taylor_printed``, ``pade``) are nested mappings of
+        columns; write them with :func:`stringstab.io.write_results`.  Unlike the JSON rows,
+        non-finite numbers stay as they are (``sup_gain`` is ``inf`` when Γ is unstable).
+
+        Examples
+        --------
+        >>> b = certify_batch([1.5, -0.5], [0.3, 1.0], [-0.1, 1.0], tau=0.1, delta=0.2, headway=1.1)
+        >>> b.columns()["sup_gain"].tolist(), b.columns()["taylor_printed"]["verdict"].tolist()
+        ([1.0, inf], ['stable', 'unstable'])
+        """
+        n = len(self)
+        cols: dict[str, Any] = {
+            "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "hurwitz": self.hurwitz,
+            "hurwitz_margin": self.hurwitz_margin, "verdict": self.verdict, "type": self.type,
+            "sup_gain": self.sup_gain, "linf_gain": self.linf_gain,
+            "peak_omega": self.peak_omega, "margin": self.margin, "omega_max": self.omega_max,
+            "taylor_derived": _taylor_columns(self.taylor_derived),
+            "taylor_printed": _taylor_columns(self.taylor_printed),
+            "method": np.full(n, self.method),
+        }
+        if self.pade is not None:
+            cols["pade"] = columns_from_records(self.pade)
+        return cols
+
     def records(self) -> list[dict[str, Any]]:
-        """One JSON row per triple (:meth:`Certificate.as_dict`)."""
-        return [self[i].as_dict() for i in range(len(self))]
+        """One JSON row per triple (:meth:`Certificate.as_dict`; non-finite numbers are None)."""
+        return records_from_columns(self.columns())
 
     def summary(self) -> dict[str, Any]:
-        """Counts per verdict and m_fss, the share certified (IDL eq 27)."""
+        """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27).
+
+        ``m_fss`` is eq 27's M_fss without its ×100 % (docs/conventions.md): every M_fss of
+        the toolkit is a fraction; the simulator's metrics keep a percentage under an old key.
+        """
         n = len(self)
         counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
         return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+
+
+def _taylor_columns(tc: TaylorCriteria) -> dict[str, Any]:
+    """The columns of :meth:`TaylorCriteria.row`, for every triple at once."""
+    names = np.array(["", *(TYPE_NAMES[k] for k in sorted(TYPE_NAMES))])
+    return {"psi1": tc.psi1, "psi2": tc.psi2, "psi3": tc.psi3, "lambda": tc.lam,
+            "verdict": np.where(tc.stable, "stable", "unstable"),
+            "type": names[np.asarray(tc.type, dtype=np.intp)]}
+
+
+#: The columns of the human table of certificates (``stringstab certify``).
+TABLE_COLUMNS: list[TableColumn] = [
+    TableColumn("t", "t"),
+    TableColumn("vehicle", "vehicle"),
+    TableColumn("k_x", "k_x"),
+    TableColumn("k_v", "k_v"),
+    TableColumn("k_a", "k_a"),
+    TableColumn("hurwitz", "hurwitz"),
+    TableColumn("verdict", "verdict"),
+    TableColumn("type", "type"),
+    TableColumn("sup|Γ|", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
+    TableColumn("margin", "margin", "%.3g"),
+    TableColumn("taylor(derived)", "taylor_derived.verdict"),
+    TableColumn("taylor(printed)", "taylor_printed.verdict"),
+    TableColumn("pade", "pade.verdict"),
+    TableColumn("pade ‖Γ‖∞", "pade.hinf", "%.6g", missing="inf"),
+]
 
 
 def _hurwitz_bands(kx: Array, kv: Array, p: Params) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:

@@ -1,54 +1,33 @@
-"""Reading gain triples K = [k_x, k_v, k_a] and writing per-triple results.
+"""Former home of gain-file reading and result writing (kept importable).
 
-Every command that takes gains (``certify`` now, region overlays and tuning
-later) reads them here, so they all accept the same inputs:
-
-* a triple on the command line, ``"0.9,-0.5,1.1"`` (:func:`parse_triple`);
-* a file (:func:`read_gains`):
-
-  - **CSV** with a header naming the columns ``k_x, k_v, k_a`` and, for a gain
-    time series from a policy rollout, ``t`` and optionally ``vehicle``; other
-    columns are ignored.  A header-less CSV of exactly three numeric columns is
-    read as ``k_x, k_v, k_a``.  Blank lines and lines starting with ``#`` are
-    skipped; a UTF-8 byte-order mark is allowed.
-  - **JSON**: a list of objects ``{"k_x": .., "k_v": .., "k_a": .., "t": ..,
-    "vehicle": ..}`` or of triples ``[k_x, k_v, k_a]``, either bare or under a
-    key ``"gains"`` (or ``"results"``, so the output of ``stringstab certify
-    --format json`` reads back).
-  - **NPZ** (:func:`numpy.savez`): arrays ``k_x, k_v, k_a`` (optional ``t``,
-    ``vehicle``) of one length, or one ``(n, 3)`` array ``K``.
-
-Bad input raises :class:`~stringstab.errors.StringStabError` with a one-line
-message naming the file, the row or column, what was expected and what was
-found; it never yields a partial table.
-
-:func:`write_results` formats per-triple result records (for instance
-:meth:`stringstab.certificate.CertificateBatch.records`) as a table, JSON or CSV
-and writes them atomically (a file is either complete or absent).
+Reading gains lives in :mod:`stringstab.io.gains` and writing results in
+:mod:`stringstab.io.results`; this module re-exports the reader and keeps the record-based
+writer (``format_results(records, ...)``) of earlier versions, built on the columnar one.
+New code should use :func:`stringstab.io.read_gains` and :func:`stringstab.io.write_results`.
 """
 
 from __future__ import annotations
 
-import csv
-import difflib
-import io
-import json
-import math
 import os
-import tempfile
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
+from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
-import numpy as np
-import numpy.typing as npt
-
 from .errors import StringStabError
+from .io import results as _results
+from .io.gains import (
+    GAIN_COLUMNS,
+    INPUT_FORMATS,
+    OPTIONAL_COLUMNS,
+    GainTable,
+    parse_triple,
+    read_gains,
+)
+from .io.plain import to_plain
 
 __all__ = [
     "FORMATS",
     "GAIN_COLUMNS",
+    "INPUT_FORMATS",
     "OPTIONAL_COLUMNS",
     "GainTable",
     "format_results",
@@ -58,644 +37,8 @@ __all__ = [
     "write_text",
 ]
 
-#: The three gain columns, in the order of K = [k_x, k_v, k_a] (IDL eq 4).
-GAIN_COLUMNS: tuple[str, str, str] = ("k_x", "k_v", "k_a")
-#: Optional columns of a gain time series: time in s and a vehicle id.
-OPTIONAL_COLUMNS: tuple[str, str] = ("t", "vehicle")
-#: Output formats of :func:`write_results`.
+#: Formats of the record-based :func:`format_results`.
 FORMATS: tuple[str, str, str] = ("table", "json", "csv")
-
-_INPUT_FORMATS = {".csv": "csv", ".json": "json", ".npz": "npz"}
-
-Array = npt.NDArray[np.float64]
-
-
-# --------------------------------------------------------------------------- table
-
-
-@dataclass(frozen=True, eq=False)
-class GainTable:
-    """Gain triples read from one source, with an optional time and vehicle per row.
-
-    Attributes
-    ----------
-    k_x, k_v, k_a : ndarray of float, shape (n,)
-        The gains (finite).
-    t : ndarray of float, shape (n,), or None
-        Time stamps in s of a gain time series (finite), if given.
-    vehicle : ndarray, shape (n,), or None
-        Vehicle ids (integers, or strings when not all are integers), if given.
-    source : str
-        Where the gains came from (a file name or ``"<command line>"``).
-
-    Examples
-    --------
-    >>> g = GainTable.from_triples([(0.9, -0.5, 1.1), (1.3, 0.0, 0.6)])
-    >>> len(g), g.K.shape
-    (2, (2, 3))
-    >>> g.rows()[0]
-    {'k_x': 0.9, 'k_v': -0.5, 'k_a': 1.1}
-    """
-
-    k_x: Array
-    k_v: Array
-    k_a: Array
-    t: Array | None = None
-    vehicle: npt.NDArray[Any] | None = None
-    source: str = "<input>"
-    ignored_columns: tuple[str, ...] = field(default=())
-
-    def __post_init__(self) -> None:
-        n = len(self.k_x)
-        for name in ("k_v", "k_a", "t", "vehicle"):
-            a = getattr(self, name)
-            if a is not None and len(a) != n:
-                raise StringStabError(
-                    f"{self.source}: {name} must have one entry per gain triple ({n}); "
-                    f"found {len(a)}"
-                )
-
-    @classmethod
-    def from_triples(
-        cls, triples: Iterable[Sequence[float]], *, source: str = "<input>"
-    ) -> GainTable:
-        """Build a table from ``[(k_x, k_v, k_a), ...]``, checking each is finite."""
-        rows = list(triples)
-        if not rows:
-            raise StringStabError(f"{source}: expected at least one gain triple; found none")
-        K = np.empty((len(rows), 3))
-        for i, r in enumerate(rows):
-            if len(r) != 3:
-                raise StringStabError(
-                    f"{source}, triple {i + 1}: expected 3 gains k_x,k_v,k_a; found {len(r)}"
-                )
-            for j, v in enumerate(r):
-                K[i, j] = _number(v, f"{source}, triple {i + 1}, {GAIN_COLUMNS[j]}")
-        return cls(K[:, 0].copy(), K[:, 1].copy(), K[:, 2].copy(), source=source)
-
-    def __len__(self) -> int:
-        return len(self.k_x)
-
-    @property
-    def K(self) -> Array:
-        """The gains as one ``(n, 3)`` array, columns k_x, k_v, k_a."""
-        return np.column_stack([self.k_x, self.k_v, self.k_a])
-
-    @property
-    def columns(self) -> list[str]:
-        """Names of the columns present, in the order of :meth:`rows`."""
-        return [c for c in OPTIONAL_COLUMNS if getattr(self, c) is not None] + list(GAIN_COLUMNS)
-
-    def meta(self, i: int) -> dict[str, Any]:
-        """The optional ``t`` / ``vehicle`` of row ``i`` as plain Python values."""
-        out: dict[str, Any] = {}
-        if self.t is not None:
-            out["t"] = float(self.t[i])
-        if self.vehicle is not None:
-            out["vehicle"] = self.vehicle[i].item()
-        return out
-
-    def rows(self) -> list[dict[str, Any]]:
-        """One plain dict per triple: ``t`` and ``vehicle`` when present, then the gains."""
-        kx, kv, ka = self.k_x.tolist(), self.k_v.tolist(), self.k_a.tolist()
-        return [
-            {**self.meta(i), "k_x": kx[i], "k_v": kv[i], "k_a": ka[i]} for i in range(len(self))
-        ]
-
-
-# --------------------------------------------------------------------------- parsing
-
-
-def _number(value: Any, where: str) -> float:
-    """A finite float from ``value``, or a StringStabError naming ``where``."""
-    if isinstance(value, (bool, np.bool_)) or value is None:
-        raise StringStabError(f"{where}: expected a finite number; found {value!r}")
-    if isinstance(value, str):
-        text = value.strip()
-        if not text:
-            raise StringStabError(f"{where}: expected a finite number; found an empty field")
-    else:
-        text = value
-    try:
-        x = float(text)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"{where}: expected a finite number; found {value!r}") from e
-    if not math.isfinite(x):
-        raise StringStabError(f"{where}: expected a finite number; found {value!r}")
-    return x
-
-
-def parse_triple(text: str, *, where: str | None = None) -> tuple[float, float, float]:
-    """Parse ``"k_x,k_v,k_a"`` (three comma-separated finite numbers).
-
-    Parameters
-    ----------
-    text : str
-        For example ``"0.9,-0.5,1.1"``; spaces around the numbers are allowed.
-    where : str, optional
-        Prefix of error messages (default: the triple itself).
-
-    Returns
-    -------
-    tuple of float
-        ``(k_x, k_v, k_a)``.
-
-    Raises
-    ------
-    StringStabError
-        If there are not exactly three fields or one is not a finite number.
-
-    Examples
-    --------
-    >>> parse_triple("0.9,-0.5,1.1")
-    (0.9, -0.5, 1.1)
-    >>> parse_triple("0.9,-0.5")
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: gain triple '0.9,-0.5': expected 3 comma-separated numbers k_x,k_v,k_a; found 2 fields
-    """
-    label = where or f"gain triple {text!r}"
-    parts = text.split(",")
-    if len(parts) != 3:
-        raise StringStabError(
-            f"{label}: expected 3 comma-separated numbers k_x,k_v,k_a; found {len(parts)} field"
-            + ("s" if len(parts) != 1 else "")
-        )
-    kx, kv, ka = (_number(p, f"{label}, {c}") for p, c in zip(parts, GAIN_COLUMNS))
-    return kx, kv, ka
-
-
-def _suggest(name: str, candidates: Iterable[str]) -> str:
-    """``"; is 'kv' a misspelling of 'k_v'?"`` for the closest candidate, or ``""``."""
-    close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
-    return f"; is {close[0]!r} a misspelling of {name!r}?" if close else ""
-
-
-def _resolve_columns(
-    names: Sequence[str], source: str, what: str = "column"
-) -> tuple[dict[str, int], tuple[str, ...]]:
-    """Map known column names to their index; error on missing/misspelt/duplicate ones."""
-    norm = [n.strip() for n in names]
-    index: dict[str, int] = {}
-    for i, n in enumerate(norm):
-        key = n.lower()
-        if key in (*GAIN_COLUMNS, *OPTIONAL_COLUMNS):
-            if key in index:
-                raise StringStabError(f"{source}: {what} {n!r} appears twice; expected it once")
-            index[key] = i
-    unknown = [n for n in norm if n.lower() not in index]
-    expected = ", ".join(GAIN_COLUMNS)
-    for col in GAIN_COLUMNS:
-        if col not in index:
-            raise StringStabError(
-                f"{source}: missing {what} {col!r}; expected {what}s {expected} "
-                f"(optional t, vehicle); found {', '.join(map(repr, norm)) or 'none'}"
-                + _suggest(col, unknown)
-            )
-    # An absent optional column with a near-miss present was most likely misspelt.
-    for col in OPTIONAL_COLUMNS:
-        if col in index:
-            continue
-        for n in unknown:
-            if len(n) > 1 and difflib.SequenceMatcher(None, n.lower(), col).ratio() >= 0.8:
-                raise StringStabError(
-                    f"{source}: unknown {what} {n!r}; is it a misspelling of {col!r}? "
-                    f"(expected {expected}, optional t, vehicle)"
-                )
-    return index, tuple(unknown)
-
-
-def _vehicle_array(values: Sequence[Any]) -> npt.NDArray[Any]:
-    """Integer ids when every id is integral, else strings."""
-    ints: list[int] = []
-    for v in values:
-        if isinstance(v, (bool, np.bool_)):
-            break
-        if isinstance(v, (int, np.integer)):
-            ints.append(int(v))
-            continue
-        if isinstance(v, str):
-            try:
-                ints.append(int(v.strip()))
-                continue
-            except ValueError:
-                break
-        if isinstance(v, (float, np.floating)) and math.isfinite(v) and float(v).is_integer():
-            ints.append(int(v))
-            continue
-        break
-    else:
-        return np.asarray(ints, dtype=np.int64)
-    return np.asarray([str(v).strip() for v in values], dtype=str)
-
-
-def _table(
-    cols: dict[str, list[Any]], source: str, where: Any, ignored: tuple[str, ...] = ()
-) -> GainTable:
-    """Check numeric columns cell by cell and build the table.
-
-    ``where(col, i)`` names the location of cell ``i`` of column ``col`` in errors.
-    """
-    n = len(cols["k_x"])
-    if n == 0:
-        raise StringStabError(f"{source}: expected at least one row of gains; found none")
-    num: dict[str, Array] = {}
-    for col in (*GAIN_COLUMNS, "t"):
-        if col not in cols:
-            continue
-        vals = cols[col]
-        arr = np.empty(n)
-        for i, v in enumerate(vals):
-            arr[i] = _number(v, where(col, i))
-        num[col] = arr
-    vehicle = None
-    if "vehicle" in cols:
-        for i, v in enumerate(cols["vehicle"]):
-            if v is None or (isinstance(v, str) and not v.strip()):
-                raise StringStabError(f"{where('vehicle', i)}: expected a vehicle id; found {v!r}")
-        vehicle = _vehicle_array(cols["vehicle"])
-    return GainTable(
-        num["k_x"], num["k_v"], num["k_a"], num.get("t"), vehicle, source=source,
-        ignored_columns=ignored,
-    )
-
-
-def _read_csv(text: str, source: str) -> GainTable:
-    lines = [
-        (lineno, ln) for lineno, ln in enumerate(text.splitlines(), start=1)
-        if ln.strip() and not ln.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise StringStabError(
-            f"{source}: empty file; expected a CSV header with columns k_x,k_v,k_a "
-            "(optional t, vehicle) and at least one row"
-        )
-    try:
-        records = list(csv.reader([ln for _, ln in lines], skipinitialspace=True))
-    except csv.Error as e:
-        raise StringStabError(f"{source}: not a readable CSV file ({e})") from e
-    header = records[0]
-    if len(header) == 1 and (sep := next((d for d in ";\t|" if d in header[0]), None)):
-        raise StringStabError(
-            f"{source}, line {lines[0][0]}: expected comma-separated columns; "
-            f"found fields separated by {sep!r}"
-        )
-    headerless = len(header) == 3 and all(_is_number(h) for h in header)
-    if headerless:
-        index = {c: j for j, c in enumerate(GAIN_COLUMNS)}
-        ignored: tuple[str, ...] = ()
-        body = list(zip(lines, records))
-    else:
-        if all(_is_number(h) for h in header):
-            raise StringStabError(
-                f"{source}, line {lines[0][0]}: expected a header naming the columns "
-                f"(k_x,k_v,k_a, optional t, vehicle) or exactly 3 numeric columns; "
-                f"found {len(header)} numbers"
-            )
-        index, ignored = _resolve_columns(header, source)
-        body = list(zip(lines[1:], records[1:]))
-    if not body:
-        raise StringStabError(
-            f"{source}: no data rows after the header; expected at least one row of gains"
-        )
-    width = len(header)
-    cols: dict[str, list[Any]] = {c: [] for c in index}
-    linenos: list[int] = []
-    for (lineno, _), rec in body:
-        if len(rec) != width:
-            raise StringStabError(
-                f"{source}, line {lineno}: expected {width} comma-separated fields "
-                f"({','.join(h.strip() for h in header)}); found {len(rec)}"
-            )
-        linenos.append(lineno)
-        for c, j in index.items():
-            cols[c].append(rec[j])
-    return _table(
-        cols, source, lambda c, i: f"{source}, line {linenos[i]}, column {c!r}", ignored
-    )
-
-
-def _is_number(s: str) -> bool:
-    try:
-        float(s)
-    except ValueError:
-        return False
-    return True
-
-
-def _read_json(text: str, source: str) -> GainTable:
-    if not text.strip():
-        raise StringStabError(
-            f"{source}: empty file; expected a JSON list of gain objects "
-            '{"k_x": .., "k_v": .., "k_a": ..} or of [k_x, k_v, k_a] triples'
-        )
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise StringStabError(
-            f"{source}: not valid JSON (line {e.lineno}, column {e.colno}: {e.msg})"
-        ) from e
-    items: Any = doc
-    key = ""
-    if isinstance(doc, dict):
-        keys = [k for k in ("gains", "results") if k in doc]
-        if not keys:
-            raise StringStabError(
-                f"{source}: expected a JSON list of gains or an object with a key 'gains'; "
-                f"found an object with keys {sorted(map(str, doc))}"
-                + _suggest("gains", map(str, doc))
-            )
-        key = keys[0]
-        items = doc[key]
-    if not isinstance(items, list):
-        raise StringStabError(
-            f"{source}: expected a list of gains{f' under {key!r}' if key else ''}; "
-            f"found {type(items).__name__}"
-        )
-    if not items:
-        raise StringStabError(f"{source}: expected at least one gain triple; found an empty list")
-    prefix = f"{source}, {key + '[' if key else 'item ['}"
-    if all(isinstance(it, list) for it in items):
-        for i, it in enumerate(items):
-            if len(it) != 3:
-                raise StringStabError(
-                    f"{prefix}{i}]: expected a triple [k_x, k_v, k_a]; found {len(it)} values"
-                )
-        cols: dict[str, list[Any]] = {c: [it[j] for it in items] for j, c in enumerate(GAIN_COLUMNS)}
-        return _table(cols, source, lambda c, i: f"{prefix}{i}], {c}")
-    first: list[str] | None = None
-    cols = {}
-    for i, it in enumerate(items):
-        if not isinstance(it, dict):
-            raise StringStabError(
-                f"{prefix}{i}]: expected an object with keys k_x, k_v, k_a "
-                f"(or a triple [k_x, k_v, k_a]); found {type(it).__name__} {it!r}"
-            )
-        keys = list(map(str, it))
-        index, _ = _resolve_columns(keys, f"{prefix}{i}]", what="key")
-        if first is None:
-            first = sorted(index)
-            cols = {c: [] for c in first}
-        elif sorted(index) != first:
-            missing = sorted(set(first) - set(index))
-            extra = sorted(set(index) - set(first))
-            raise StringStabError(
-                f"{prefix}{i}]: expected the same keys as item 0 ({', '.join(first)}); "
-                + (f"missing {', '.join(missing)}" if missing else f"extra {', '.join(extra)}")
-            )
-        values = list(it.values())
-        for c, j in index.items():
-            cols[c].append(values[j])
-    return _table(cols, source, lambda c, i: f"{prefix}{i}], key {c!r}")
-
-
-def _read_npz(path: Path, source: str) -> GainTable:
-    import zipfile
-
-    try:
-        if not zipfile.is_zipfile(path):
-            raise StringStabError(
-                f"{source}: not an NPZ archive (numpy.savez); expected arrays k_x, k_v, k_a "
-                "or K (n, 3)"
-            )
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except StringStabError:
-        raise
-    except ValueError as e:
-        raise StringStabError(
-            f"{source}: not a readable NPZ of numeric arrays (object arrays are refused; {e})"
-        ) from e
-    except (OSError, EOFError, zipfile.BadZipFile) as e:
-        raise StringStabError(f"{source}: not a readable NPZ file ({e})") from e
-    if not arrays:
-        raise StringStabError(
-            f"{source}: empty NPZ; expected arrays k_x, k_v, k_a (optional t, vehicle) or K (n, 3)"
-        )
-    names = list(arrays)
-    if "K" in arrays and not any(c in arrays for c in GAIN_COLUMNS):
-        K = arrays["K"]
-        if K.ndim != 2 or K.shape[1] != 3:
-            raise StringStabError(
-                f"{source}: array 'K' must have shape (n, 3) with columns k_x, k_v, k_a; "
-                f"found shape {K.shape}"
-            )
-        cols: dict[str, Any] = {c: K[:, j] for j, c in enumerate(GAIN_COLUMNS)}
-        for c in OPTIONAL_COLUMNS:
-            if c in arrays:
-                cols[c] = arrays[c]
-        ignored = tuple(n for n in names if n not in ("K", *OPTIONAL_COLUMNS))
-    else:
-        cand = [n for n in names if n not in OPTIONAL_COLUMNS]
-        if len(cand) == 1 and arrays[cand[0]].ndim == 2 and arrays[cand[0]].shape[1] == 3:
-            raise StringStabError(
-                f"{source}: expected arrays k_x, k_v, k_a (optional t, vehicle) or one (n, 3) "
-                f"array K; found {', '.join(map(repr, names))} (name the (n, 3) array 'K')"
-            )
-        index, ignored = _resolve_columns(names, source, what="array")
-        cols = {c: arrays[names[j]] for c, j in index.items()}
-    n = len(cols["k_x"])
-    for c, a in cols.items():
-        if a.ndim != 1 or len(a) != n:
-            raise StringStabError(
-                f"{source}: array {c!r} must be 1-D of length {n} (one entry per triple); "
-                f"found shape {a.shape}"
-            )
-        if c != "vehicle" and not (np.issubdtype(a.dtype, np.number) and not np.iscomplexobj(a)):
-            raise StringStabError(
-                f"{source}: array {c!r} must be real numbers; found dtype {a.dtype}"
-            )
-    # Fast vectorised check, then a precise message naming the first bad entry.
-    for c in (*GAIN_COLUMNS, "t"):
-        if c in cols:
-            a = np.asarray(cols[c], dtype=np.float64)
-            bad = np.flatnonzero(~np.isfinite(a))
-            if bad.size:
-                i = int(bad[0])
-                raise StringStabError(
-                    f"{source}: array {c!r}, index {i}: expected a finite number; "
-                    f"found {float(a[i])!r}"
-                )
-            cols[c] = a
-    vehicle = _vehicle_array(cols["vehicle"].tolist()) if "vehicle" in cols else None
-    if n == 0:
-        raise StringStabError(f"{source}: expected at least one gain triple; found none")
-    return GainTable(
-        cols["k_x"], cols["k_v"], cols["k_a"], cols.get("t"), vehicle, source=source,
-        ignored_columns=ignored,
-    )
-
-
-def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = None) -> GainTable:
-    """Read gain triples from a CSV, JSON or NPZ file (see the module docstring).
-
-    Parameters
-    ----------
-    source : path or text stream
-        A file path; ``"-"`` or an open text stream reads CSV or JSON text
-        (JSON when it starts with ``[`` or ``{``).
-    fmt : {"csv", "json", "npz"}, optional
-        Override the format implied by the file extension.
-
-    Returns
-    -------
-    GainTable
-        The gains, with ``t`` and ``vehicle`` when the file has them.
-
-    Raises
-    ------
-    StringStabError
-        On a missing or unreadable file, an unsupported extension, an empty file,
-        missing or misspelt columns (with the close match suggested), or a field
-        that is not a finite number (naming its line and column).
-
-    Examples
-    --------
-    >>> import io
-    >>> g = read_gains(io.StringIO("t,k_x,k_v,k_a\\n0.0,0.9,-0.5,1.1\\n0.1,1.3,0,0.6\\n"))
-    >>> g.t.tolist(), g.k_x.tolist()
-    ([0.0, 0.1], [0.9, 1.3])
-    >>> read_gains(io.StringIO("t,k_x,kv,k_a\\n0,1,1,1\\n"))
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: <stream>: missing column 'k_v'; expected columns k_x, k_v, k_a (optional t, vehicle); found 't', 'k_x', 'kv', 'k_a'; is 'kv' a misspelling of 'k_v'?
-    """
-    if fmt is not None and fmt not in ("csv", "json", "npz"):
-        raise StringStabError(f"gain file format must be csv, json or npz; got {fmt!r}")
-    if not isinstance(source, (str, os.PathLike)) or str(source) == "-":
-        if isinstance(source, (str, os.PathLike)):
-            import sys
-
-            stream: IO[str] = sys.stdin
-            name = "<stdin>"
-        else:
-            stream = source
-            name = str(getattr(source, "name", "<stream>"))
-            if not isinstance(name, str) or name.isdigit():
-                name = "<stream>"
-        if fmt == "npz":
-            raise StringStabError(f"{name}: NPZ cannot be read from a text stream; give a path")
-        text = stream.read()
-        if text.startswith("\ufeff"):
-            text = text[1:]
-        kind = fmt or ("json" if text.lstrip()[:1] in ("[", "{") else "csv")
-        return _read_json(text, name) if kind == "json" else _read_csv(text, name)
-
-    path = Path(source)
-    name = str(source)
-    kind_or_none = fmt or _INPUT_FORMATS.get(path.suffix.lower())
-    if kind_or_none is None:
-        raise StringStabError(
-            f"{name}: unsupported file extension {path.suffix or '(none)'!r}; "
-            "expected .csv, .json or .npz"
-        )
-    kind = kind_or_none
-    if not path.exists():
-        raise StringStabError(f"{name}: no such file; expected a readable {kind.upper()} file")
-    if path.is_dir():
-        raise StringStabError(f"{name}: is a directory; expected a {kind.upper()} file")
-    try:
-        with open(path, "rb"):
-            pass
-    except OSError as e:
-        raise StringStabError(f"{name}: cannot read the file ({e.strerror or e})") from e
-    if kind == "npz":
-        return _read_npz(path, name)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise StringStabError(
-            f"{name}: not UTF-8 text (byte {e.start}); expected a UTF-8 {kind.upper()} file"
-        ) from e
-    except OSError as e:
-        raise StringStabError(f"{name}: cannot read the file ({e.strerror or e})") from e
-    return _read_json(text, name) if kind == "json" else _read_csv(text, name)
-
-
-# --------------------------------------------------------------------------- writing
-
-
-def _plain(x: Any) -> Any:
-    """JSON-safe plain Python values; non-finite floats become None (JSON null)."""
-    t = type(x)
-    if t is float:
-        return x if x - x == 0.0 else None  # inf - inf and nan - nan are nan
-    if t is str or t is int or t is bool or x is None:
-        return x
-    if isinstance(x, Mapping):
-        return {k if type(k) is str else str(k): _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _plain(x.tolist())
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        f = float(x)
-        return f if math.isfinite(f) else None
-    return x
-
-
-def _flatten(rec: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for k, v in rec.items():
-        if type(v) is dict or isinstance(v, Mapping):
-            out.update(_flatten(v, f"{prefix}{k}_"))
-        else:
-            out[f"{prefix}{k}"] = v
-    return out
-
-
-def _cell(v: Any) -> str:
-    if v is None:
-        return ""
-    if isinstance(v, float):
-        return repr(v)
-    return str(v)
-
-
-def _fmt_num(v: Any, spec: str = ".6g") -> str:
-    if v is None:
-        return "inf" if spec == "sup" else "-"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, (int, float)):
-        return format(v, ".6g" if spec == "sup" else spec)
-    return str(v)
-
-
-_TABLE_COLUMNS: list[tuple[str, str, str]] = [
-    # (header, record key, number format)
-    ("t", "t", ".6g"),
-    ("vehicle", "vehicle", ""),
-    ("k_x", "k_x", ".6g"),
-    ("k_v", "k_v", ".6g"),
-    ("k_a", "k_a", ".6g"),
-    ("hurwitz", "hurwitz", ""),
-    ("verdict", "verdict", ""),
-    ("type", "type", ""),
-    ("sup|Γ|", "sup_gain", "sup"),
-    ("ω_peak", "peak_omega", ".4g"),
-    ("margin", "margin", ".3g"),
-    ("taylor(derived)", "taylor_derived.verdict", ""),
-    ("taylor(printed)", "taylor_printed.verdict", ""),
-    ("pade", "pade.verdict", ""),
-    ("pade ‖Γ‖∞", "pade.hinf", "sup"),
-]
-
-
-def _get(rec: Mapping[str, Any], path: tuple[str, ...]) -> Any:
-    v: Any = rec
-    for part in path:
-        if not isinstance(v, Mapping) or part not in v:
-            return _MISSING
-        v = v[part]
-    return v
-
-
-_MISSING = object()
 
 
 def format_results(
@@ -707,25 +50,10 @@ def format_results(
 ) -> str:
     """Render per-triple result records as a table, JSON or CSV text.
 
-    Parameters
-    ----------
-    records : sequence of dict
-        One dict per triple, e.g. from
-        :meth:`stringstab.certificate.CertificateBatch.records`, possibly with
-        ``t`` / ``vehicle`` keys.  Nested dicts (``taylor_derived``) are kept
-        in JSON and flattened with ``_`` in CSV (``taylor_derived_verdict``).
-    fmt : {"table", "json", "csv"}
-        ``json`` gives ``{"params": .., "results": [..], "summary": ..}`` with
-        non-finite numbers as ``null``; ``csv`` gives one row per record and
-        repeats ``params`` as columns; ``table`` is for people, with the
-        parameters in a header line and the summary in a footer line.
-    params, summary : dict, optional
-        Model parameters and totals, included as described.
-
-    Returns
-    -------
-    str
-        The text, ending in a newline.
+    The records (one dict per triple, one nesting level) are turned into columns
+    (:func:`stringstab.io.columns_from_records`) and written by
+    :func:`stringstab.io.format_results`; the table shows the certificate's columns
+    (:data:`stringstab.certificate.TABLE_COLUMNS`).
 
     Examples
     --------
@@ -736,88 +64,13 @@ def format_results(
     """
     if fmt not in FORMATS:
         raise StringStabError(f"output format must be one of {', '.join(FORMATS)}; got {fmt!r}")
-    recs = [_plain(r) for r in records]
-    if fmt == "json":
-        doc: dict[str, Any] = {}
-        if params is not None:
-            doc["params"] = _plain(params)
-        doc["results"] = recs
-        if summary is not None:
-            doc["summary"] = _plain(summary)
-        # One result per line: readable, grep-able, and fast (C encoder; indent= is not).
-        dump = json.JSONEncoder(ensure_ascii=False, allow_nan=False).encode
-        parts = [f" {json.dumps(k)}: {dump(v)}" for k, v in doc.items() if k != "results"]
-        rows = ",\n".join("  " + dump(r) for r in recs)
-        results = f' "results": [\n{rows}\n ]' if recs else ' "results": []'
-        parts.insert(1 if params is not None else 0, results)
-        return "{\n" + ",\n".join(parts) + "\n}\n"
-    if fmt == "csv":
-        flat = [_flatten(r) for r in recs]
-        extra = {k: v for k, v in _plain(params or {}).items() if not isinstance(v, Mapping)}
-        header: list[str] = []
-        for r in flat:
-            for k in r:
-                if k not in header:
-                    header.append(k)
-        header += [k for k in extra if k not in header]
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(header)
-        for r in flat:
-            row = {**extra, **r}
-            w.writerow([_cell(row.get(k)) for k in header])
-        return buf.getvalue()
-    # table
-    paths = [(h, tuple(key.split(".")), spec) for h, key, spec in _TABLE_COLUMNS]
-    cols = [c for c in paths if any(_get(r, c[1]) is not _MISSING for r in recs)]
-    body = [
-        [_fmt_num(v, spec) if (v := _get(r, key)) is not _MISSING else "" for _, key, spec in cols]
-        for r in recs
-    ]
-    widths = [max([len(h), *(len(row[j]) for row in body)]) for j, (h, _, _) in enumerate(cols)]
-    lines: list[str] = []
-    if params is not None:
-        lines.append(
-            "# " + ", ".join(f"{k} = {_fmt_num(v, 'g')}" for k, v in _plain(params).items())
-        )
-    lines.append("  ".join(h.ljust(wd) for (h, _, _), wd in zip(cols, widths)).rstrip())
-    for cells in body:
-        lines.append("  ".join(c.ljust(wd) for c, wd in zip(cells, widths)).rstrip())
-    if summary is not None:
-        s = _plain(summary)
-        lines.append(
-            "# " + ", ".join(
-                f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in s.items()
-            )
-        )
-    return "\n".join(lines) + "\n"
+    table = None
+    if fmt == "table":
+        from .certificate import TABLE_COLUMNS
 
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def write_results(
-    records: Sequence[Mapping[str, Any]],
-    dest: str | os.PathLike[str] | IO[str],
-    fmt: str = "table",
-    *,
-    params: Mapping[str, Any] | None = None,
-    summary: Mapping[str, Any] | None = None,
-) -> None:
-    """Write :func:`format_results` text to a path (atomically) or a text stream.
-
-    A path is written through a temporary file in the same directory and then
-    renamed, so it is either complete or left untouched (never partial).
-
-    Raises
-    ------
-    StringStabError
-        On an unknown format or when the file cannot be written.
-    """
-    write_text(format_results(records, fmt, params=params, summary=summary), dest)
+        table = TABLE_COLUMNS
+    columns = _results.columns_from_records([to_plain(r) for r in records])
+    return _results.format_results(columns, fmt, params=params, summary=summary, table=table)
 
 
 def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
@@ -828,23 +81,21 @@ def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
     StringStabError
         When the file cannot be written.
     """
-    if not isinstance(dest, (str, os.PathLike)):
-        try:
-            dest.write(text)
-        except UnicodeEncodeError:  # e.g. an ASCII terminal: Γ, ω, ‖ become '?'
-            enc = getattr(dest, "encoding", None) or "ascii"
-            dest.write(text.encode(enc, "replace").decode(enc))
-        return
-    path = Path(dest)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as e:
-        raise StringStabError(f"{dest}: cannot write the output file ({e.strerror or e})") from e
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise StringStabError(f"{dest}: cannot write the output file ({e.strerror or e})") from e
+        _results.write_text(text, dest)
+    except StringStabError as e:
+        cause = e.__cause__
+        reason = (getattr(cause, "strerror", None) or cause) if cause is not None else e
+        raise StringStabError(f"{dest}: cannot write the output file ({reason})") from e
+
+
+def write_results(
+    records: Sequence[Mapping[str, Any]],
+    dest: str | os.PathLike[str] | IO[str],
+    fmt: str = "table",
+    *,
+    params: Mapping[str, Any] | None = None,
+    summary: Mapping[str, Any] | None = None,
+) -> None:
+    """Write :func:`format_results` text to a path (atomically) or a text stream."""
+    write_text(format_results(records, fmt, params=params, summary=summary), dest)

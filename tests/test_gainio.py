@@ -157,7 +157,7 @@ def test_unreadable_file(tmp_path, monkeypatch):
     def deny(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr("stringstab.gainio.open", deny, raising=False)
+    monkeypatch.setattr("stringstab.io.gains.open", deny, raising=False)
     with pytest.raises(StringStabError, match=r"locked.csv: cannot read the file \(Permission denied\)"):
         read_gains(p)
 

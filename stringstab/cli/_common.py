@@ -4,16 +4,27 @@ from __future__ import annotations
 
 import argparse
 import re
+from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
-from ..gainio import GainTable, parse_triple, read_gains
+from ..io import (
+    BINARY_FORMATS,
+    RESULT_FORMATS,
+    GainTable,
+    check_output_file,
+    parse_triple,
+    read_gains,
+)
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
 
 __all__ = [
     "NEGATIVE_NUMBER",
+    "RESULT_FORMATS",
     "add_gain_arguments",
     "add_model_arguments",
+    "add_output_arguments",
+    "check_output",
     "gains_from_args",
     "model_params",
 ]
@@ -44,7 +55,30 @@ def add_gain_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("triples", nargs="*", metavar="K_X,K_V,K_A",
                    help="gain triples, e.g. 0.9,-0.5,1.1 (or use --file)")
     p.add_argument("--file", "-f", metavar="F",
-                   help="read triples from a .csv, .json or .npz file ('-' reads CSV/JSON from stdin)")
+                   help="read triples from a .csv, .json, .npz or .parquet file "
+                        "('-' reads CSV/JSON from stdin)")
+
+
+def add_output_arguments(p: argparse.ArgumentParser,
+                         formats: tuple[str, ...] = RESULT_FORMATS) -> None:
+    """``--format`` (default ``table``) and ``--out FILE`` of a command that writes results."""
+    p.add_argument("--format", choices=formats, default="table",
+                   help="output format (default: table); parquet and npz need --out")
+    p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
+
+
+def check_output(args: Any) -> Path | None:
+    """``--out`` checked before any work (see :func:`stringstab.io.check_output_file`).
+
+    Returns the path, or None for standard output; a binary ``--format`` needs ``--out``.
+    """
+    if args.out is None:
+        if args.format in BINARY_FORMATS:
+            raise StringStabError(
+                f"--format {args.format} writes a binary file; expected --out FILE, got none"
+            )
+        return None
+    return check_output_file(args.out, what="--out (expected a file path in an existing directory)")
 
 
 def gains_from_args(args: Any) -> GainTable:

@@ -1,9 +1,11 @@
 """``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
 
-Reads triples from the command line or a file (:mod:`stringstab.gainio`),
-certifies them with :func:`stringstab.certificate.certify_batch` and writes a
-table, JSON or CSV.  Exit code 0 when every triple is certified, 1 when any is
-not (``not_certified`` or ``inconclusive``), 2 on bad input (nothing printed).
+Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
+certifies them with :func:`stringstab.certificate.certify_batch` and writes the
+batch's columns (:meth:`~stringstab.certificate.CertificateBatch.columns`) as a
+table, JSON, CSV, Parquet or NPZ (:func:`stringstab.io.write_results`).  Exit code 0
+when every triple is certified, 1 when any is not (``not_certified`` or
+``inconclusive``), 2 on bad input (nothing printed, no file written).
 """
 
 from __future__ import annotations
@@ -11,13 +13,18 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
-from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
-from ..gainio import FORMATS, write_results
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from ._common import add_gain_arguments, add_model_arguments, gains_from_args, model_params
+from ._common import (
+    add_gain_arguments,
+    add_model_arguments,
+    add_output_arguments,
+    check_output,
+    gains_from_args,
+    model_params,
+)
 
 __all__ = ["PROGRESS_ROWS", "add_parser", "run"]
 
@@ -29,19 +36,22 @@ examples:
   stringstab certify 0.9,-0.5,1.1 1.3,0,0.6
   stringstab certify -0.5,1,1 --delta 0.3              # negative gains need no quoting
   stringstab certify --file rollout.csv --format json --out certificates.json
+  stringstab certify --file big.npz --format parquet --out certificates.parquet
   stringstab certify 0.9,-0.5,1.1 --method pade         # also python-control's Padé numbers
 
 input files: CSV with a header k_x,k_v,k_a (a gain time series adds t and
 optionally vehicle), JSON (a list of {{"k_x","k_v","k_a"}} objects or of triples,
-bare or under "gains"), or NPZ (arrays k_x, k_v, k_a [, t, vehicle] or K (n,3)).
+bare or under "gains"), NPZ (arrays k_x, k_v, k_a [, t, vehicle] or K (n,3)) or
+Parquet (columns k_x, k_v, k_a [, t, vehicle]).
+
+output: table (for people: sup|Γ| and margin rounded, ω_peak in rad/s), or every
+column in json, csv, parquet or npz (the last two need --out).
 
 exit status: 0 every triple certified; 1 some triple not_certified or
 inconclusive; 2 bad input (no verdicts printed, no file written).
 defaults: tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s (IDL paper
 Table 2; tau from Zhou et al. 2020). See docs/certify.md.
 """
-
-
 
 def add_parser(sub: Any) -> None:
     """Register ``certify``."""
@@ -65,13 +75,10 @@ def add_parser(sub: Any) -> None:
                         "python-control's Padé + norm('inf') numbers, warning where they disagree")
     p.add_argument("--pade-order", default="5", metavar="N",
                    help="Padé order of the delay for --method pade (default: 5)")
-    p.add_argument("--format", choices=FORMATS, default="table", help="output format (default: table)")
-    p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
+    add_output_arguments(p)
     p.add_argument("--no-progress", action="store_true",
                    help=f"never show the progress bar (default: shown on a terminal or > {PROGRESS_ROWS} rows)")
     p.set_defaults(func=run)
-
-
 
 
 def _pade_order(text: str) -> int:
@@ -85,6 +92,7 @@ def _pade_order(text: str) -> int:
 
 
 def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
+    """One warning on stderr listing (up to five) rows where Padé and the exact verdict differ."""
     bad = [(i, r) for i, r in enumerate(records) if r.get("pade") and not r["pade"].get("agrees", True)]
     if not bad:
         return
@@ -109,15 +117,11 @@ def run(args: argparse.Namespace) -> int:
     """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input."""
     tau, delta, headway = model_params(args)
     order = _pade_order(args.pade_order)
-    if args.out:
-        out = Path(args.out)
-        if out.is_dir() or not out.resolve().parent.is_dir():
-            raise StringStabError(
-                f"--out {args.out}: expected a file path in an existing directory"
-            )
+    out = check_output(args)
     table = gains_from_args(args)
 
-    from ..certificate import certify_batch
+    from ..certificate import TABLE_COLUMNS, certify_batch
+    from ..io import write_results
 
     n = len(table)
     progress = not args.no_progress and (sys.stderr.isatty() or n > PROGRESS_ROWS)
@@ -128,18 +132,18 @@ def run(args: argparse.Namespace) -> int:
             table.k_x, table.k_v, table.k_a, tau=tau, delta=delta, headway=headway,
             method=args.method, pade_order=order, progress=progress,
         )
-    records = [{**table.meta(i), **rec} for i, rec in enumerate(batch.records())]
     params: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "method": args.method}
     if args.method == "pade":
         params["pade_order"] = order
     summary = batch.summary()
-    write_results(records, args.out or sys.stdout, args.format, params=params, summary=summary)
+    write_results({**table.meta_columns(), **batch.columns()}, out, args.format, params=params,
+                  summary=summary, table=TABLE_COLUMNS, what="--out")
     if args.method == "pade":
-        _warn_disagreements(records, order)
-    if args.out:
+        _warn_disagreements([{**table.meta(i), **r} for i, r in enumerate(batch.records())], order)
+    if out is not None:
         print(
             f"stringstab certify: {summary['certified']} of {summary['n']} certified; "
-            f"wrote {args.format} to {args.out}",
+            f"wrote {args.format} to {out}",
             file=sys.stderr,
         )
     return 0 if summary["certified"] == summary["n"] else 1

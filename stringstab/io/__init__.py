@@ -1,5 +1,6 @@
 """The I/O home: result tables, JSON-safe values and safe, all-or-nothing output files and folders.
 
+:mod:`~stringstab.io.gains` reads gain files for every command;
 :mod:`~stringstab.io.results` writes every command's result columns (table, JSON, CSV,
 Parquet, NPZ) with one vectorised writer.
 
@@ -11,6 +12,14 @@ complete or absent and an output folder never holds a mix of two runs.
 
 from __future__ import annotations
 
+from .gains import (
+    GAIN_COLUMNS,
+    INPUT_FORMATS,
+    OPTIONAL_COLUMNS,
+    GainTable,
+    parse_triple,
+    read_gains,
+)
 from .outputs import (
     MANIFEST,
     OutputDir,
@@ -28,6 +37,7 @@ from .results import (
     columns_from_records,
     flatten_columns,
     format_results,
+    records_from_columns,
     render_table,
     write_results,
     write_text,
@@ -35,8 +45,12 @@ from .results import (
 
 __all__ = [
     "BINARY_FORMATS",
+    "GAIN_COLUMNS",
+    "INPUT_FORMATS",
     "MANIFEST",
+    "OPTIONAL_COLUMNS",
     "RESULT_FORMATS",
+    "GainTable",
     "OutputDir",
     "TableColumn",
     "atomic_path",
@@ -48,6 +62,9 @@ __all__ = [
     "dumps_json",
     "flatten_columns",
     "format_results",
+    "parse_triple",
+    "read_gains",
+    "records_from_columns",
     "render_table",
     "to_plain",
     "write_results",

@@ -54,6 +54,7 @@ __all__ = [
     "columns_from_records",
     "flatten_columns",
     "format_results",
+    "records_from_columns",
     "render_table",
     "write_results",
     "write_text",
@@ -222,6 +223,40 @@ def columns_from_records(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]
         else:
             out[k] = {kk: [(r.get(k) or {}).get(kk) for r in records] for kk in sub}
     return out
+
+
+def records_from_columns(columns: Columns) -> list[dict[str, Any]]:
+    """The rows of result columns as plain dicts (groups nested; NaN, inf and None as None).
+
+    The inverse of :func:`columns_from_records`, and the rows of the ``json`` format.
+
+    Examples
+    --------
+    >>> records_from_columns({"a": np.array([1.0, np.inf]), "g": {"x": np.array([1, 2])}})
+    [{'a': 1.0, 'g': {'x': 1}}, {'a': None, 'g': {'x': 2}}]
+    """
+    cols = _normalise(columns)
+
+    def plain(leaf: _Leaf) -> list[Any]:
+        vals = leaf.values.tolist()
+        if leaf.kind == "f":
+            vals = [v if v - v == 0.0 else None for v in vals]
+        if leaf.mask is not None:
+            for i in np.flatnonzero(leaf.mask).tolist():
+                vals[i] = None
+        return vals
+
+    names: list[str] = []
+    lists: list[Any] = []
+    for name, c in cols.items():
+        names.append(name)
+        if isinstance(c, dict):
+            keys = list(c)
+            sub = [plain(leaf) for leaf in c.values()]
+            lists.append([dict(zip(keys, row)) for row in zip(*sub)] if sub else [])
+        else:
+            lists.append(plain(c))
+    return [dict(zip(names, row)) for row in zip(*lists)]
 
 
 # --------------------------------------------------------------------------- cells (pyarrow)
