@@ -292,10 +292,15 @@ def _cells(leaf: _Leaf, style: str) -> Any:
         bad = ~np.isfinite(v)
         if bad.any():
             mask = bad if mask is None else (mask | bad)
-        s = pc.cast(pa.array(v, type=pa.float64()), pa.string())
-        # shortest round-trip digits; integral values keep a '.0' (as Python writes them)
-        s = pc.if_else(pc.match_substring_regex(s, r"^-?\d+$"),
-                       pc.binary_join_element_wise(s, ".0", ""), s)
+        s = pc.cast(pa.array(v, type=pa.float64()), pa.string())  # shortest round-trip digits
+        # integral values keep a '.0', as Python writes them (1.0, not 1)
+        whole = (np.abs(v) < 1e15) & (np.trunc(v) == v)
+        if whole.any():
+            as_int = pc.cast(pa.array(np.where(whole, v, 0.0).astype(np.int64)), pa.string())
+            s = pc.if_else(pa.array(whole), pc.binary_join_element_wise(as_int, ".0", ""), s)
+            negative_zero = whole & (v == 0.0) & np.signbit(v)
+            if negative_zero.any():
+                s = pc.if_else(pa.array(negative_zero), pa.scalar("-0.0", pa.string()), s)
     elif k == "i":
         s = pc.cast(pa.array(v, type=pa.int64()), pa.string())
     elif k == "b":
@@ -306,9 +311,15 @@ def _cells(leaf: _Leaf, style: str) -> Any:
             s = _mapped(v, lambda x: json.dumps(x, ensure_ascii=False))
         else:
             s = _mapped(v, _csv_quote)
-    if mask is not None:
+    if mask is not None and mask.any():
         s = pc.if_else(pa.array(mask), pa.scalar(None, pa.string()), s)
     return s
+
+
+def _filled(cells: Any, text: str) -> Any:
+    """``cells`` with nulls replaced by ``text``."""
+    _, pc = _pa()
+    return pc.fill_null(cells, text) if cells.null_count else cells
 
 
 def _csv_quote(x: str) -> str:
@@ -345,7 +356,7 @@ def _csv(cols: Mapping[str, _Leaf | dict[str, _Leaf]], params: Mapping[str, Any]
     header = ",".join(_csv_quote(h) for h in [*flat, *extra])
     if n == 0:
         return header + "\n"
-    pieces = [pc.fill_null(_cells(leaf, "csv"), "") for leaf in flat.values()]
+    pieces = [_filled(_cells(leaf, "csv"), "") for leaf in flat.values()]
     for v in extra.values():
         pieces.append(pa.scalar(_csv_cell(v), pa.string()))
     rows = pc.binary_join_element_wise(*pieces, ",")
@@ -378,12 +389,12 @@ def _json_rows(cols: Mapping[str, _Leaf | dict[str, _Leaf]]) -> str:
                 lit.append(("" if j == 0 else ", ") + key(k))
                 pieces.append(pa.scalar("".join(lit), pa.string()))
                 lit = []
-                pieces.append(pc.fill_null(_cells(leaf, "json"), "null"))
+                pieces.append(_filled(_cells(leaf, "json"), "null"))
             lit.append("}")
         else:
             pieces.append(pa.scalar("".join(lit), pa.string()))
             lit = []
-            pieces.append(pc.fill_null(_cells(c, "json"), "null"))
+            pieces.append(_filled(_cells(c, "json"), "null"))
     lit.append("}")
     pieces.append(pa.scalar("".join(lit), pa.string()))
     rows = pc.binary_join_element_wise(*pieces, "")
