@@ -4,6 +4,11 @@ Each sub-command lives in its own module of this package and exposes
 ``add_parser(subparsers)`` (which registers it and sets ``func``) and a
 ``run(args) -> int``.  Bad input (:class:`~stringstab.errors.StringStabError`)
 becomes a one-line message on stderr and exit code 2; no verdict is printed.
+
+Sub-commands are registered lazily: ``stringstab --help`` lists them from
+:data:`HELP` and ``stringstab NAME ...`` imports only ``stringstab.cli.NAME``,
+so a quick command does not pay for the imports of the others (SymPy for
+``derive``, matplotlib for ``region``, gymnasium for ``simulate``).
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from typing import Any
 from .. import __version__
 from ..errors import StringStabError
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = ["COMMANDS", "HELP", "build_parser", "main"]
 
 #: Sub-command modules, in the order ``stringstab --help`` lists them.
 COMMANDS: list[str] = [
@@ -30,6 +35,18 @@ COMMANDS: list[str] = [
     "hcfs",
     "demo",
 ]
+
+#: One-line help of each sub-command, shown by ``stringstab --help`` without importing it
+#: (tests check that each equals the help its module registers).  A command missing here
+#: is imported to be listed.
+HELP: dict[str, str] = {
+    "derive": "derive Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions symbolically",
+    "certify": "certify gain triples K = [k_x, k_v, k_a] as string stable (exact delay)",
+    "region": "map the string-stable gains on a 2-D slice or a 3-D grid (figures + data)",
+    "tune": "repair gain triples that are not string stable (region growing or projection)",
+    "simulate": "simulate a platoon behind a leader; write trajectories, metrics JSON and figures",
+    "demo": "run a demo of the whole pipeline on bundled data",
+}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -44,8 +61,23 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every available sub-command registered."""
+def _chosen(argv: Sequence[str]) -> str | None:
+    """The sub-command named in ``argv`` (the first argument not starting with '-')."""
+    for a in argv:
+        if not a.startswith("-"):
+            return a if a in COMMANDS else None
+        if a == "--":
+            return None
+    return None
+
+
+def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
+    """The argument parser with every sub-command registered.
+
+    With ``lazy``, only ``command`` (if any) is imported and fully registered; the others are
+    listed with their :data:`HELP` line, which is all ``stringstab --help`` and argparse's
+    choice check need.
+    """
     parser = _Parser(
         prog="stringstab",
         description="Exact, delay-aware string-stability analysis of car-following controllers.",
@@ -54,6 +86,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
+        if lazy and name != command and name in HELP:
+            sub.add_parser(name, help=HELP[name], add_help=False)
+            continue
         try:
             mod = importlib.import_module(f"{__name__}.{name}")
         except ModuleNotFoundError as e:
@@ -66,7 +101,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stringstab`` console script; returns the exit code."""
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    command = _chosen(argv)
+    parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
