@@ -1,7 +1,10 @@
 """The traffic simulator: leaders, platoon dynamics, controllers and Gymnasium environments.
 
-* :mod:`~stringstab.traffic.leaders` — lead-vehicle trajectories (driving cycles, synthetic
-  profiles, NGSIM pairs, CSV files) and a train/test split;
+* leaders: :mod:`~stringstab.traffic.trajectory` (the trajectory type),
+  :mod:`~stringstab.traffic.cycles` (driving cycles), :mod:`~stringstab.traffic.synthetic`
+  (synthetic profiles), :mod:`~stringstab.traffic.loaders` (CSV files, NGSIM pairs),
+  :mod:`~stringstab.traffic.split` (a train/test split), and
+  :mod:`~stringstab.traffic.leaders` (a leader by name; re-exports all of these);
 * :mod:`~stringstab.traffic.platoon` — vectorised platoon dynamics (IDL eqs 1-2, 5-7) and
   :func:`simulate`;
 * :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM;
