@@ -13,9 +13,11 @@ jerk squared c              :func:`jerk_squared`                 33
 M_CI (mean squared jerk)    :func:`comfort_index`                34
 time headway h              :func:`time_headway`                 22
 M_effi                      :func:`efficiency_index`             35
-m_p (damping ratio)         :func:`damping_ratio`                29
+m_p (damping ratio)         :func:`damping_ratio`,                29
+                            :func:`damping_ratios_from_energy`
 M_lss                       :func:`lss_index`                    30
 M_fss                       :func:`fss_ratio`                    27-28
+all of a simulated run      :func:`platoon_metrics`              —
 collisions                  :func:`collision_count`              —
 ==========================  ===================================  ==========
 
@@ -36,6 +38,13 @@ Notes on the printed equations
 * Eq 31 writes the time step as τ; it is Δt here (τ is the actuator lag elsewhere).
 * Eq 34 divides by N·T; M_CI is called the *mean* squared jerk, so the mean over the N·(T−1)
   jerk samples is returned.
+* Eq 27 multiplies by 100 %; the toolkit reports M_fss as a fraction in [0, 1] (key ``m_fss``,
+  as ``stringstab certify`` does; docs/conventions.md).  :func:`fss_ratio` and the key
+  ``M_fss`` of :func:`platoon_metrics` keep the percentage of earlier versions.
+
+Layering: these functions work on arrays.  :func:`platoon_metrics` reads a run's arrays
+(:class:`stringstab.traffic.PlatoonResult` is one such run) and calls nothing back on it;
+``PlatoonResult.metrics()`` calls :func:`platoon_metrics`, never the reverse.
 """
 
 from __future__ import annotations
@@ -46,6 +55,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import constants
 from .errors import StringStabError
 from .params import positive
 
@@ -53,6 +63,7 @@ __all__ = [
     "collision_count",
     "comfort_index",
     "damping_ratio",
+    "damping_ratios_from_energy",
     "efficiency_index",
     "fss_ratio",
     "jerk_squared",
@@ -68,9 +79,9 @@ Array = npt.NDArray[np.float64]
 ArrayLike = npt.ArrayLike
 
 #: TTC* threshold of the safety metrics, s (IDL Table 2).
-TTC_STAR = 3.0
+TTC_STAR = constants.TTC_STAR
 #: Lower speed bound v_min, m/s (IDL Table 2).
-V_MIN = 0.001
+V_MIN = constants.SPEED_MIN
 
 
 def time_to_collision(gap: ArrayLike, speed: ArrayLike, pred_speed: ArrayLike) -> Array:
@@ -207,6 +218,24 @@ def damping_ratio(accel: ArrayLike, pred_accel: ArrayLike, *, axis: int = -1) ->
         return np.asarray(np.sqrt(np.sum(a * a, axis=axis) / np.sum(p * p, axis=axis)))
 
 
+def damping_ratios_from_energy(sum_sq_accel: ArrayLike) -> Array:
+    """m_p of every follower from each vehicle's Σ_t a_t² (eq 29, intended form), (..., N).
+
+    ``sum_sq_accel`` has shape (..., N + 1) with vehicle 0 the leader.  NaN where a
+    predecessor never accelerates (0/0), ``inf`` where only the follower does.
+
+    Examples
+    --------
+    >>> damping_ratios_from_energy([4.0, 1.0, 0.25]).tolist()
+    [0.5, 0.5]
+    """
+    s = np.asarray(sum_sq_accel, dtype=np.float64)
+    if s.ndim < 1 or s.shape[-1] < 2:
+        raise StringStabError(f"sum_sq_accel must have shape (..., N + 1 >= 2); got {s.shape}")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(np.sqrt(s[..., 1:] / s[..., :-1]))
+
+
 def platoon_damping_ratios(accel: ArrayLike) -> Array:
     """m_p of every follower of a platoon relative to its predecessor (eq 29, intended form).
 
@@ -227,7 +256,7 @@ def platoon_damping_ratios(accel: ArrayLike) -> Array:
     a = np.asarray(accel, dtype=np.float64)
     if a.ndim < 2 or a.shape[-2] < 2:
         raise StringStabError(f"accel must have shape (..., N + 1 >= 2, T); got {a.shape}")
-    return damping_ratio(a[..., 1:, :], a[..., :-1, :])
+    return damping_ratios_from_energy(np.sum(a * a, axis=-1))
 
 
 def lss_index(m_p: ArrayLike) -> Array:
@@ -242,8 +271,8 @@ def lss_index(m_p: ArrayLike) -> Array:
 
 
 def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, delta: float,
-              headway: float) -> float:
-    """M_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28), in %.
+              headway: float, percent: bool = True) -> float:
+    """M_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
 
     m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
     (:func:`stringstab.certificate.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
@@ -256,16 +285,21 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
         Gains at every (vehicle, moment), any common shape.
     tau, delta, headway : float
         τ, δ and T*, s.
+    percent : bool
+        Return eq 27's percentage in [0, 100] (the default, as in earlier versions), or the
+        fraction in [0, 1] the toolkit reports (``percent=False``; docs/conventions.md).
 
     Returns
     -------
     float
-        Percentage in [0, 100].
 
     Examples
     --------
     >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1)
     50.0
+    >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1,
+    ...           percent=False)
+    0.5
     """
     from .certificate import certify_batch
     from .params import as_gains
@@ -277,7 +311,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     uniq, inverse = np.unique(K, axis=0, return_inverse=True)
     cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway)
     ok = np.asarray(cert.verdict == "certified")[np.ravel(inverse)]
-    return float(100.0 * ok.mean())
+    return float(100.0 * ok.mean()) if percent else float(ok.mean())
 
 
 def collision_count(gap: ArrayLike, *, axis: int = -1) -> npt.NDArray[np.int64]:
@@ -306,7 +340,8 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
     """All IDL metrics of a simulated run (:class:`stringstab.traffic.PlatoonResult`).
 
     Followers only (the leader is prescribed).  For a batch of platoons, per-vehicle lists are
-    nested per platoon and the scalar indices pool every platoon.
+    nested per platoon and the scalar indices pool every platoon.  Only the run's arrays are
+    read (``sum_sq_accel``, ``gap``, ``speed``, ``accel``, ``gains``, ``params``, ...).
 
     Returns
     -------
@@ -314,10 +349,12 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
         ``m_p`` (eq 29, per follower), ``max_m_p``, ``M_lss`` (eq 30), ``TIT`` (eqs 31-32,
         summed over followers) and ``TIT_per_vehicle``, ``M_CI`` (eq 34), ``M_effi`` (eq 35),
         ``min_ttc``, ``min_gap``, ``min_headway``, ``collisions`` (events) and
-        ``collided_vehicles`` (1-based positions), ``M_fss`` (eq 27, % — None if the controller
-        is not of the eq-4 form or ``certificate`` is False).
+        ``collided_vehicles`` (1-based positions), ``m_fss`` (eq 27 as a fraction in [0, 1])
+        and ``M_fss`` (the same in %, the key of earlier versions) — both None if the
+        controller is not of the eq-4 form or ``certificate`` is False.  Units: s² for TIT,
+        m²/s⁶ for M_CI, s for M_effi, min_ttc and min_headway, m for min_gap.
     """
-    mp = np.asarray(result.damping_ratios)
+    mp = damping_ratios_from_energy(result.sum_sq_accel)
     out: dict[str, Any] = {
         "m_p": mp.round(6).tolist(),
         "max_m_p": float(np.max(mp)),
@@ -342,12 +379,16 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
             ttc_star=ttc_star,
         )
     out["M_fss"] = None
+    out["m_fss"] = None
     if certificate and result.gains is not None and result.params.get("headway") is not None:
         taus = np.unique(np.asarray(result.params["tau"], dtype=np.float64))
         if taus.size == 1:
             G = result.gains
-            out["M_fss"] = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
-                                     delta=result.params["delta"], headway=result.params["headway"])
+            share = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
+                              delta=result.params["delta"], headway=result.params["headway"],
+                              percent=False)
+            out["m_fss"] = share
+            out["M_fss"] = 100.0 * share
     for key in ("min_ttc", "min_headway", "M_effi"):
         if key in out and not math.isfinite(out[key]):
             out[key] = None

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..constants import SPEED_MAX, STANDSTILL
 from ..errors import StringStabError
 from ..params import DEFAULT_HEADWAY, as_gains, positive
 
@@ -55,7 +56,7 @@ __all__ = [
 Array = npt.NDArray[np.float64]
 
 #: Standstill spacing l_0, m (IDL paper Table 2).
-DEFAULT_STANDSTILL = 2.0
+DEFAULT_STANDSTILL = STANDSTILL
 
 
 @dataclass(frozen=True, slots=True)
@@ -321,7 +322,7 @@ class CACCController(Controller):
 
     def __init__(self, *, k_a: float = 1.0, k_v: float = 0.58, k_d: float = 0.1, k: float = 0.3,
                  t_system: float = DEFAULT_HEADWAY, r_min: float = DEFAULT_STANDSTILL,
-                 speed_intended: float = 33.3) -> None:
+                 speed_intended: float = SPEED_MAX) -> None:
         self.k_a, self.k_v, self.k_d, self.k = (float(k_a), float(k_v), float(k_d), float(k))
         self.t_system = positive("t_system", t_system, allow_zero=True)
         self.r_min = positive("r_min", r_min, allow_zero=True)
@@ -366,8 +367,8 @@ class IDMController(Controller):
     36.45
     """
 
-    def __init__(self, *, desired_speed: float = 33.3, time_headway: float = 1.6,
-                 min_gap: float = 2.0, max_accel: float = 0.73, comfortable_decel: float = 1.67,
+    def __init__(self, *, desired_speed: float = SPEED_MAX, time_headway: float = 1.6,
+                 min_gap: float = STANDSTILL, max_accel: float = 0.73, comfortable_decel: float = 1.67,
                  exponent: float = 4.0) -> None:
         self.v0 = positive("desired_speed", desired_speed)
         self.T = positive("time_headway", time_headway, allow_zero=True)

@@ -40,8 +40,9 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from ..constants import DT, GAIN_BOUNDS, STATE_SCALES, TTC_STAR
 from ..errors import StringStabError
-from ..metrics import TTC_STAR, time_headway, time_to_collision
+from ..metrics import time_headway, time_to_collision
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from .controllers import DEFAULT_STANDSTILL, Observation
 from .leaders import FollowingPair, Trajectory, cycle
@@ -54,7 +55,7 @@ Array = npt.NDArray[np.float64]
 ActionMode = Literal["gains", "accel"]
 
 #: α_p, α_v, α_acc of eq 16 (Table 2).
-SCALES = (25.0, 2.5, 4.5)
+SCALES = STATE_SCALES
 
 
 def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
@@ -208,7 +209,7 @@ def _spaces(action: ActionMode, gain_bounds: tuple[float, float],
 
 
 def _default_leaders() -> list[Trajectory]:
-    return [cycle(name, dt=0.1) for name in ("udds", "hwfet", "us06", "wltc3b")]
+    return [cycle(name, dt=DT) for name in ("udds", "hwfet", "us06", "wltc3b")]
 
 
 class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]]):
@@ -261,7 +262,7 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                  action: ActionMode = "gains", tau: float = DEFAULT_TAU, delta: float = DEFAULT_DELTA,
                  headway: float = DEFAULT_HEADWAY, standstill: float = DEFAULT_STANDSTILL,
                  model: Model = "lag", limits: Limits | None = None, length: float = DEFAULT_LENGTH,
-                 gain_bounds: tuple[float, float] = (-2.0, 2.0),
+                 gain_bounds: tuple[float, float] = GAIN_BOUNDS,
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True,
@@ -347,7 +348,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                  delta: float = DEFAULT_DELTA, headway: float = DEFAULT_HEADWAY,
                  standstill: float = DEFAULT_STANDSTILL, model: Model = "lag",
                  limits: Limits | None = None, length: float = DEFAULT_LENGTH,
-                 gain_bounds: tuple[float, float] = (-2.0, 2.0),
+                 gain_bounds: tuple[float, float] = GAIN_BOUNDS,
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True,

@@ -53,7 +53,9 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from ..constants import ACCEL_MAX, ACCEL_MIN, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError
+from ..metrics import damping_ratios_from_energy, platoon_metrics, time_headway
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
 from .controllers import Controller, Observation
 from .leaders import Trajectory
@@ -78,10 +80,10 @@ class Limits:
     Limits(accel_min=-7.6, accel_max=3.0, speed_min=0.0, speed_max=33.3)
     """
 
-    accel_min: float = -7.6
-    accel_max: float = 3.0
+    accel_min: float = ACCEL_MIN
+    accel_max: float = ACCEL_MAX
     speed_min: float = 0.0
-    speed_max: float = 33.3
+    speed_max: float = SPEED_MAX
 
     def __post_init__(self) -> None:
         vals = (self.accel_min, self.accel_max, self.speed_min, self.speed_max)
@@ -383,21 +385,15 @@ class PlatoonResult:
     @property
     def headway(self) -> Array:
         """Time headway h (eq 22) of each follower (P, N, T), s; NaN at standstill."""
-        from ..metrics import time_headway
-
         return time_headway(self.gap, self._need("speed")[..., 1:, :])
 
     @property
     def damping_ratios(self) -> Array:
         """m_p of each follower relative to its predecessor (eq 29, intended form), (P, N)."""
-        s = self.sum_sq_accel
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.sqrt(s[..., 1:] / s[..., :-1])
+        return damping_ratios_from_energy(self.sum_sq_accel)
 
-    def metrics(self, *, ttc_star: float = 3.0, certificate: bool = True) -> dict[str, Any]:
+    def metrics(self, *, ttc_star: float = TTC_STAR, certificate: bool = True) -> dict[str, Any]:
         """The IDL paper's evaluation metrics of this run (see :func:`stringstab.metrics.platoon_metrics`)."""
-        from ..metrics import platoon_metrics
-
         return platoon_metrics(self, ttc_star=ttc_star, certificate=certificate)
 
 

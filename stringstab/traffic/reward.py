@@ -21,7 +21,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from ..metrics import TTC_STAR, time_headway, time_to_collision
+from ..constants import ACCEL_MAX, ACCEL_MIN, HEADWAY_MU, HEADWAY_SIGMA, TTC_STAR
+from ..metrics import time_headway, time_to_collision
 
 __all__ = [
     "ACCEL_MAX",
@@ -37,10 +38,8 @@ __all__ = [
 
 Array = npt.NDArray[np.float64]
 
-#: acc_max and acc_min, m/s² (Table 2).
-ACCEL_MAX, ACCEL_MIN = 3.0, -7.6
-#: μ and σ of the log-normal time-headway density (eq 23, from Zhu et al. 2020).
-HEADWAY_MU, HEADWAY_SIGMA = 0.4226, 0.4365
+# acc_max, acc_min (Table 2) and the μ, σ of the log-normal headway density (eq 23, Zhu et al.
+# 2020) are the toolkit's constants, re-exported here.
 
 
 def safety_reward(ttc: npt.ArrayLike, *, ttc_star: float = TTC_STAR,
