@@ -1,13 +1,21 @@
-"""``stringstab simulate``: drive a platoon with a leader and write trajectories, metrics, figures."""
+"""``stringstab simulate``: drive a platoon with a leader and write trajectories, metrics, figures.
+
+Refused before anything is simulated or written (exit 2, one line): an output folder that
+cannot be written or holds another command's outputs, a leader faster than the followers'
+speed limit, and a step ``--dt`` longer than τ or δ (the run would be a sampled-data system
+whose behaviour the continuous-time certificate and M_fss do not describe).  A leader that
+accelerates beyond the followers' limits is simulated with a warning.
+"""
 
 from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
+import sys
 from typing import Any
 
-from ..errors import StringStabError
+from ..constants import DT, STANDSTILL, TTC_STAR
+from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
 
 __all__ = ["DEFAULT_GAINS", "add_parser", "parse_gains", "run"]
@@ -18,7 +26,8 @@ DEFAULT_GAINS = "1.2,0.5,0.6"
 
 def add_parser(sub: Any) -> None:
     """Register ``simulate``."""
-    from ..traffic.leaders import CYCLES, SYNTHETIC
+    from ..traffic.cycles import CYCLES
+    from ..traffic.synthetic import SYNTHETIC
 
     p = sub.add_parser(
         "simulate",
@@ -27,7 +36,9 @@ def add_parser(sub: Any) -> None:
             "Simulate N followers (IDL third-order model, eqs 5-7, actuator lag tau, predecessor "
             "acceleration received delta late, limits [-7.6, 3] m/s^2 and [0, 33.3] m/s) behind a "
             "leader, and write trajectories, the IDL metrics (m_p, M_lss, TIT, M_CI, M_effi, "
-            "M_fss, collisions) and figures like the paper's Figs 7-8."
+            "M_fss, collisions) and figures like the paper's Figs 7-8. Refused: a leader above "
+            "the speed limit, --dt longer than tau or delta, an output folder that cannot be "
+            "written."
         ),
         epilog=(
             f"Leaders: cycles {', '.join(sorted(CYCLES))}; synthetic {', '.join(SYNTHETIC)} "
@@ -42,30 +53,36 @@ def add_parser(sub: Any) -> None:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--gains", metavar="K_X,K_V,K_A", default=None,
                    help=f"fixed gains of the linear law (default {DEFAULT_GAINS}, certified)")
-    g.add_argument("--gains-file", metavar="CSV",
-                   help="time-varying gains: CSV with columns t,k_x,k_v,k_a (held between rows)")
+    g.add_argument("--gains-file", metavar="FILE",
+                   help="time-varying gains: a gain file (as for certify --file) with columns "
+                        "t,k_x,k_v,k_a held between rows; with a vehicle column, one series per "
+                        "follower 1..N")
     p.add_argument("--tau", type=float, default=DEFAULT_TAU, help=f"actuator lag, s (default {DEFAULT_TAU})")
     p.add_argument("--delta", type=float, default=DEFAULT_DELTA,
                    help=f"communication delay, s (default {DEFAULT_DELTA})")
     p.add_argument("--headway", type=float, default=DEFAULT_HEADWAY,
                    help=f"desired time headway T*, s (default {DEFAULT_HEADWAY})")
-    p.add_argument("--standstill", type=float, default=2.0, help="standstill spacing l0, m (default 2)")
+    p.add_argument("--standstill", type=float, default=STANDSTILL,
+                   help=f"standstill spacing l0, m (default {STANDSTILL:g})")
     p.add_argument("--length", type=float, default=5.0, help="vehicle length, m (default 5)")
-    p.add_argument("--dt", type=float, default=0.1, help="simulation step, s (default 0.1)")
+    p.add_argument("--dt", type=float, default=DT,
+                   help=f"simulation step, s, at most tau and delta (default {DT:g})")
     p.add_argument("--duration", type=float, default=None, help="keep only the first seconds of the leader")
     p.add_argument("--hold", type=float, default=0.0, metavar="SECONDS",
                    help="then let the leader hold its final speed this long (lets the platoon settle)")
     p.add_argument("--model", choices=("lag", "kinematic"), default="lag",
                    help="third-order model with exact ZOH (default) or the paper's eqs 1-2")
-    p.add_argument("--ttc-star", type=float, default=3.0, help="TTC* threshold, s (default 3)")
+    p.add_argument("--ttc-star", type=float, default=TTC_STAR,
+                   help=f"TTC* threshold, s (default {TTC_STAR:g})")
     p.add_argument("--format", choices=("npz", "csv"), default="npz", help="trajectory file format")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
-    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output directory (an earlier run's files in it are replaced)")
     p.set_defaults(func=run)
 
 
 def parse_gains(text: str) -> tuple[float, float, float]:
-    """``"k_x,k_v,k_a"`` → three finite floats.
+    """``"k_x,k_v,k_a"`` → three finite floats (:func:`stringstab.io.parse_triple`).
 
     Raises
     ------
@@ -77,14 +94,12 @@ def parse_gains(text: str) -> tuple[float, float, float]:
     >>> parse_gains("1.2, 0.5,0.6")
     (1.2, 0.5, 0.6)
     """
-    parts = [s.strip() for s in str(text).split(",")]
+    from ..io import parse_triple
+
     try:
-        vals = tuple(float(s) for s in parts)
-    except ValueError as e:
-        raise StringStabError(f"--gains must be three numbers k_x,k_v,k_a; got {text!r}") from e
-    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
-        raise StringStabError(f"--gains must be three finite numbers k_x,k_v,k_a; got {text!r}")
-    return vals  # type: ignore[return-value]
+        return parse_triple(str(text))
+    except StringStabError as e:
+        raise StringStabError(f"--gains must be three finite numbers k_x,k_v,k_a; {e}") from e
 
 
 def _controller(args: argparse.Namespace, headway: float) -> Any:
@@ -119,11 +134,33 @@ def _certificate(controller: Any, tau: float, delta: float) -> dict[str, Any] | 
             "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
 
 
+def _check_step(dt: float, tau: float, delta: float) -> None:
+    """Refuse a step longer than the actuator lag or the delay (see the module docstring)."""
+    limit = min(tau, delta) if delta > 0 else tau
+    if dt > limit * (1 + 1e-12):
+        longer = [f"the actuator lag tau = {tau:g} s"] if dt > tau * (1 + 1e-12) else []
+        if delta > 0 and dt > delta * (1 + 1e-12):
+            longer.append(f"the delay delta = {delta:g} s")
+        raise StringStabError(
+            f"--dt {dt:g} s is longer than {' and '.join(longer)}: the command would be held "
+            "over more than one lag or the delayed acceleration interpolated across a whole "
+            "step, so the run would not be the continuous-time platoon its certificate and "
+            f"M_fss describe; expected --dt <= {limit:g} s"
+        )
+
+
+def _fmt(v: Any, spec: str, unit: str = "") -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "n/a"
+    return f"{v:{spec}}{unit}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``simulate``."""
+    from ..io import OutputDir
     from ..traffic.leaders import leader_by_name
-    from ..traffic.output import write_run
-    from ..traffic.platoon import simulate
+    from ..traffic.output import RUN_FILES, write_run
+    from ..traffic.platoon import check_leader, simulate
 
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
     if args.followers < 1:
@@ -131,14 +168,24 @@ def run(args: argparse.Namespace) -> int:
     for name in ("dt", "standstill", "length", "ttc_star"):
         v = getattr(args, name)
         if not (math.isfinite(v) and (v > 0 or (name == "standstill" and v == 0))):
-            raise StringStabError(f"--{name.replace('_', '-')} must be a finite number > 0; got {v!r}")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise StringStabError(f"--out must be a directory; {str(out)!r} is a file")
+            raise StringStabError(
+                f"--{name.replace('_', '-')} must be a finite number > 0; got {show(v)}"
+            )
     if not (math.isfinite(args.hold) and args.hold >= 0):
-        raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {args.hold!r}")
+        raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
+    _check_step(args.dt, tau, delta)
+    out = OutputDir(args.out, command="simulate", owns=RUN_FILES, what="--out")
     leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
+    warnings = check_leader(leader)
     controller = _controller(args, headway)
+    n_series = getattr(controller, "followers", None)
+    if n_series is not None and n_series != args.followers:
+        raise StringStabError(
+            f"--gains-file {args.gains_file} has gain series for followers 1..{n_series}; "
+            f"expected --followers {n_series}, got {args.followers}"
+        )
+    for w in warnings:
+        print(f"stringstab simulate: warning: {w}", file=sys.stderr)
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length)
     metrics = result.metrics(ttc_star=args.ttc_star)
@@ -147,19 +194,22 @@ def run(args: argparse.Namespace) -> int:
                 "duration_s": leader.duration, **result.params},
         **metrics,
         "certificate": _certificate(controller, tau, delta),
+        "warnings": warnings,
     }
     title = (f"{leader.name}: {args.followers} followers, {args.controller}"
              + (f" K=({args.gains or DEFAULT_GAINS})" if args.controller == "linear" and not args.gains_file else ""))
-    files = write_run(result, out, metrics=doc, fmt=args.format, figures=not args.no_figures,
-                      title=title)
+    with out:
+        files = write_run(result, out, metrics=doc, fmt=args.format, figures=not args.no_figures,
+                          title=title)
     mp = metrics["m_p"]
-    print(f"simulated {leader.name} ({leader.duration:g} s, dt={args.dt:g} s), {args.followers} followers, "
-          f"{args.controller} controller, model={args.model}")
-    shown = ", ".join(f"{v:.3f}" for v in mp[:20]) + (", ..." if len(mp) > 20 else "")
-    print(f"m_p per follower (eq 29): {shown}")
-    print(f"max m_p = {metrics['max_m_p']:.4f}, M_lss = {metrics['M_lss']:.4f}, "
-          f"collisions = {metrics['collisions']}, TIT = {metrics['TIT']:.3f}, "
-          f"M_CI = {metrics['M_CI']:.4f}, M_effi = {metrics['M_effi']}, "
-          f"M_fss = {metrics['M_fss'] if metrics['M_fss'] is not None else 'n/a'}")
-    print(f"wrote {', '.join(files.values())} to {out}/")
+    print(f"simulated {leader.name} ({leader.duration:g} s, dt = {args.dt:g} s), "
+          f"{args.followers} followers, {args.controller} controller, model = {args.model}")
+    shown = ", ".join(_fmt(v, ".3f") for v in mp[:20]) + (", ..." if len(mp) > 20 else "")
+    print(f"m_p per follower (eq 29, follower/predecessor acceleration energy): {shown}")
+    print(f"max m_p = {_fmt(metrics['max_m_p'], '.3f')}, M_lss = {_fmt(metrics['M_lss'], '.3f')}, "
+          f"collisions = {metrics['collisions']}, TIT = {_fmt(metrics.get('TIT'), '.3f', ' s²')}, "
+          f"M_CI = {_fmt(metrics.get('M_CI'), '.4g', ' m²/s⁶')}, "
+          f"M_effi = {_fmt(metrics.get('M_effi'), '.3f', ' s')}, "
+          f"m_fss = {_fmt(metrics['m_fss'], '.3f')} (share of vehicle-moments certified)")
+    print(f"wrote {', '.join(files.values())} to {out.root}/")
     return 0

@@ -12,7 +12,9 @@ Three guarantees, for every command of the toolkit:
    into place (``os.replace``, atomic on POSIX), so a reader never sees half a file.
 3. **One run per folder.**  An :class:`OutputDir` writes every file of a run into a staging folder
    and moves them in only when the run succeeds, deleting the files its own earlier run (listed in
-   the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A failed run leaves the
+   the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A command whose outputs
+   have fixed names may instead declare them (``owns=``): then no manifest is written, and those
+   of its names this run did not write are deleted.  A failed run leaves the
    previous outputs untouched; a folder written by a *different* command is refused; files the
    toolkit did not write are never deleted.
 """
@@ -24,7 +26,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -219,6 +221,9 @@ class OutputDir:
     command : str
         Who writes it (e.g. ``"region"``); a folder whose manifest names another command is
         refused, so two different runs are never mixed in one folder.
+    owns : iterable of str, optional
+        Every name this command can write, for a folder without a manifest: on success, the
+        names of ``owns`` this run did not write are deleted (an earlier run's leftovers).
 
     Examples
     --------
@@ -238,10 +243,11 @@ class OutputDir:
     """
 
     def __init__(self, path: str | os.PathLike[str], *, command: str,
-                 what: str = "output folder") -> None:
+                 what: str = "output folder", owns: Iterable[str] | None = None) -> None:
         self.root = check_output_dir(path, what=what)
         self.command = command
         self.what = what
+        self.owns = None if owns is None else tuple(owns)
         self._staging: Path | None = None
         self._written: list[str] = []
         old = self._read_manifest()
@@ -333,9 +339,10 @@ class OutputDir:
         staging = self.staging
         old = self._read_manifest() or {}
         new = [n for n in self._written if (staging / n).is_file()]
+        stale = list(self.owns) if self.owns is not None else old.get("files", [])
         try:
             mode = 0o666 & ~_umask()
-            for name in old.get("files", []):
+            for name in stale:
                 if isinstance(name, str) and name not in new and ".." not in Path(name).parts:
                     (self.root / name).unlink(missing_ok=True)
             for name in new:
@@ -343,11 +350,12 @@ class OutputDir:
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.chmod(staging / name, mode)
                 os.replace(staging / name, dest)
-            from .. import __version__
+            if self.owns is None:
+                from .. import __version__
 
-            manifest = {"command": self.command, "version": __version__, "files": new}
-            atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
-                              what=self.what)
+                manifest = {"command": self.command, "version": __version__, "files": new}
+                atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
+                                  what=self.what)
         except OSError as e:
             raise StringStabError(
                 f"{self.what}: cannot move the outputs into {str(self.root)!r} ({_reason(e)})"

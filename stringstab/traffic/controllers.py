@@ -27,7 +27,6 @@ References
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -38,7 +37,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..constants import SPEED_MAX, STANDSTILL
-from ..errors import StringStabError
+from ..errors import StringStabError, show
+from ..io.gains import GainTable
 from ..params import DEFAULT_HEADWAY, as_gains, positive
 
 __all__ = [
@@ -218,42 +218,95 @@ class TimeVaryingLinearController(Controller):
             self._fn, self._table = None, tab
         self._last: tuple[int, Array] | None = None
 
+    #: Followers with their own gain series (from a file with a ``vehicle`` column), else None.
+    followers: int | None = None
+
     @classmethod
     def from_csv(cls, path: str | Path, *, headway: float = DEFAULT_HEADWAY,
                  standstill: float = DEFAULT_STANDSTILL) -> TimeVaryingLinearController:
-        """Gains from a CSV file with header ``t, k_x, k_v, k_a`` held from each t to the next.
+        """Gains from a gain time series file, held from each ``t`` to the next.
+
+        The file is read by :func:`stringstab.io.read_gains`, the reader of every command, so
+        CSV (comment lines allowed), JSON, NPZ and Parquet files with columns ``t, k_x, k_v,
+        k_a`` work, as does the bundled ``stringstab/data/examples/gain_rollout.csv``.  With a
+        ``vehicle`` column, vehicle ``i`` (an integer, 1 = first follower) gets its own series
+        and the platoon must have exactly those followers (see :meth:`from_table`).
 
         Raises
         ------
         StringStabError
-            If the file is missing, its columns differ, or times are not increasing.
+            If the file cannot be read, has no ``t`` column, or times are not increasing.
         """
-        p = Path(path)
-        try:
-            with p.open(newline="", encoding="utf-8-sig") as fh:
-                rows = [r for r in csv.reader(fh) if r]
-        except OSError as e:
-            raise StringStabError(f"cannot read gain file {str(p)!r}: {e.strerror or e}") from e
-        want = ["t", "k_x", "k_v", "k_a"]
-        if not rows or [c.strip().lower() for c in rows[0]] != want:
+        from ..io import read_gains
+
+        return cls.from_table(read_gains(path), headway=headway, standstill=standstill)
+
+    @classmethod
+    def from_table(cls, table: GainTable, *, headway: float = DEFAULT_HEADWAY,
+                   standstill: float = DEFAULT_STANDSTILL) -> TimeVaryingLinearController:
+        """Gains from a :class:`~stringstab.io.GainTable` time series (see :meth:`from_csv`).
+
+        Before the first ``t`` of a series its first gains apply, after the last its last.
+
+        Examples
+        --------
+        >>> from stringstab.io import GainTable
+        >>> import numpy as np
+        >>> g = GainTable(np.array([1.2, 0.1]), np.array([0.5, 0.58]), np.array([0.6, 1.0]),
+        ...               t=np.array([0.0, 5.0]), source="gains")
+        >>> TimeVaryingLinearController.from_table(g).followers is None
+        True
+        """
+        src = table.source
+        if table.t is None:
             raise StringStabError(
-                f"gain file {str(p)!r}: expected columns {want}; found {rows[0] if rows else []}"
+                f"{src}: a gain time series needs a column t (s); found columns "
+                f"{', '.join(table.columns)}"
             )
-        try:
-            arr = np.array([[float(c) for c in r] for r in rows[1:]], dtype=np.float64)
-        except ValueError as e:
-            raise StringStabError(f"gain file {str(p)!r}: not a number ({e})") from e
-        if arr.shape[0] < 1 or arr.shape[1:] != (4,) or not np.isfinite(arr).all():
-            raise StringStabError(f"gain file {str(p)!r}: needs at least one row of 4 finite numbers")
-        if (np.diff(arr[:, 0]) <= 0).any():
-            raise StringStabError(f"gain file {str(p)!r}: t must be strictly increasing")
-        times, table = arr[:, 0], arr[:, 1:]
+        t, K = table.t, table.K
+        if table.vehicle is None:
+            series = {0: (t, K)}
+        else:
+            ids = table.vehicle
+            if ids.dtype.kind not in "iu" or ids.min() < 1:
+                raise StringStabError(
+                    f"{src}: vehicle ids must be the followers' positions 1, 2, ... (integers, "
+                    f"1 = first behind the leader); found {show(sorted(set(ids.tolist()))[:5])}"
+                )
+            present = np.unique(ids)
+            if present.tolist() != list(range(1, int(present.max()) + 1)):
+                raise StringStabError(
+                    f"{src}: expected a gain series for every follower 1..{int(present.max())}; "
+                    f"found vehicles {show(present.tolist())}"
+                )
+            series = {int(v): (t[ids == v], K[ids == v]) for v in present}
+        for v, (tv, _) in series.items():
+            if (np.diff(tv) <= 0).any():
+                i = int(np.argmax(np.diff(tv) <= 0))
+                who = f" of vehicle {v}" if v else ""
+                raise StringStabError(
+                    f"{src}: t{who} must be strictly increasing; found t = {show(tv[i])} "
+                    f"then {show(tv[i + 1])}"
+                )
+        times = np.unique(t)
+        # gains in force at every time of any series: (len(times), n_series, 3)
+        table_k = np.stack(
+            [Kv[np.maximum(np.searchsorted(tv, times, side="right") - 1, 0)]
+             for tv, Kv in series.values()], axis=1)
+        n = len(series) if table.vehicle is not None else None
 
         def schedule(obs: Observation) -> Array:
-            i = int(np.searchsorted(times, obs.t + 1e-9, side="right")) - 1
-            return table[max(i, 0)]
+            i = max(int(np.searchsorted(times, obs.t + 1e-9, side="right")) - 1, 0)
+            if n is not None and obs.gap.shape[-1] != n:
+                raise StringStabError(
+                    f"{src}: has gain series for followers 1..{n}; the platoon has "
+                    f"{obs.gap.shape[-1]} followers: expected {n}"
+                )
+            return table_k[i] if n is not None else table_k[i, 0]
 
-        return cls(schedule, headway=headway, standstill=standstill)
+        ctrl = cls(schedule, headway=headway, standstill=standstill)
+        ctrl.followers = n
+        return ctrl
 
     @property
     def headway(self) -> float:

@@ -1,44 +1,64 @@
-"""Writing a simulated run: trajectories (NPZ or CSV), a metrics JSON and figures."""
+"""Writing a simulated run: trajectories (NPZ or CSV), a metrics JSON and figures.
+
+Every file is written all-or-nothing: :func:`save_trajectories` through a temporary file,
+:func:`write_run` through an :class:`~stringstab.io.OutputDir` that owns the names in
+:data:`RUN_FILES`, so a run into a folder of an earlier run replaces its files (and removes
+those this run does not write) or, if it fails, leaves them as they were.
+"""
 
 from __future__ import annotations
 
-import csv
 import json
-import math
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
 from ..errors import StringStabError
+from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
 from .platoon import PlatoonResult
 
-__all__ = ["save_trajectories", "write_run"]
+__all__ = ["RUN_FILES", "save_trajectories", "write_run"]
 
 Format = Literal["npz", "csv"]
 
+#: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
+RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "metrics.json",
+                              "platoon.png", "damping.png")
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
-    if isinstance(x, np.generic):
-        return _jsonable(x.item())
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
+
+def _trajectory_columns(result: PlatoonResult) -> dict[str, np.ndarray]:
+    """One row per (time, vehicle); vehicle 0 (the leader) has no gap, headway or command."""
+    assert result.speed is not None and result.position is not None and result.accel is not None
+    n_veh, T = result.speed.shape
+    gap, hw = result.gap, result.headway
+    cmd = result.command if result.command is not None else np.full_like(gap, np.nan)
+
+    def followers(a: np.ndarray) -> np.ndarray:  # (N, T) -> (T, N + 1) with NaN for the leader
+        out = np.full((T, n_veh), np.nan)
+        out[:, 1:] = a.T
+        return out.ravel()
+
+    return {
+        "t": np.repeat(np.round(result.t, 9), n_veh),
+        "vehicle": np.tile(np.arange(n_veh), T),
+        "position": np.round(result.position.T.ravel(), 6),
+        "speed": np.round(result.speed.T.ravel(), 6),
+        "accel": np.round(result.accel.T.ravel(), 6),
+        "gap": np.round(followers(gap), 6),
+        "headway": np.round(followers(hw), 6),
+        "command": np.round(followers(cmd), 6),
+    }
 
 
 def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = "npz") -> Path:
-    """Save a single-platoon run's trajectories.
+    """Save a single-platoon run's trajectories (atomically: complete or absent).
 
     ``npz``: arrays ``t`` (T,), ``position``, ``speed``, ``accel`` (N + 1, T; row 0 the
     leader), ``gap``, ``headway``, ``command`` (N, T), ``gains`` if any, and ``params`` (JSON).
     ``csv``: one row per (time, vehicle) with columns ``t, vehicle, position, speed, accel,
-    gap, headway, command`` (vehicle 0 is the leader; its gap, headway and command are empty).
+    gap, headway, command`` (vehicle 0 is the leader; its gap, headway and command are empty;
+    values rounded to 1e-6 in SI units: s, m, m/s, m/s², s, m/s²).
 
     Returns
     -------
@@ -49,53 +69,30 @@ def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = 
         raise StringStabError("save_trajectories needs a run recorded with record=True")
     if result.speed.ndim != 2:
         raise StringStabError("save_trajectories saves one platoon; select one from the batch first")
+    if fmt not in ("npz", "csv"):
+        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {fmt!r}")
     p = Path(path)
+    if fmt == "csv":
+        write_results(_trajectory_columns(result), p, "csv", what="trajectories")
+        return p
     gap, hw = result.gap, result.headway
     cmd = result.command if result.command is not None else np.full_like(gap, np.nan)
-    if fmt == "npz":
-        arrays: dict[str, Any] = dict(t=result.t, position=result.position, speed=result.speed,
-                                      accel=result.accel, gap=gap, headway=hw, command=cmd,
-                                      params=np.array(json.dumps(_jsonable(result.params))))
-        if result.gains is not None:
-            arrays["gains"] = result.gains
-        np.savez_compressed(p, **arrays)
-    elif fmt == "csv":
-        n_veh, T = result.speed.shape
-        with p.open("w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(["t", "vehicle", "position", "speed", "accel", "gap", "headway", "command"])
-            for k in range(T):
-                t = f"{result.t[k]:.6g}"
-                for i in range(n_veh):
-                    extra = ["", "", ""] if i == 0 else [
-                        f"{gap[i - 1, k]:.6f}",
-                        "" if not np.isfinite(hw[i - 1, k]) else f"{hw[i - 1, k]:.6f}",
-                        f"{cmd[i - 1, k]:.6f}",
-                    ]
-                    w.writerow([t, i, f"{result.position[i, k]:.6f}", f"{result.speed[i, k]:.6f}",
-                                f"{result.accel[i, k]:.6f}", *extra])
-    else:
-        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {fmt!r}")
+    arrays: dict[str, Any] = dict(t=result.t, position=result.position, speed=result.speed,
+                                  accel=result.accel, gap=gap, headway=hw, command=cmd,
+                                  params=np.array(json.dumps(to_plain(result.params))))
+    if result.gains is not None:
+        arrays["gains"] = result.gains
+    with atomic_path(p, what="trajectories") as tmp:
+        np.savez_compressed(tmp, **arrays)
     return p
 
 
-def write_run(result: PlatoonResult, out: str | Path, *, metrics: dict[str, Any],
-              fmt: Format = "npz", figures: bool = True, title: str | None = None) -> dict[str, str]:
-    """Write ``trajectories.{npz,csv}``, ``metrics.json`` and (optionally) the figures.
-
-    Figures: ``platoon.png`` (speed, acceleration, spacing and headway of every vehicle,
-    like the IDL paper's Figs 7-8) and ``damping.png`` (m_p per follower).
-
-    Returns
-    -------
-    dict
-        ``{kind: file name}`` of everything written under ``out``.
-    """
-    d = Path(out)
-    d.mkdir(parents=True, exist_ok=True)
+def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: Format,
+           figures: bool, title: str | None) -> dict[str, str]:
     files: dict[str, str] = {}
-    traj = save_trajectories(result, d / f"trajectories.{fmt}", fmt=fmt)
-    files["trajectories"] = traj.name
+    name = f"trajectories.{fmt}"
+    save_trajectories(result, out.path(name), fmt=fmt)
+    files["trajectories"] = name
     if figures:
         from matplotlib.figure import Figure
 
@@ -103,16 +100,41 @@ def write_run(result: PlatoonResult, out: str | Path, *, metrics: dict[str, Any]
 
         fig, _ = plot_platoon(result, title=title,
                               fig=Figure(figsize=(12, 7.5), layout="constrained"))
-        fig.savefig(d / "platoon.png", dpi=110)
+        fig.savefig(out.path("platoon.png"), dpi=110)
         fig = Figure(figsize=(6, 3.5), layout="constrained")
         ax = fig.subplots()
         plot_damping_ratios(result.damping_ratios, ax=ax)
         ax.set_title("acceleration L2 damping ratio per follower (IDL eq 29)")
-        fig.savefig(d / "damping.png", dpi=110)
+        fig.savefig(out.path("damping.png"), dpi=110)
         files["figure_platoon"] = "platoon.png"
         files["figure_damping"] = "damping.png"
     files["metrics"] = "metrics.json"
-    doc = {**metrics, "files": dict(files)}
-    (d / "metrics.json").write_text(json.dumps(_jsonable(doc), indent=2, ensure_ascii=False) + "\n",
-                                    encoding="utf-8")
+    out.write_text("metrics.json", dumps_json({**metrics, "files": dict(files)}))
     return files
+
+
+def write_run(result: PlatoonResult, out: str | Path | OutputDir, *, metrics: dict[str, Any],
+              fmt: Format = "npz", figures: bool = True, title: str | None = None) -> dict[str, str]:
+    """Write ``trajectories.{npz,csv}``, ``metrics.json`` and (optionally) the figures.
+
+    Figures: ``platoon.png`` (speed, acceleration, spacing and headway of every vehicle,
+    like the IDL paper's Figs 7-8) and ``damping.png`` (m_p per follower).
+
+    Parameters
+    ----------
+    out : path or OutputDir
+        The folder: written all-or-nothing, replacing the files of an earlier run (see
+        :data:`RUN_FILES`); or an open :class:`~stringstab.io.OutputDir` (e.g. checked by a
+        command before it simulated) that the caller commits.
+
+    Returns
+    -------
+    dict
+        ``{kind: file name}`` of everything written under ``out``.
+    """
+    if fmt not in ("npz", "csv"):
+        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {fmt!r}")
+    if isinstance(out, OutputDir):
+        return _write(result, out, metrics, fmt, figures, title)
+    with OutputDir(out, command="simulate", owns=RUN_FILES) as d:
+        return _write(result, d, metrics, fmt, figures, title)

@@ -60,7 +60,7 @@ from ..params import DEFAULT_DELTA, DEFAULT_TAU
 from .controllers import Controller, Observation
 from .leaders import Trajectory
 
-__all__ = ["DEFAULT_LENGTH", "Limits", "Platoon", "PlatoonResult", "simulate"]
+__all__ = ["DEFAULT_LENGTH", "Limits", "Platoon", "PlatoonResult", "check_leader", "simulate"]
 
 Array = npt.NDArray[np.float64]
 
@@ -98,6 +98,55 @@ class Limits:
             raise StringStabError(
                 f"speed limits must satisfy 0 <= speed_min < speed_max; got [{self.speed_min}, {self.speed_max}]"
             )
+
+
+def check_leader(leader: Trajectory, limits: Limits | None = None) -> list[str]:
+    """Refuse a leader the followers cannot follow; warn where it outruns their limits.
+
+    A leader faster than the followers' speed limit is refused: they would saturate at v_max
+    and fall behind without end, so the spacing, TTC and m_p of the run would describe the
+    limit, not the controller (a 100 m/s leader makes m_p NaN).  A leader accelerating
+    beyond [acc_min, acc_max] is accepted with a warning: the followers' commands are limited
+    to that range, so where the leader exceeds it they cannot match it.
+
+    Returns
+    -------
+    list of str
+        Warnings, one sentence each (empty when the leader is within every limit).
+
+    Raises
+    ------
+    StringStabError
+        If the leader's speed exceeds ``limits.speed_max``.
+
+    Examples
+    --------
+    >>> from stringstab.traffic.trajectory import from_speed
+    >>> print(*check_leader(from_speed([0, 1], [20.0, 25.0], dt=0.1)))
+    the leader accelerates at up to 5 m/s², beyond the followers' limit acc_max = 3 m/s² (first at t = 0 s): they cannot match it there, so the metrics measure the limits as well as the controller
+    """
+    lim = limits or Limits()
+    v, a = leader.speed, leader.accel
+    k = int(np.argmax(v))
+    if v[k] > lim.speed_max + 1e-9:
+        raise StringStabError(
+            f"leader {leader.name!r} reaches {float(v[k]):.4g} m/s at t = {k * leader.dt:.4g} s, "
+            f"above the followers' speed limit v_max = {lim.speed_max:g} m/s (IDL Table 2): they "
+            f"could not follow it; expected a leader within [0, {lim.speed_max:g}] m/s"
+        )
+    warnings = []
+    for side, bound, beyond in (("max", lim.accel_max, a > lim.accel_max + 1e-9),
+                                ("min", lim.accel_min, a < lim.accel_min - 1e-9)):
+        if beyond.any():
+            peak = float(a.max() if side == "max" else a.min())
+            first = int(np.argmax(beyond)) * leader.dt
+            word = "accelerates" if side == "max" else "brakes"
+            warnings.append(
+                f"the leader {word} at up to {abs(peak):.4g} m/s², beyond the followers' limit "
+                f"acc_{side} = {bound:g} m/s² (first at t = {first:.4g} s): they cannot match "
+                "it there, so the metrics measure the limits as well as the controller"
+            )
+    return warnings
 
 
 def _check_lag_delay(tau: npt.ArrayLike, delta: float) -> tuple[Array, float]:
