@@ -1,32 +1,44 @@
 """The main job: a demo of the whole pipeline on bundled data (``stringstab demo``).
 
 Each capability of the toolkit contributes one *step*: a function
-``step(out: Path, log: Callable[[str], None]) -> dict`` that writes its outputs
-under ``out`` and returns a small summary.  :func:`run_demo` runs them in order
-and writes ``summary.json``.  The whole demo runs in a few minutes at most.
+``step(out: Path, log: Callable[[str], None]) -> dict`` that calls the library, writes its
+outputs under ``out`` and returns a small summary built from the results it computed (never
+from files it wrote).  :func:`run_demo` runs them in order and writes ``summary.json``; the
+output folder is checked before any step runs and written all-or-nothing
+(:class:`stringstab.io.OutputDir`), so a failed demo leaves an earlier one untouched and a
+new one replaces it whole.
 """
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["STEPS", "run_demo"]
+from .constants import DELTA, HEADWAY, TAU
+
+__all__ = ["DEMO_TRIPLES", "STEPS", "TUNE_TRIPLES", "run_demo"]
 
 Log = Callable[[str], None]
 Step = Callable[[Path, Log], dict[str, Any]]
 
+PARAMS = {"tau": TAU, "delta": DELTA, "headway": HEADWAY}
+ROLLOUT = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
+
 
 def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     """Derive Γ(s), Ψ1-Ψ3, Λ and compare with the printed formulas."""
-    from .cli import main
+    # The text, LaTeX and JSON renderings of the derivation live with the derive command.
+    from .cli import derive as rendering
+    from .io import atomic_write_text, dumps_json
+    from .symbolic import derive_all
 
-    for fmt, name in (("json", "derive.json"), ("latex", "derive.tex"), ("text", "derive.txt")):
-        main(["derive", "--errata", "--format", fmt, "--out", str(out / name)])
-    doc = json.loads((out / "derive.json").read_text())
+    doc = rendering.derive_document(None, None, with_errata=True)
+    exprs = derive_all(None, {})
+    atomic_write_text(out / "derive.json", dumps_json(doc))
+    atomic_write_text(out / "derive.tex", rendering._latex(exprs, doc))
+    atomic_write_text(out / "derive.txt", rendering._text(exprs, doc))
     wrong = [f"eq {e['equation']} ({e['key']})" for e in doc["errata"] if not e["matches"]]
     log(f"derived Γ(s) = {doc['gamma']}")
     log(f"errata: {len(wrong)} printed formulas differ from the derivation: {', '.join(wrong)}")
@@ -40,43 +52,45 @@ DEMO_TRIPLES = ["0.9,-0.5,1.1", "1.3,0,0.6", "0.45,0.6,0.3", "0.2,0.7,0", "-0.5,
 
 def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     """Certify a few triples and a bundled gain time series (exact delay)."""
-    from .cli import main
+    import numpy as np
 
-    rollout = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
+    from .certificate import TABLE_COLUMNS, certify_batch
+    from .io import GainTable, parse_triple, read_gains, write_results
+
+    params = {**PARAMS, "method": "exact"}
     files = []
-    for fmt in ("json", "table"):
-        name = f"triples.{'txt' if fmt == 'table' else fmt}"
-        main(["certify", *DEMO_TRIPLES, "--format", fmt, "--out", str(out / name)])
-        files.append(name)
-    for fmt in ("json", "csv", "table"):
-        name = f"rollout.{'txt' if fmt == 'table' else fmt}"
-        main(["certify", "--file", str(rollout), "--format", fmt, "--out", str(out / name)])
-        files.append(name)
-    triples = json.loads((out / "triples.json").read_text())
-    for r in triples["results"]:
-        sup = "inf" if r["sup_gain"] is None else f"{r['sup_gain']:.4g}"
-        log(
-            f"K=({r['k_x']:g}, {r['k_v']:g}, {r['k_a']:g}): {r['verdict']} (sup|Γ| = {sup}); "
-            f"printed Proposition 1: {r['taylor_printed']['verdict']}"
-        )
-    rollout_doc = json.loads((out / "rollout.json").read_text())
-    s = rollout_doc["summary"]
+    tables = {"triples": GainTable.from_triples([parse_triple(t) for t in DEMO_TRIPLES]),
+              "rollout": read_gains(ROLLOUT)}
+    batches = {}
+    for name, g in tables.items():
+        b = batches[name] = certify_batch(g.k_x, g.k_v, g.k_a, tau=TAU, delta=DELTA, headway=HEADWAY)
+        columns = {**g.meta_columns(), **b.columns()}
+        for fmt in ("json", "table") if name == "triples" else ("json", "csv", "table"):
+            fname = f"{name}.{'txt' if fmt == 'table' else fmt}"
+            write_results(columns, out / fname, fmt, params=params, summary=b.summary(),
+                          table=TABLE_COLUMNS)
+            files.append(fname)
+    triples = batches["triples"]
+    for i in range(len(triples)):
+        c = triples[i]
+        sup = f"{c.sup_gain:.4g}"
+        log(f"K=({c.k_x:g}, {c.k_v:g}, {c.k_a:g}): {c.verdict} (sup|Γ| = {sup}); "
+            f"printed Proposition 1: {c.taylor_printed['verdict']}")
+    roll, g = batches["rollout"], tables["rollout"]
+    s = roll.summary()
     first_bad: dict[str, float] = {}
-    for r in rollout_doc["results"]:
-        if r["verdict"] != "certified":
-            first_bad.setdefault(str(r["vehicle"]), r["t"])
-    log(
-        f"gain time series ({rollout.name}): {s['certified']} of {s['n']} rows certified "
-        f"(M_fss = {s['m_fss']:.3f}); first uncertified t per vehicle: {first_bad}"
-    )
+    assert g.vehicle is not None and g.t is not None
+    for i in np.flatnonzero(~roll.certified).tolist():
+        first_bad.setdefault(str(g.vehicle[i]), float(g.t[i]))
+    log(f"gain time series ({ROLLOUT.name}): {s['certified']} of {s['n']} rows certified "
+        f"(m_fss = {s['m_fss']:.3f}); first uncertified t per vehicle: {first_bad}")
     return {
         "files": files,
-        "params": triples["params"],
-        "triples": [
-            {"K": [r["k_x"], r["k_v"], r["k_a"]], "verdict": r["verdict"],
-             "taylor_printed": r["taylor_printed"]["verdict"]}
-            for r in triples["results"]
-        ],
+        "params": params,
+        "triples": [{"K": [float(triples.k_x[i]), float(triples.k_v[i]), float(triples.k_a[i])],
+                     "verdict": str(triples.verdict[i]),
+                     "taylor_printed": triples[i].taylor_printed["verdict"]}
+                    for i in range(len(triples))],
         "rollout": s,
         "rollout_first_uncertified_t": first_bad,
     }
@@ -84,26 +98,30 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
 
 def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
     """A 10-vehicle platoon behind the §5.1-style leader: certified gains vs the CACC baseline."""
-    from .cli import main
+    from .traffic.controllers import CACCController, LinearController
+    from .traffic.leaders import leader_by_name
+    from .traffic.output import run_document, write_run
+    from .traffic.platoon import check_leader, simulate
 
-    runs = {
-        "certified": ["--controller", "linear", "--gains", "1.2,0.5,0.6"],
-        "cacc": ["--controller", "cacc"],
-    }
+    leader = leader_by_name("mix")
+    warnings = check_leader(leader)
+    runs = {"certified": LinearController(1.2, 0.5, 0.6, headway=HEADWAY),
+            "cacc": CACCController(t_system=HEADWAY)}
     summary: dict[str, Any] = {}
-    for name, extra in runs.items():
-        main(["simulate", "--leader", "mix", "--followers", "10", *extra, "--out", str(out / name)])
-        doc = json.loads((out / name / "metrics.json").read_text())
+    for name, controller in runs.items():
+        result = simulate(leader, controller, 10, tau=TAU, delta=DELTA)
+        doc = run_document(result, leader=leader, controller=controller, spec="mix",
+                           warnings=warnings)
+        files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {name}")
         cert = doc["certificate"] or {}
-        log(
-            f"{name}: K={cert.get('k_x')},{cert.get('k_v')},{cert.get('k_a')} "
-            f"({cert.get('verdict')}); m_p = {', '.join(f'{v:.2f}' for v in doc['m_p'])}; "
-            f"max m_p {doc['max_m_p']:.3f}, collisions {doc['collisions']}, TIT {doc['TIT']:.3f}, "
-            f"M_CI {doc['M_CI']:.3f}, M_fss {doc['M_fss']}%"
-        )
+        m_p = ", ".join("n/a" if v is None else f"{v:.2f}" for v in doc["m_p"])
+        log(f"{name}: K={cert.get('k_x')},{cert.get('k_v')},{cert.get('k_a')} "
+            f"({cert.get('verdict')}); m_p = {m_p}; max m_p {doc['max_m_p']:.3f}, "
+            f"collisions {doc['collisions']}, TIT {doc['TIT']:.3f} s², "
+            f"M_CI {doc['M_CI']:.3f} m²/s⁶, m_fss {doc['m_fss']}")
         summary[name] = {k: doc[k] for k in ("m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_CI",
-                                             "M_effi", "M_fss")}
-        summary[name]["files"] = [f"{name}/{f}" for f in doc["files"].values()]
+                                             "M_effi", "m_fss", "M_fss")}
+        summary[name]["files"] = [f"{name}/{f}" for f in files.values()]
     return summary
 
 
@@ -114,16 +132,16 @@ def _step_region(out: Path, log: Log) -> dict[str, Any]:
     matplotlib.use("Agg")
     import numpy as np
 
-    from .gainio import read_gains
+    from .io import read_gains
     from .plots import save_figures
     from .regions import region_map
 
     g = np.linspace(-2.0, 2.0, 121)
-    rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1,
+    rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
                       progress=False)
-    rollout = read_gains(Path(__file__).parent / "data" / "examples" / "gain_rollout.csv")
     files = [rmap.save_npz(out / "region.npz").name]
-    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=rollout, dpi=110)]
+    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=read_gains(ROLLOUT),
+                                           dpi=110)]
     for line in rmap.report().splitlines():
         log(line)
     return {"files": files, "class_shares": rmap.class_shares(),
@@ -136,38 +154,48 @@ TUNE_TRIPLES = ["0.9,-0.5,1.1", "0.2,0.7,0", "-0.5,1,1", "1,-1.2,0.5", "0.3,0.2,
 
 
 def _step_tune(out: Path, log: Log) -> dict[str, Any]:
-    """Repair uncertified triples by region growing (IDL §3.3) and by projection; draw the moves."""
+    """Repair uncertified triples by region growing (IDL §3.3) and by projection; draw the moves.
+
+    Each triple is solved once per method; the files and the figure are written from those
+    results.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import numpy as np
 
-    from .cli import main
-    from .gainio import parse_triple
+    from .io import atomic_path, columns_from_records, parse_triple, write_results
     from .tuning import plot_moves, project, region_growing
 
-    main(["tune", *TUNE_TRIPLES, "--method", "both", "--format", "json",
-          "--out", str(out / "tune.json")])
-    main(["tune", *TUNE_TRIPLES, "--method", "both", "--out", str(out / "tune.txt")])
-    doc = json.loads((out / "tune.json").read_text())
-    for r in doc["results"]:
-        log(
-            f"{r['method']:>14}: K0=({r['k_x_in']:g}, {r['k_v_in']:g}, {r['k_a_in']:g}) -> "
-            f"({r['k_x']:.4g}, {r['k_v']:.4g}, {r['k_a']:.4g}), moved {r['distance']:.4g}, "
-            f"{'certified' if r['certified'] else 'NOT certified'} ({r['status']})"
-        )
-    tau, delta, headway = 0.1, 0.2, 1.1
     results = []
     for t in TUNE_TRIPLES:
         K = parse_triple(t)
-        results += [region_growing(K, tau=tau, delta=delta, headway=headway),
-                    project(K, tau=tau, delta=delta, headway=headway)]
-    drawn = plot_moves(results, tau=tau, delta=delta, headway=headway, k_a=0.6, n=101)
+        results += [region_growing(K, tau=TAU, delta=DELTA, headway=HEADWAY),
+                    project(K, tau=TAU, delta=DELTA, headway=HEADWAY)]
+    records = [r.as_dict() for r in results]
+    for r in records:
+        log(f"{r['method']:>14}: K0=({r['k_x_in']:g}, {r['k_v_in']:g}, {r['k_a_in']:g}) -> "
+            f"({r['k_x']:.4g}, {r['k_v']:.4g}, {r['k_a']:.4g}), moved {r['distance']:.4g}, "
+            f"{'certified' if r['certified'] else 'NOT certified'} ({r['status']})")
+    summary: dict[str, Any] = {}
+    for method in dict.fromkeys(r["method"] for r in records):
+        rs = [r for r in records if r["method"] == method]
+        moved = [r["distance"] for r in rs if r["status"] == "repaired"]
+        summary[method] = {"n": len(rs), "certified": sum(r["certified"] for r in rs),
+                           "repaired": len(moved),
+                           "median_distance_moved": float(np.median(moved)) if moved else 0.0}
+    params = {**PARAMS, "method": "both"}
+    columns = columns_from_records(records)
+    write_results(columns, out / "tune.json", "json", params=params, summary=summary)
+    write_results(columns, out / "tune.txt", "table", params=params, summary=summary)
+    drawn = plot_moves(results, tau=TAU, delta=DELTA, headway=HEADWAY, k_a=0.6, n=101)
     fig = drawn["ax"].figure
     fig.tight_layout()
-    fig.savefig(out / "tune_moves.png", dpi=110, bbox_inches="tight")
+    with atomic_path(out / "tune_moves.png") as tmp:
+        fig.savefig(tmp, dpi=110, bbox_inches="tight")
     plt.close(fig)
-    return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": doc["summary"]}
+    return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": summary}
 
 
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
@@ -186,7 +214,9 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
     Parameters
     ----------
     out : path
-        Output directory (created if needed).
+        Output folder: checked before any step runs (a file, a folder that cannot be written
+        or one holding another command's outputs is refused), created if needed, and written
+        all-or-nothing, replacing an earlier demo's files.
     log : callable
         Receives one line of progress at a time.
     only : list of str, optional
@@ -196,20 +226,29 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
     -------
     dict
         ``{step: summary}``, also written to ``out/summary.json``.
+
+    Raises
+    ------
+    StringStabError
+        If ``out`` cannot be used or a step name is unknown (before any work).
     """
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from .errors import StringStabError
+    from .io import OutputDir
+
+    names = [n for n, _ in STEPS]
+    for o in only or []:
+        if o not in names:
+            raise StringStabError(f"unknown demo step {o!r}; expected one of {names}")
     summary: dict[str, Any] = {}
-    for name, step in STEPS:
-        if only and name not in only:
-            continue
-        t0 = time.perf_counter()
-        log(f"== {name} ==")
-        d = out / name
-        d.mkdir(exist_ok=True)
-        result = step(d, log)
-        result["seconds"] = round(time.perf_counter() - t0, 2)
-        summary[name] = result
-        log(f"   ({result['seconds']} s, outputs in {d})")
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, ensure_ascii=False) + "\n")
+    with OutputDir(out, command="demo", what="demo output folder") as d:
+        for name, step in STEPS:
+            if only and name not in only:
+                continue
+            t0 = time.perf_counter()
+            log(f"== {name} ==")
+            result = step(d.folder(name), log)
+            result["seconds"] = round(time.perf_counter() - t0, 2)
+            summary[name] = result
+            log(f"   ({result['seconds']} s, outputs in {d.final(name)})")
+        d.write_json("summary.json", summary)
     return summary

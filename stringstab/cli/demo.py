@@ -17,7 +17,9 @@ def add_parser(sub: Any) -> None:
         help="run a demo of the whole pipeline on bundled data",
         description="Steps: " + ", ".join(name for name, _ in STEPS),
     )
-    p.add_argument("--out", default="demo-out", help="output directory (default: demo-out)")
+    p.add_argument("--out", default="demo-out",
+                   help="output directory (default: demo-out); an earlier demo's files in it are "
+                        "replaced, and it is left untouched if the demo fails")
     p.add_argument("--only", action="append", metavar="STEP", help="run only this step (repeatable)")
     p.set_defaults(func=run)
 

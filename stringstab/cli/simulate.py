@@ -123,17 +123,6 @@ def _controller(args: argparse.Namespace, headway: float) -> Any:
                             standstill=args.standstill)
 
 
-def _certificate(controller: Any, tau: float, delta: float) -> dict[str, Any] | None:
-    K = controller.gains(None) if not controller.time_varying else None
-    if K is None or controller.headway is None or K.ndim != 1:
-        return None
-    from ..certificate import certify
-
-    c = certify(float(K[0]), float(K[1]), float(K[2]), tau=tau, delta=delta, headway=controller.headway)
-    return {"k_x": float(K[0]), "k_v": float(K[1]), "k_a": float(K[2]), "verdict": c.verdict,
-            "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
-
-
 def _check_step(dt: float, tau: float, delta: float) -> None:
     """Refuse a step longer than the actuator lag or the delay (see the module docstring)."""
     limit = min(tau, delta) if delta > 0 else tau
@@ -159,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``simulate``."""
     from ..io import OutputDir
     from ..traffic.leaders import leader_by_name
-    from ..traffic.output import RUN_FILES, write_run
+    from ..traffic.output import RUN_FILES, run_document, write_run
     from ..traffic.platoon import check_leader, simulate
 
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
@@ -188,14 +177,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"stringstab simulate: warning: {w}", file=sys.stderr)
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length)
-    metrics = result.metrics(ttc_star=args.ttc_star)
-    doc = {
-        "run": {"leader": args.leader, "leader_name": leader.name, "followers": args.followers,
-                "duration_s": leader.duration, **result.params},
-        **metrics,
-        "certificate": _certificate(controller, tau, delta),
-        "warnings": warnings,
-    }
+    doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
+                       ttc_star=args.ttc_star, warnings=warnings)
+    metrics = doc
     title = (f"{leader.name}: {args.followers} followers, {args.controller}"
              + (f" K=({args.gains or DEFAULT_GAINS})" if args.controller == "linear" and not args.gains_file else ""))
     with out:

@@ -250,6 +250,7 @@ class OutputDir:
         self.owns = None if owns is None else tuple(owns)
         self._staging: Path | None = None
         self._written: list[str] = []
+        self._folders: list[str] = []
         old = self._read_manifest()
         if old is not None and old.get("command") != command:
             raise StringStabError(
@@ -304,6 +305,17 @@ class OutputDir:
             self._written.append(rel.as_posix())
         return p
 
+    def folder(self, name: str) -> Path:
+        """A staging sub-folder whose every file (written by anyone) is part of the run.
+
+        For writers that fill a folder themselves (a demo step, a figure set).
+        """
+        p = self.path(name)
+        self._written.remove(Path(name).as_posix())
+        p.mkdir(parents=True, exist_ok=True)
+        self._folders.append(Path(name).as_posix())
+        return p
+
     def final(self, name: str) -> Path:
         """Where output ``name`` will be once the run has succeeded."""
         return self.root / name
@@ -339,12 +351,19 @@ class OutputDir:
         staging = self.staging
         old = self._read_manifest() or {}
         new = [n for n in self._written if (staging / n).is_file()]
+        for folder in self._folders:
+            new += sorted(f.relative_to(staging).as_posix()
+                          for f in (staging / folder).rglob("*") if f.is_file())
+        new = list(dict.fromkeys(new))
         stale = list(self.owns) if self.owns is not None else old.get("files", [])
         try:
             mode = 0o666 & ~_umask()
             for name in stale:
                 if isinstance(name, str) and name not in new and ".." not in Path(name).parts:
                     (self.root / name).unlink(missing_ok=True)
+                    for parent in Path(name).parents[:-1]:  # folders it leaves empty go too
+                        with contextlib.suppress(OSError):
+                            (self.root / parent).rmdir()
             for name in new:
                 dest = self.root / name
                 dest.parent.mkdir(parents=True, exist_ok=True)

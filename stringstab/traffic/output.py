@@ -9,22 +9,69 @@ those this run does not write) or, if it fails, leaves them as they were.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
+from ..constants import TTC_STAR
 from ..errors import StringStabError
 from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
 from .platoon import PlatoonResult
 
-__all__ = ["RUN_FILES", "save_trajectories", "write_run"]
+__all__ = ["RUN_FILES", "run_document", "save_trajectories", "write_run"]
 
 Format = Literal["npz", "csv"]
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
 RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "metrics.json",
                               "platoon.png", "damping.png")
+
+
+def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: str | None = None,
+                 ttc_star: float = TTC_STAR, warnings: Sequence[str] = ()) -> dict[str, Any]:
+    """The ``metrics.json`` document of a run: its settings, the IDL metrics and a certificate.
+
+    ``certificate`` holds the exact certificate (:func:`stringstab.certificate.certify`) of
+    the controller's gains when they are fixed and of the eq-4 form, else None.
+
+    Parameters
+    ----------
+    result : PlatoonResult
+        The run.
+    leader : Trajectory
+        Its leader.
+    controller : Controller
+        Its controller.
+    spec : str, optional
+        How the leader was named (e.g. on the command line).
+    ttc_star : float
+        TTC* of the safety metrics, s.
+    warnings : sequence of str
+        Warnings about the run (e.g. from :func:`~stringstab.traffic.platoon.check_leader`).
+    """
+    metrics = result.metrics(ttc_star=ttc_star)
+    return {
+        "run": {"leader": spec if spec is not None else leader.name, "leader_name": leader.name,
+                "followers": result.n_followers, "duration_s": leader.duration, **result.params},
+        **metrics,
+        "certificate": _certificate(controller, result.params),
+        "warnings": list(warnings),
+    }
+
+
+def _certificate(controller: Any, params: dict[str, Any]) -> dict[str, Any] | None:
+    K = controller.gains(None) if not controller.time_varying else None
+    taus = np.unique(np.asarray(params.get("tau"), dtype=np.float64))
+    if K is None or controller.headway is None or np.ndim(K) != 1 or taus.size != 1:
+        return None
+    from ..certificate import certify
+
+    c = certify(float(K[0]), float(K[1]), float(K[2]), tau=float(taus[0]),
+                delta=params["delta"], headway=controller.headway)
+    return {"k_x": float(K[0]), "k_v": float(K[1]), "k_a": float(K[2]), "verdict": c.verdict,
+            "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
 
 
 def _trajectory_columns(result: PlatoonResult) -> dict[str, np.ndarray]:
