@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import constants
-from .errors import StringStabError
+from .errors import StringStabError, show
 
 __all__ = [
     "DEFAULT_DELTA",
@@ -90,10 +90,10 @@ def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "")
     try:
         x = float(value)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number; got {value!r}") from e
+        raise StringStabError(f"{name} must be a number; got {show(value)}") from e
     if not (math.isfinite(x) and (x >= 0 if allow_zero else x > 0)):
         op = ">=" if allow_zero else ">"
-        raise StringStabError(f"{name} must be a finite number {op} 0{unit}; got {value!r}")
+        raise StringStabError(f"{name} must be a finite number {op} 0{unit}; got {show(value)}")
     return x
 
 
@@ -101,9 +101,9 @@ def _finite(name: str, value: Any) -> float:
     try:
         x = float(value)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number; got {value!r}") from e
+        raise StringStabError(f"{name} must be a number; got {show(value)}") from e
     if not math.isfinite(x):
-        raise StringStabError(f"{name} must be finite; got {value!r}")
+        raise StringStabError(f"{name} must be finite; got {show(value)}")
     return x
 
 
@@ -117,13 +117,13 @@ def check_params(tau: Any, delta: Any, headway: Any) -> tuple[float, float, floa
     """
     t = _finite("tau (actuator lag)", tau)
     if not t > 0:
-        raise StringStabError(f"tau (actuator lag) must be a finite number > 0 s; got {tau!r}")
+        raise StringStabError(f"tau (actuator lag) must be a finite number > 0 s; got {show(tau)}")
     d = _finite("delta (communication delay)", delta)
     if d < 0:
-        raise StringStabError(f"delta (communication delay) must be >= 0 s; got {delta!r}")
+        raise StringStabError(f"delta (communication delay) must be >= 0 s; got {show(delta)}")
     h = _finite("headway (desired time headway T*)", headway)
     if h < 0:
-        raise StringStabError(f"headway (desired time headway T*) must be >= 0 s; got {headway!r}")
+        raise StringStabError(f"headway (desired time headway T*) must be >= 0 s; got {show(headway)}")
     return t, d, h
 
 
@@ -150,5 +150,5 @@ def as_gains(
         if bad.any():
             idx = np.argwhere(bad)[0]
             where = f" at index {tuple(int(i) for i in idx)}" if a.ndim else ""
-            raise StringStabError(f"{name} must be finite{where}; got {float(a[tuple(idx)])!r}")
+            raise StringStabError(f"{name} must be finite{where}; got {show(float(a[tuple(idx)]))}")
     return arrs[0], arrs[1], arrs[2]

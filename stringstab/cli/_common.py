@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..io import (
     BINARY_FORMATS,
     RESULT_FORMATS,
@@ -94,5 +94,5 @@ def gains_from_args(args: Any) -> GainTable:
         raise StringStabError(
             "expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none"
         )
-    triples = [parse_triple(t, where=f"triple {i + 1} {t!r}") for i, t in enumerate(args.triples)]
+    triples = [parse_triple(t, where=f"triple {i + 1} {show(t)}") for i, t in enumerate(args.triples)]
     return GainTable.from_triples(triples, source="<command line>")

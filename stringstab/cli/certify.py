@@ -15,7 +15,7 @@ import sys
 import warnings
 from typing import Any
 
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ._common import (
     add_gain_arguments,
@@ -85,9 +85,9 @@ def _pade_order(text: str) -> int:
     try:
         n = int(text)
     except ValueError as e:
-        raise StringStabError(f"--pade-order must be an integer >= 1; got {text!r}") from e
+        raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}") from e
     if n < 1:
-        raise StringStabError(f"--pade-order must be an integer >= 1; got {text!r}")
+        raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}")
     return n
 
 

@@ -27,12 +27,12 @@ def add_parser(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``demo``."""
     from ..demo import STEPS, run_demo
-    from ..errors import StringStabError
+    from ..errors import StringStabError, show
 
     names = [n for n, _ in STEPS]
     for o in args.only or []:
         if o not in names:
-            raise StringStabError(f"--only: unknown step {o!r}; expected one of {names}")
+            raise StringStabError(f"--only: unknown step {show(o)}; expected one of {names}")
     run_demo(args.out, only=args.only)
     print(f"demo done: outputs in {args.out}/ (summary.json)")
     return 0

@@ -111,7 +111,7 @@ def _controller(args: argparse.Namespace, headway: float) -> Any:
     )
 
     if args.controller != "linear" and (args.gains or args.gains_file):
-        raise StringStabError(f"--gains/--gains-file apply to --controller linear, not {args.controller!r}")
+        raise StringStabError(f"--gains/--gains-file apply to --controller linear, not {show(args.controller)}")
     if args.controller == "cacc":
         return CACCController(t_system=headway, r_min=args.standstill)
     if args.controller == "idm":

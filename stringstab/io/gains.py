@@ -225,7 +225,7 @@ def parse_triple(text: str, *, where: str | None = None) -> tuple[float, float, 
     ...
     stringstab.errors.StringStabError: gain triple '0.9,-0.5': expected 3 comma-separated numbers k_x,k_v,k_a; found 2 fields
     """
-    label = where or f"gain triple {text!r}"
+    label = where or f"gain triple {show(text)}"
     parts = text.split(",")
     if len(parts) != 3:
         raise StringStabError(
@@ -239,7 +239,7 @@ def parse_triple(text: str, *, where: str | None = None) -> tuple[float, float, 
 def _suggest(name: str, candidates: Iterable[str]) -> str:
     """``"; is 'kv' a misspelling of 'k_v'?"`` for the closest candidate, or ``""``."""
     close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
-    return f"; is {close[0]!r} a misspelling of {name!r}?" if close else ""
+    return f"; is {show(close[0])} a misspelling of {show(name)}?" if close else ""
 
 
 def _resolve_columns(
@@ -252,14 +252,14 @@ def _resolve_columns(
         key = n.lower()
         if key in (*GAIN_COLUMNS, *OPTIONAL_COLUMNS):
             if key in index:
-                raise StringStabError(f"{source}: {what} {n!r} appears twice; expected it once")
+                raise StringStabError(f"{source}: {what} {show(n)} appears twice; expected it once")
             index[key] = i
     unknown = [n for n in norm if n.lower() not in index]
     expected = ", ".join(GAIN_COLUMNS)
     for col in GAIN_COLUMNS:
         if col not in index:
             raise StringStabError(
-                f"{source}: missing {what} {col!r}; expected {what}s {expected} "
+                f"{source}: missing {what} {show(col)}; expected {what}s {expected} "
                 f"(optional t, vehicle); found {', '.join(map(repr, norm)) or 'none'}"
                 + _suggest(col, unknown)
             )
@@ -270,7 +270,7 @@ def _resolve_columns(
         for n in unknown:
             if len(n) > 1 and difflib.SequenceMatcher(None, n.lower(), col).ratio() >= 0.8:
                 raise StringStabError(
-                    f"{source}: unknown {what} {n!r}; is it a misspelling of {col!r}? "
+                    f"{source}: unknown {what} {show(n)}; is it a misspelling of {show(col)}? "
                     f"(expected {expected}, optional t, vehicle)"
                 )
     return index, tuple(unknown)
@@ -366,7 +366,7 @@ def _read_csv(text: str, source: str) -> GainTable:
     if len(header) == 1 and (sep := next((d for d in ";\t|" if d in header[0]), None)):
         raise StringStabError(
             f"{source}, line {lines[0][0]}: expected comma-separated columns; "
-            f"found fields separated by {sep!r}"
+            f"found fields separated by {show(sep)}"
         )
     headerless = len(header) == 3 and all(_is_number(h) for h in header)
     if headerless:
@@ -397,7 +397,7 @@ def _read_csv(text: str, source: str) -> GainTable:
     fields = list(zip(*recs))
     cols: dict[str, list[Any]] = {c: list(fields[j]) for c, j in index.items()}
     return _table(
-        cols, source, lambda c, i: f"{source}, line {body[i][0][0]}, column {c!r}", ignored
+        cols, source, lambda c, i: f"{source}, line {body[i][0][0]}, column {show(c)}", ignored
     )
 
 
@@ -435,7 +435,7 @@ def _read_json(text: str, source: str) -> GainTable:
         items = doc[key]
     if not isinstance(items, list):
         raise StringStabError(
-            f"{source}: expected a list of gains{f' under {key!r}' if key else ''}; "
+            f"{source}: expected a list of gains{f' under {show(key)}' if key else ''}; "
             f"found {type(items).__name__}"
         )
     if not items:
@@ -455,7 +455,7 @@ def _read_json(text: str, source: str) -> GainTable:
         if not isinstance(it, dict):
             raise StringStabError(
                 f"{prefix}{i}]: expected an object with keys k_x, k_v, k_a "
-                f"(or a triple [k_x, k_v, k_a]); found {type(it).__name__} {it!r}"
+                f"(or a triple [k_x, k_v, k_a]); found {type(it).__name__} {show(it)}"
             )
         keys = list(map(str, it))
         index, _ = _resolve_columns(keys, f"{prefix}{i}]", what="key")
@@ -472,7 +472,7 @@ def _read_json(text: str, source: str) -> GainTable:
         values = list(it.values())
         for c, j in index.items():
             cols[c].append(values[j])
-    return _table(cols, source, lambda c, i: f"{prefix}{i}], key {c!r}")
+    return _table(cols, source, lambda c, i: f"{prefix}{i}], key {show(c)}")
 
 
 def _read_npz(path: Path, source: str) -> GainTable:
@@ -547,12 +547,12 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
     for c, a in cols.items():
         if a.ndim != 1 or len(a) != n:
             raise StringStabError(
-                f"{source}: array {c!r} must be 1-D of length {n} (one entry per triple); "
+                f"{source}: array {show(c)} must be 1-D of length {n} (one entry per triple); "
                 f"found shape {a.shape}"
             )
         if c != "vehicle" and not (np.issubdtype(a.dtype, np.number) and not np.iscomplexobj(a)):
             raise StringStabError(
-                f"{source}: array {c!r} must be real numbers; found dtype {a.dtype}"
+                f"{source}: array {show(c)} must be real numbers; found dtype {a.dtype}"
             )
     # Fast vectorised check, then a precise message naming the first bad entry.
     for c in (*GAIN_COLUMNS, "t"):
@@ -562,8 +562,8 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
             if bad.size:
                 i = int(bad[0])
                 raise StringStabError(
-                    f"{source}: array {c!r}, index {i}: expected a finite number; "
-                    f"found {float(a[i])!r}"
+                    f"{source}: array {show(c)}, index {i}: expected a finite number; "
+                    f"found {show(float(a[i]))}"
                 )
             cols[c] = a
     vehicle = _vehicle_array(cols["vehicle"].tolist()) if "vehicle" in cols else None
@@ -639,7 +639,7 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
     kind_or_none = fmt or INPUT_FORMATS.get(path.suffix.lower())
     if kind_or_none is None:
         raise StringStabError(
-            f"{name}: unsupported file extension {path.suffix or '(none)'!r}; "
+            f"{name}: unsupported file extension {show(path.suffix or '(none)')}; "
             "expected .csv, .json or .npz (or .parquet)"
         )
     kind = kind_or_none

@@ -12,7 +12,7 @@ from importlib import resources
 import numpy as np
 
 from ..constants import DT, SPEED_MAX
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from .trajectory import Trajectory, from_speed
 
 __all__ = ["CYCLES", "CYCLE_ALIASES", "cycle"]
@@ -63,7 +63,7 @@ def cycle(name: str, *, dt: float = DT, speed_max: float | None = SPEED_MAX) -> 
     key = str(name).strip().lower()
     key = CYCLE_ALIASES.get(key, key)
     if key not in CYCLES:
-        raise StringStabError(f"unknown driving cycle {name!r}; expected one of {sorted(CYCLES)}")
+        raise StringStabError(f"unknown driving cycle {show(name)}; expected one of {sorted(CYCLES)}")
     fname = CYCLES[key][0]
     res = resources.files("stringstab").joinpath("data").joinpath("cycles").joinpath(fname)
     with res.open("r", encoding="utf-8-sig") as fh:

@@ -41,7 +41,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..constants import DT, GAIN_BOUNDS, STATE_SCALES, TTC_STAR
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..metrics import time_headway, time_to_collision
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from .controllers import DEFAULT_STANDSTILL, Observation
@@ -100,10 +100,10 @@ class _Core:
         if len(dts) != 1:
             raise StringStabError(f"all leaders must share one step dt; got {sorted(dts)}")
         if action not in ("gains", "accel"):
-            raise StringStabError(f"action must be 'gains' or 'accel'; got {action!r}")
+            raise StringStabError(f"action must be 'gains' or 'accel'; got {show(action)}")
         lo, hi = (float(b) for b in gain_bounds)
         if not lo < hi:
-            raise StringStabError(f"gain_bounds must be (low, high) with low < high; got {gain_bounds!r}")
+            raise StringStabError(f"gain_bounds must be (low, high) with low < high; got {show(gain_bounds)}")
         self.items, self.n, self.dt = items, int(n), trs[0].dt
         self.action, self.gain_bounds = action, (lo, hi)
         self.headway, self.standstill = float(headway), float(standstill)
@@ -269,7 +269,7 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                  gain_filter: Callable[[Array], npt.ArrayLike] | None = None,
                  order: Literal["random", "sequential"] = "random") -> None:
         if order not in ("random", "sequential"):
-            raise StringStabError(f"order must be 'random' or 'sequential'; got {order!r}")
+            raise StringStabError(f"order must be 'random' or 'sequential'; got {show(order)}")
         self._core = _Core(leaders if leaders is not None else _default_leaders(), 1, action=action,
                            tau=tau, delta=delta, headway=headway, standstill=standstill, model=model,
                            limits=limits, length=length, gain_bounds=gain_bounds, weights=weights,
@@ -354,7 +354,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                  terminate_on_collision: bool = True,
                  gain_filter: Callable[[Array], npt.ArrayLike] | None = None) -> None:
         if int(num_envs) < 1:
-            raise StringStabError(f"num_envs must be >= 1; got {num_envs!r}")
+            raise StringStabError(f"num_envs must be >= 1; got {show(num_envs)}")
         self.num_envs = int(num_envs)
         self._core = _Core(leaders if leaders is not None else _default_leaders(), self.num_envs,
                            action=action, tau=tau, delta=delta, headway=headway,

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ..constants import DT, SPEED_MAX
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from .cycles import CYCLE_ALIASES, CYCLES, cycle
 from .loaders import FEET, FollowingPair, load_csv, load_ngsim_pairs
 from .split import train_test_split
@@ -64,12 +64,12 @@ def _parse_kwargs(spec: str, fn: Callable[..., Any], what: str) -> dict[str, Any
         key = key.strip()
         if not sep or key not in accepted:
             raise StringStabError(
-                f"{what}: expected KEY=VALUE with KEY in {accepted}; got {item!r}"
+                f"{what}: expected KEY=VALUE with KEY in {accepted}; got {show(item)}"
             )
         try:
             num = float(val)
         except ValueError as e:
-            raise StringStabError(f"{what}: {key} must be a number; got {val.strip()!r}") from e
+            raise StringStabError(f"{what}: {key} must be a number; got {show(val.strip())}") from e
         out[key] = int(num) if key == "waves" else num
     return out
 
@@ -108,29 +108,29 @@ def leader_by_name(spec: str, *, dt: float = DT, duration: float | None = None) 
     key = name.strip().lower()
     if key in SYNTHETIC:
         fn = SYNTHETIC[key]
-        kwargs = _parse_kwargs(params, fn, f"leader {key!r}")
+        kwargs = _parse_kwargs(params, fn, f"leader {show(key)}")
         missing = [p.name for p in inspect.signature(fn).parameters.values()
                    if p.default is p.empty and p.name not in kwargs]
         if missing:
             raise StringStabError(
-                f"leader {key!r} needs {', '.join(missing)}: expected "
-                f"{key}:{'=...,'.join(missing)}=... (e.g. {key}:omega=0.5); got {spec!r}"
+                f"leader {show(key)} needs {', '.join(missing)}: expected "
+                f"{key}:{'=...,'.join(missing)}=... (e.g. {key}:omega=0.5); got {show(spec)}"
             )
         tr = fn(dt=dt, **kwargs)
     elif key in CYCLES or key in CYCLE_ALIASES:
         if params:
-            raise StringStabError(f"leader {key!r} takes no parameters; got {params!r}")
+            raise StringStabError(f"leader {show(key)} takes no parameters; got {show(params)}")
         tr = cycle(key, dt=dt)
     elif spec.lower().endswith(".csv") or Path(spec).is_file():
         tr = load_csv(spec, dt=dt)
     else:
         raise StringStabError(
-            f"unknown leader {spec!r}; expected a cycle {sorted(CYCLES)}, a synthetic profile "
+            f"unknown leader {show(spec)}; expected a cycle {sorted(CYCLES)}, a synthetic profile "
             f"{sorted(SYNTHETIC)} (NAME:key=value,...) or the path of a 't, v[, a]' CSV file"
         )
     if duration is not None:
         if not duration > 0:
-            raise StringStabError(f"duration must be > 0 s; got {duration!r}")
+            raise StringStabError(f"duration must be > 0 s; got {show(duration)}")
         n = min(tr.n_steps, math.floor(duration / tr.dt + 1e-9) + 1)
         tr = tr.window(0, max(n, 2))
     return tr

@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..constants import DT
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from .trajectory import Trajectory, from_speed
 
 __all__ = ["FEET", "FollowingPair", "load_csv", "load_ngsim_pairs"]
@@ -50,36 +50,36 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
         with p.open(newline="", encoding="utf-8-sig") as fh:
             rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     except OSError as e:
-        raise StringStabError(f"cannot read leader CSV {str(p)!r}: {e.strerror or e}") from e
+        raise StringStabError(f"cannot read leader CSV {show(str(p))}: {e.strerror or e}") from e
     if not rows:
-        raise StringStabError(f"leader CSV {str(p)!r} is empty; expected a header 't, v' or 't, v, a'")
+        raise StringStabError(f"leader CSV {show(str(p))} is empty; expected a header 't, v' or 't, v, a'")
     header = [c.strip().lower() for c in rows[0]]
     if header not in (["t", "v"], ["t", "v", "a"]):
         raise StringStabError(
-            f"leader CSV {str(p)!r}: expected columns 't, v' or 't, v, a' (SI units: s, m/s, "
+            f"leader CSV {show(str(p))}: expected columns 't, v' or 't, v, a' (SI units: s, m/s, "
             f"m/s^2); found {[c.strip() for c in rows[0]]}"
         )
     data = []
     for i, r in enumerate(rows[1:], start=2):
         if len(r) != len(header):
             raise StringStabError(
-                f"leader CSV {str(p)!r} line {i}: expected {len(header)} values; got {len(r)}"
+                f"leader CSV {show(str(p))} line {i}: expected {len(header)} values; got {len(r)}"
             )
         try:
             vals = [float(c) for c in r]
         except ValueError as e:
-            raise StringStabError(f"leader CSV {str(p)!r} line {i}: not a number in {r}") from e
+            raise StringStabError(f"leader CSV {show(str(p))} line {i}: not a number in {r}") from e
         if not all(math.isfinite(x) for x in vals):
-            raise StringStabError(f"leader CSV {str(p)!r} line {i}: values must be finite; got {r}")
+            raise StringStabError(f"leader CSV {show(str(p))} line {i}: values must be finite; got {r}")
         data.append(vals)
     if len(data) < 2:
-        raise StringStabError(f"leader CSV {str(p)!r}: needs at least 2 data rows; got {len(data)}")
+        raise StringStabError(f"leader CSV {show(str(p))}: needs at least 2 data rows; got {len(data)}")
     arr = np.asarray(data)
     try:
         tr = from_speed(arr[:, 0], arr[:, 1], dt=dt, accel=arr[:, 2] if arr.shape[1] == 3 else None,
                         speed_max=speed_max, name=p.stem)
     except StringStabError as e:
-        raise StringStabError(f"leader CSV {str(p)!r}: {e}") from e
+        raise StringStabError(f"leader CSV {show(str(p))}: {e}") from e
     tr.meta["source"] = str(p)
     return tr
 
@@ -173,14 +173,14 @@ def load_ngsim_pairs(
     try:
         fh = p.open(newline="", encoding="utf-8-sig")
     except OSError as e:
-        raise StringStabError(f"cannot read NGSIM file {str(p)!r}: {e.strerror or e}") from e
+        raise StringStabError(f"cannot read NGSIM file {show(str(p))}: {e.strerror or e}") from e
     with fh:
         reader = csv.reader(fh)
         header = [c.strip().lower() for c in next(reader, [])]
         missing = [c for c in _NGSIM_REQUIRED if c.lower() not in header]
         if missing:
             raise StringStabError(
-                f"NGSIM file {str(p)!r}: missing columns {missing}; expected the US-101/I-80 "
+                f"NGSIM file {show(str(p))}: missing columns {missing}; expected the US-101/I-80 "
                 f"format with {list(_NGSIM_REQUIRED)} (and optionally v_Length, Location)"
             )
         cols = [*_NGSIM_REQUIRED, *(c for c in ("v_Length",) if c.lower() in header)]
@@ -194,7 +194,7 @@ def load_ngsim_pairs(
             try:
                 num.append([float(r[i]) for i in idx])
             except (ValueError, IndexError) as e:
-                raise StringStabError(f"NGSIM file {str(p)!r} line {line}: bad numeric value") from e
+                raise StringStabError(f"NGSIM file {show(str(p))} line {line}: bad numeric value") from e
             locs.append(r[loc_i].strip().lower() if loc_i is not None and loc_i < len(r) else "")
     if not num:
         return []
@@ -203,7 +203,7 @@ def load_ngsim_pairs(
     if location is not None:
         if loc_i is None:
             raise StringStabError(
-                f"NGSIM file {str(p)!r} has no Location column; cannot select location {location!r}"
+                f"NGSIM file {show(str(p))} has no Location column; cannot select location {show(location)}"
             )
         keep = loc_arr == location.strip().lower()
         arr, loc_arr = arr[keep], loc_arr[keep]

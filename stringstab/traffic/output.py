@@ -16,7 +16,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..constants import TTC_STAR
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
 from .platoon import PlatoonResult
 
@@ -117,7 +117,7 @@ def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = 
     if result.speed.ndim != 2:
         raise StringStabError("save_trajectories saves one platoon; select one from the batch first")
     if fmt not in ("npz", "csv"):
-        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {fmt!r}")
+        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {show(fmt)}")
     p = Path(path)
     if fmt == "csv":
         write_results(_trajectory_columns(result), p, "csv", what="trajectories")
@@ -180,7 +180,7 @@ def write_run(result: PlatoonResult, out: str | Path | OutputDir, *, metrics: di
         ``{kind: file name}`` of everything written under ``out``.
     """
     if fmt not in ("npz", "csv"):
-        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {fmt!r}")
+        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {show(fmt)}")
     if isinstance(out, OutputDir):
         return _write(result, out, metrics, fmt, figures, title)
     with OutputDir(out, command="simulate", owns=RUN_FILES) as d:

@@ -54,7 +54,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..constants import ACCEL_MAX, ACCEL_MIN, SPEED_MAX, TTC_STAR
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..metrics import damping_ratios_from_energy, platoon_metrics, time_headway
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
 from .controllers import Controller, Observation
@@ -130,7 +130,7 @@ def check_leader(leader: Trajectory, limits: Limits | None = None) -> list[str]:
     k = int(np.argmax(v))
     if v[k] > lim.speed_max + 1e-9:
         raise StringStabError(
-            f"leader {leader.name!r} reaches {float(v[k]):.4g} m/s at t = {k * leader.dt:.4g} s, "
+            f"leader {show(leader.name)} reaches {float(v[k]):.4g} m/s at t = {k * leader.dt:.4g} s, "
             f"above the followers' speed limit v_max = {lim.speed_max:g} m/s (IDL Table 2): they "
             f"could not follow it; expected a leader within [0, {lim.speed_max:g}] m/s"
         )
@@ -153,15 +153,15 @@ def _check_lag_delay(tau: npt.ArrayLike, delta: float) -> tuple[Array, float]:
     try:
         t = np.asarray(tau, dtype=np.float64)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"tau (actuator lag) must be a number > 0 s; got {tau!r}") from e
+        raise StringStabError(f"tau (actuator lag) must be a number > 0 s; got {show(tau)}") from e
     if not (np.isfinite(t).all() and (t > 0).all()):
-        raise StringStabError(f"tau (actuator lag) must be a finite number > 0 s; got {tau!r}")
+        raise StringStabError(f"tau (actuator lag) must be a finite number > 0 s; got {show(tau)}")
     try:
         d = float(delta)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"delta (communication delay) must be a number >= 0 s; got {delta!r}") from e
+        raise StringStabError(f"delta (communication delay) must be a number >= 0 s; got {show(delta)}") from e
     if not (math.isfinite(d) and d >= 0):
-        raise StringStabError(f"delta (communication delay) must be a finite number >= 0 s; got {delta!r}")
+        raise StringStabError(f"delta (communication delay) must be a finite number >= 0 s; got {show(delta)}")
     return t, d
 
 
@@ -208,12 +208,12 @@ class Platoon:
                  length: float = DEFAULT_LENGTH) -> None:
         if int(n_platoons) < 1 or int(n_followers) < 1:
             raise StringStabError(
-                f"n_platoons and n_followers must be >= 1; got {n_platoons!r} and {n_followers!r}"
+                f"n_platoons and n_followers must be >= 1; got {show(n_platoons)} and {show(n_followers)}"
             )
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            raise StringStabError(f"dt must be a finite number > 0 s; got {dt!r}")
+            raise StringStabError(f"dt must be a finite number > 0 s; got {show(dt)}")
         if model not in ("lag", "kinematic"):
-            raise StringStabError(f"model must be 'lag' or 'kinematic'; got {model!r}")
+            raise StringStabError(f"model must be 'lag' or 'kinematic'; got {show(model)}")
         tau_arr, d = _check_lag_delay(tau, delta)
         P, N = int(n_platoons), int(n_followers)
         self.P, self.N, self.dt, self.model, self.delta = P, N, float(dt), model, d
@@ -541,9 +541,9 @@ def simulate(
     try:
         N = int(n_followers)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}") from e
+        raise StringStabError(f"n_followers must be an integer >= 1; got {show(n_followers)}") from e
     if N < 1 or N != n_followers:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}")
+        raise StringStabError(f"n_followers must be an integer >= 1; got {show(n_followers)}")
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
@@ -561,9 +561,9 @@ def simulate(
     sumsq = np.zeros((P, N + 1))
     min_gap = np.full((P, N), np.inf)
     gains_rec: Array | None = None
-    show = (P * N * T > 1e8) if progress is None else bool(progress)
+    show_bar = (P * N * T > 1e8) if progress is None else bool(progress)
     steps: Any = range(T)
-    if show:
+    if show_bar:
         from tqdm.auto import tqdm
 
         steps = tqdm(steps, total=T, unit="step", desc=f"simulate {P}x{N}", mininterval=0.5)
@@ -595,7 +595,7 @@ def simulate(
             ul = np.clip(u, lim.accel_min, lim.accel_max)
         if record:
             cmd[k] = ul
-    if show:
+    if show_bar:
         steps.close()
 
     def lead(a: Array | None, axes: tuple[int, ...]) -> Array | None:

@@ -7,7 +7,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 
 __all__ = ["train_test_split"]
 
@@ -42,7 +42,7 @@ def train_test_split(
     if n < 2:
         raise StringStabError(f"train_test_split needs at least 2 items; got {n}")
     if not (0.0 < test_fraction < 1.0):
-        raise StringStabError(f"test_fraction must be in (0, 1); got {test_fraction!r}")
+        raise StringStabError(f"test_fraction must be in (0, 1); got {show(test_fraction)}")
     n_test = min(max(round(test_fraction * n), 1), n - 1)
     order = np.random.default_rng(seed).permutation(n) if shuffle else np.arange(n)
     return [items[i] for i in order[: n - n_test]], [items[i] for i in order[n - n_test:]]

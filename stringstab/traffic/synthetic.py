@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..params import positive
 from .trajectory import Trajectory, _grid, from_accel_segments
 
@@ -61,14 +61,14 @@ def sinusoid(
     """
     d = positive("dt", dt, unit=" s")
     if not (math.isfinite(omega) and omega > 0):
-        raise StringStabError(f"omega must be a finite number > 0 rad/s; got {omega!r}")
+        raise StringStabError(f"omega must be a finite number > 0 rad/s; got {show(omega)}")
     if not (0 <= amplitude <= speed):
         raise StringStabError(
-            f"amplitude must be between 0 and the mean speed {speed!r} m/s; got {amplitude!r}"
+            f"amplitude must be between 0 and the mean speed {show(speed)} m/s; got {show(amplitude)}"
         )
     t = _grid(0.0, float(duration), d)
     if t.shape[0] < 2:
-        raise StringStabError(f"duration must be at least one step; got {duration!r}")
+        raise StringStabError(f"duration must be at least one step; got {show(duration)}")
     wt = omega * t
     tr = Trajectory(d, speed * t - amplitude / omega * np.sin(wt), speed - amplitude * np.cos(wt),
                     amplitude * omega * np.sin(wt), f"sinusoid(omega={omega:g})")
@@ -95,8 +95,8 @@ def hard_braking(
     """
     if not (decel < 0 and to_speed < speed):
         raise StringStabError(
-            f"hard_braking needs decel < 0 and to_speed < speed; got decel={decel!r}, "
-            f"speed={speed!r}, to_speed={to_speed!r}"
+            f"hard_braking needs decel < 0 and to_speed < speed; got decel={show(decel)}, "
+            f"speed={show(speed)}, to_speed={show(to_speed)}"
         )
     return from_accel_segments(
         [(0.0, cruise_before), (decel, (to_speed - speed) / decel), (0.0, cruise_after)],
@@ -122,8 +122,8 @@ def hard_acceleration(
     """
     if not (accel > 0 and to_speed > speed):
         raise StringStabError(
-            f"hard_acceleration needs accel > 0 and to_speed > speed; got accel={accel!r}, "
-            f"speed={speed!r}, to_speed={to_speed!r}"
+            f"hard_acceleration needs accel > 0 and to_speed > speed; got accel={show(accel)}, "
+            f"speed={show(speed)}, to_speed={show(to_speed)}"
         )
     return from_accel_segments(
         [(0.0, cruise_before), (accel, (to_speed - speed) / accel), (0.0, cruise_after)],
@@ -153,8 +153,8 @@ def stop_and_go(
     if not (speed_high > speed_low >= 0 and accel > 0 and decel < 0 and waves >= 1):
         raise StringStabError(
             "stop_and_go needs speed_high > speed_low >= 0, accel > 0, decel < 0, waves >= 1; got "
-            f"speed_high={speed_high!r}, speed_low={speed_low!r}, accel={accel!r}, "
-            f"decel={decel!r}, waves={waves!r}"
+            f"speed_high={show(speed_high)}, speed_low={show(speed_low)}, accel={show(accel)}, "
+            f"decel={show(decel)}, waves={show(waves)}"
         )
     dv = speed_high - speed_low
     segs: list[tuple[float, float]] = [(0.0, dwell_high)]

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..constants import DT, SPEED_MAX
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 from ..params import positive
 
 __all__ = ["Trajectory", "from_accel_segments", "from_speed"]
@@ -55,7 +55,7 @@ class Trajectory:
 
     def __post_init__(self) -> None:
         if not (isinstance(self.dt, (int, float)) and math.isfinite(self.dt) and self.dt > 0):
-            raise StringStabError(f"trajectory step dt must be a finite number > 0 s; got {self.dt!r}")
+            raise StringStabError(f"trajectory step dt must be a finite number > 0 s; got {show(self.dt)}")
         arrs = []
         for nm in ("position", "speed", "accel"):
             a = np.ascontiguousarray(getattr(self, nm), dtype=np.float64)
@@ -102,7 +102,7 @@ class Trajectory:
         """
         n = round(float(seconds) / self.dt)
         if n < 0:
-            raise StringStabError(f"hold needs seconds >= 0; got {seconds!r}")
+            raise StringStabError(f"hold needs seconds >= 0; got {show(seconds)}")
         v_end = self.speed[-1]
         x_tail = self.position[-1] + v_end * self.dt * np.arange(1, n + 1)
         accel = self.accel.copy()
@@ -197,14 +197,14 @@ def from_speed(
     if (steps <= 0).any():
         i = int(np.argmax(steps <= 0))
         raise StringStabError(
-            f"t must be strictly increasing; got t[{i}]={tt[i]!r} then t[{i + 1}]={tt[i + 1]!r}"
+            f"t must be strictly increasing; got t[{i}]={show(tt[i])} then t[{i + 1}]={show(tt[i + 1])}"
         )
     if (vv < 0).any():
         i = int(np.argmax(vv < 0))
-        raise StringStabError(f"speed must be >= 0 m/s; got {vv[i]!r} at t={tt[i]!r}")
+        raise StringStabError(f"speed must be >= 0 m/s; got {show(vv[i])} at t={show(tt[i])}")
     grid = _grid(tt[0], tt[-1], d)
     if grid.shape[0] < 2:
-        raise StringStabError(f"the profile lasts {tt[-1] - tt[0]!r} s, shorter than one step dt={d!r} s")
+        raise StringStabError(f"the profile lasts {show(tt[-1] - tt[0])} s, shorter than one step dt={show(d)} s")
     v = np.interp(grid, tt, vv)
     capped = np.zeros(v.shape, dtype=bool)
     if speed_max is not None:
@@ -254,11 +254,11 @@ def from_accel_segments(
     seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2)
     accs, durs = seg[:, 0], seg[:, 1]
     if not (np.isfinite(seg).all() and (durs >= 0).all()):
-        raise StringStabError(f"segments must be (finite accel, finite duration >= 0); got {segments!r}")
+        raise StringStabError(f"segments must be (finite accel, finite duration >= 0); got {show(segments)}")
     edges = np.r_[0.0, np.cumsum(durs)]
     n = math.floor(edges[-1] / d + 1e-9)
     if n < 1:
-        raise StringStabError(f"segments must last at least one step dt={d!r} s; got {edges[-1]!r} s")
+        raise StringStabError(f"segments must last at least one step dt={show(d)} s; got {show(edges[-1])} s")
     grid = np.arange(n + 1) * d
     # the step average of the piecewise-constant acceleration (exactly a_j inside a segment)
     lo = np.clip(np.searchsorted(edges, grid[:-1] + 1e-9 * d, side="right") - 1, 0, len(accs) - 1)
