@@ -358,11 +358,14 @@ def _read_csv(text: str, source: str) -> GainTable:
             f"{source}: empty file; expected a CSV header with columns k_x,k_v,k_a "
             "(optional t, vehicle) and at least one row"
         )
-    try:
-        records = list(csv.reader([ln for _, ln in lines], skipinitialspace=True))
-    except csv.Error as e:
-        raise StringStabError(f"{source}: not a readable CSV file ({e})") from e
-    header = records[0]
+
+    def parse(rows: list[tuple[int, str]]) -> list[list[str]]:
+        try:
+            return list(csv.reader([ln for _, ln in rows], skipinitialspace=True))
+        except csv.Error as e:
+            raise StringStabError(f"{source}: not a readable CSV file ({e})") from e
+
+    header = parse(lines[:1])[0]
     if len(header) == 1 and (sep := next((d for d in ";\t|" if d in header[0]), None)):
         raise StringStabError(
             f"{source}, line {lines[0][0]}: expected comma-separated columns; "
@@ -372,7 +375,7 @@ def _read_csv(text: str, source: str) -> GainTable:
     if headerless:
         index = {c: j for j, c in enumerate(GAIN_COLUMNS)}
         ignored: tuple[str, ...] = ()
-        body = list(zip(lines, records))
+        body = lines
     else:
         if all(_is_number(h) for h in header):
             raise StringStabError(
@@ -381,24 +384,55 @@ def _read_csv(text: str, source: str) -> GainTable:
                 f"found {len(header)} numbers"
             )
         index, ignored = _resolve_columns(header, source)
-        body = list(zip(lines[1:], records[1:]))
+        body = lines[1:]
     if not body:
         raise StringStabError(
             f"{source}: no data rows after the header; expected at least one row of gains"
         )
     width = len(header)
-    recs = [rec for _, rec in body]
+    fast = _fast_csv([ln for _, ln in body], index, width)
+    if fast is not None:
+        return GainTable(fast["k_x"], fast["k_v"], fast["k_a"], fast.get("t"), fast.get("vehicle"),
+                         source=source, ignored_columns=ignored)
+    recs = parse(body)
     if any(len(rec) != width for rec in recs):
-        (lineno, _), rec = next((b, r) for b, r in body if len(r) != width)
+        k = next(k for k, r in enumerate(recs) if len(r) != width)
         raise StringStabError(
-            f"{source}, line {lineno}: expected {width} comma-separated fields "
-            f"({','.join(h.strip() for h in header)}); found {len(rec)}"
+            f"{source}, line {body[k][0]}: expected {width} comma-separated fields "
+            f"({','.join(h.strip() for h in header)}); found {len(recs[k])}"
         )
     fields = list(zip(*recs))
     cols: dict[str, list[Any]] = {c: list(fields[j]) for c, j in index.items()}
     return _table(
-        cols, source, lambda c, i: f"{source}, line {body[i][0][0]}, column {show(c)}", ignored
+        cols, source, lambda c, i: f"{source}, line {body[i][0]}, column {show(c)}", ignored
     )
+
+
+def _fast_csv(lines: list[str], index: dict[str, int], width: int) -> dict[str, Any] | None:
+    """The columns of plain numeric CSV rows, parsed in C (numpy.loadtxt); None if not plain.
+
+    Plain: no quotes, ``width`` fields on every row, finite numbers in the numeric columns and
+    a non-empty vehicle id.  Anything else returns None and is read by the cell-by-cell path,
+    which names the first bad cell.
+    """
+    if any('"' in ln or ln.count(",") != width - 1 for ln in lines):
+        return None
+    numeric = [c for c in index if c != "vehicle"]
+    try:
+        arr = np.loadtxt(lines, delimiter=",", usecols=[index[c] for c in numeric],
+                         dtype=np.float64, comments=None, ndmin=2)
+    except ValueError:
+        return None
+    if arr.shape != (len(lines), len(numeric)) or not np.isfinite(arr).all():
+        return None
+    out: dict[str, Any] = {c: np.ascontiguousarray(arr[:, j]) for j, c in enumerate(numeric)}
+    if "vehicle" in index:
+        j = index["vehicle"]
+        ids = [ln.split(",")[j].strip() for ln in lines]
+        if not all(ids):
+            return None
+        out["vehicle"] = _vehicle_array(ids)
+    return out
 
 
 def _is_number(s: str) -> bool:
