@@ -444,8 +444,9 @@ def _table_cells(leaf: _Leaf, spec: TableColumn) -> list[str]:
     if k == "b":
         cells = np.where(v, "yes", "no").tolist()
     elif k == "f":
-        fmt = spec.fmt.__mod__
-        cells = [fmt(x) if x == x else spec.missing for x in v.tolist()]
+        cells = list(map(spec.fmt.__mod__, v.tolist()))
+        for i in np.flatnonzero(np.isnan(v)).tolist():
+            cells[i] = spec.missing
     elif k == "i":
         fmt = spec.fmt.__mod__ if "d" in spec.fmt else str
         cells = list(map(fmt, v.tolist()))

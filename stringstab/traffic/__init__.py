@@ -44,13 +44,14 @@ from .leaders import (
     stop_and_go,
     train_test_split,
 )
-from .output import save_trajectories, write_run
-from .platoon import Limits, Platoon, PlatoonResult, simulate
+from .output import RUN_FILES, run_document, save_trajectories, write_run
+from .platoon import Limits, Platoon, PlatoonResult, check_leader, simulate
 from .plots import plot_damping_ratios, plot_platoon, plot_vehicles
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
 
 __all__ = [
     "CYCLES",
+    "RUN_FILES",
     "SCALES",
     "SYNTHETIC",
     "BatchedCarFollowingEnv",
@@ -68,6 +69,7 @@ __all__ = [
     "PlatoonResult",
     "TimeVaryingLinearController",
     "Trajectory",
+    "check_leader",
     "comfort_reward",
     "cycle",
     "efficiency_reward",
@@ -84,6 +86,7 @@ __all__ = [
     "plot_platoon",
     "plot_vehicles",
     "reward",
+    "run_document",
     "safety_reward",
     "save_trajectories",
     "simulate",
