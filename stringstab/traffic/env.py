@@ -45,9 +45,11 @@ from ..errors import StringStabError, show
 from ..metrics import time_headway, time_to_collision
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from .controllers import DEFAULT_STANDSTILL, Observation
-from .leaders import FollowingPair, Trajectory, cycle
+from .cycles import cycle
+from .loaders import FollowingPair
 from .platoon import DEFAULT_LENGTH, Limits, Model, Platoon
 from .reward import reward
+from .trajectory import Trajectory
 
 __all__ = ["SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "state_vector"]
 

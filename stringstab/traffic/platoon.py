@@ -58,7 +58,7 @@ from ..errors import StringStabError, show
 from ..metrics import damping_ratios_from_energy, platoon_metrics, time_headway
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
 from .controllers import Controller, Observation
-from .leaders import Trajectory
+from .trajectory import Trajectory
 
 __all__ = ["DEFAULT_LENGTH", "Limits", "Platoon", "PlatoonResult", "check_leader", "simulate"]
 
