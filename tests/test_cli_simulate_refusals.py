@@ -106,3 +106,14 @@ def test_a_second_run_replaces_the_first(capsys, tmp_path):
     (out / "notes.txt").write_text("mine")
     assert main(["simulate", *SHORT, "--followers", "2", "--format", "csv", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt", "trajectories.csv"]
+
+
+def test_parquet_trajectories(tmp_path, capsys):
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "out"
+    assert main(["simulate", *SHORT, "--followers", "2", "--format", "parquet", "--out", str(out)]) == 0
+    t = pq.read_table(out / "trajectories.parquet")
+    assert t.column_names == ["t", "vehicle", "position", "speed", "accel", "gap", "headway", "command"]
+    assert t.num_rows == 101 * 3
+    with open(out / "metrics.json") as fh:  # the run document beside it
+        assert json.load(fh)["run"]["followers"] == 2

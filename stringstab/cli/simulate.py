@@ -74,7 +74,8 @@ def add_parser(sub: Any) -> None:
                    help="third-order model with exact ZOH (default) or the paper's eqs 1-2")
     p.add_argument("--ttc-star", type=float, default=TTC_STAR,
                    help=f"TTC* threshold, s (default {TTC_STAR:g})")
-    p.add_argument("--format", choices=("npz", "csv"), default="npz", help="trajectory file format")
+    p.add_argument("--format", choices=("npz", "csv", "parquet"), default="npz",
+                   help="trajectory file format (default: npz)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (an earlier run's files in it are replaced)")

@@ -22,11 +22,11 @@ from .platoon import PlatoonResult
 
 __all__ = ["RUN_FILES", "run_document", "save_trajectories", "write_run"]
 
-Format = Literal["npz", "csv"]
+Format = Literal["npz", "csv", "parquet"]
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
-RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "metrics.json",
-                              "platoon.png", "damping.png")
+RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "trajectories.parquet",
+                              "metrics.json", "platoon.png", "damping.png")
 
 
 def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: str | None = None,
@@ -74,8 +74,11 @@ def _certificate(controller: Any, params: dict[str, Any]) -> dict[str, Any] | No
             "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
 
 
-def _trajectory_columns(result: PlatoonResult) -> dict[str, np.ndarray]:
-    """One row per (time, vehicle); vehicle 0 (the leader) has no gap, headway or command."""
+def _trajectory_columns(result: PlatoonResult, digits: int | None = 6) -> dict[str, np.ndarray]:
+    """One row per (time, vehicle); vehicle 0 (the leader) has no gap, headway or command.
+
+    Values are rounded to ``digits`` decimals (None: full precision).
+    """
     assert result.speed is not None and result.position is not None and result.accel is not None
     n_veh, T = result.speed.shape
     gap, hw = result.gap, result.headway
@@ -86,15 +89,18 @@ def _trajectory_columns(result: PlatoonResult) -> dict[str, np.ndarray]:
         out[:, 1:] = a.T
         return out.ravel()
 
+    def r(a: np.ndarray) -> np.ndarray:
+        return a if digits is None else np.round(a, digits)
+
     return {
         "t": np.repeat(np.round(result.t, 9), n_veh),
         "vehicle": np.tile(np.arange(n_veh), T),
-        "position": np.round(result.position.T.ravel(), 6),
-        "speed": np.round(result.speed.T.ravel(), 6),
-        "accel": np.round(result.accel.T.ravel(), 6),
-        "gap": np.round(followers(gap), 6),
-        "headway": np.round(followers(hw), 6),
-        "command": np.round(followers(cmd), 6),
+        "position": r(result.position.T.ravel()),
+        "speed": r(result.speed.T.ravel()),
+        "accel": r(result.accel.T.ravel()),
+        "gap": r(followers(gap)),
+        "headway": r(followers(hw)),
+        "command": r(followers(cmd)),
     }
 
 
@@ -105,7 +111,9 @@ def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = 
     leader), ``gap``, ``headway``, ``command`` (N, T), ``gains`` if any, and ``params`` (JSON).
     ``csv``: one row per (time, vehicle) with columns ``t, vehicle, position, speed, accel,
     gap, headway, command`` (vehicle 0 is the leader; its gap, headway and command are empty;
-    values rounded to 1e-6 in SI units: s, m, m/s, m/s², s, m/s²).
+    values rounded to 1e-6 in SI units: s, m, m/s, m/s², s, m/s²).  ``parquet``: the same
+    columns at full precision (the leader's empty cells are NaN), the run's parameters as
+    JSON in the file metadata.
 
     Returns
     -------
@@ -116,11 +124,15 @@ def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = 
         raise StringStabError("save_trajectories needs a run recorded with record=True")
     if result.speed.ndim != 2:
         raise StringStabError("save_trajectories saves one platoon; select one from the batch first")
-    if fmt not in ("npz", "csv"):
-        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {show(fmt)}")
+    if fmt not in ("npz", "csv", "parquet"):
+        raise StringStabError(f"trajectory format must be 'npz', 'csv' or 'parquet'; got {show(fmt)}")
     p = Path(path)
     if fmt == "csv":
         write_results(_trajectory_columns(result), p, "csv", what="trajectories")
+        return p
+    if fmt == "parquet":
+        write_results(_trajectory_columns(result, None), p, "parquet", params=result.params,
+                      what="trajectories")
         return p
     gap, hw = result.gap, result.headway
     cmd = result.command if result.command is not None else np.full_like(gap, np.nan)
@@ -179,8 +191,8 @@ def write_run(result: PlatoonResult, out: str | Path | OutputDir, *, metrics: di
     dict
         ``{kind: file name}`` of everything written under ``out``.
     """
-    if fmt not in ("npz", "csv"):
-        raise StringStabError(f"trajectory format must be 'npz' or 'csv'; got {show(fmt)}")
+    if fmt not in ("npz", "csv", "parquet"):
+        raise StringStabError(f"trajectory format must be 'npz', 'csv' or 'parquet'; got {show(fmt)}")
     if isinstance(out, OutputDir):
         return _write(result, out, metrics, fmt, figures, title)
     with OutputDir(out, command="simulate", owns=RUN_FILES) as d:
