@@ -116,4 +116,7 @@ def test_parquet_trajectories(tmp_path, capsys):
     assert t.column_names == ["t", "vehicle", "position", "speed", "accel", "gap", "headway", "command"]
     assert t.num_rows == 101 * 3
     with open(out / "metrics.json") as fh:  # the run document beside it
-        assert json.load(fh)["run"]["followers"] == 2
+        doc = json.load(fh)
+    assert doc["run"]["followers"] == 2
+    assert doc["units"]["TIT"] == "s^2" and doc["units"]["M_CI"] == "m^2/s^6"
+    assert set(doc["units"]) <= set(doc)

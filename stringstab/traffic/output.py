@@ -20,9 +20,16 @@ from ..errors import StringStabError, show
 from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
 from .platoon import PlatoonResult
 
-__all__ = ["RUN_FILES", "run_document", "save_trajectories", "write_run"]
+__all__ = ["RUN_FILES", "UNITS", "run_document", "save_trajectories", "write_run"]
 
 Format = Literal["npz", "csv", "parquet"]
+
+#: The unit of each metric of ``metrics.json`` (SI; "" for ratios and counts).
+UNITS: dict[str, str] = {
+    "m_p": "", "max_m_p": "", "M_lss": "", "collisions": "", "collided_vehicles": "",
+    "min_gap": "m", "TIT": "s^2", "TIT_per_vehicle": "s^2", "M_CI": "m^2/s^6", "M_effi": "s",
+    "min_ttc": "s", "min_headway": "s", "ttc_star": "s", "m_fss": "", "M_fss": "%",
+}
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
 RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "trajectories.parquet",
@@ -56,6 +63,7 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
         "run": {"leader": spec if spec is not None else leader.name, "leader_name": leader.name,
                 "followers": result.n_followers, "duration_s": leader.duration, **result.params},
         **metrics,
+        "units": {k: v for k, v in UNITS.items() if k in metrics},
         "certificate": _certificate(controller, result.params),
         "warnings": list(warnings),
     }
