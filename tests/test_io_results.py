@@ -172,6 +172,7 @@ def test_gain_csv_fast_and_cell_by_cell_paths_agree(tmp_path: Path):
     (tmp_path / "plain.csv").write_text(plain)
     (tmp_path / "quoted.csv").write_text(quoted)
     a, b = read_gains(tmp_path / "plain.csv"), read_gains(tmp_path / "quoted.csv")
-    assert_array_equal(a.K, K) and assert_array_equal(b.K, K)
+    assert_array_equal(a.K, K)
+    assert_array_equal(b.K, K)
     assert_array_equal(a.t, b.t)
     assert a.vehicle.tolist() == b.vehicle.tolist() == [1 + i % 2 for i in range(50)]
