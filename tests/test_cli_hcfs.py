@@ -25,12 +25,16 @@ def test_verify_tiny_run(tmp_path, capsys):
     assert "smallest counterexample" in text and "no frame falsifies" in text
 
 
-def test_verify_with_figures(tmp_path):
+def test_verify_beta_and_csv_leader(tmp_path, capsys):
+    lead = tmp_path / "lead.csv"
+    lead.write_text("t,v\n0,10\n5,10\n10,15\n20,15\n")
     out = tmp_path / "rep"
-    assert main(["hcfs", "verify", "-J", "3", "-N", "2", "--leader", "stop-and-go:waves=1",
-                 "--beta", "0.25", "--out", str(out)]) == 0
-    assert len(list(out.glob("*.png"))) == 3
-    assert json.loads((out / "report.json").read_text())["beta"] == 0.25
+    assert main(["hcfs", "verify", "-J", "3", "-N", "2", "--leader", str(lead), "--beta", "0.25",
+                 "--no-figures", "--out", str(out)]) == 0
+    doc = json.loads((out / "report.json").read_text())
+    assert doc["beta"] == 0.25 and doc["setup"]["leaders"][0] == {"name": "lead", "duration_s": 20.0,
+                                                                  "frames": 101}
+    assert "wrote report.md, report.json to" in capsys.readouterr().out
 
 
 def test_verify_exit_1_when_a_guarantee_breaks(tmp_path, monkeypatch):
@@ -51,11 +55,11 @@ def test_verify_exit_1_when_a_guarantee_breaks(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     ("args", "match"),
     [
-        (["-J", "0"], "--jerk-limit J must be a finite number > 0; got '0'"),
-        (["-J", "-1"], "--jerk-limit J must be a finite number > 0; got '-1'"),
-        (["-J", "nan"], "--jerk-limit J must be a finite number > 0; got 'nan'"),
-        (["-J", "inf"], "--jerk-limit J must be a finite number > 0; got 'inf'"),
-        (["-J", "2", "x"], "--jerk-limit J must be a finite number > 0; got 'x'"),
+        (["-J", "0"], "--jerk-limit J must be a finite number > 0 m/s^3; got '0'"),
+        (["-J", "-1"], "--jerk-limit J must be a finite number > 0 m/s^3; got '-1'"),
+        (["-J", "nan"], "--jerk-limit J must be a finite number > 0 m/s^3; got 'nan'"),
+        (["-J", "inf"], "--jerk-limit J must be a finite number > 0 m/s^3; got 'inf'"),
+        (["-J", "2", "x"], "--jerk-limit J must be a number; got 'x'"),
         (["-J", "2", "--beta", "1.5"], r"beta must be a number in [0, 1] (eq 13); got '1.5'"),
         (["-J", "2", "--beta", "-0.1"], "beta must be a number in [0, 1]"),
         (["-J", "2", "--beta", "nan"], "beta must be a number in [0, 1]"),

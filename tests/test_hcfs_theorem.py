@@ -14,6 +14,7 @@ from stringstab.hcfs.theorem import (
     DEFAULT_TOL,
     check_theorem,
     jerk_bound,
+    lattice_search,
     tight_example,
     weight_change,
 )
@@ -145,30 +146,23 @@ def test_weight_change_table_is_exhaustive():
     assert float(jerk_bound(5.0, -0.4, True, False, beta=0.25, dt=DT)) == pytest.approx(1.1, abs=1e-15)
 
 
-def _lattice_examples(q):
-    """Every 2-frame sequence on the lattice L/q (start on CACC, beta = 0.5) with P1 and P2."""
-    L = 1.0
-    vals = np.arange(-q, q + 1) / q * L
-    steps = np.arange(-q, q + 1) / q * L
-    g = np.array(np.meshgrid(vals, vals, steps, steps, [0, 1], [0, 1], indexing="ij")).reshape(6, -1)
-    a1 = np.stack([g[0], g[0] + g[2]], axis=-1)
-    a2 = np.stack([g[1], g[1] + g[3]], axis=-1)
-    use = np.stack([g[4], g[5]], axis=-1).astype(bool)
-    return a1, a2, use
-
-
 def test_exhaustive_lattice_search_finds_the_smallest_counterexample():
-    """(b) Dropping P3: on the lattice of step L/q the smallest |a1_{k−1} − a2_{k−1}| of a
-    counterexample is one lattice unit, for every q — no ε > 0 relaxation of P3 saves C."""
+    """(b) Dropping P3: on the lattice of step J T / q the smallest |a1_{k−1} − a2_{k−1}| of a
+    counterexample is one lattice unit, for every q — no ε > 0 relaxation of P3 saves C; at
+    that gap the largest step is the bound J T (1 + max|Δλ|/q) = J T (1 + 1/(2q)) at β = 0.5."""
     for q in (2, 4, 8):
-        a1, a2, use = _lattice_examples(q)
-        chk = check_theorem(a1, a2, use, jerk_limit=1.0 / DT, dt=DT, beta=0.5)
-        cex = chk.counterexamples[:, 0]
-        assert cex.any() and not chk.violations.any() and not chk.bound_violations.any()
-        assert chk.gap_prev[cex, 0].min() == pytest.approx(1.0 / q, abs=1e-12)
-        # at the smallest gap the largest step is exactly the bound J T + |a1 − a2|/2
-        smallest = cex & np.isclose(chk.gap_prev[:, 0], 1.0 / q)
-        assert chk.step[smallest, 0].max() == pytest.approx(1.0 + 0.5 / q, abs=1e-12)
+        s = lattice_search(q, beta=0.5)
+        chk = s.check
+        assert chk.counterexamples.any() and not chk.violations.any()
+        assert not chk.bound_violations.any() and (chk.step <= chk.bound + 1e-12).all()
+        assert chk.rate_ddpg.all() and chk.rate_cacc.all()
+        assert s.smallest_gap == pytest.approx(1.0 / q, abs=1e-12)
+        assert s.largest_step_at_smallest_gap == pytest.approx(1.0 + 0.5 / q, abs=1e-12)
+        # independent recomputation of the outputs: C fails exactly where |a_1 − a_0| > J T
+        lam, _ = switch_weights(s.use_ddpg, beta=0.5, initial=s.initial)
+        out = lam * s.a1 + (1 - lam) * s.a2
+        assert np.array_equal(np.abs(out[:, 1] - out[:, 0]) > 1 + 2 * DEFAULT_TOL,
+                              ~chk.conclusion[:, 0])
 
 
 SEARCH_J = 5.0

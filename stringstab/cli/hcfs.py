@@ -64,19 +64,6 @@ def add_parser(sub: Any) -> None:
     v.set_defaults(func=run)
 
 
-def _floats(name: str, values: list[str]) -> list[float]:
-    out = []
-    for s in values:
-        try:
-            x = float(s)
-        except ValueError as e:
-            raise StringStabError(f"{name} must be a finite number > 0; got {s!r}") from e
-        if not (math.isfinite(x) and x > 0):
-            raise StringStabError(f"{name} must be a finite number > 0; got {s!r}")
-        out.append(x)
-    return out
-
-
 def _policy(spec: str) -> Any:
     from ..hcfs.ddpg import load_ddpg
     from ..hcfs.policy import LeaderSpeedMatcher
@@ -95,9 +82,10 @@ def run_verify(args: argparse.Namespace) -> int:
     from ..hcfs.report import write_report
     from ..hcfs.switching import check_beta
     from ..hcfs.verify import verify
+    from ..params import positive
     from ..traffic.leaders import leader_by_name
 
-    Js = _floats("--jerk-limit J", args.jerk_limit)
+    Js = [positive("--jerk-limit J", s, unit=" m/s^3") for s in args.jerk_limit]
     beta = check_beta(args.beta)
     if args.followers < 1:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
@@ -132,7 +120,9 @@ def run_verify(args: argparse.Namespace) -> int:
               f"jerk {sm.jerk:.4g} > J")
     verdict = ("no frame falsifies the theorem, the bound or the jerk-safe variant" if ver.ok
                else f"{len(ver.violations)} frame(s) falsify a guarantee")
-    print(f"{verdict}; wrote {', '.join(sorted(files.values()))} to {out}/")
+    n_fig = sum(name.endswith(".png") for name in files.values())
+    print(f"{verdict}; wrote report.md, report.json" + (f" and {n_fig} figures" if n_fig else "")
+          + f" to {out}/")
     return 0 if ver.ok else 1
 
 

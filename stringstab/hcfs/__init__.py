@@ -70,10 +70,12 @@ from .switching import (
 )
 from .theorem import (
     DEFAULT_TOL,
+    LatticeSearch,
     TheoremCheck,
     check_jerk_limit,
     check_theorem,
     jerk_bound,
+    lattice_search,
     tight_example,
     weight_change,
 )
@@ -104,6 +106,7 @@ __all__ = [
     "Frame",
     "HCFSRun",
     "HCFSVectorEnv",
+    "LatticeSearch",
     "LeaderSpeedMatcher",
     "RunConfig",
     "ScaledPolicy",
@@ -119,6 +122,7 @@ __all__ = [
     "closed_loop_matrix",
     "default_training_leaders",
     "jerk_bound",
+    "lattice_search",
     "limit_step",
     "load_ddpg",
     "plot_figure",

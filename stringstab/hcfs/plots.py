@@ -39,7 +39,7 @@ def _title(run: HCFSRun, i: int) -> str:
 
 
 def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
-    """Speed of the leader (black) and every follower over time (Fig. 4).
+    """Speed of the leader (dashed black) and every follower over time (Fig. 4).
 
     Returns
     -------
@@ -49,7 +49,7 @@ def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     ax = _ax(ax)
     lc = plot_vehicles(run.t, run.speed[i, 1:], ax=ax, first_position=1,
                        n_positions=run.n_followers)
-    (lead,) = ax.plot(run.t, run.speed[i, 0], color="k", lw=1.2, label="leader")
+    (lead,) = ax.plot(run.t, run.speed[i, 0], color="k", lw=0.9, ls="--", label="leader")
     lo, hi = float(run.speed[i].min()), float(run.speed[i].max())
     pad = 0.05 * (hi - lo) or 0.5
     ax.set_ylim(lo - pad, hi + pad)

@@ -37,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..params import positive
+from ..params import count, positive
 from ..traffic.leaders import Trajectory
 from ..traffic.platoon import Limits, Platoon
 from .cacc import CACC
@@ -250,12 +250,7 @@ def simulate_hcfs(
     """
     if not all(hasattr(leader, a) for a in ("dt", "position", "speed", "accel", "n_steps")):
         raise StringStabError(f"leader must be a Trajectory; got {type(leader).__name__}")
-    try:
-        N = int(n_followers)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}") from e
-    if N < 1 or N != n_followers:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}")
+    N = count("n_followers", n_followers)
     cfgs = tuple(c if isinstance(c, RunConfig) else RunConfig(*c) for c in configs)
     if not cfgs:
         raise StringStabError("configs must name at least one (mode, jerk limit)")

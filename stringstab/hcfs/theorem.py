@@ -49,10 +49,12 @@ from .switching import check_beta, switch_weights
 
 __all__ = [
     "DEFAULT_TOL",
+    "LatticeSearch",
     "TheoremCheck",
     "check_jerk_limit",
     "check_theorem",
     "jerk_bound",
+    "lattice_search",
     "tight_example",
     "weight_change",
 ]
@@ -224,8 +226,10 @@ class TheoremCheck:
         """max |a_k − a_{k−1}| / T over all frames, m/s³."""
         return float(self.step.max()) / self.dt if self.step.size else 0.0
 
-    def counts(self) -> dict[str, int]:
+    def counts(self, index: Any = ...) -> dict[str, int]:
         """Numbers of frames where each premise holds or fails, and of failures.
+
+        ``index`` selects part of the leading axes (e.g. one vehicle); default all frames.
 
         Examples
         --------
@@ -233,10 +237,10 @@ class TheoremCheck:
         >>> c.counts()["frames"], c.counts()["violations"]
         (1, 0)
         """
-        n = int(self.step.size)
+        n = int(self.step[index].size)
 
         def cnt(a: BoolArray) -> int:
-            return int(np.count_nonzero(a))
+            return int(np.count_nonzero(a[index]))
 
         return {
             "frames": n,
@@ -395,3 +399,71 @@ def tight_example(jerk_limit: float, *, gap: float, case: Case = "switch", beta:
     a1 = np.array([g, g + s * L])
     a2 = np.array([0.0, s * L])
     return a1, a2, c
+
+
+@dataclass(frozen=True)
+class LatticeSearch:
+    """Every 2-frame sequence on a lattice obeying P1 and P2, checked (:func:`lattice_search`).
+
+    Attributes
+    ----------
+    q : int
+        Lattice points per J T.
+    a1, a2 : array (M, 2)
+        The candidates of each sequence, in units of J T.
+    use_ddpg : bool array (M, 2)
+        The eq-12 choices.
+    initial : bool array (M,)
+        The choice before frame 0.
+    check : TheoremCheck
+        The theorem evaluated on every sequence (J T = 1).
+    """
+
+    q: int
+    a1: Array
+    a2: Array
+    use_ddpg: BoolArray
+    initial: BoolArray
+    check: TheoremCheck
+
+    @property
+    def smallest_gap(self) -> float:
+        """The smallest |a1_0 − a2_0| (in J T) of a counterexample (inf if there is none)."""
+        cex = self.check.counterexamples[:, 0]
+        return float(self.check.gap_prev[cex, 0].min()) if cex.any() else math.inf
+
+    @property
+    def largest_step_at_smallest_gap(self) -> float:
+        """The largest |a_1 − a_0| (in J T) among the counterexamples with the smallest gap."""
+        chk = self.check
+        at = chk.counterexamples[:, 0] & np.isclose(chk.gap_prev[:, 0], self.smallest_gap)
+        return float(chk.step[at, 0].max()) if at.any() else math.nan
+
+
+def lattice_search(q: int, *, beta: float = BETA) -> LatticeSearch:
+    """Exhaustive counterexample search without P3, on the lattice J T / q (J T = 1).
+
+    Enumerates every 2-frame sequence with start values a1_0, a2_0 ∈ [−J T, J T] and steps
+    in [−J T, J T] on the lattice (so P1 and P2 hold), every choice at both frames and before
+    them, and checks the theorem.  The proposition of ``docs/hcfs.md`` predicts the smallest
+    counterexample gap to be one lattice unit, 1/q, with a step of 1 + max|Δλ|/q at that gap.
+    The number of sequences is 8 (2q + 1)⁴: keep q ≤ 12 or so (3·10⁶ sequences).
+
+    Examples
+    --------
+    >>> s = lattice_search(4)
+    >>> s.smallest_gap, s.largest_step_at_smallest_gap, int(s.check.violations.sum())
+    (0.25, 1.125, 0)
+    """
+    n = int(q)
+    if n < 1:
+        raise StringStabError(f"q must be an integer >= 1; got {q!r}")
+    vals = np.arange(-n, n + 1) / n
+    g = np.array(np.meshgrid(vals, vals, vals, vals, [0, 1], [0, 1], [0, 1],
+                             indexing="ij")).reshape(7, -1)
+    a1 = np.stack([g[0], g[0] + g[2]], axis=-1)
+    a2 = np.stack([g[1], g[1] + g[3]], axis=-1)
+    use = np.stack([g[5], g[6]], axis=-1).astype(bool)
+    initial = g[4].astype(bool)
+    chk = check_theorem(a1, a2, use, jerk_limit=1.0, dt=1.0, beta=beta, initial=initial)
+    return LatticeSearch(n, a1, a2, use, initial, chk)

@@ -85,29 +85,13 @@ def _vehicle_stats(run: HCFSRun, i: int, chk: TheoremCheck) -> list[dict[str, An
     veh_jerk = np.abs(np.diff(run.accel[i, 1:], axis=-1)).max(axis=-1) / T
     rows = []
     for v in range(run.n_followers):
-        n = int(chk.step.shape[-1])
-
-        def cnt(a: np.ndarray, v: int = v) -> int:
-            return int(np.count_nonzero(a[v]))
-
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio_bound = chk.step[v] / chk.bound[v]
         rows.append({
             "vehicle": v + 1,
             "max_jerk": float(chk.step[v].max() / T),
             "max_jerk_over_J": float(chk.step[v].max() / chk.step_limit),
             "max_vehicle_jerk": float(veh_jerk[v]),
-            "frames": n,
-            "P1_holds": cnt(chk.rate_ddpg), "P1_fails": n - cnt(chk.rate_ddpg),
-            "P2_holds": cnt(chk.rate_cacc), "P2_fails": n - cnt(chk.rate_cacc),
-            "P3_holds": cnt(chk.equal_prev), "P3_fails": n - cnt(chk.equal_prev),
-            "premises_hold": cnt(chk.premises),
-            "conclusion_fails": n - cnt(chk.conclusion),
-            "violations": cnt(chk.violations),
-            "counterexamples": cnt(chk.counterexamples),
-            "bound_violations": cnt(chk.bound_violations),
-            "max_step_over_bound": float(np.nanmax(ratio_bound)),
-            "switches": cnt(chk.switch),
+            **chk.counts(v),
+            "max_step_over_bound": float((chk.step[v] / chk.bound[v]).max()),
             "ddpg_share": float(run.use_ddpg[i, v].mean()),
             "collided": bool(run.collided[i, v]),
             "min_gap": float(run.gap[i, v].min()),

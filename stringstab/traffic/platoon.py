@@ -54,7 +54,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..params import DEFAULT_DELTA, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from .controllers import Controller, Observation
 from .leaders import Trajectory
 
@@ -493,12 +493,7 @@ def simulate(
             f"controller must be a stringstab Controller (command, equilibrium_gap, gains); "
             f"got {type(controller).__name__}"
         )
-    try:
-        N = int(n_followers)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}") from e
-    if N < 1 or N != n_followers:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {n_followers!r}")
+    N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
