@@ -13,7 +13,8 @@ def test_verify_tiny_run(tmp_path, capsys):
     rc = main(["hcfs", "verify", "--jerk-limit", "2.5", "5", "--followers", "4", "--leader", "us06",
                "stop-and-go:waves=1", "--duration", "60", "--no-figures", "--out", str(out)])
     assert rc == 0
-    assert sorted(p.name for p in out.iterdir()) == ["report.json", "report.md"]
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "report.json", "report.md"]
     doc = json.loads((out / "report.json").read_text())
     assert doc["ok"] is True and doc["exit_code"] == 0 and doc["violations"] == []
     assert doc["setup"]["n_followers"] == 4 and doc["setup"]["jerk_limits"] == [2.5, 5.0]
@@ -92,8 +93,24 @@ def test_verify_out_is_a_file(tmp_path, capsys):
     f = tmp_path / "file"
     f.write_text("x")
     assert main(["hcfs", "verify", "-J", "2", "--out", str(f)]) == 2
-    assert "--out must be a directory" in capsys.readouterr().err
+    assert f"--out: expected a folder; {str(f)!r} is a file" in capsys.readouterr().err
     assert f.read_text() == "x"
+
+
+def test_verify_refuses_another_commands_folder_and_replaces_its_own(tmp_path, capsys):
+    from stringstab.io import OutputDir
+
+    other = tmp_path / "other"
+    with OutputDir(other, command="region") as od:
+        od.write_text("x.txt", "x")
+    assert main(["hcfs", "verify", "-J", "2", "--leader", "stop-and-go:waves=1", "--no-figures",
+                 "--out", str(other)]) == 2
+    assert "holds the outputs of 'stringstab region'" in capsys.readouterr().err
+    out = tmp_path / "rep"
+    args = ["hcfs", "verify", "-J", "2", "--leader", "stop-and-go:waves=1", "--out", str(out)]
+    assert main(args) == 0 and len(list(out.glob("*.png"))) == 3
+    assert main([*args, "--no-figures"]) == 0  # the second run removes the first run's figures
+    assert not list(out.glob("*.png")) and (out / "report.md").is_file()
 
 
 def test_hcfs_needs_a_subcommand(capsys):

@@ -97,7 +97,8 @@ def test_bad_inputs():
 
 def test_report(ver, tmp_path):
     files = write_report(ver, tmp_path, figures=False, command="stringstab hcfs verify ...")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.json", "report.md"]
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "report.json", "report.md"]
     assert sorted(files.values()) == ["report.json", "report.md"]
     doc = json.loads((tmp_path / "report.json").read_text())
     assert doc["ok"] is True and doc["exit_code"] == 0

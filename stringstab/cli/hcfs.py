@@ -82,6 +82,7 @@ def run_verify(args: argparse.Namespace) -> int:
     from ..hcfs.report import write_report
     from ..hcfs.switching import check_beta
     from ..hcfs.verify import verify
+    from ..io import OutputDir
     from ..params import positive
     from ..traffic.leaders import leader_by_name
 
@@ -91,9 +92,7 @@ def run_verify(args: argparse.Namespace) -> int:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise StringStabError(f"--out must be a directory; {str(out)!r} is a file")
+    out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [leader_by_name(s, dt=DT, duration=args.duration) for s in args.leader]
     policy = _policy(args.policy)
     command = shlex.join([
@@ -101,10 +100,11 @@ def run_verify(args: argparse.Namespace) -> int:
         "--followers", str(args.followers), "--leader", *args.leader,
         *(["--duration", f"{args.duration:g}"] if args.duration is not None else []),
         "--beta", f"{beta:g}", "--policy", args.policy,
-        *(["--no-figures"] if args.no_figures else []), "--out", str(out),
+        *(["--no-figures"] if args.no_figures else []), "--out", args.out,
     ])
     ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta)
-    files = write_report(ver, out, figures=not args.no_figures, command=command)
+    with out:
+        files = write_report(ver, out, figures=not args.no_figures, command=command)
     print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")
     for x in ver.results:
         if x["mode"] in ("paper", "safe"):
@@ -122,7 +122,7 @@ def run_verify(args: argparse.Namespace) -> int:
                else f"{len(ver.violations)} frame(s) falsify a guarantee")
     n_fig = sum(name.endswith(".png") for name in files.values())
     print(f"{verdict}; wrote report.md, report.json" + (f" and {n_fig} figures" if n_fig else "")
-          + f" to {out}/")
+          + f" to {args.out.rstrip('/')}/")
     return 0 if ver.ok else 1
 
 

@@ -38,6 +38,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import constants as _toolkit
+from ..traffic.platoon import DEFAULT_LENGTH
+
 __all__ = [
     "ACCEL_MAX",
     "ACCEL_MIN",
@@ -64,8 +67,8 @@ V2V_DELAY = 0.005
 ACCEL_MAX = 3.0
 #: a_min, m/s² (chosen: −a_max, see the module docstring).
 ACCEL_MIN = -3.0
-#: v_max, m/s (chosen: the toolkit's road speed limit).
-SPEED_MAX = 33.3
+#: v_max, m/s (chosen: the toolkit's road speed limit, IDL Table 2).
+SPEED_MAX = _toolkit.SPEED_MAX
 #: The jerk threshold the paper's figures compare with, 2a_max/T = 30 m/s³ (HCFS §IV-A).
 PAPER_JERK_LIMIT = 2.0 * ACCEL_MAX / DT
 #: Soft-switch coefficient at a switch (HCFS eq 14).
@@ -74,8 +77,8 @@ BETA = 0.5
 PLATOON_SIZES = (4, 6, 8)
 #: Followers in the DDPG training platoon (HCFS §IV).
 TRAINING_FOLLOWERS = 6
-#: Vehicle length L, m (chosen).
-LENGTH = 5.0
+#: Vehicle length L, m (chosen: the toolkit's vehicle length).
+LENGTH = DEFAULT_LENGTH
 #: Safe space headway h, m: the desired bumper-to-bumper gap (chosen).
 SPACING = 5.0
 #: Gains k1-k4 of the derived eq-11 CACC law (chosen, Table I lost).

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
-from ..gainio import write_text
+from ..io import atomic_write_text
 from .env import HCFSVectorEnv
 from .policy import ScaledPolicy
 
@@ -77,7 +77,7 @@ def save_ddpg(policy: ScaledPolicy, directory: str | Path) -> Path:
     if not hasattr(policy.policy, "save"):
         raise StringStabError(f"only a policy trained by stringstab.rl can be saved; got {type(policy.policy).__name__}")
     policy.policy.save(d)
-    write_text(json.dumps({"scales": policy.scales.tolist(), "label": policy.label}) + "\n", d / _SIDECAR)
+    atomic_write_text(d / _SIDECAR, json.dumps({"scales": policy.scales.tolist(), "label": policy.label}) + "\n")
     return d
 
 

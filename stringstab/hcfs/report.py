@@ -1,19 +1,18 @@
 """The verification report: Markdown and JSON, and the figures (Figs 4-6 of the paper, per J).
 
-:func:`write_report` writes into a directory ``report.md``, ``report.json`` and, per leader and
-jerk limit, ``speed_*.png``, ``jerk_*.png`` and ``switching_*.png``.  Text files are written
-atomically (:func:`stringstab.gainio.write_text`).
+:func:`write_report` writes into a folder ``report.md``, ``report.json`` and, per leader and
+jerk limit, ``speed_*.png``, ``jerk_*.png`` and ``switching_*.png``, all-or-nothing
+(:class:`stringstab.io.OutputDir`).
 """
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
 from typing import Any
 
-from ..gainio import write_text
+from ..io import OutputDir
 from .theorem import Case, tight_example, weight_change
 from .verify import Frame, Verification
 
@@ -210,17 +209,21 @@ def report_markdown(ver: Verification, *, command: str | None = None,
     return "\n".join(lines) + "\n"
 
 
-def write_report(ver: Verification, out: str | Path, *, figures: bool = True,
+def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: bool = True,
                  command: str | None = None) -> dict[str, str]:
     """Write ``report.md``, ``report.json`` and (optionally) the figures into ``out``.
+
+    ``out`` is a folder path or an open :class:`~stringstab.io.OutputDir`; a path is written
+    all-or-nothing through one (command ``"hcfs verify"``): a failure leaves the folder as it was.
 
     Returns
     -------
     dict
         ``{kind: file name}`` of everything written.
     """
-    d = Path(out)
-    d.mkdir(parents=True, exist_ok=True)
+    if not isinstance(out, OutputDir):
+        with OutputDir(out, command="hcfs verify") as od:
+            return write_report(ver, od, figures=figures, command=command)
     files: dict[str, str] = {}
     figs = _figure_names(ver) if figures else None
     if figs:
@@ -233,13 +236,10 @@ def write_report(ver: Verification, out: str | Path, *, figures: bool = True,
                 n_panels = 4 if kind != "switching" else 2
                 fig = Figure(figsize=(11, 2.4 * n_panels + 0.6), layout="constrained")
                 plot_figure(ver.runs[r], J, kind, fig=fig)
-                fig.savefig(d / name, dpi=90)
+                fig.savefig(out.path(name), dpi=90)
                 files[name] = name
-    doc = report_dict(ver, command=command)
-    write_text(json.dumps(doc, indent=1, ensure_ascii=False, allow_nan=False) + "\n",
-               d / "report.json")
+    out.write_json("report.json", report_dict(ver, command=command))
     files["json"] = "report.json"
-    write_text(report_markdown(ver, command=command, figures=figs), d / "report.md")
+    out.write_text("report.md", report_markdown(ver, command=command, figures=figs))
     files["markdown"] = "report.md"
     return files
-
