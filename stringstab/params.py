@@ -33,6 +33,7 @@ __all__ = [
     "Params",
     "as_gains",
     "check_params",
+    "count",
     "positive",
 ]
 
@@ -95,6 +96,32 @@ def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "")
         op = ">=" if allow_zero else ">"
         raise StringStabError(f"{name} must be a finite number {op} 0{unit}; got {show(value)}")
     return x
+
+
+def count(name: str, value: Any) -> int:
+    """``value`` as an int that is >= 1 (a number of vehicles, platoons, steps).
+
+    Raises
+    ------
+    StringStabError
+        Unless ``value`` is an integer (or an integral number) >= 1.
+
+    Examples
+    --------
+    >>> count("n_followers", 4)
+    4
+    >>> count("n_followers", 2.5)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: n_followers must be an integer >= 1; got 2.5
+    """
+    try:
+        n = int(value)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"{name} must be an integer >= 1; got {show(value)}") from e
+    if n < 1 or n != value:
+        raise StringStabError(f"{name} must be an integer >= 1; got {show(value)}")
+    return n
 
 
 def _finite(name: str, value: Any) -> float:

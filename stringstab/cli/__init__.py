@@ -45,6 +45,7 @@ HELP: dict[str, str] = {
     "region": "map the string-stable gains on a 2-D slice or a 3-D grid (figures + data)",
     "tune": "repair gain triples that are not string stable (region growing or projection)",
     "simulate": "simulate a platoon behind a leader; write trajectories, metrics JSON and figures",
+    "hcfs": "the HCFS hybrid DDPG/CACC strategy: verify its jerk theorem in closed loop",
     "demo": "run a demo of the whole pipeline on bundled data",
 }
 

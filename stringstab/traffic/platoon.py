@@ -56,7 +56,7 @@ import numpy.typing as npt
 from ..constants import ACCEL_MAX, ACCEL_MIN, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..metrics import damping_ratios_from_energy, platoon_metrics, time_headway
-from ..params import DEFAULT_DELTA, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from .controllers import Controller, Observation
 from .trajectory import Trajectory
 
@@ -538,12 +538,7 @@ def simulate(
             f"controller must be a stringstab Controller (command, equilibrium_gap, gains); "
             f"got {type(controller).__name__}"
         )
-    try:
-        N = int(n_followers)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {show(n_followers)}") from e
-    if N < 1 or N != n_followers:
-        raise StringStabError(f"n_followers must be an integer >= 1; got {show(n_followers)}")
+    N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)

@@ -1,0 +1,131 @@
+"""``stringstab hcfs verify``: check the HCFS jerk theorem in closed loop and write a report."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shlex
+from pathlib import Path
+from typing import Any
+
+from ..errors import StringStabError
+
+__all__ = ["add_parser", "run", "run_verify"]
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``hcfs`` (with its sub-command ``verify``)."""
+    from ..hcfs.constants import BETA, PAPER_JERK_LIMIT
+    from ..traffic.leaders import CYCLES, SYNTHETIC
+
+    p = sub.add_parser(
+        "hcfs",
+        help="the HCFS hybrid DDPG/CACC strategy: verify its jerk theorem in closed loop",
+        description="The HCFS paper's hybrid car-following strategy (DDPG and CACC switched by "
+                    "reward, eqs 12-14) and its jerk theorem.",
+    )
+    hs = p.add_subparsers(dest="hcfs_command", metavar="SUBCOMMAND")
+    hs.required = True
+    v = hs.add_parser(
+        "verify",
+        help="simulate HCFS for jerk limits J and check the theorem's premises and conclusion at every frame",
+        description=(
+            "Simulate N followers (T = 0.2 s, 5 ms V2V delay, HCFS section IV) behind each leader "
+            "under CACC alone, the learned policy alone, HCFS by eqs 12-14 and HCFS with a "
+            "jerk-safe variant, each candidate rate-limited to J*T; evaluate the theorem's "
+            "premises (P1, P2: candidates rate-limited; P3: a1 = a2 at the previous frame) and "
+            "its conclusion |a_k - a_(k-1)| <= J T at every frame, and the bound that holds "
+            "without P3.  Writes report.md, report.json and figures like the paper's Figs 4-6.  "
+            "Exit 0 when no frame falsifies the theorem where its premises hold (nor the bound, "
+            "nor the jerk-safe variant), 1 otherwise, 2 on bad input."
+        ),
+        epilog=(
+            f"Leaders: cycles {', '.join(sorted(CYCLES))}; synthetic {', '.join(SYNTHETIC)} "
+            "(NAME:key=value,...); or a CSV file with columns 't, v' or 't, v, a' (SI units). "
+            f"The paper's figures compare the jerk with 2a_max/T = {PAPER_JERK_LIMIT:g} m/s^3, "
+            "which the acceleration bounds alone guarantee."
+        ),
+    )
+    v.add_argument("--jerk-limit", "-J", nargs="+", required=True, metavar="J",
+                   help="jerk limits J in m/s^3 (each finite and > 0)")
+    v.add_argument("--followers", "-N", type=int, default=8, metavar="N",
+                   help="followers per platoon (the paper uses 4, 6, 8; default 8)")
+    v.add_argument("--leader", nargs="+", default=["udds"], metavar="SPEC",
+                   help="one or more leaders (default: udds)")
+    v.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="keep only the first S seconds of each leader")
+    v.add_argument("--beta", default=str(BETA), metavar="B",
+                   help=f"soft-switch coefficient at a switch, in [0, 1] (eq 14: {BETA:g})")
+    v.add_argument("--policy", default="stand-in", metavar="stand-in|DIR",
+                   help="the learned candidate: 'stand-in' (a hand-written, deliberately imperfect "
+                        "law, labelled as such) or a DDPG saved by stringstab.hcfs.save_ddpg")
+    v.add_argument("--no-figures", action="store_true", help="skip the figures")
+    v.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    v.set_defaults(func=run)
+
+
+def _policy(spec: str) -> Any:
+    from ..hcfs.ddpg import load_ddpg
+    from ..hcfs.policy import LeaderSpeedMatcher
+
+    if spec == "stand-in":
+        return LeaderSpeedMatcher()
+    p = Path(spec)
+    if not p.is_dir():
+        raise StringStabError(f"--policy must be 'stand-in' or a directory saved by save_ddpg; got {spec!r}")
+    return load_ddpg(p)
+
+
+def run_verify(args: argparse.Namespace) -> int:
+    """Run ``hcfs verify``: validate everything, simulate, check, write the report."""
+    from ..hcfs.constants import DT
+    from ..hcfs.report import write_report
+    from ..hcfs.switching import check_beta
+    from ..hcfs.verify import verify
+    from ..io import OutputDir
+    from ..params import positive
+    from ..traffic.leaders import leader_by_name
+
+    Js = [positive("--jerk-limit J", s, unit=" m/s^3") for s in args.jerk_limit]
+    beta = check_beta(args.beta)
+    if args.followers < 1:
+        raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
+    out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
+    leaders = [leader_by_name(s, dt=DT, duration=args.duration) for s in args.leader]
+    policy = _policy(args.policy)
+    command = shlex.join([
+        "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
+        "--followers", str(args.followers), "--leader", *args.leader,
+        *(["--duration", f"{args.duration:g}"] if args.duration is not None else []),
+        "--beta", f"{beta:g}", "--policy", args.policy,
+        *(["--no-figures"] if args.no_figures else []), "--out", args.out,
+    ])
+    ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta)
+    with out:
+        files = write_report(ver, out, figures=not args.no_figures, command=command)
+    print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")
+    for x in ver.results:
+        if x["mode"] in ("paper", "safe"):
+            t = x["totals"]
+            print(f"  {x['leader']:>14s}  J = {x['jerk_limit']:<6g} {x['mode']:5s}: max jerk "
+                  f"{t['max_jerk']:.3g} m/s^3 ({t['max_jerk_over_J']:.3g} J), P3 fails "
+                  f"{t['P3_fails']}/{t['frames']}, conclusion fails {t['conclusion_fails']}, "
+                  f"theorem violations {t['violations']}, bound violations {t['bound_violations']}")
+    sm = ver.smallest_counterexample
+    if sm is not None:
+        print(f"smallest counterexample: |a1 - a2| = {sm.gap_prev:.3g} m/s^2 at the previous frame "
+              f"({sm.leader}, J = {sm.jerk_limit:g}, follower {sm.vehicle}, t = {sm.t:.1f} s): "
+              f"jerk {sm.jerk:.4g} > J")
+    verdict = ("no frame falsifies the theorem, the bound or the jerk-safe variant" if ver.ok
+               else f"{len(ver.violations)} frame(s) falsify a guarantee")
+    n_fig = sum(name.endswith(".png") for name in files.values())
+    print(f"{verdict}; wrote report.md, report.json" + (f" and {n_fig} figures" if n_fig else "")
+          + f" to {args.out.rstrip('/')}/")
+    return 0 if ver.ok else 1
+
+
+def run(args: argparse.Namespace) -> int:
+    """Dispatch ``hcfs`` sub-commands."""
+    return run_verify(args)

@@ -1,0 +1,155 @@
+"""Figures of an HCFS run, like the paper's Figs 4-6: speed, jerk with the limit drawn, switching.
+
+Every function takes ``ax=None`` (or ``fig=None``) and returns what it drew.  Followers are
+coloured by their position in the platoon (:func:`stringstab.traffic.plots.plot_vehicles`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..traffic.plots import plot_vehicles
+from .simulate import HCFSRun
+
+__all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_speed", "plot_switching"]
+
+#: Panel titles of the modes; the policy's label says whether it is a DDPG or a stand-in.
+MODE_TITLES = {
+    "cacc": "CACC alone",
+    "policy": "{policy} alone",
+    "paper": "HCFS, eqs 12-14 (beta = {beta:g})",
+    "safe": "HCFS, jerk-safe variant",
+}
+
+
+def _ax(ax: Any) -> Any:
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots()
+    return ax
+
+
+def _title(run: HCFSRun, i: int) -> str:
+    p = run.params
+    short = "stand-in policy" if p.get("policy_is_stand_in") else p.get("policy_label", "policy")
+    return MODE_TITLES[run.configs[i].mode].format(policy=short, beta=p["beta"])
+
+
+def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
+    """Speed of the leader (dashed black) and every follower over time (Fig. 4).
+
+    Returns
+    -------
+    list
+        [leader Line2D, followers LineCollection].
+    """
+    ax = _ax(ax)
+    lc = plot_vehicles(run.t, run.speed[i, 1:], ax=ax, first_position=1,
+                       n_positions=run.n_followers)
+    (lead,) = ax.plot(run.t, run.speed[i, 0], color="k", lw=0.9, ls="--", label="leader")
+    lo, hi = float(run.speed[i].min()), float(run.speed[i].max())
+    pad = 0.05 * (hi - lo) or 0.5
+    ax.set_ylim(lo - pad, hi + pad)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("speed v (m/s)")
+    ax.set_title(_title(run, i), fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
+    return [lead, lc]
+
+
+def plot_jerk(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
+    """Jerk (a_k − a_{k−1})/T of every follower's command, with ±J and ±2a_max/T drawn (Fig. 5).
+
+    Every frame is drawn (no decimation), so single-frame spikes show.
+
+    Returns
+    -------
+    list
+        [followers LineCollection, +J line, −J line, +2a_max/T line, −2a_max/T line].
+    """
+    ax = _ax(ax)
+    a0 = run.params["initial_accel"]
+    out = np.concatenate([np.full((run.n_followers, 1), a0), run.output[i]], axis=-1)
+    jerk = np.diff(out, axis=-1) / run.dt
+    lc = plot_vehicles(run.t, jerk, ax=ax, first_position=1, n_positions=run.n_followers,
+                       max_points=run.t.size)
+    J = run.configs[i].jerk_limit
+    paper = 2.0 * run.params["accel_max"] / run.dt
+    lines = [ax.axhline(s * J, color="r", ls="--", lw=1.0, label="±J" if s > 0 else None)
+             for s in (1, -1)]
+    lines += [ax.axhline(s * paper, color="0.5", ls=":", lw=1.0,
+                         label="±2a_max/T" if s > 0 else None) for s in (1, -1)]
+    m = max(float(np.abs(jerk).max()), J) * 1.15
+    ax.set_ylim(-max(m, paper * 1.05), max(m, paper * 1.05))
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("jerk (m/s³)")
+    ax.set_title(f"{_title(run, i)}: max |jerk| = {np.abs(jerk).max():.3g}, J = {J:g}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
+    return [lc, *lines]
+
+
+def plot_switching(run: HCFSRun, i: int, *, ax: Any = None) -> Any:
+    """Weight λ of the learned candidate per follower over time (Fig. 6): 0 CACC, 1 policy.
+
+    Soft switches (λ = β or 1 − β) show as intermediate shades.
+
+    Returns
+    -------
+    matplotlib.image.AxesImage
+    """
+    ax = _ax(ax)
+    N = run.n_followers
+    t0, t1 = float(run.t[0]), float(run.t[-1]) + run.dt
+    img = ax.imshow(run.weight[i], aspect="auto", interpolation="nearest", cmap="coolwarm",
+                    vmin=0.0, vmax=1.0, extent=(t0, t1, N + 0.5, 0.5))
+    ax.set_yticks(np.arange(1, N + 1))
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("follower")
+    ax.set_title(f"{_title(run, i)}: weight of the policy (0 = CACC, 1 = policy)", fontsize=9)
+    return img
+
+
+def plot_figure(run: HCFSRun, jerk_limit: float, kind: str, *, fig: Any = None) -> tuple[Any, Any]:
+    """One figure with a panel per mode of ``run`` at ``jerk_limit``.
+
+    Parameters
+    ----------
+    run : HCFSRun
+        A run containing configurations at ``jerk_limit``.
+    jerk_limit : float
+        J, m/s³.
+    kind : {"speed", "jerk", "switching"}
+        :func:`plot_speed`, :func:`plot_jerk` (every mode) or :func:`plot_switching` (the HCFS
+        modes).
+    fig : matplotlib Figure, optional
+        Where to draw.
+
+    Returns
+    -------
+    (Figure, list of Axes)
+    """
+    from ..errors import StringStabError
+
+    draw = {"speed": plot_speed, "jerk": plot_jerk, "switching": plot_switching}
+    if kind not in draw:
+        raise StringStabError(f"kind must be one of {sorted(draw)}; got {kind!r}")
+    idx = [i for i, c in enumerate(run.configs) if np.isclose(c.jerk_limit, jerk_limit)
+           and (kind != "switching" or c.mode in ("paper", "safe"))]
+    if not idx:
+        raise StringStabError(f"the run has no configuration at J={jerk_limit!r} for a {kind} figure")
+    if fig is None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(11, 2.6 * len(idx) + 0.6), layout="constrained")
+    axes = list(np.atleast_1d(fig.subplots(len(idx), 1, sharex=True)))
+    for ax, i in zip(axes, idx):
+        draw[kind](run, i, ax=ax)
+    for ax in axes[:-1]:
+        ax.set_xlabel("")
+    fig.suptitle(f"{run.leader.name}, {run.n_followers} followers, J = {jerk_limit:g} m/s³")
+    return fig, axes
