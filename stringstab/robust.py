@@ -520,7 +520,7 @@ def _schur_box(kx: Array, kv: Array, box: Box, H: float, max_depth: int = 14) ->
                          for i, g in enumerate(term.g))
             low = np.maximum(term.r.lo, term.c.lo - spread)
             ok &= low > _SCHUR_RTOL * term.r.mag
-            bad |= term.c.lo < -_SCHUR_RTOL * term.c.mag
+            bad |= term.c.lo <= -_SCHUR_RTOL * term.c.mag
         if bad.any():
             b_own = owner[bad]
             new = ~fail[b_own]

@@ -64,6 +64,7 @@ __all__ = [
     "SampledModel",
     "SampledTransferFunction",
     "characteristic_polynomial",
+    "dc_margin",
     "epsilon",
     "m",
     "phi_functions",
@@ -277,6 +278,34 @@ def w_coefficients() -> dict[str, sp.Expr]:
     for k in range(2):
         out[f"ell{k}"] = sp.factor(q.coeff_monomial(w**k)).subs(back)
     return out
+
+
+@lru_cache(maxsize=1)
+def dc_margin() -> sp.Expr:
+    """c₂ in |D(e^{jθ})|² − |N(e^{jθ})|² = c₂ θ² + O(θ⁴): the sampled analogue of Ψ3.
+
+    H(1) = 1 makes the θ⁰ term vanish; |H(e^{jθ})| ≤ 1 near θ = 0 requires c₂ ≥ 0.
+    Derived in the w-form (w = z − 1, |w|² = ρ ≈ θ², w² = −ρz): the θ² coefficient is
+    φ1p²(δ1² − δ0δ1 − 2δ0δ2) − φ1²(ν1² − ν0ν1 − 2ν0ν2) + 2φ1² k_a ℓ0 ν0 with
+    φ1 = 1 − e^{−H/τ}, φ1p = 1 − e^{−H/τ_p}.  It does not depend on δ; in a homogeneous
+    platoon (τ_p = τ) it is H² φ1⁴ times Ψ3 of the continuous loop (IDL eq 14, derived),
+    so the low-frequency condition is the same for every sampling period.
+
+    Examples
+    --------
+    >>> from stringstab.symbolic import derived_psi
+    >>> phi1 = 1 - sp.exp(-sample_time / tau)
+    >>> c2 = dc_margin().subs(tau_prev, tau)
+    >>> sp.simplify(c2 - sample_time**2 * phi1**4 * derived_psi()[2])
+    0
+    """
+    c = w_coefficients()
+    d0, d1, d2 = c["delta0"], c["delta1"], c["delta2"]
+    n0, n1, n2 = c["nu0"], c["nu1"], c["nu2"]
+    f1 = 1 - sp.exp(-sample_time / tau)
+    f1p = 1 - sp.exp(-sample_time / tau_prev)
+    return sp.expand(f1p**2 * (d1**2 - d0 * d1 - 2 * d0 * d2)
+                     - f1**2 * (n1**2 - n0 * n1 - 2 * n0 * n2) + 2 * f1**2 * k_a * c["ell0"] * n0)
 
 
 def phi_functions(x: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
