@@ -257,8 +257,8 @@ def _robust_g(
     with np.errstate(divide="ignore", invalid="ignore"):
         s = np.clip(np.where(e_hi > e_lo, e_lo / (e_lo - e_hi), 0.0), 0.0, 1.0)
     s = np.where(e_lo > 0, 0.0, np.where(e_hi < 0, 1.0, s))
-    tau_w = t_lo + s * (t_hi - t_lo)
-    h_w = h_at_max + s * (h_at_min - h_at_max)
+    tau_w = np.clip(t_lo + s * (t_hi - t_lo), t_lo, t_hi)
+    h_w = np.clip(h_at_max + s * (h_at_min - h_at_max), h_lo, h_hi)
     cx, cv = 2.0 * kx * ka, 2.0 * kv * ka
     r0 = (1.0 - ka * ka) * w2 - 2.0 * kx - kv * kv
 
