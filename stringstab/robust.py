@@ -76,10 +76,14 @@ from .sampled import (
     _Coeffs,
     _curvature,
     _eval_cells,
+    _num,
+    _one_triple,
     _part,
     _peak,
+    _Results,
     _schur_terms,
     _spread,
+    _Verdict,
     split_delay,
 )
 
@@ -672,12 +676,8 @@ def _robust_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *, hete
 # ---------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------
-def _num(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
-
 @dataclass(frozen=True)
-class RobustCertificate:
+class RobustCertificate(_Verdict):
     """The robust certificate of one gain triple over a parameter box.
 
     Attributes
@@ -727,11 +727,6 @@ class RobustCertificate:
     witness_theta: float
     n_evals: int = 0
 
-    @property
-    def certified(self) -> bool:
-        """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
-
     def as_dict(self) -> dict[str, Any]:
         """A JSON row (non-finite numbers become None)."""
         return {
@@ -745,7 +740,7 @@ class RobustCertificate:
 
 
 @dataclass(frozen=True)
-class RobustCertificateBatch:
+class RobustCertificateBatch(_Results):
     """Robust certificates of many triples, as arrays (fields of :class:`RobustCertificate`)."""
 
     k_x: Array
@@ -766,14 +761,6 @@ class RobustCertificateBatch:
     witness_theta: Array
     n_evals: npt.NDArray[np.int64]
 
-    def __len__(self) -> int:
-        return int(self.k_x.size)
-
-    @property
-    def certified(self) -> npt.NDArray[np.bool_]:
-        """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
-
     def __getitem__(self, i: int) -> RobustCertificate:
         return RobustCertificate(
             k_x=float(self.k_x[i]), k_v=float(self.k_v[i]), k_a=float(self.k_a[i]),
@@ -787,15 +774,6 @@ class RobustCertificateBatch:
             n_evals=int(self.n_evals[i]),
         )
 
-    def records(self) -> list[dict[str, Any]]:
-        """One JSON row per triple."""
-        return [self[i].as_dict() for i in range(len(self))]
-
-    def summary(self) -> dict[str, Any]:
-        """Counts per verdict and the share certified."""
-        n = len(self)
-        counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
-        return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
 
 
 def certify_robust_batch(
@@ -893,10 +871,6 @@ def certify_robust(
     >>> c.verdict
     'certified'
     """
-    for name, v in (("k_x", k_x), ("k_v", k_v), ("k_a", k_a)):
-        if np.ndim(v) != 0:
-            raise StringStabError(
-                f"certify_robust takes one triple; {name} has shape {np.shape(v)}; "
-                "use certify_robust_batch")
+    _one_triple("certify_robust", "certify_robust_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     return certify_robust_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
                                 sample_time=sample_time, heterogeneous=heterogeneous)[0]

@@ -552,6 +552,19 @@ def _response(theta: Array, co: _Coeffs, m: int, ka: Array) -> npt.NDArray[np.co
         return np.asarray(co.phi1.lo / co.phi1p.lo * N / D)
 
 
+def _on_circle(theta: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any,
+               sample_time: Any, tau_prev: Any) -> tuple[Array, Array, _Coeffs, int,
+                                                         tuple[int, ...]]:
+    """Validated, broadcast and flattened θ and k_a, the coefficients, m and the shape."""
+    p, H, tp = _validate(tau, delta, headway, sample_time, tau_prev)
+    th = np.asarray(theta, dtype=float)
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    shape = np.broadcast_shapes(th.shape, kx.shape)
+    kx, kv, ka, th = (np.broadcast_to(v, shape).ravel() for v in (kx, kv, ka, th))
+    co, m = _point_coeffs(kx, kv, ka, p, H, tp)
+    return th, ka, co, m, shape
+
+
 def sampled_response(
     theta: npt.ArrayLike, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
     *, tau: float, delta: float, headway: float, sample_time: float,
@@ -584,15 +597,10 @@ def sampled_response(
     >>> np.round(np.abs(h), 6).tolist()
     [1.0, 0.760411]
     """
-    p, H, tp = _validate(tau, delta, headway, sample_time, tau_prev)
-    th = np.asarray(theta, dtype=float)
-    kx, kv, ka = as_gains(k_x, k_v, k_a)
-    shape = np.broadcast_shapes(th.shape, kx.shape)
-    kx, kv, ka, th = (np.broadcast_to(v, shape).ravel() for v in (kx, kv, ka, th))
-    co, m = _point_coeffs(kx, kv, ka, p, H, tp)
-    out = _response(th, co, m, ka)
-    # θ = 0: H(1) = 1 exactly whenever Δ(1) ≠ 0 (k_x ≠ 0); the w-form divides 0/0 at k_x = 0
-    return out.reshape(shape)
+    th, ka, co, m, shape = _on_circle(theta, k_x, k_v, k_a, tau, delta, headway, sample_time,
+                                      tau_prev)
+    # H(1) = 1 whenever Δ(1) ≠ 0 (k_x ≠ 0); at k_x = 0 the w-form gives 0/0 = nan at θ = 0
+    return _response(th, co, m, ka).reshape(shape)
 
 
 def _eval_margin(theta: Array, co: _Coeffs, m: Array | int) -> tuple[Array, Array]:
@@ -645,14 +653,9 @@ def sampled_margin(
     ...  for H in (0.1, 0.01, 0.001)]  # the gap shrinks like H
     [-2.117, -0.471, -0.052]
     """
-    p, H, tp = _validate(tau, delta, headway, sample_time, tau_prev)
-    th = np.asarray(theta, dtype=float)
-    kx, kv, ka = as_gains(k_x, k_v, k_a)
-    shape = np.broadcast_shapes(th.shape, kx.shape)
-    kx, kv, ka, th = (np.broadcast_to(v, shape).ravel() for v in (kx, kv, ka, th))
-    co, m = _point_coeffs(kx, kv, ka, p, H, tp)
-    g, _ = _eval_margin(th, co, m)
-    return np.asarray(g).reshape(shape)
+    th, _, co, m, shape = _on_circle(theta, k_x, k_v, k_a, tau, delta, headway, sample_time,
+                                     tau_prev)
+    return np.asarray(_eval_margin(th, co, m)[0]).reshape(shape)
 
 
 # ---------------------------------------------------------------------------
@@ -681,6 +684,17 @@ def _schur_bands(delta: list[_Iv]) -> tuple[npt.NDArray[np.bool_], npt.NDArray[n
     return sure, fail
 
 
+def _loop_delta(k_x: Any, k_v: Any, tau: Any, headway: Any,
+                sample_time: Any) -> tuple[list[_Iv], tuple[int, ...]]:
+    """δ0, δ1, δ2 of the follower's loop (flattened) and the gains' shape."""
+    p = Params(*check_params(tau, 0.0, headway))
+    H = positive("sample_time (sampling period H)", sample_time, unit=" s")
+    kx, kv, _ = as_gains(k_x, k_v, 0.0)
+    shape = kx.shape
+    kx, kv = kx.ravel(), kv.ravel()
+    return _point_coeffs(kx, kv, np.zeros_like(kx), p, H, p.tau)[0].delta, shape
+
+
 def schur(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float, sample_time: float,
 ) -> npt.NDArray[np.bool_]:
@@ -694,14 +708,8 @@ def schur(
     >>> schur([1.2, 1.2, -0.5], [0.5, 40.0, 1.0], tau=0.1, headway=1.1, sample_time=0.1).tolist()
     [True, False, False]
     """
-    check_params(tau, 0.0, headway)
-    H = positive("sample_time (sampling period H)", sample_time, unit=" s")
-    kx, kv, _ = as_gains(k_x, k_v, 0.0)
-    shape = kx.shape
-    kx, kv = kx.ravel(), kv.ravel()
-    p = Params(tau, 0.0, headway)
-    co, _ = _point_coeffs(kx, kv, np.zeros_like(kx), p, H, p.tau)
-    return _schur_bands(co.delta)[0].reshape(shape)
+    delta, shape = _loop_delta(k_x, k_v, tau, headway, sample_time)
+    return _schur_bands(delta)[0].reshape(shape)
 
 
 def _z_coeffs(delta: list[Array]) -> tuple[Array, Array, Array]:
@@ -720,14 +728,8 @@ def spectral_radius(
     >>> float(np.round(spectral_radius(1.2, 0.5, tau=0.1, headway=1.1, sample_time=0.1), 4))
     0.8888
     """
-    check_params(tau, 0.0, headway)
-    H = positive("sample_time (sampling period H)", sample_time, unit=" s")
-    kx, kv, _ = as_gains(k_x, k_v, 0.0)
-    shape = kx.shape
-    kx, kv = kx.ravel(), kv.ravel()
-    p = Params(tau, 0.0, headway)
-    co, _ = _point_coeffs(kx, kv, np.zeros_like(kx), p, H, p.tau)
-    return _spectral_radius([d.lo for d in co.delta]).reshape(shape)
+    delta, shape = _loop_delta(k_x, k_v, tau, headway, sample_time)
+    return _spectral_radius([d.lo for d in delta]).reshape(shape)
 
 
 def _spectral_radius(delta: list[Array]) -> Array:
@@ -934,8 +936,19 @@ def _peak(co: _Coeffs, m: int, ka: Array, W: Array, worst: Array) -> tuple[Array
     return best, best_w
 
 
+class _Verdict:
+    """``certified``, shared by the single-triple result classes."""
+
+    verdict: str
+
+    @property
+    def certified(self) -> bool:
+        """True iff the verdict is ``"certified"``."""
+        return self.verdict == "certified"
+
+
 @dataclass(frozen=True)
-class SampledCertificate:
+class SampledCertificate(_Verdict):
     """The sampled-data certificate of one gain triple.
 
     Attributes
@@ -982,11 +995,6 @@ class SampledCertificate:
     margin: float
     n_evals: int = 0
 
-    @property
-    def certified(self) -> bool:
-        """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
-
     def as_dict(self) -> dict[str, Any]:
         """A JSON row (non-finite numbers become None)."""
         return {
@@ -999,8 +1007,44 @@ class SampledCertificate:
         }
 
 
+class _Results:
+    """The batch protocol shared by the result classes: len, ``certified``, rows, summary."""
+
+    k_x: Array
+    verdict: npt.NDArray[np.str_]
+
+    def __len__(self) -> int:
+        return int(self.k_x.size)
+
+    def __getitem__(self, i: int) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    @property
+    def certified(self) -> npt.NDArray[np.bool_]:
+        """Boolean array: verdict == "certified"."""
+        return np.asarray(self.verdict == "certified")
+
+    def records(self) -> list[dict[str, Any]]:
+        """One JSON row per triple (non-finite numbers as None)."""
+        return [self[i].as_dict() for i in range(len(self))]
+
+    def summary(self) -> dict[str, Any]:
+        """Counts per verdict and m_fss, the share certified (IDL eq 27)."""
+        n = len(self)
+        counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
+        return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+
+
+def _one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
+    """Refuse arrays where a single-triple function takes scalars."""
+    for name, v in gains.items():
+        if np.ndim(v) != 0:
+            raise StringStabError(
+                f"{fn} takes one triple; {name} has shape {np.shape(v)}; use {batch_fn}")
+
+
 @dataclass(frozen=True)
-class SampledCertificateBatch:
+class SampledCertificateBatch(_Results):
     """Sampled certificates of many triples, as arrays (fields of :class:`SampledCertificate`)."""
 
     k_x: Array
@@ -1019,14 +1063,6 @@ class SampledCertificateBatch:
     margin: Array
     n_evals: npt.NDArray[np.int64]
 
-    def __len__(self) -> int:
-        return int(self.k_x.size)
-
-    @property
-    def certified(self) -> npt.NDArray[np.bool_]:
-        """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
-
     def __getitem__(self, i: int) -> SampledCertificate:
         return SampledCertificate(
             k_x=float(self.k_x[i]), k_v=float(self.k_v[i]), k_a=float(self.k_a[i]),
@@ -1038,15 +1074,6 @@ class SampledCertificateBatch:
             n_evals=int(self.n_evals[i]),
         )
 
-    def records(self) -> list[dict[str, Any]]:
-        """One JSON row per triple."""
-        return [self[i].as_dict() for i in range(len(self))]
-
-    def summary(self) -> dict[str, Any]:
-        """Counts per verdict and the share certified."""
-        n = len(self)
-        counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
-        return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
 
 
 def certify_sampled_batch(
@@ -1136,10 +1163,6 @@ def certify_sampled(
     >>> c.verdict, c.sup_gain, c.schur
     ('certified', 1.0, True)
     """
-    for name, v in (("k_x", k_x), ("k_v", k_v), ("k_a", k_a)):
-        if np.ndim(v) != 0:
-            raise StringStabError(
-                f"certify_sampled takes one triple; {name} has shape {np.shape(v)}; "
-                "use certify_sampled_batch")
+    _one_triple("certify_sampled", "certify_sampled_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     return certify_sampled_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
                                  sample_time=sample_time, tau_prev=tau_prev)[0]
