@@ -112,6 +112,20 @@ _SCHUR_RTOL = 1e-12
 def parse_interval(text: str, name: str = "value") -> Interval:
     """Parse ``"LO:HI"`` (or a plain number, a point interval) into ``(lo, hi)``.
 
+    For the command line (``--tau 0.1:0.5``); range checks (τ > 0, δ ≥ 0) are
+    :func:`check_box`'s.
+
+    Parameters
+    ----------
+    text : str
+        ``"0.1:0.5"`` or ``"0.2"``.
+    name : str
+        What the interval is, for the error message.
+
+    Returns
+    -------
+    (float, float)
+
     Raises
     ------
     StringStabError
@@ -146,6 +160,11 @@ def parse_interval(text: str, name: str = "value") -> Interval:
 
 def as_interval(value: Any, name: str = "value") -> Interval:
     """A number, a ``(lo, hi)`` pair or a ``"LO:HI"`` string as a checked ``(lo, hi)``.
+
+    Raises
+    ------
+    StringStabError
+        On a value that is none of these, a non-finite end, or lo > hi.
 
     Examples
     --------
@@ -863,6 +882,15 @@ def certify_robust(
     sample_time: float | None = None, heterogeneous: bool = True,
 ) -> RobustCertificate:
     """Certify one gain triple over a parameter box (see :func:`certify_robust_batch`).
+
+    Returns
+    -------
+    RobustCertificate
+
+    Raises
+    ------
+    StringStabError
+        On a malformed box, a bad sample time or gains, or arrays instead of one triple.
 
     Examples
     --------

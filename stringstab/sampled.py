@@ -501,6 +501,16 @@ def split_delay(delta: float, sample_time: float) -> tuple[int, float]:
     Uses the exact ``math.fmod`` so that a δ on a multiple of H gives ε = 0 when the
     float division would not.
 
+    Parameters
+    ----------
+    delta, sample_time : float
+        δ ≥ 0 and H > 0, s (not validated here).
+
+    Returns
+    -------
+    (int, float)
+        m and ε.
+
     Examples
     --------
     >>> split_delay(0.2, 0.1), split_delay(0.25, 0.1)[0], split_delay(0.0, 0.05)
@@ -642,7 +652,18 @@ def sampled_margin(
     """g_H(θ) = τ²τ_p²(|D|² − |N|²)/(H⁶ ρ): ≥ 0 iff |H(e^{jθ})| ≤ 1 (module docstring).
 
     Tends to the continuous margin g(ω) of :func:`stringstab.frequency.margin_g` at
-    θ = ωH as H → 0; at θ = 0 it is the sampled analogue of Ψ3.
+    θ = ωH as H → 0; at θ = 0 it is the sampled analogue of Ψ3
+    (:func:`stringstab.sampled_symbolic.dc_margin`).
+
+    Parameters
+    ----------
+    theta, k_x, k_v, k_a, tau, delta, headway, sample_time, tau_prev
+        As for :func:`sampled_response`.
+
+    Returns
+    -------
+    ndarray
+        g_H at each θ (broadcast shape).
 
     Examples
     --------
@@ -701,7 +722,24 @@ def schur(
     """Internal stability of the sampled loop: is Δ(z) Schur (all roots inside |z| < 1)?
 
     Decided by the bilinear conditions (:func:`stringstab.sampled_symbolic.schur_conditions`)
-    in the w-form; True only outside a relative 10⁻¹² band around the boundary.
+    in the w-form; True only outside a relative 10⁻¹² band around the boundary.  Δ does not
+    depend on δ, k_a or the predecessor's lag.
+
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Gains (broadcast together).
+    tau, headway, sample_time : float
+        τ > 0, T* ≥ 0, H > 0 (s).
+
+    Returns
+    -------
+    ndarray of bool
+
+    Raises
+    ------
+    StringStabError
+        On parameters out of range or non-finite gains.
 
     Examples
     --------
@@ -722,6 +760,8 @@ def spectral_radius(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float, sample_time: float,
 ) -> Array:
     """max |root| of Δ(z) (< 1 iff Schur), from companion-matrix eigenvalues.
+
+    Parameters and errors as for :func:`schur`; returns an array of the gains' shape.
 
     Examples
     --------
@@ -1155,7 +1195,16 @@ def certify_sampled(
     k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
     sample_time: float, tau_prev: float | None = None,
 ) -> SampledCertificate:
-    """Certify one gain triple for the sampled-data loop.
+    """Certify one gain triple for the sampled-data loop (see :func:`certify_sampled_batch`).
+
+    Returns
+    -------
+    SampledCertificate
+
+    Raises
+    ------
+    StringStabError
+        On bad parameters or gains, or arrays instead of one triple.
 
     Examples
     --------

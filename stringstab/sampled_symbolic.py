@@ -60,11 +60,13 @@ import sympy as sp
 from .symbolic import k_a, k_v, k_x, routh_hurwitz, tau, vehicle_model
 
 __all__ = [
+    "SAMPLED_SUBSTITUTABLE",
     "W_COEFFICIENT_NAMES",
     "SampledModel",
     "SampledTransferFunction",
     "characteristic_polynomial",
     "dc_margin",
+    "derive_sampled_all",
     "epsilon",
     "m",
     "phi_functions",
@@ -360,3 +362,48 @@ def schur_conditions() -> list[sp.Expr]:
     out = [sp.expand(c) for c in reversed(coeffs)]
     out.append(sp.expand(dets[1]))
     return out
+
+
+#: Symbols of the sampled derivation a caller may substitute (with those of
+#: :data:`stringstab.symbolic.SUBSTITUTABLE`).
+SAMPLED_SUBSTITUTABLE: dict[str, sp.Symbol] = {
+    str(x): x for x in (sample_time, tau_prev, epsilon, m)
+}
+
+
+def derive_sampled_all(substitute: dict[sp.Symbol, sp.Expr] | None = None) -> dict[str, object]:
+    """Every sampled-data expression under stable keys (for ``stringstab derive --sample-time``).
+
+    Keys: ``H`` (one expression), ``H_numerator_direct``, ``H_numerator_delayed``,
+    ``H_denominator``, ``characteristic_polynomial``, ``w_coefficients`` (a dict, keys
+    :data:`W_COEFFICIENT_NAMES`), ``schur_conditions`` (each > 0, in δ0, δ1, δ2) and
+    ``dc_margin``.
+
+    Parameters
+    ----------
+    substitute : dict, optional
+        Symbol → value substitutions applied to every expression (e.g. τ, δ, H, ε, m).
+
+    Examples
+    --------
+    >>> d = derive_sampled_all({tau: sp.Rational(1, 10), tau_prev: sp.Rational(1, 10),
+    ...                         sample_time: sp.Rational(1, 10)})
+    >>> d["w_coefficients"]["delta3"], sorted(d)[:2]
+    (1, ['H', 'H_denominator'])
+    """
+    sub = substitute or {}
+
+    def f(e: sp.Expr) -> sp.Expr:
+        return sp.expand(e.subs(sub)) if sub else e
+
+    tf = sampled_transfer()
+    return {
+        "H": tf.expr.subs(sub) if sub else tf.expr,
+        "H_numerator_direct": f(tf.numerator_direct),
+        "H_numerator_delayed": f(tf.numerator_delayed),
+        "H_denominator": f(tf.denominator),
+        "characteristic_polynomial": sp.collect(f(characteristic_polynomial()), z),
+        "w_coefficients": {k: f(v) for k, v in w_coefficients().items()},
+        "schur_conditions": schur_conditions(),
+        "dc_margin": f(dc_margin()),
+    }
