@@ -12,7 +12,8 @@ Measured by the tool (issue 10, item 4); prints its tables, asserts nothing.
    (:func:`stringstab.robust.certify_robust_batch`): continuous time on the same grid,
    and sampled at Δt = 0.1 s on a coarser grid (``--n-robust-sampled``, default 11³).
 3. **The paper's range and example gains.**  How much of the continuous-certified part
-   of [−2, 2]³ survives at the paper's own step (Δt = 0.1 s: NGSIM at 10 Hz, IDL §4.1.1),
+   of [−2, 2]³ survives at the paper's own step (Δt = 0.1 s: not printed, but its leaders
+   are NGSIM trajectories at 10 Hz, IDL §4.1.1),
    and the verdicts of gains used as examples: K = (1.2, 0.5, 0.6) (this toolkit's
    examples) and the CACC baseline (k_x, k_v, k_a) = (0.1, 0.58, 1.0) of van Arem et al.
    used by the IDL paper, also at the HCFS paper's step Δt = 0.2 s.
