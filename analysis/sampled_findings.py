@@ -32,12 +32,13 @@ import time
 
 import numpy as np
 
+from stringstab import constants
 from stringstab.certificate import check
 from stringstab.robust import certify_robust_batch
 from stringstab.sampled import certify_sampled, certify_sampled_batch, check_sampled
 
-TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
-PERIODS = (0.05, 0.1, 0.2)
+TAU, DELTA, HEADWAY = constants.TAU, constants.DELTA, constants.HEADWAY
+PERIODS = (0.05, constants.DT, 0.2)  # around the IDL paper's step; 0.2 s is HCFS's
 
 
 def load() -> str:
@@ -45,7 +46,7 @@ def load() -> str:
 
 
 def grid(n: int) -> np.ndarray:
-    g = np.linspace(-2.0, 2.0, n)
+    g = np.linspace(*constants.GAIN_BOUNDS, n)
     return np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
@@ -98,7 +99,7 @@ def robust_tables(K: np.ndarray, Ks: np.ndarray) -> None:
             row.append(share(v == "certified").strip())
         print(f"| [{t[0]}, {t[1]}] | " + " | ".join(row) + " |")
     print(f"({time.perf_counter() - t0:.1f} s)")
-    H = 0.1
+    H = constants.DT
     print(f"\nsampled at Δt = {H} s, heterogeneous lags (τ_prev in the τ box), "
           f"{len(Ks)} triples: certified / inconclusive share")
     sub_t, sub_d = taus[:3], deltas[:3]
@@ -137,7 +138,7 @@ def main() -> None:
     print(f"# sampled and robust findings: {args.n}³ = {len(K)} triples over [-2, 2]³, "
           f"τ = {TAU} s, δ = {DELTA} s, T* = {HEADWAY} s; {load()}")
     cert = sampling(K)
-    H = 0.1
+    H = constants.DT
     s = check_sampled(*K[cert].T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H).verdict
     print(f"\nthe paper's range at its own step (Δt = {H} s): {np.count_nonzero(s == 'certified')} of "
           f"the {np.count_nonzero(cert)} continuous-certified grid points survive "

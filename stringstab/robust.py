@@ -65,7 +65,7 @@ import numpy.typing as npt
 
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound
 from .certificate import _curvature_bound, _hurwitz_bands, tail_bound
-from .errors import StringStabError
+from .errors import StringStabError, show
 from .frequency import gain_squared, margin_g_coefficients
 from .params import Params, as_gains, positive
 from .sampled import (
@@ -180,18 +180,18 @@ def as_interval(value: Any, name: str = "value") -> Interval:
         try:
             lo, hi = float(value[0]), float(value[1])
         except (TypeError, ValueError) as e:
-            raise StringStabError(f"{name} interval ends must be numbers; got {value!r}") from e
+            raise StringStabError(f"{name} interval ends must be numbers; got {show(value)}") from e
         if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise StringStabError(f"{name} interval ends must be finite numbers; got {value!r}")
+            raise StringStabError(f"{name} interval ends must be finite numbers; got {show(value)}")
         if lo > hi:
-            raise StringStabError(f"{name} interval must have lo <= hi; got {value!r}")
+            raise StringStabError(f"{name} interval must have lo <= hi; got {show(value)}")
         return lo, hi
     try:
         v = float(value)
     except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number or a (lo, hi) pair; got {value!r}") from e
+        raise StringStabError(f"{name} must be a number or a (lo, hi) pair; got {show(value)}") from e
     if not math.isfinite(v):
-        raise StringStabError(f"{name} must be a finite number; got {value!r}")
+        raise StringStabError(f"{name} must be a finite number; got {show(value)}")
     return v, v
 
 
