@@ -1,0 +1,215 @@
+"""A vectorised one-dimensional branch and bound: is f ≥ 0 on [0, Ω_i] for every item i?
+
+The engine behind the sampled-data and robust certificates (:mod:`stringstab.sampled`,
+:mod:`stringstab.robust`).  Each item i (a gain triple, or a gain triple and a cell of
+uncertain parameters) has a function f_i on [0, Ω_i] that the caller can evaluate at any
+points, returning for each point
+
+* a *point value* f_i(x) at one admissible parameter value (used to prove a violation:
+  f_i(x) < −slack is a witness),
+* a *lower bound* of f over the item's parameter cell at x (equal to the point value
+  when the cell is a point), and
+* a round-off *slack*,
+
+and for each interval [l, r] between consecutive points a bound M ≥ |f''| over [l, r]
+(and the cell).  Then on [l, r] of width h, for every parameter of the cell,
+
+    f ≥ min(f_low(l), f_low(r)) − M h²/8 − max(slack(l), slack(r))
+
+(the error bound of linear interpolation: f(x) ≥ the chord − M (x − l)(r − x)/2 and the
+chord ≥ the smaller end value).  An interval whose bound is ≥ 0 is settled; the others
+are split into 4 to 64 pieces (as many as the curvature bound says are needed) and
+re-checked, all items at once, for up to ``max_rounds`` rounds.
+
+Items end ``certified`` (every interval settled), ``violated`` (a point value below
+−slack: a witness), ``inconclusive`` (too many undecided intervals, or rounds ran out)
+or ``pending``: intervals the caller asked to ``hold`` (e.g. where the parameter cell,
+not the frequency interval, is too wide) are returned for the caller to split the cell.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["CERTIFIED", "INCONCLUSIVE", "PENDING", "VIOLATED", "BranchAndBound", "branch_and_bound"]
+
+Array = npt.NDArray[np.float64]
+Index = npt.NDArray[np.intp]
+
+#: Item outcomes.
+CERTIFIED, VIOLATED, INCONCLUSIVE, PENDING = 0, 1, 2, 3
+
+#: ``evaluate(idx, X)`` with X of shape (len(idx), k + 1), sorted along axis 1, returns
+#: (point values, lower bounds, slacks) of shape (len(idx), k + 1) and curvature bounds
+#: of shape (len(idx), k) for the k intervals between consecutive columns.
+Evaluate = Callable[[Index, Array], tuple[Array, Array, Array, Array]]
+
+#: ``hold(idx, L, R, low_gap, curv)`` → mask of undecided intervals to hand back to the
+#: caller instead of refining them (``low_gap`` = point − lower bound at the worse end,
+#: ``curv`` = M h²/8).
+Hold = Callable[[Index, Array, Array, Array, Array], npt.NDArray[np.bool_]]
+
+
+@dataclass
+class BranchAndBound:
+    """Outcome per item, and the intervals handed back (see the module docstring).
+
+    Attributes
+    ----------
+    status : ndarray of int8
+        :data:`CERTIFIED`, :data:`VIOLATED`, :data:`INCONCLUSIVE` or :data:`PENDING`.
+    minimum : ndarray
+        Smallest point value found (an upper bound on min f).
+    argmin : ndarray
+        Where it was found.
+    n_evals : ndarray of int
+        Point evaluations per item.
+    grid_x, grid_f : ndarray
+        The initial grid and the point values on it (for reporting, e.g. a peak search).
+    pending_item, pending_lo, pending_hi : ndarray
+        The held intervals (item index, ends).
+    """
+
+    status: npt.NDArray[np.int8]
+    minimum: Array
+    argmin: Array
+    n_evals: npt.NDArray[np.int64]
+    grid_x: Array
+    grid_f: Array
+    pending_item: Index
+    pending_lo: Array
+    pending_hi: Array
+
+
+def _lower(G: Array, Glow: Array, E: Array, M: Array, X: Array) -> tuple[Array, Array, Array, Array]:
+    h = X[:, 1:] - X[:, :-1]
+    sl = np.maximum(E[:, :-1], E[:, 1:])
+    end = np.minimum(Glow[:, :-1], Glow[:, 1:])
+    curv = M * h * h / 8.0
+    low_gap = np.maximum(G[:, :-1] - Glow[:, :-1], G[:, 1:] - Glow[:, 1:])
+    return end - curv - sl, end - sl, curv, low_gap
+
+
+def branch_and_bound(
+    n: int, evaluate: Evaluate, *, right: Array | None = None, n_grid: int = 64,
+    intervals: tuple[Index, Array, Array] | None = None, max_rounds: int = 30,
+    max_intervals: int = 1024, refine: npt.NDArray[np.bool_] | None = None,
+    hold: Hold | None = None,
+) -> BranchAndBound:
+    """Decide f_i ≥ 0 on [0, right_i] (or on given intervals) for n items.
+
+    Parameters
+    ----------
+    n : int
+        Number of items.
+    evaluate : callable
+        See :data:`Evaluate`.
+    right : ndarray, optional
+        Right ends Ω_i of the domains [0, Ω_i] (with ``n_grid`` initial intervals each).
+    n_grid : int
+        Initial intervals per item.
+    intervals : (item, lo, hi), optional
+        Start from these intervals instead (each evaluated at its two ends).
+    max_rounds, max_intervals : int
+        Refinement rounds; undecided intervals per item beyond which the item is
+        inconclusive.
+    refine : bool array, optional
+        Items to refine at all (others keep the verdict of the first evaluation).
+    hold : callable, optional
+        See :data:`Hold`.
+
+    Returns
+    -------
+    BranchAndBound
+    """
+    minimum = np.full(n, np.inf)
+    argmin = np.zeros(n)
+    n_evals = np.zeros(n, dtype=np.int64)
+    violated = np.zeros(n, dtype=bool)
+    inconclusive = np.zeros(n, dtype=bool)
+    held: list[tuple[Index, Array, Array]] = []
+    if intervals is None:
+        if right is None:
+            raise ValueError("branch_and_bound needs right or intervals")
+        u = np.linspace(0.0, 1.0, n_grid + 1)
+        X = np.asarray(right, dtype=float)[:, None] * u[None, :]
+        idx = np.arange(n)
+    else:
+        idx, lo, hi = intervals
+        X = np.stack([lo, hi], axis=1)
+    G, Glow, E, M = evaluate(idx, X) if idx.size else (X, X, X, X[:, 1:])
+    grid_x, grid_f = (X, G) if intervals is None else (np.zeros((n, 0)), np.zeros((n, 0)))
+
+    while True:
+        np.add.at(n_evals, idx, X.shape[1])
+        if idx.size:
+            j = np.argmin(G, axis=1)
+            rows = np.arange(idx.size)
+            gmin = G[rows, j]
+            np.minimum.at(minimum, idx, gmin)
+            better = gmin <= minimum[idx]
+            argmin[idx[better]] = X[rows, j][better]
+            viol = np.any(G < -E, axis=1)
+            if viol.any():
+                violated[np.unique(idx[viol])] = True
+        low, gap, curv, low_gap = _lower(G, Glow, E, M, X)
+        und = (low < 0) & ~violated[idx][:, None]
+        if refine is not None:
+            skip = und & ~refine[idx][:, None]
+            if skip.any():  # undecided but not to be refined: never certified
+                inconclusive[np.unique(idx[np.nonzero(skip)[0]])] = True
+            und &= refine[idx][:, None]
+        ii, kk = np.nonzero(und)
+        it, L, R = idx[ii], X[ii, kk], X[ii, kk + 1]
+        gp, Mi = gap[ii, kk], M[ii, kk]
+        if hold is not None and it.size:
+            hm = hold(it, L, R, low_gap[ii, kk], curv[ii, kk])
+            if hm.any():
+                held.append((it[hm], L[hm], R[hm]))
+                keep = ~hm
+                it, L, R, gp, Mi = it[keep], L[keep], R[keep], gp[keep], Mi[keep]
+        if it.size == 0:
+            break
+        if max_rounds <= 0:
+            inconclusive[np.unique(it)] = True
+            break
+        max_rounds -= 1
+        counts = np.bincount(it, minlength=n)
+        over = counts > max_intervals
+        if over.any():
+            inconclusive |= over
+            keep = ~over[it]
+            it, L, R, gp, Mi = it[keep], L[keep], R[keep], gp[keep], Mi[keep]
+            if it.size == 0:
+                break
+        # enough pieces that M h²/8 ≤ gap/2 where the end values are clearly positive
+        with np.errstate(divide="ignore", invalid="ignore"):
+            need = np.where(gp > 0, (R - L) * np.sqrt(Mi / (4.0 * gp)), 4.0)
+        split = int(min(max(4, 2 ** math.ceil(math.log2(max(float(np.max(need)), 1.0)))), 64))
+        while split > 4 and it.size * split > 2_000_000:
+            split //= 2
+        v = np.linspace(0.0, 1.0, split + 1)
+        idx = it
+        X = L[:, None] + (R - L)[:, None] * v[None, :]
+        G, Glow, E, M = evaluate(idx, X)
+
+    status = np.full(n, CERTIFIED, dtype=np.int8)
+    pend = np.zeros(n, dtype=bool)
+    if held:
+        pi = np.concatenate([h[0] for h in held])
+        pend[pi] = True
+        pl = np.concatenate([h[1] for h in held])
+        ph = np.concatenate([h[2] for h in held])
+    else:
+        pi, pl, ph = np.zeros(0, dtype=np.intp), np.zeros(0), np.zeros(0)
+    status[pend] = PENDING
+    status[inconclusive] = INCONCLUSIVE
+    status[violated] = VIOLATED
+    keep = ~violated[pi] & ~inconclusive[pi]
+    return BranchAndBound(status, minimum, argmin, n_evals, grid_x, grid_f,
+                          pi[keep], pl[keep], ph[keep])
