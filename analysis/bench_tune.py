@@ -29,6 +29,12 @@ machine); and how often the projection moves no further than region growing
 (+1e-9), over the inputs where region growing returned a *certified* repair
 (the fair comparison) and over all inputs where it returned any repair.
 
+``--baseline DIR`` adds a same-run A/B comparison of the projection: DIR holds an
+older copy of the package (``DIR/stringstab``, e.g. ``git archive main stringstab |
+tar -x -C DIR``), loaded under the name ``stringstab_baseline``; each triple is
+repaired by both, alternating which goes first, and the medians, their ratio and
+the largest difference in the outputs are printed.
+
 ``--loop N`` adds a control-loop scenario: a random walk of N steps
 K_t = clip(K_{t−1} + N(0, 0.02² I)) from an uncertified start, repaired at each
 step by a :class:`stringstab.tuning.Projector` (cache + warm start from the
@@ -42,10 +48,14 @@ Prints its figures; asserts nothing about time.  Example::
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
 import json
 import os
+import sys
 import time
 from collections import Counter
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -144,6 +154,54 @@ def compare(pj: dict[str, np.ndarray], rg: dict[str, np.ndarray]) -> dict[str, A
     }
 
 
+def load_baseline(path: str) -> Any:
+    """``DIR/stringstab`` imported as the package ``stringstab_baseline``; its tuning module."""
+    root = Path(path) / "stringstab"
+    spec = importlib.util.spec_from_file_location(
+        "stringstab_baseline", root / "__init__.py", submodule_search_locations=[str(root)])
+    if spec is None or spec.loader is None:
+        raise SystemExit(f"--baseline {path}: expected a folder holding stringstab/__init__.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["stringstab_baseline"] = mod
+    spec.loader.exec_module(mod)
+    return importlib.import_module("stringstab_baseline.tuning")
+
+
+def ab_projection(K: np.ndarray, p: dict[str, float], base: Any) -> dict[str, Any]:
+    """The projection of this tree against the baseline's, interleaved triple by triple."""
+    from stringstab import tuning as new
+
+    t_new = np.empty(len(K))
+    t_old = np.empty(len(K))
+    dk = np.empty(len(K))
+    dd = np.empty(len(K))
+    same_verdict = np.empty(len(K), dtype=bool)
+    for i, k in enumerate(K):
+        order = ((new, t_new), (base, t_old)) if i % 2 else ((base, t_old), (new, t_new))
+        res = {}
+        for mod, out in order:
+            t0 = time.perf_counter()
+            r = mod.project(k, **p)
+            out[i] = time.perf_counter() - t0
+            res[mod is new] = r
+        dk[i] = float(np.max(np.abs(np.subtract(res[True].k, res[False].k))))
+        dd[i] = res[True].distance - res[False].distance
+        same_verdict[i] = res[True].verdict == res[False].verdict
+    return {
+        "n": len(K),
+        "this_ms_median": float(np.median(t_new) * 1e3),
+        "baseline_ms_median": float(np.median(t_old) * 1e3),
+        "ratio_median_this_over_baseline": float(np.median(t_new) / np.median(t_old)),
+        "this_ms_p99": float(np.percentile(t_new, 99) * 1e3),
+        "baseline_ms_p99": float(np.percentile(t_old, 99) * 1e3),
+        "max_abs_difference_in_K": float(dk.max()) if len(K) else 0.0,
+        "share_identical_K": float(np.mean(dk == 0.0)) if len(K) else float("nan"),
+        "share_K_differs_over_1e-6": float(np.mean(dk > 1e-6)) if len(K) else float("nan"),
+        "distance_this_minus_baseline_min_max": [float(dd.min()), float(dd.max())] if len(K) else [],
+        "share_same_verdict": float(same_verdict.mean()) if len(K) else float("nan"),
+    }
+
+
 def control_loop(rng: np.random.Generator, steps: int, p: dict[str, float]) -> dict[str, Any]:
     K = np.empty((steps, 3))
     k = uncertified_uniform(rng, 1, p)[0]
@@ -187,6 +245,8 @@ def main() -> None:
     ap.add_argument("--delta", type=float, default=DEFAULT_DELTA)
     ap.add_argument("--headway", type=float, default=DEFAULT_HEADWAY)
     ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    ap.add_argument("--baseline", metavar="DIR",
+                    help="also compare the projection with the package in DIR/stringstab (A/B)")
     args = ap.parse_args()
     p = {"tau": args.tau, "delta": args.delta, "headway": args.headway}
     rng = np.random.default_rng(args.seed)
@@ -195,6 +255,10 @@ def main() -> None:
     # build solvers, the certified map and lambdified criteria before timing
     project((0.9, -0.5, 1.1), **p)
     region_growing((0.9, -0.5, 1.1), **p)
+    base = None
+    if args.baseline:
+        base = load_baseline(args.baseline)
+        base.project((0.9, -0.5, 1.1), **p)
     report: dict[str, Any] = {"n": args.n, "seed": args.seed, "params": p, "sigma": args.sigma}
     for set_name in args.sets.split(","):
         K = (uncertified_uniform(rng, args.n, p) if set_name == "uniform"
@@ -213,6 +277,10 @@ def main() -> None:
                 if m in res:
                     rep[f"projection_vs_{m}"] = compare(res["projection"], res[m])
                     print(f"projection vs {m}: " + json.dumps(rep[f"projection_vs_{m}"]))
+        if base is not None:
+            rep["ab_projection"] = ab_projection(K, p, base)
+            print(f"A/B projection, this tree vs {args.baseline} "
+                  f"(load {os.getloadavg()[0]:.2f}): " + json.dumps(rep["ab_projection"]))
         report[set_name] = rep
     if args.loop:
         report["control_loop"] = control_loop(rng, args.loop, p)

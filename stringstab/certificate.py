@@ -53,10 +53,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import _generated as _gen
+from . import margin as _margin
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
-from .frequency import gain_squared, margin_g_coefficients
+from .frequency import gain_squared
 from .io.results import TableColumn, columns_from_records, records_from_columns
+from .margin import tail_bound
 from .params import Params, as_gains
 
 __all__ = [
@@ -84,76 +87,21 @@ _HURWITZ_RTOL = 1e-12  # relative band around the Hurwitz boundary left inconclu
 
 
 # ---------------------------------------------------------------------------
-# Step 1: tail bound
+# Step 1, the tail bound, is :func:`stringstab.margin.tail_bound` (re-exported here).
 # ---------------------------------------------------------------------------
-def tail_bound(t2: Array, a: Array, b: Array, cx: Array, cv: Array) -> Array:
-    """A frequency Ω with g(ω) > 0 for every ω > Ω (step 1 of the module docstring).
-
-    Parameters
-    ----------
-    t2, a, b, cx, cv : ndarray
-        Coefficients of g from :func:`stringstab.frequency.margin_g_coefficients`.
-
-    Returns
-    -------
-    ndarray
-        Ω ≥ 1e-3, elementwise.
-
-    Examples
-    --------
-    >>> from stringstab.frequency import margin_g_coefficients, margin_g
-    >>> co = margin_g_coefficients(np.array([0.9]), -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
-    >>> W = tail_bound(*co)
-    >>> w = np.linspace(W[0], 50 * W[0], 10_000)
-    >>> bool(np.all(margin_g(w, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1) > 0))
-    True
-    """
-    t2, a, b, cx, cv = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (t2, a, b, cx, cv)))
-    A = np.maximum(-a, 0.0) / t2
-    B = np.abs(cv) / t2
-    C = np.maximum(np.abs(cx) - b, 0.0) / t2
-    # Fujiwara's bound on the roots of w^4 + 0 w^3 - A w^2 - B w - C
-    w = 2.0 * np.maximum.reduce([np.sqrt(A), np.cbrt(B), np.sqrt(np.sqrt(C / 2.0))])
-    w = np.maximum(w, 1e-3)
-    for _ in range(30):
-        L = ((w * w - A) * w - B) * w - C
-        dL = (4.0 * w * w - 2.0 * A) * w - B
-        step = np.where(dL > 0, L / np.where(dL > 0, dL, 1.0), 0.0)
-        # iterates stay >= the root; stop shrinking below the floor
-        w = np.maximum(w - step, 1e-3)
-        if np.all(step <= 1e-6 * w):  # any iterate is a valid bound: stop when settled
-            break
-    W = w * (1.0 + 1e-9) + 1e-12
-    Lw = ((W * W - A) * W - B) * W - C
-    bad = ~(Lw > 0) & ((A > 0) | (B > 0) | (C > 0))
-    if bad.any():  # pragma: no cover - defensive: fall back to the raw Fujiwara bound
-        fb = 2.0 * np.maximum.reduce([np.sqrt(A), np.cbrt(B), np.sqrt(np.sqrt(C / 2.0))]) + 1.0
-        W = np.where(bad, fb, W)
-    return W
-
-
-def _g_and_scale(
-    w: Array, t2: Array, a: Array, b: Array, cx: Array, cv: Array, d: Array, mag: tuple[Array, ...]
-) -> tuple[Array, Array]:
-    """g(ω) and its round-off slack, broadcasting coefficient columns against ω."""
-    w2 = w * w
-    dw = d * w
-    g = t2 * w2 * w2 + a * w2 + b + cx * np.cos(dw) - cv * w * np.sin(dw)
-    ma, mb = mag
-    scale = t2 * w2 * w2 + ma * w2 + mb + np.abs(cx) + np.abs(cv) * w
-    return g, _SLACK * scale
-
-
-def _curvature_bound(
-    r: Array, t2: Array, a: Array, cx: Array, cv: Array, d: Array
-) -> Array:
-    """M ≥ |g''(ω)| for ω ∈ [0, r] (step 2 of the module docstring)."""
-    return 12.0 * t2 * r * r + 2.0 * np.abs(a) + np.abs(cx) * d * d + np.abs(cv) * (2.0 * d + d * d * r)
-
-
 def col(v: Array) -> Array:
     """A 1-D array as a column, to broadcast against a frequency grid."""
     return v[:, None]
+
+
+def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
+    """g on the grid ``w`` and its round-off slack (step 3).
+
+    ``Q`` holds, as columns (shape (11, n, 1)), the 5 coefficients of g, their 5
+    round-off scales and δ of each row of ``w``.
+    """
+    g, scale = _margin.g_and_scale(w, Q[:5], Q[5:10], Q[10])
+    return g, _SLACK * scale
 
 
 # ---------------------------------------------------------------------------
@@ -176,17 +124,18 @@ def _exact_chunk(
     refine: npt.NDArray[np.bool_] | None = None,
 ) -> _Exact:
     n = kx.size
-    t2, a, b, cx, cv = (np.broadcast_to(np.asarray(v, float), (n,)).copy()
-                        for v in margin_g_coefficients(kx, kv, ka, tau=tau, delta=delta, headway=headway))
-    c = kv + headway * kx
-    mag_a = 1.0 + 2.0 * tau * np.abs(c) + ka * ka
-    mag_b = c * c + 2.0 * np.abs(kx) + kv * kv
-    d = np.full(n, float(delta))
-    Om = tail_bound(t2, a, b, cx, cv)
+    # one row per coefficient of g (5), per round-off scale (5), and δ: indexed together
+    Q = np.empty((11, n))
+    for i, v in enumerate((*_gen.margin_coefficients(kx, kv, ka, tau, delta, headway),
+                           *_gen.margin_coefficient_scales(kx, kv, ka, tau, delta, headway),
+                           delta)):
+        Q[i] = v
+    Om = tail_bound(*Q[:5])
 
     u = np.linspace(0.0, 1.0, n_grid + 1)
     W = Om[:, None] * u[None, :]
-    G, E = _g_and_scale(W, col(t2), col(a), col(b), col(cx), col(cv), col(d), (col(mag_a), col(mag_b)))
+    Qc = Q[:, :, None]
+    G, E = _g_and_slack(W, Qc)
     violated = np.any(G < -E, axis=1)
     imin = np.argmin(G, axis=1)
     margin = G[np.arange(n), imin]
@@ -195,7 +144,7 @@ def _exact_chunk(
 
     # interval lower bounds
     h = (Om / n_grid)[:, None]
-    M = _curvature_bound(W[:, 1:], col(t2), col(a), col(cx), col(cv), col(d))
+    M = _margin.curvature_bound(W[:, 1:], Qc[:5], Qc[10])
     Gl, Gr = G[:, :-1], G[:, 1:]
     slack = np.maximum(E[:, :-1], E[:, 1:])
     lower = np.minimum(Gl, Gr) - M * h * h / 8.0 - slack
@@ -233,10 +182,8 @@ def _exact_chunk(
             split //= 2
         v = np.linspace(0.0, 1.0, split + 1)
         Wn = L[:, None] + (R - L)[:, None] * v[None, :]
-        Gn, En = _g_and_scale(
-            Wn, col(t2[tri]), col(a[tri]), col(b[tri]), col(cx[tri]), col(cv[tri]), col(d[tri]),
-            (col(mag_a[tri]), col(mag_b[tri])),
-        )
+        Qt = Q[:, tri, None]
+        Gn, En = _g_and_slack(Wn, Qt)
         np.add.at(n_evals, tri, split - 1)
         # track the minimum found and violations
         jmin = np.argmin(Gn, axis=1)
@@ -248,7 +195,7 @@ def _exact_chunk(
         if viol_int.any():
             violated[np.unique(tri[viol_int])] = True
         hn = ((R - L) / split)[:, None]
-        Mn = _curvature_bound(Wn[:, 1:], col(t2[tri]), col(a[tri]), col(cx[tri]), col(cv[tri]), col(d[tri]))
+        Mn = _margin.curvature_bound(Wn[:, 1:], Qt[:5], Qt[10])
         lowern = np.minimum(Gn[:, :-1], Gn[:, 1:]) - Mn * hn * hn / 8.0 - np.maximum(En[:, :-1], En[:, 1:])
         und = (lowern < 0) & ~violated[tri][:, None]
         ii, kk = np.nonzero(und)
@@ -281,13 +228,15 @@ def _peak(
     """
     n = kx.size
     rows = np.arange(n)
-    c = kv + headway * kx
+    p0, p1, p2, p3 = (np.broadcast_to(np.asarray(v, float), (n,))
+                      for v in _gen.denominator_abs2_coefficients(kx, kv, ka, tau, delta, headway))
     w2 = W * W
-    D2 = (col(kx) - w2) ** 2 + w2 * (col(c) - tau * w2) ** 2
+    D2 = ((col(p0) * w2 + col(p1)) * w2 + col(p2)) * w2 + col(p3)  # |D(jω)|², a cubic in ω²
     with np.errstate(divide="ignore", invalid="ignore"):
         G2 = np.where(D2 > 0, 1.0 - w2 * G / D2, np.inf)
     G2[:, 0] = np.where(kx != 0, 1.0, np.inf)  # Γ(0) = k_x/k_x
-    qa, qb, qc = 3.0 * tau * tau, 2.0 * (1.0 - 2.0 * tau * c), c * c - 2.0 * kx
+    # resonances: the roots of d|D|²/dx = 3p0 x² + 2p1 x + p2
+    qa, qb, qc = 3.0 * p0, 2.0 * p1, p2
     disc = qb * qb - 4.0 * qa * qc
     sq = np.sqrt(np.maximum(disc, 0.0))
     extra = np.stack([np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0)
@@ -770,16 +719,18 @@ def certify_pade(
 
     p = Params(tau, delta, headway)
     kx, kv, ka = (float(v) for v in as_gains(k_x, k_v, k_a))
-    s = control.tf("s")
     if p.delta > 0:
         num_d, den_d = control.pade(p.delta, order)
         delay = control.tf(num_d, den_d)
     else:
         delay = control.tf([1.0], [1.0])
-    den = control.tf([p.tau, 1.0, kv + p.headway * kx, kx], [1.0])
-    sys = (kx + kv * s + ka * s * s * delay) / den
-    poles = np.concatenate([np.roots([p.tau, 1.0, kv + p.headway * kx, kx]),
-                            np.asarray(control.poles(delay))])
+    # N(s) = n0(s) + n1(s) e^{-δs} and D(s), generated from the derivation
+    d_co = [float(c) for c in _gen.denominator_coefficients(kx, kv, ka, p.tau, p.delta, p.headway)]
+    n_co = [float(c) for c in _gen.numerator_coefficients(kx, kv, ka, p.tau, p.delta, p.headway)]
+    n0, n1 = n_co[:_gen.NUMERATOR_SPLIT], n_co[_gen.NUMERATOR_SPLIT:]
+    den = control.tf(d_co, [1.0])
+    sys = (control.tf(n0, [1.0]) + control.tf(n1, [1.0]) * delay) / den
+    poles = np.concatenate([np.roots(d_co), np.asarray(control.poles(delay))])
     stable = bool(np.all(poles.real < 0))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -1,9 +1,10 @@
 """Vectorised string-stability criteria: Hurwitz, Proposition 1 and the types I-IV.
 
-All functions broadcast over arrays of gains (and parameters) and are built from
-the *derived* SymPy expressions of :mod:`stringstab.symbolic` (or, for the
-``printed`` source, from :mod:`stringstab.printed`), turned into NumPy with
-``lambdify`` at the edge.
+All functions broadcast over arrays of gains (and parameters) and evaluate the
+*derived* SymPy expressions of :mod:`stringstab.symbolic` (or, for the
+``printed`` source, those of :mod:`stringstab.printed`) through the numeric code
+generated from them (:mod:`stringstab._generated`, ``python -m stringstab.codegen``),
+so no SymPy is imported at run time.
 
 Two Taylor-based verdicts are offered, because they differ:
 
@@ -31,15 +32,20 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import _generated as _gen
 from .params import as_gains, check_params
-from .symbolic import lambdify_psi
 
 __all__ = [
+    "HURWITZ_LABELS",
     "TYPE_NAMES",
     "TaylorCriteria",
     "hurwitz",
+    "hurwitz_conditions",
+    "hurwitz_gradients",
     "hurwitz_margin",
+    "hurwitz_ok",
     "proposition1",
+    "psi",
     "stability_type",
     "taylor_criteria",
 ]
@@ -48,6 +54,71 @@ Array = npt.NDArray[np.float64]
 
 #: Names of the stability types of IDL §3.3, indexed by the integer codes 1-4.
 TYPE_NAMES: dict[int, str] = {1: "I", 2: "II", 3: "III", 4: "IV"}
+#: The Hurwitz conditions of :func:`hurwitz_conditions`, as people write them.
+HURWITZ_LABELS: tuple[str, ...] = ("k_x", "k_v + (T* - tau) k_x")
+_PSI = {"derived": _gen.psi_derived, "printed": _gen.psi_printed}
+
+
+def psi(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: npt.ArrayLike, delta: npt.ArrayLike, headway: npt.ArrayLike, source: str = "derived",
+) -> tuple[Array, Array, Array, Array]:
+    """Ψ1, Ψ2, Ψ3 and Λ = Ψ2² − 4Ψ1Ψ3 (IDL eqs 12-15), broadcast together.
+
+    ``source="derived"``: :func:`stringstab.symbolic.derived_psi` (exact-delay series);
+    ``"printed"``: the IDL paper's eqs 12-14 as printed (:mod:`stringstab.printed`).
+    Λ is evaluated from Ψ1-Ψ3 by its definition (eq 15) rather than from its expanded
+    form (~4x slower in NumPy and no more accurate).
+
+    Examples
+    --------
+    >>> [round(float(v), 6) for v in psi(1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1)]
+    [0.010293, 0.592, 0.71, 0.321231]
+    """
+    try:
+        fn = _PSI[source]
+    except KeyError:
+        raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}") from None
+    args = (k_x, k_v, k_a, tau, delta, headway)
+    shape = np.broadcast_shapes(*(np.shape(v) for v in args))
+    p1, p2, p3 = (np.broadcast_to(np.asarray(o, dtype=float), shape)
+                  for o in fn(*(np.asarray(v, dtype=float) for v in args)))
+    return p1, p2, p3, p2 * p2 - 4.0 * p1 * p3
+
+
+def hurwitz_conditions(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike = 0.0,
+    *, tau: float, headway: float,
+) -> tuple[Array, ...]:
+    """The values of the Hurwitz conditions of Γ's denominator; each must be > 0.
+
+    Generated from :func:`stringstab.symbolic.hurwitz_conditions`: k_x and
+    k_v + (T* − τ)k_x (:data:`HURWITZ_LABELS`).  Works on arrays and on floats.
+
+    Examples
+    --------
+    >>> [float(c) for c in hurwitz_conditions(1.0, 0.5, tau=0.1, headway=1.1)]
+    [1.0, 1.5]
+    """
+    return tuple(_gen.hurwitz_conditions(k_x, k_v, k_a, tau, 0.0, headway))
+
+
+def hurwitz_gradients(*, tau: float, headway: float) -> Array:
+    """∇_K of each Hurwitz condition (they are linear in K): one row per condition.
+
+    Examples
+    --------
+    >>> hurwitz_gradients(tau=0.1, headway=1.1).tolist()
+    [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]
+    """
+    flat = np.asarray(_gen.hurwitz_gradients(tau, 0.0, headway), dtype=float)
+    return flat.reshape(-1, 3)
+
+
+def hurwitz_ok(k_x: float, k_v: float, k_a: float = 0.0, *, tau: float, headway: float,
+               margin: float = 0.0) -> bool:
+    """Scalar form of :func:`hurwitz` for inner loops: every condition > ``margin``."""
+    return all(c > margin for c in _gen.hurwitz_conditions(k_x, k_v, k_a, tau, 0.0, headway))
 
 
 def hurwitz(
@@ -65,12 +136,14 @@ def hurwitz(
     >>> hurwitz([1.0, -1.0, 1.0], [0.5, 0.5, -1.2], tau=0.1, headway=1.1)
     array([ True, False, False])
     """
-    kx, kv, _ = as_gains(k_x, k_v, k_a)
-    c1 = kx
-    c2 = kv + (headway - tau) * kx
-    s1 = rtol * np.abs(kx)
-    s2 = rtol * (np.abs(kv) + abs(headway - tau) * np.abs(kx))
-    return np.asarray((c1 > s1) & (c2 > s2))
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    conds = _gen.hurwitz_conditions(kx, kv, ka, tau, 0.0, headway)
+    if rtol:
+        scales = _gen.hurwitz_scales(kx, kv, ka, tau, 0.0, headway)
+        ok = [c > rtol * sc for c, sc in zip(conds, scales)]
+    else:
+        ok = [c > 0 for c in conds]
+    return np.asarray(np.logical_and.reduce(ok) & np.ones(kx.shape, dtype=bool))
 
 
 def hurwitz_margin(
@@ -89,8 +162,10 @@ def hurwitz_margin(
     shape = kx.shape
     kx, kv = kx.ravel(), kv.ravel()
     n = kx.size
+    lead, *rest = (np.broadcast_to(np.asarray(c, dtype=float), (n,))
+                   for c in _gen.denominator_coefficients(kx, kv, 0.0, tau, 0.0, headway))
     C = np.zeros((n, 3, 3))
-    C[:, 0, :] = -np.stack([np.full(n, 1.0 / tau), (kv + headway * kx) / tau, kx / tau], axis=1)
+    C[:, 0, :] = -np.stack([r / lead for r in rest], axis=1)  # companion matrix of D(s)
     C[:, 1, 0] = 1.0
     C[:, 2, 1] = 1.0
     ev = np.linalg.eigvals(C) if n else np.zeros((0, 3))
@@ -168,7 +243,7 @@ def taylor_criteria(
     """
     tau, delta, headway = check_params(tau, delta, headway)
     kx, kv, ka = as_gains(k_x, k_v, k_a)
-    psi1, psi2, psi3, lam = lambdify_psi(source)(kx, kv, ka, tau, delta, headway)
+    psi1, psi2, psi3, lam = psi(kx, kv, ka, tau=tau, delta=delta, headway=headway, source=source)
     return TaylorCriteria(
         source, psi1, psi2, psi3, lam, proposition1(psi1, psi2, psi3, lam, source=source),
         stability_type(psi2, psi3, lam),

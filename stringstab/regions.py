@@ -43,7 +43,7 @@ point with Λ ≤ 0.  The class map shows the types; the verdicts are in
 Evaluation is chunked in blocks of grid points (memory bounded by the block
 size, not the grid) and spread over worker processes.  The Taylor quantities
 are evaluated as polynomials in one gain with coefficients on the plane of the
-other two (Horner's rule, coefficients from the SymPy expressions of
+other two (Horner's rule, coefficients generated from the SymPy expressions of
 :func:`stringstab.symbolic.derived_psi` and :func:`stringstab.printed.printed_psi`);
 this agrees with :func:`stringstab.criteria.taylor_criteria` to round-off
 (~1e-15 relative), so only grid points lying exactly on a boundary Ψ = 0 or
@@ -63,9 +63,8 @@ import math
 import multiprocessing
 import os
 import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cache
 from itertools import combinations
 from pathlib import Path
 from typing import Any
@@ -73,6 +72,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import _generated as _gen
 from .criteria import TYPE_NAMES, hurwitz, proposition1, stability_type
 from .errors import StringStabError
 from .params import Params
@@ -124,43 +124,21 @@ _TAYLOR_SECONDS_PER_POINT = 1.5e-7
 
 
 # --------------------------------------------------------------------------- Taylor on a grid
-@cache
-def _psi_coefficients(source: str, g0: str, g1: str, g2: str) -> tuple[Callable[..., Any], ...]:
-    """Per Ψ1, Ψ2, Ψ3, Λ: f(g1, g2, τ, δ, T*) -> coefficients of the polynomial in g0.
-
-    Symbolic first: the SymPy expressions are expanded as polynomials in the gain
-    ``g0``; only their coefficients are lambdified.
-    """
-    import sympy as sp
-
-    from .symbolic import GAINS, PARAMS, derived_psi
-
-    sym = dict(zip(GAIN_NAMES, GAINS))
-    if source == "derived":
-        exprs = derived_psi(None)
-    else:
-        from .printed import printed_psi
-
-        exprs = printed_psi()
-    out = []
-    for e in exprs:
-        coeffs = sp.Poly(sp.expand(e), sym[g0]).all_coeffs()  # highest power first
-        out.append(sp.lambdify([sym[g1], sym[g2], *PARAMS], coeffs, modules="numpy", cse=True))
-    return tuple(out)
-
-
 def _psi_grid(
     source: str, names: tuple[str, str, str], x0: Array, x1: Array, x2: Array, p: Params
 ) -> tuple[Array, Array, Array, Array]:
-    """Ψ1, Ψ2, Ψ3, Λ on the grid x0 × x1 × x2 (shape (n0, n1, n2)), by Horner in x0."""
-    fs = _psi_coefficients(source, *names)
+    """Ψ1, Ψ2, Ψ3, Λ on the grid x0 × x1 × x2 (shape (n0, n1, n2)), by Horner in x0.
+
+    The coefficients of each Ψ as a polynomial in the gain ``names[0]`` are generated
+    from the SymPy expressions (:func:`stringstab._generated.psi_polynomials`).
+    """
     shape = (x0.size, x1.size, x2.size)
     a0 = x0.reshape(-1, 1, 1)
-    a1 = x1.reshape(1, -1, 1)
-    a2 = x2.reshape(1, 1, -1)
+    polys = _gen.psi_polynomials(
+        source, names[0], **{names[1]: x1.reshape(1, -1, 1), names[2]: x2.reshape(1, 1, -1)},
+        tau=p.tau, delta=p.delta, headway=p.headway)
     res = []
-    for f in fs:
-        coeffs = f(a1, a2, p.tau, p.delta, p.headway)
+    for coeffs in polys:
         r = np.empty(shape)
         r[...] = coeffs[0]
         for c in coeffs[1:]:
@@ -231,10 +209,7 @@ def _blocks(n0: int, n1: int, n2: int, target: int) -> list[tuple[int, int, int,
 
 
 def _warm(methods: tuple[str, ...], names: tuple[str, str, str]) -> None:
-    """Build the lambdified functions once (forked workers inherit them)."""
-    _psi_coefficients("derived", *names)
-    if "printed" in methods:
-        _psi_coefficients("printed", *names)
+    """Run the certificate once (imports and caches; forked workers inherit them)."""
     if "exact" in methods:
         from .certificate import certify_batch
 

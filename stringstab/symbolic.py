@@ -413,7 +413,9 @@ def lambdify_psi(
         ``"derived"``: :func:`derived_psi` (exact-delay series); ``"printed"``:
         the IDL paper's eqs 12-15 as printed (:mod:`stringstab.printed`).
     delay_order : int or None
-        Only for ``"derived"``; see :func:`margin_series`.
+        Only for ``"derived"``; see :func:`margin_series`.  ``None`` and the
+        printed forms use the code generated from these expressions
+        (:func:`stringstab.criteria.psi`); other orders are lambdified here.
 
     Returns
     -------
@@ -427,27 +429,35 @@ def lambdify_psi(
     >>> [round(float(v), 6) for v in f(1.0, 0.5, 0.2, 0.1, 0.2, 1.1)]
     [0.010293, 0.592, 0.71, 0.321231]
     """
-    if source == "derived":
-        exprs = derived_psi(delay_order)
-    elif source == "printed":
-        from .printed import printed_psi
-
-        exprs = printed_psi()
-    else:
+    if source not in ("derived", "printed"):
         raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}")
+    if source == "printed" or delay_order is None:
+        # the generated code of these two (stringstab._generated, tested against SymPy)
+        from functools import partial
+
+        from .criteria import psi as _psi
+
+        fn = partial(_psi, source=source)
+
+        def psi(k_x, k_v, k_a, tau, delta, headway):  # type: ignore[no-untyped-def]
+            return fn(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway)
+
+        psi.__doc__ = f"(Ψ1, Ψ2, Ψ3, Λ) from the {source} forms (generated code)."
+        return psi
+    exprs = derived_psi(delay_order)
     # Ψ1-Ψ3 are low-degree polynomials; Λ is evaluated from them by its
     # definition Ψ2² − 4Ψ1Ψ3 (eq 15) rather than from its expanded form, which
     # is ~4x slower in NumPy (integer powers) and no more accurate.
-    fn = sp.lambdify([*GAINS, *PARAMS], list(exprs[:3]), modules="numpy", cse=True)
+    lam = sp.lambdify([*GAINS, *PARAMS], list(exprs[:3]), modules="numpy", cse=True)
 
-    def psi(k_x, k_v, k_a, tau, delta, headway):  # type: ignore[no-untyped-def]
+    def psi_n(k_x, k_v, k_a, tau, delta, headway):  # type: ignore[no-untyped-def]
         shape = np.broadcast_shapes(*(np.shape(v) for v in (k_x, k_v, k_a, tau, delta, headway)))
         p1, p2, p3 = (np.broadcast_to(np.asarray(o, dtype=float), shape)
-                      for o in fn(k_x, k_v, k_a, tau, delta, headway))
+                      for o in lam(k_x, k_v, k_a, tau, delta, headway))
         return p1, p2, p3, p2 * p2 - 4.0 * p1 * p3
 
-    psi.__doc__ = f"(Ψ1, Ψ2, Ψ3, Λ) from the {source} forms."
-    return psi
+    psi_n.__doc__ = f"(Ψ1, Ψ2, Ψ3, Λ) from the derived forms, delay order {delay_order}."
+    return psi_n
 
 
 #: Names a caller may substitute with :func:`derive_all` (everything but s and ω).

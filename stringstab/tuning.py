@@ -46,10 +46,18 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from . import margin as _margin
 from .certificate import Certificate, certify, certify_batch, check
-from .criteria import TYPE_NAMES, taylor_criteria
+from .criteria import (
+    HURWITZ_LABELS,
+    TYPE_NAMES,
+    hurwitz,
+    hurwitz_conditions,
+    hurwitz_gradients,
+    hurwitz_ok,
+    taylor_criteria,
+)
 from .errors import StringStabError
-from .frequency import margin_g_coefficients
 from .params import Params, positive
 
 __all__ = [
@@ -252,7 +260,7 @@ def _rg_accept(K: Array, p: Params, criterion: str, check_hurwitz: bool) -> npt.
                          source=criterion)
     ok = tc.stable & (tc.type <= 2)
     if check_hurwitz:
-        ok &= (K[:, 0] > 0) & (K[:, 1] + (p.headway - p.tau) * K[:, 0] > 0)
+        ok &= hurwitz(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, headway=p.headway)
     return np.asarray(ok)
 
 
@@ -491,16 +499,9 @@ def _nlp(n_slots: int) -> Any:
     K0, w = par[0:3], par[3:6]
     tau, delta, T = par[6], par[7], par[8]
     kx, kv, ka = x[0], x[1], x[2]
-    c = kv + T * kx
-    a = 1 - 2 * tau * c - ka * ka
-    b = c * c - 2 * kx - kv * kv
-    gs = []
-    for j in range(n_slots):
-        om = par[9 + j]
-        gs.append(tau**2 * om**4 + a * om**2 + b + 2 * kx * ka * ca.cos(delta * om)
-                  - 2 * kv * ka * om * ca.sin(delta * om))
+    gs = _margin.casadi_g([par[9 + j] for j in range(n_slots)], kx, kv, ka, tau, delta, T)
     f = ca.sum1(w * (x - K0) ** 2)
-    g = ca.vertcat(kx, kv + (T - tau) * kx, *gs)
+    g = ca.vertcat(*hurwitz_conditions(kx, kv, ka, tau=tau, headway=T), *gs)
     opts = {
         "print_time": False,
         "error_on_fail": False,
@@ -516,72 +517,14 @@ def _nlp(n_slots: int) -> Any:
                      {"x": x, "p": par, "f": f, "g": g}, opts)
 
 
-def _g_coeffs(K: Array, p: Params) -> tuple[float, float, float, float, float]:
-    t2, a, b, cx, cv = margin_g_coefficients(K[0], K[1], K[2], tau=p.tau, delta=p.delta,
-                                             headway=p.headway)
-    return float(t2), float(a), float(b), float(cx), float(cv)
-
-
-def _g_dips(K: Array, p: Params, threshold: float, n: int = 384,
-            max_minima: int = 12) -> tuple[float, list[float]]:
-    """Cheap scan of g(·; K): (minimum found, refined local minimisers with g < threshold).
-
-    A dense grid on [0, Ω_F], Ω_F Fujiwara's bound beyond which g > 0 (see
-    :func:`stringstab.certificate.tail_bound`), then the ``max_minima`` lowest
-    local minima of the grid are zoomed into (a 9-point grid, shrunk ×4, six
-    times) and those below ``threshold`` returned.  Used only to pick
-    frequencies and to detect violations, never to certify.
-    """
-    t2, a, b, cx, cv = _g_coeffs(K, p)
-    A = max(-a, 0.0) / t2
-    B = abs(cv) / t2
-    C = max(abs(cx) - b, 0.0) / t2
-    om_max = max(2.0 * max(math.sqrt(A), B ** (1.0 / 3.0), (C / 2.0) ** 0.25), 1.0)
-    d = p.delta
-
-    def g(w: Array) -> Array:
-        w2 = w * w
-        return np.asarray(t2 * w2 * w2 + a * w2 + b + cx * np.cos(d * w) - cv * w * np.sin(d * w))
-
-    W = np.linspace(0.0, om_max, n)
-    Gv = g(W)
-    gmin = float(Gv.min())
-    # local minima of the grid (including the end point ω = 0), the lowest first; a dip
-    # narrower than the grid spacing can hide between samples, so all are refined
-    left = np.concatenate([[np.inf], Gv[:-1]])
-    right = np.concatenate([Gv[1:], [np.inf]])
-    idx = np.flatnonzero((Gv <= left) & (Gv <= right))
-    idx = idx[np.argsort(Gv[idx])[:max_minima]]
-    centres = W[idx]
-    half = np.full(idx.size, om_max / (n - 1))
-    v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(6):
-        Wl = np.maximum(centres[:, None] + half[:, None] * v[None, :], 0.0)
-        Gl = g(Wl)
-        jl = np.argmin(Gl, axis=1)
-        centres = Wl[np.arange(idx.size), jl]
-        half = half / 4.0
-    gl = g(centres)
-    gmin = min(gmin, float(gl.min()))
-    return gmin, [float(c) for c, gv in zip(centres, gl) if gv < threshold]
+def _g_dips(K: Array, p: Params, threshold: float) -> tuple[float, list[float]]:
+    """The violating dips of g(·; K) (:func:`stringstab.margin.local_minima`)."""
+    return _margin.local_minima(K, tau=p.tau, delta=p.delta, headway=p.headway, threshold=threshold)
 
 
 def _g_and_grad(om: Array, K: Array, p: Params) -> tuple[Array, Array]:
-    """g(ω; K) and its gradient in K (rows: frequencies), g as in :func:`_nlp`."""
-    kx, kv, ka = float(K[0]), float(K[1]), float(K[2])
-    tau, d, T = p.tau, p.delta, p.headway
-    c = kv + T * kx
-    a = 1.0 - 2.0 * tau * c - ka * ka
-    b = c * c - 2.0 * kx - kv * kv
-    w2 = om * om
-    co, si = np.cos(d * om), np.sin(d * om)
-    g = tau * tau * w2 * w2 + a * w2 + b + 2.0 * kx * ka * co - 2.0 * kv * ka * om * si
-    grad = np.stack([
-        -2.0 * tau * T * w2 + 2.0 * c * T - 2.0 + 2.0 * ka * co,
-        -2.0 * tau * w2 + 2.0 * c - 2.0 * kv - 2.0 * ka * om * si,
-        -2.0 * ka * w2 + 2.0 * kx * co - 2.0 * kv * om * si,
-    ], axis=1)
-    return g, grad
+    """g(ω; K) and ∇_K g (rows: frequencies): :func:`stringstab.margin.gradient`."""
+    return _margin.gradient(om, K, tau=p.tau, delta=p.delta, headway=p.headway)
 
 
 def _predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
@@ -618,43 +561,14 @@ def _predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
 
 
 def _g_full(om: float, K: Array, p: Params) -> tuple[float, Array, float, Array, float, Array]:
-    """g(ω; K) with the derivatives the KKT Newton step needs (scalar ω).
+    """g(ω; K) with the derivatives the KKT Newton step needs, in scalar arithmetic.
 
-    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g), g as in :func:`_nlp`.
-    Written out in scalar arithmetic on purpose (reusing the vectorised
-    :func:`_g_and_grad` costs ~0.5 ms of median repair latency);
-    ``tests/test_tuning.py::test_hand_derivatives_of_g_match_sympy`` checks every
-    term against SymPy's derivatives of the derived margin.
+    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g): :func:`stringstab.margin.newton_terms`
+    (the generated derivatives in ``math``-module arithmetic; the vectorised form costs
+    ~0.5 ms of median repair latency).
     """
-    kx, kv, ka = float(K[0]), float(K[1]), float(K[2])
-    tau, d, T = p.tau, p.delta, p.headway
-    c = kv + T * kx
-    a = 1.0 - 2.0 * tau * c - ka * ka
-    b = c * c - 2.0 * kx - kv * kv
-    w2 = om * om
-    co, si = math.cos(d * om), math.sin(d * om)
-    g = tau * tau * w2 * w2 + a * w2 + b + 2.0 * kx * ka * co - 2.0 * kv * ka * om * si
-    gk = np.array([
-        -2.0 * tau * T * w2 + 2.0 * c * T - 2.0 + 2.0 * ka * co,
-        -2.0 * tau * w2 + 2.0 * c - 2.0 * kv - 2.0 * ka * om * si,
-        -2.0 * ka * w2 + 2.0 * kx * co - 2.0 * kv * om * si,
-    ])
-    s1 = si + d * om * co  # d(ω sin δω)/dω
-    gw = (4.0 * tau * tau * w2 * om + 2.0 * a * om - 2.0 * kx * ka * d * si
-          - 2.0 * kv * ka * s1)
-    gwk = np.array([
-        -4.0 * tau * T * om - 2.0 * ka * d * si,
-        -4.0 * tau * om - 2.0 * ka * s1,
-        -4.0 * ka * om - 2.0 * kx * d * si - 2.0 * kv * s1,
-    ])
-    gww = (12.0 * tau * tau * w2 + 2.0 * a - 2.0 * kx * ka * d * d * co
-           - 2.0 * kv * ka * (2.0 * d * co - d * d * om * si))
-    gkk = np.array([
-        [2.0 * T * T, 2.0 * T, 2.0 * co],
-        [2.0 * T, 0.0, -2.0 * om * si],
-        [2.0 * co, -2.0 * om * si, -2.0 * w2],
-    ])
-    return g, gk, gw, gwk, gww, gkk
+    return _margin.newton_terms(om, float(K[0]), float(K[1]), float(K[2]), p.tau, p.delta,
+                                p.headway)
 
 
 def _kkt_newton(K0: Array, cons: list[tuple[Any, ...]], p: Params, w: Array, eps: float,
@@ -722,20 +636,18 @@ def _kkt_newton(K0: Array, cons: list[tuple[Any, ...]], p: Params, w: Array, eps
     return None  # pragma: no cover
 
 
-def _hurwitz_ok(K: Array, p: Params) -> bool:
-    return bool(K[0] > 0 and K[1] + (p.headway - p.tau) * K[0] > 0)
-
-
 def _surely_uncertifiable(K: Array, p: Params) -> tuple[bool, list[float]]:
     """(True, frequencies) when K provably cannot be certified: not Hurwitz or g(ω) < 0 found.
 
     A violation g(ω) < −1e-9·scale at any ω means |Γ(jω)| > 1 there, so the
     (sound) certificate can never certify K; no certificate call is needed.
     """
-    _, a, b, cx, cv = _g_coeffs(K, p)
+    _, a, b, cx, cv = (float(c) for c in _margin.coefficients(
+        K[0], K[1], K[2], tau=p.tau, delta=p.delta, headway=p.headway))
     scale = 1.0 + abs(a) + abs(b) + abs(cx) + abs(cv)
     _, dips = _g_dips(K, p, threshold=-1e-9 * scale)
-    return (not _hurwitz_ok(K, p)) or bool(dips), dips
+    stable = hurwitz_ok(float(K[0]), float(K[1]), float(K[2]), tau=p.tau, headway=p.headway)
+    return (not stable) or bool(dips), dips
 
 
 @lru_cache(maxsize=16)
@@ -745,7 +657,8 @@ def _certified_map(tau: float, delta: float, headway: float, lo: float, hi: floa
     g = np.linspace(lo, hi, n)
     KX, KV, KA = np.meshgrid(g, g, g, indexing="ij")
     kx, kv, ka = KX.ravel(), KV.ravel(), KA.ravel()
-    keep = (kx >= margin) & (kv + (headway - tau) * kx >= margin)
+    keep = np.all([c >= margin for c in hurwitz_conditions(kx, kv, ka, tau=tau, headway=headway)],
+                  axis=0)
     b = certify_batch(kx[keep], kv[keep], ka[keep], tau=tau, delta=delta, headway=headway)
     pts = np.column_stack([kx[keep], kv[keep], ka[keep]])[b.certified]
     pts.setflags(write=False)
@@ -1013,8 +926,8 @@ class Projector:
         lo, hi = self.bounds
         m = self.hurwitz_margin
         eye = np.eye(3)
-        lins = [(eye[0], m, "k_x >= m"), (np.array([p.headway - p.tau, 1.0, 0.0]), m,
-                                          "k_v + (T* - tau) k_x >= m")]
+        lins = [(row, m, f"{label} >= m") for row, label in
+                zip(hurwitz_gradients(tau=p.tau, headway=p.headway), HURWITZ_LABELS)]
         lins += [(eye[i], lo, f"{_GAIN_NAMES[i]} >= lo") for i in range(3)]
         lins += [(-eye[i], -hi, f"{_GAIN_NAMES[i]} <= hi") for i in range(3)]
         om_arr = np.asarray([o for o in omegas if o > 0], dtype=float)
@@ -1093,10 +1006,9 @@ class Projector:
         cap = _SLOTS[-1]
         if len(omegas) <= cap:
             return omegas
-        t2, a, b, cx, cv = _g_coeffs(x, self.params)
-        d = self.params.delta
+        p = self.params
         om = np.asarray(omegas[1:])
-        gv = t2 * om**4 + a * om**2 + b + cx * np.cos(d * om) - cv * om * np.sin(d * om)
+        gv = _margin.g(om, x[0], x[1], x[2], tau=p.tau, delta=p.delta, headway=p.headway)
         keep = np.sort(np.argsort(gv)[: cap - 1])
         return [omegas[0], *om[keep].tolist()]
 

@@ -1,0 +1,535 @@
+"""Numeric code generated from the symbolic derivation: DO NOT EDIT.
+
+Written by ``python -m stringstab.codegen`` from :mod:`stringstab.symbolic` (and the
+printed Ψ of :mod:`stringstab.printed`); ``tests/test_margin.py`` checks that this file
+equals a fresh generation and agrees with SymPy.  Only arithmetic, ``abs`` and the
+``cos``/``sin`` passed in are used, so every function evaluates NumPy arrays (the
+default), Python floats (``cos=math.cos, sin=math.sin``) and CasADi symbols
+(``cos=casadi.cos, sin=casadi.sin``) alike.  The public interface is
+:mod:`stringstab.margin` and :mod:`stringstab.criteria`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from numpy import cos as _np_cos
+from numpy import sin as _np_sin
+
+#: Names of the coefficients returned by :func:`margin_coefficients`.
+MARGIN_COEFFICIENTS = ('t2', 'a', 'b', 'cx', 'cv')
+
+
+def margin_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """(t2, a, b, cx, cv) with g(ω) = t2 ω⁴ + a ω² + b + cx cos(δω) − cv ω sin(δω)."""
+    _x0 = 2*k_v
+    _x1 = 2*k_x
+    _x2 = _x1*headway
+    return (
+        (tau*tau),
+        1 - (k_a*k_a) - _x0*tau - _x2*tau,
+        -_x1 + _x2*k_v + (k_x*k_x)*(headway*headway),
+        _x1*k_a,
+        _x0*k_a,
+    )
+
+
+def margin_coefficient_scales(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Σ |term| of each coefficient of :func:`margin_coefficients` (round-off scales)."""
+    _x0 = 2*abs(k_x)
+    return (
+        (tau*tau),
+        1 + (k_a*k_a) + 2*tau*abs(k_v) + _x0*headway*tau,
+        _x0 + (k_x*k_x)*(headway*headway) + 2*headway*abs(k_v*k_x),
+        2*abs(k_a*k_x),
+        2*abs(k_a*k_v),
+    )
+
+
+def margin_from_coefficients(omega: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, delta: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> Any:
+    """g(ω) from the coefficients of :func:`margin_coefficients`."""
+    _q0 = (omega*omega)
+    _x0 = delta*omega
+    return b + _q0*a + cx*cos(_x0) + t2*(_q0*_q0) - cv*omega*sin(_x0)
+
+
+def margin_and_scale(omega: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, s_t2: Any, s_a: Any, s_b: Any, s_cx: Any, s_cv: Any, delta: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(g(ω), Σ |term of g(ω)| bound) from the coefficients and their scales."""
+    _x0 = (omega*omega)
+    _x1 = delta*omega
+    _x2 = _x0*_x0
+    return (
+        b + _x0*a + _x2*t2 + cx*cos(_x1) - cv*omega*sin(_x1),
+        s_b + s_cx + _x0*s_a + _x2*s_t2 + s_cv*omega,
+    )
+
+
+def margin_curvature_bound(r: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, delta: Any) -> Any:
+    """M ≥ |g''(ω)| for every ω in [0, r], from the coefficients."""
+    _x0 = (delta*delta)
+    _x1 = abs(cv)
+    return 2*abs(a) + _x0*abs(cx) + 2*_x1*delta + 12*t2*(r*r) + _x0*_x1*r
+
+
+def margin_g(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> Any:
+    """g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (IDL eq 10, exact delay)."""
+    _q0 = (omega*omega)
+    _x0 = 2*k_v
+    _x1 = 2*k_x
+    _x2 = _x1*headway
+    _x3 = delta*omega
+    _c0 = (tau*tau)
+    _c1 = 1 - (k_a*k_a) - _x0*tau - _x2*tau
+    _c2 = -_x1 + _x2*k_v + (k_x*k_x)*(headway*headway)
+    _c3 = _x1*k_a
+    _c4 = _x0*k_a
+    return _c2 + _q0*_c1 + _c0*(_q0*_q0) + _c3*cos(_x3) - _c4*omega*sin(_x3)
+
+
+def margin_gradient(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(g, ∂g/∂k_x, ∂g/∂k_v, ∂g/∂k_a) at ω."""
+    _x0 = 2*tau
+    _x1 = 2*k_x
+    _x2 = _x1*headway
+    _x3 = (headway*headway)
+    _x4 = 2*k_a
+    _x5 = 2*k_v
+    _x6 = (omega*omega)
+    _x7 = delta*omega
+    _x8 = cos(_x7)
+    _x9 = omega*sin(_x7)
+    _c0 = (tau*tau)
+    _c1 = 1 - (k_a*k_a) - _x0*k_v - _x2*tau
+    _c2 = -_x1 + _x2*k_v + _x3*(k_x*k_x)
+    _c3 = _x1*k_a
+    _c4 = _x4*k_v
+    _c5 = -_x0*headway
+    _c6 = -2 + _x1*_x3 + _x5*headway
+    _c8 = -_x0
+    _c10 = -_x4
+    return (
+        _c2 + _x6*_c1 + _x8*_c3 + _c0*(_x6*_x6) - _x9*_c4,
+        _c6 + _x4*_x8 + _x6*_c5,
+        _x2 + _x6*_c8 - _x4*_x9,
+        _x1*_x8 + _x6*_c10 - _x5*_x9,
+    )
+
+
+def margin_newton(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(g, ∇_K g (3), ∂g/∂ω, ∇_K ∂g/∂ω (3), ∂²g/∂ω², ∇²_KK g (xx, xv, xa, vv, va, aa)) at ω."""
+    _x0 = 2*tau
+    _x1 = 2*k_x
+    _x2 = _x1*headway
+    _x3 = (headway*headway)
+    _x4 = 2*k_a
+    _x5 = 2*k_v
+    _x6 = (omega*omega)
+    _x7 = delta*omega
+    _x8 = cos(_x7)
+    _x10 = sin(_x7)
+    _x11 = _x10*omega
+    _x12 = -_x10 - _x7*_x8
+    _x14 = _x10*delta
+    _x15 = 2*omega
+    _x16 = 2*_x8
+    _x17 = (delta*delta)
+    _c0 = (tau*tau)
+    _c1 = 1 - (k_a*k_a) - _x0*k_v - _x2*tau
+    _c2 = -_x1 + _x2*k_v + _x3*(k_x*k_x)
+    _c3 = _x1*k_a
+    _c4 = _x4*k_v
+    _c5 = -_x0*headway
+    _c6 = -2 + _x1*_x3 + _x5*headway
+    _c8 = -_x0
+    _c10 = -_x4
+    _c13 = 2*_x3
+    _c14 = 2*headway
+    _x9 = _x8*_c3
+    _x13 = 2*_c1
+    return (
+        _x9 + _c2 + _x6*_c1 + _c0*(_x6*_x6) - _x11*_c4,
+        _c6 + _x4*_x8 + _x6*_c5,
+        _x2 + _x6*_c8 - _x11*_x4,
+        _x1*_x8 + _x6*_c10 - _x11*_x5,
+        _x12*_c4 + _x13*omega - _x14*_c3 + 4*_x6*_c0*omega,
+        _x15*_c5 - _x14*_x4,
+        _x12*_x4 + _x15*_c8,
+        _x12*_x5 + _x15*_c10 - _x1*_x14,
+        _x13 + _c4*(_x11*_x17 - _x16*delta) - _x17*_x9 + 12*_x6*_c0,
+        _c13,
+        _c14,
+        _x16,
+        0,
+        -2*_x11,
+        -2*_x6,
+    )
+
+
+def psi_derived(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """(Ψ1, Ψ2, Ψ3), derived forms (IDL eqs 12-14)."""
+    _q0 = (delta*delta)
+    _x0 = k_a*k_x
+    _x1 = 2*k_v
+    _x2 = 2*k_x
+    _x3 = _x2*headway
+    return (
+        (tau*tau) + _x0*(_q0*_q0)/12 + _q0*k_a*k_v*delta/3,
+        1 - (k_a*k_a) - _q0*_x0 - _x1*tau - _x3*tau - _x1*k_a*delta,
+        -_x2 + _x2*k_a + _x3*k_v + (k_x*k_x)*(headway*headway),
+    )
+
+
+def psi_printed(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """(Ψ1, Ψ2, Ψ3), printed forms (IDL eqs 12-14)."""
+    _q0 = (delta*delta)
+    _x0 = k_a*k_v
+    _x1 = 2*k_x
+    _x2 = k_v*headway
+    return (
+        (tau*tau) + _q0*_x0*delta/3,
+        1 - (k_a*k_a) - _x1*tau - 2*_x0*delta - 2*_x2*tau + _q0*k_a*k_x,
+        -_x1 + _x1*_x2 + _x1*k_a + (k_x*k_x)*(headway*headway),
+    )
+
+
+def _psi_poly_derived_k_x(k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_x, derived forms, flat."""
+    _x0 = (delta*delta*delta*delta)
+    _x1 = _x0*k_a
+    _x2 = (tau*tau)
+    _x3 = (delta*delta*delta)
+    _x4 = _x3*k_v
+    _x5 = _x4*k_a
+    _x6 = (delta*delta)
+    _x7 = _x6*k_a
+    _x8 = 2*tau
+    _x9 = (k_a*k_a)
+    _x10 = 2*k_a
+    _x11 = k_v*delta
+    _x12 = (headway*headway)
+    _x13 = k_v*headway
+    _x14 = 2*_x1/3
+    _x15 = 4*tau
+    _x16 = _x15*headway
+    _x17 = 8*_x2
+    _x18 = _x9*k_a
+    _x19 = _x15*k_v
+    _x20 = (k_v*k_v)
+    _x21 = _x20*k_a
+    _x22 = 8*delta*tau
+    _x23 = 4*_x20
+    _x24 = 4*_x11
+    return (
+        _x1/12,
+        _x2 + _x5/3,
+        -_x7 - _x8*headway,
+        1 - _x9 - _x10*_x11 - _x8*k_v,
+        _x12,
+        -2 + _x10 + 2*_x13,
+        0,
+        -_x1*_x12/3,
+        _x14 + _x16*_x7 - _x13*_x14 - 4*_x12*_x5/3 + _x0*_x9/3,
+        _x17 - _x16 - 2*_x7 + 8*_x5/3 + _x16*_x9 + _x19*_x7 - _x17*k_a + 2*_x18*_x6 + 4*_x4*_x9/3 + _x13*_x22*k_a - 8*_x21*_x3*headway/3,
+        1 - _x19 - 2*_x9 + _x18*_x24 + _x19*_x9 + _x2*_x23 + _x21*_x22 + _x9*_x9 - _x24*k_a + _x23*_x6*_x9,
+    )
+
+
+_PSI_POLY_SIZES_DERIVED_K_X = (2, 2, 3, 4)
+
+
+def _psi_poly_derived_k_v(k_x: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_v, derived forms, flat."""
+    _x0 = (delta*delta*delta)
+    _x1 = _x0*k_a
+    _x2 = (tau*tau)
+    _x3 = (delta*delta*delta*delta)
+    _x4 = k_a*k_x
+    _x5 = 2*tau
+    _x6 = k_a*delta
+    _x7 = (k_a*k_a)
+    _x8 = (delta*delta)
+    _x9 = _x4*_x8
+    _x10 = k_x*headway
+    _x11 = 2*k_x
+    _x12 = (k_x*k_x)
+    _x13 = (headway*headway)
+    _x14 = _x12*_x13
+    _x15 = _x11*k_a
+    _x16 = 8*_x6*tau
+    _x17 = 8*_x1/3
+    _x18 = 4*tau
+    _x19 = _x7*k_a
+    _x20 = _x18*_x7
+    _x21 = _x12*_x3
+    _x22 = 2*_x21*k_a/3
+    _x23 = 8*_x2
+    return (
+        _x1/3,
+        _x2 + _x3*_x4/12,
+        -_x5 - 2*_x6,
+        1 - _x7 - _x9 - _x10*_x5,
+        _x11*headway,
+        _x14 + _x15 - _x11,
+        _x16 + 4*_x2 - _x10*_x17 + 4*_x7*_x8,
+        _x20 - _x18 - 4*_x6 + _x10*_x16 + _x17*k_x + _x18*_x9 - _x22*headway + 4*_x19*delta - 4*_x1*_x14/3 + 4*_x0*_x7*k_x/3,
+        1 + _x22 - 2*_x7 + _x10*_x20 + _x23*k_x + _x7*_x7 - _x10*_x18 - _x15*_x8 - _x23*_x4 + _x21*_x7/3 + _x11*_x19*_x8 + _x12*_x18*_x8*k_a*headway - _x12*_x13*_x3*k_a*k_x/3,
+    )
+
+
+_PSI_POLY_SIZES_DERIVED_K_V = (2, 2, 2, 3)
+
+
+def _psi_poly_derived_k_a(k_x: Any, k_v: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_a, derived forms, flat."""
+    _x0 = (delta*delta*delta)
+    _x1 = _x0*k_v
+    _x2 = (delta*delta*delta*delta)
+    _x3 = (tau*tau)
+    _x4 = (delta*delta)
+    _x5 = _x4*k_x
+    _x6 = 2*k_v
+    _x7 = 2*k_x
+    _x8 = _x7*headway
+    _x9 = (k_x*k_x)
+    _x10 = (headway*headway)
+    _x11 = _x10*_x9
+    _x12 = 4*k_v
+    _x13 = 2*_x5 + _x12*delta
+    _x14 = _x12*tau
+    _x15 = (k_v*k_v)
+    _x16 = 4*_x15
+    _x17 = _x2*_x9
+    _x18 = k_x*headway
+    _x19 = 4*_x18*tau
+    _x20 = 8*_x3*k_x
+    return (
+        _x1/3 + _x2*k_x/12,
+        _x3,
+        -1,
+        -_x5 - _x6*delta,
+        1 - _x6*tau - _x8*tau,
+        _x7,
+        _x11 - _x7 + _x8*k_v,
+        1,
+        _x13,
+        -2 + _x14 + _x19 + _x17/3 + _x16*_x4 + 4*_x1*k_x/3,
+        -_x13 - _x20 - 4*_x1*_x11/3 + 2*_x2*_x9/3 + 8*_x15*delta*tau - 8*_x0*_x15*_x18/3 - 2*_x17*k_v*headway/3 + 8*_x0*k_v*k_x/3 + 4*_x4*_x9*headway*tau + 4*_x4*k_v*k_x*tau - _x10*_x2*_x9*k_x/3 + 8*k_v*k_x*delta*headway*tau,
+        1 + _x20 - _x14 - _x19 + _x16*_x3,
+    )
+
+
+_PSI_POLY_SIZES_DERIVED_K_A = (2, 3, 2, 5)
+
+
+def _psi_poly_printed_k_x(k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_x, printed forms, flat."""
+    _x0 = (tau*tau)
+    _x1 = (delta*delta*delta)
+    _x2 = _x1*k_v
+    _x3 = _x2*k_a
+    _x4 = 2*tau
+    _x5 = (delta*delta)
+    _x6 = _x5*k_a
+    _x7 = (k_a*k_a)
+    _x8 = 2*k_a
+    _x9 = k_v*delta
+    _x10 = k_v*headway
+    _x11 = (headway*headway)
+    _x12 = 4*_x0*_x11
+    _x13 = 4*tau
+    _x14 = _x13*_x6
+    _x15 = _x7*k_a
+    _x16 = (k_v*k_v)
+    _x17 = _x16*headway
+    _x18 = 4*_x9
+    return (
+        _x0 + _x3/3,
+        _x6 - _x4,
+        1 - _x7 - _x10*_x4 - _x8*_x9,
+        _x11,
+        -2 + _x8 + 2*_x10,
+        0,
+        -_x12 - _x14 + 4*_x0 + _x7*(_x5*_x5) - 4*_x11*_x3/3,
+        -_x13 + 8*_x0 - _x10*_x14 - 8*_x0*k_a - 2*_x15*_x5 + 2*_x5*k_a + 4*_x7*tau - 20*_x2*_x7/3 - 8*_x1*_x17*k_a/3 + 8*_x1*k_a*k_v/3 + 8*k_a*k_v*delta*tau,
+        1 - 2*_x7 + _x12*_x16 + _x15*_x18 + _x7*_x7 - _x10*_x13 - _x18*k_a + _x10*_x13*_x7 + 4*_x16*_x5*_x7 + 8*_x17*k_a*delta*tau,
+    )
+
+
+_PSI_POLY_SIZES_PRINTED_K_X = (1, 2, 3, 3)
+
+
+def _psi_poly_printed_k_v(k_x: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_v, printed forms, flat."""
+    _x0 = (delta*delta*delta)
+    _x1 = _x0*k_a
+    _x2 = (tau*tau)
+    _x3 = k_a*delta
+    _x4 = headway*tau
+    _x5 = (k_a*k_a)
+    _x6 = 2*k_x
+    _x7 = (delta*delta)
+    _x8 = k_a*k_x
+    _x9 = _x7*_x8
+    _x10 = (k_x*k_x)
+    _x11 = (headway*headway)
+    _x12 = _x10*_x11
+    _x13 = _x6*k_a
+    _x14 = 4*_x5
+    _x15 = 4*_x2
+    _x16 = _x5*k_a
+    _x17 = 4*_x4
+    _x18 = k_x*tau
+    _x19 = 8*_x2
+    return (
+        _x1/3,
+        _x2,
+        -2*_x3 - 2*_x4,
+        1 + _x9 - _x5 - _x6*tau,
+        _x6*headway,
+        _x12 + _x13 - _x6,
+        _x11*_x15 + _x14*_x7 + 8*_x3*_x4 - 8*_x1*k_x*headway/3,
+        -_x17 - 4*_x3 - _x17*_x9 + 4*_x16*delta - 4*_x1*_x12/3 + 4*_x5*headway*tau - 20*_x0*_x5*k_x/3 + 8*_x0*k_a*k_x/3 + 8*k_a*k_x*delta*tau,
+        1 - 4*_x18 - 2*_x5 + _x10*_x15 + _x13*_x7 + _x14*_x18 + _x19*k_x + _x5*_x5 - _x12*_x15 - _x19*_x8 + _x10*_x5*(_x7*_x7) - _x16*_x6*_x7 - 4*_x10*_x7*k_a*tau,
+    )
+
+
+_PSI_POLY_SIZES_PRINTED_K_V = (2, 2, 2, 3)
+
+
+def _psi_poly_printed_k_a(k_x: Any, k_v: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients (highest power first) of Ψ1, Ψ2, Ψ3, Λ as polynomials in k_a, printed forms, flat."""
+    _x0 = (delta*delta*delta)
+    _x1 = _x0*k_v
+    _x2 = (tau*tau)
+    _x3 = (delta*delta)
+    _x4 = _x3*k_x
+    _x5 = k_v*delta
+    _x6 = 2*k_x
+    _x7 = k_v*headway
+    _x8 = (k_x*k_x)
+    _x9 = (headway*headway)
+    _x10 = _x8*_x9
+    _x11 = 4*_x5
+    _x12 = 2*_x4
+    _x13 = 4*tau
+    _x14 = _x13*k_x
+    _x15 = (k_v*k_v)
+    _x16 = 4*_x15
+    _x17 = _x13*_x7
+    _x18 = 8*_x2*k_x
+    _x19 = 4*_x2
+    return (
+        _x1/3,
+        _x2,
+        -1,
+        _x4 - 2*_x5,
+        1 - _x6*tau - 2*_x7*tau,
+        _x6,
+        _x10 - _x6 + _x6*_x7,
+        1,
+        _x11 - _x12,
+        -2 + _x14 + _x17 + _x16*_x3 + _x8*(_x3*_x3) - 20*_x1*k_x/3,
+        _x12 - _x11 - _x18 - _x17*_x4 - 4*_x1*_x10/3 - _x13*_x3*_x8 + 8*_x0*k_v*k_x/3 + 8*_x15*delta*headway*tau + 8*k_v*k_x*delta*tau - 8*_x0*_x15*k_x*headway/3,
+        1 + _x18 - _x14 - _x17 + _x19*_x8 - _x10*_x19 + _x16*_x2*_x9,
+    )
+
+
+_PSI_POLY_SIZES_PRINTED_K_A = (2, 3, 2, 5)
+
+
+def psi_polynomials(source: str, gain: str, **values: Any) -> tuple[tuple[Any, ...], ...]:
+    """Ψ1, Ψ2, Ψ3, Λ as polynomials in ``gain``: four tuples of coefficients (highest
+    power first) in the other two gains and the parameters, passed by name.
+    """
+    flat = _PSI_POLY[source, gain](**values)
+    sizes = _PSI_POLY_SIZES[source, gain]
+    out, i = [], 0
+    for n in sizes:
+        out.append(flat[i:i + n])
+        i += n
+    return tuple(out)
+
+
+_PSI_POLY: dict[tuple[str, str], Any] = {("derived", "k_x"): _psi_poly_derived_k_x, ("derived", "k_v"): _psi_poly_derived_k_v, ("derived", "k_a"): _psi_poly_derived_k_a, ("printed", "k_x"): _psi_poly_printed_k_x, ("printed", "k_v"): _psi_poly_printed_k_v, ("printed", "k_a"): _psi_poly_printed_k_a}
+_PSI_POLY_SIZES: dict[tuple[str, str], tuple[int, ...]] = {("derived", "k_x"): _PSI_POLY_SIZES_DERIVED_K_X, ("derived", "k_v"): _PSI_POLY_SIZES_DERIVED_K_V, ("derived", "k_a"): _PSI_POLY_SIZES_DERIVED_K_A, ("printed", "k_x"): _PSI_POLY_SIZES_PRINTED_K_X, ("printed", "k_v"): _PSI_POLY_SIZES_PRINTED_K_V, ("printed", "k_a"): _PSI_POLY_SIZES_PRINTED_K_A}
+
+
+def hurwitz_conditions(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Internal-stability conditions of Γ: each must be > 0 (from symbolic.hurwitz_conditions)."""
+    return (
+        k_x,
+        k_v + k_x*(headway - tau),
+    )
+
+
+def hurwitz_scales(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Σ |coefficient|·|gain| of each Hurwitz condition (the scale of a relative margin)."""
+    _x0 = abs(k_x)
+    return (
+        _x0,
+        _x0*abs(headway - tau) + abs(k_v),
+    )
+
+
+def hurwitz_gradients(tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """∇_K of each Hurwitz condition, flat (3 per condition; the conditions are linear in K)."""
+    return (
+        1,
+        0,
+        0,
+        headway - tau,
+        1,
+        0,
+    )
+
+
+def gamma_parts(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(Re N(jω), Im N(jω), Re D(jω), Im D(jω)) of Γ = N/D (IDL eq 11, derived)."""
+    _x0 = delta*omega
+    _x1 = (omega*omega)
+    _x2 = _x1*k_a
+    _x3 = k_v*omega
+    return (
+        k_x - _x2*cos(_x0),
+        _x3 + _x2*sin(_x0),
+        k_x - _x1,
+        _x3 + k_x*headway*omega - _x1*omega*tau,
+    )
+
+
+def denominator_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients of D(s), highest power of s first."""
+    return (
+        tau,
+        1,
+        k_v + k_x*headway,
+        k_x,
+    )
+
+
+#: How many of :func:`numerator_coefficients` belong to the delay-free part n0(s).
+NUMERATOR_SPLIT = 2
+
+
+def numerator_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients of N(s) = n0(s) + n1(s)·e^(−δs), highest power of s first: 2 of n0, then 3 of n1."""
+    return (
+        k_v,
+        k_x,
+        k_a,
+        0,
+        0,
+    )
+
+
+def denominator_abs2_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Coefficients of |D(jω)|² as a polynomial in x = ω², highest power first."""
+    _x0 = 2*k_x
+    _x1 = _x0*headway
+    _x2 = (k_x*k_x)
+    return (
+        (tau*tau),
+        1 - _x1*tau - 2*k_v*tau,
+        (k_v*k_v) - _x0 + _x1*k_v + _x2*(headway*headway),
+        _x2,
+    )

@@ -1,0 +1,326 @@
+"""The frequency-domain margin g(ω) and everything computed from it: one home.
+
+For the derived transfer function Γ(s) = N(s)/D(s) (IDL eq 11, derived form,
+:func:`stringstab.symbolic.gamma`), |Γ(jω)| ≤ 1 at ω > 0 iff
+
+.. math::
+    g(ω) = \\frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
+         = t_2 ω^4 + a ω^2 + b + c_x \\cos δω - c_v ω \\sin δω \\;\\ge\\; 0,
+
+with t₂ = τ², c = k_v + T*k_x, a = 1 − 2τc − k_a², b = c² − 2k_x − k_v²,
+c_x = 2k_xk_a, c_v = 2k_vk_a (g(0) = Ψ3).  Every formula here is *generated* from
+the SymPy derivation into :mod:`stringstab._generated` (``python -m stringstab.codegen``),
+so the certificate, the region maps, the gain repair and the NLP evaluate the same
+expressions, in three forms:
+
+* **vectorised** (NumPy broadcasting): :func:`coefficients`, :func:`g`,
+  :func:`g_and_scale`, :func:`curvature_bound`, :func:`gradient`;
+* **scalar** (the ``math`` module, for inner loops where NumPy's per-call
+  overhead dominates): :func:`newton_terms`;
+* **CasADi** (symbolic, for the projection NLP): :func:`casadi_g`.
+
+Beside them, the bounds the branch and bound of :mod:`stringstab.certificate`
+rests on: :func:`curvature_bound` (M ≥ |g''| on [0, r]) and :func:`tail_bound`
+(Ω with g > 0 beyond it, from Fujiwara's root bound refined by Newton's method).
+
+References
+----------
+IDL paper, Definition 1 (eq 10), eq 11 (derived form) and eqs 12-14 (g(0) = Ψ3).
+M. Fujiwara, "Über die obere Schranke des absoluten Betrages der Wurzeln einer
+algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _generated as _gen
+
+__all__ = [
+    "MarginCoefficients",
+    "casadi_g",
+    "coefficient_scales",
+    "coefficients",
+    "curvature_bound",
+    "fujiwara_bound",
+    "g",
+    "g_and_scale",
+    "g_from_coefficients",
+    "gradient",
+    "local_minima",
+    "newton_terms",
+    "tail_bound",
+    "tail_coefficients",
+]
+
+ArrayLike = npt.ArrayLike
+Array = npt.NDArray[np.float64]
+#: Coefficients (or scales) of g: a :class:`MarginCoefficients`, a tuple or an array of 5 rows.
+_Coefficients = Any
+
+
+class MarginCoefficients(NamedTuple):
+    """g(ω) = t2 ω⁴ + a ω² + b + cx cos(δω) − cv ω sin(δω) (broadcast arrays or floats)."""
+
+    t2: Any
+    a: Any
+    b: Any
+    cx: Any
+    cv: Any
+
+
+def coefficients(
+    k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
+    *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
+) -> MarginCoefficients:
+    """The coefficients (t2, a, b, cx, cv) of g (generated from the SymPy derivation).
+
+    Examples
+    --------
+    >>> c = coefficients(1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1)
+    >>> round(float(c.b + c.cx), 12)  # g(0) = Ψ3
+    0.71
+    """
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
+    return MarginCoefficients(*_gen.margin_coefficients(kx, kv, ka, tau, delta, headway))
+
+
+def coefficient_scales(
+    k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
+    *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
+) -> MarginCoefficients:
+    """Σ |term| of each coefficient: the scale of its round-off (≥ its absolute value)."""
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
+    return MarginCoefficients(*_gen.margin_coefficient_scales(kx, kv, ka, tau, delta, headway))
+
+
+def g_from_coefficients(omega: ArrayLike, co: _Coefficients,
+                        delta: ArrayLike) -> Array:
+    """g(ω) from its coefficients (broadcasting coefficient columns against a grid of ω)."""
+    t2, a, b, cx, cv = co
+    return np.asarray(_gen.margin_from_coefficients(np.asarray(omega, dtype=float), t2, a, b, cx, cv,
+                                                    delta))
+
+
+def g_and_scale(omega: Array, co: _Coefficients,
+                scales: _Coefficients, delta: Any) -> tuple[Array, Array]:
+    """(g(ω), S(ω)) with S(ω) ≥ Σ |terms of g(ω)|: a round-off slack is a multiple of S."""
+    t2, a, b, cx, cv = co
+    st2, sa, sb, scx, scv = scales
+    gv, sv = _gen.margin_and_scale(omega, t2, a, b, cx, cv, st2, sa, sb, scx, scv, delta)
+    return gv, sv
+
+
+def g(
+    omega: ArrayLike, k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
+    *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
+) -> Array:
+    """g(ω) = (|D(jω)|² − |N(jω)|²)/ω², continuous at ω = 0 where g(0) = Ψ3.
+
+    Examples
+    --------
+    >>> float(g(0.0, 1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1))  # = Ψ3
+    0.71
+    """
+    co = coefficients(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway)
+    return g_from_coefficients(omega, co, delta)
+
+
+def curvature_bound(r: ArrayLike, co: _Coefficients,
+                    delta: ArrayLike) -> Array:
+    """M ≥ |g''(ω)| for every ω ∈ [0, r], term by term (generated from the basis of g).
+
+    For g = t2ω⁴ + aω² + b + cx cos δω − cv ω sin δω this is
+    M = 12 t2 r² + 2|a| + |cx| δ² + |cv| (2δ + δ² r).
+    """
+    t2, a, b, cx, cv = co
+    return np.asarray(_gen.margin_curvature_bound(r, t2, a, b, cx, cv, delta))
+
+
+def gradient(omega: ArrayLike, K: ArrayLike, *, tau: float, delta: float,
+             headway: float) -> tuple[Array, Array]:
+    """g(ω; K) and ∇_K g(ω; K) on an array of frequencies (rows of the gradient: ω).
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        Frequencies, rad/s.
+    K : array_like, shape (3,)
+        The gains (k_x, k_v, k_a).
+
+    Returns
+    -------
+    (ndarray (n,), ndarray (n, 3))
+    """
+    w = np.asarray(omega, dtype=float)
+    kx, kv, ka = K[0], K[1], K[2]  # type: ignore[index]
+    gv, gx, gvv, ga = _gen.margin_gradient(w, kx, kv, ka, tau, delta, headway)
+    grad = np.empty((*w.shape, 3))
+    grad[..., 0] = gx
+    grad[..., 1] = gvv
+    grad[..., 2] = ga
+    return np.asarray(gv, dtype=float), grad
+
+
+def newton_terms(omega: float, k_x: float, k_v: float, k_a: float,
+                 tau: float, delta: float, headway: float
+                 ) -> tuple[float, Array, float, Array, float, Array]:
+    """g and the derivatives a Newton step on the KKT system needs, in scalar arithmetic.
+
+    The ``math``-module form of the generated derivatives (NumPy's per-call overhead
+    costs more than the arithmetic at one frequency).
+
+    Returns
+    -------
+    tuple
+        (g, ∇_K g, ∂g/∂ω, ∇_K ∂g/∂ω, ∂²g/∂ω², ∇²_KK g) at ω, the vectors as arrays of
+        shape (3,) and the Hessian (3, 3).
+    """
+    (gv, g0, g1, g2, gw, gw0, gw1, gw2, gww,
+     hxx, hxv, hxa, hvv, hva, haa) = _gen.margin_newton(
+        omega, k_x, k_v, k_a, tau, delta, headway, math.cos, math.sin)
+    return (gv, np.array((g0, g1, g2)), gw, np.array((gw0, gw1, gw2)), gww,
+            np.array(((hxx, hxv, hxa), (hxv, hvv, hva), (hxa, hva, haa))))
+
+
+def casadi_g(omegas: Sequence[Any], k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any,
+             headway: Any) -> list[Any]:
+    """g(ω_j; K) for each ω_j of ``omegas``, as CasADi expressions (the projection NLP).
+
+    The generated coefficients are built once and shared by every frequency (as in
+    :func:`g_from_coefficients`), with ``casadi.cos``/``casadi.sin``.
+
+    Examples
+    --------
+    >>> import casadi
+    >>> K = casadi.SX.sym("K", 3)
+    >>> (e,) = casadi_g([0.0], K[0], K[1], K[2], 0.1, 0.2, 1.1)
+    >>> float(casadi.Function("g", [K], [e])([1.0, 0.5, 0.2]))  # = Ψ3
+    0.71
+    """
+    import casadi
+
+    t2, a, b, cx, cv = _gen.margin_coefficients(k_x, k_v, k_a, tau, delta, headway)
+    return [_gen.margin_from_coefficients(w, t2, a, b, cx, cv, delta, casadi.cos, casadi.sin)
+            for w in omegas]
+
+
+# --------------------------------------------------------------------------- tail bound
+def tail_coefficients(t2: ArrayLike, a: ArrayLike, b: ArrayLike, cx: ArrayLike,
+                      cv: ArrayLike) -> tuple[Array, Array, Array]:
+    """(A, B, C) with g(ω)/t2 ≥ ω⁴ − Aω² − Bω − C for ω ≥ 0.
+
+    Each trigonometric term is bounded by its magnitude: cx cos δω ≥ −|cx|,
+    −cv ω sin δω ≥ −|cv| ω; so A = max(−a, 0)/t2, B = |cv|/t2, C = max(|cx| − b, 0)/t2.
+    """
+    A = np.maximum(np.negative(a), 0.0) / t2
+    B = np.abs(cv) / t2
+    C = np.maximum(np.abs(cx) - b, 0.0) / t2
+    if not np.shape(A) == np.shape(B) == np.shape(C):
+        A, B, C = np.broadcast_arrays(A, B, C)
+    return np.asarray(A, dtype=float), np.asarray(B, dtype=float), np.asarray(C, dtype=float)
+
+
+def fujiwara_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
+    """Fujiwara's bound 2·max(√A, ∛B, (C/2)^¼) on the roots of ω⁴ − Aω² − Bω − C.
+
+    Examples
+    --------
+    >>> float(fujiwara_bound(4.0, 0.0, 0.0))  # ω⁴ − 4ω² has its roots at 0 and ±2
+    4.0
+    """
+    return np.asarray(2.0 * np.maximum(np.maximum(np.sqrt(A), np.cbrt(B)),
+                                       np.sqrt(np.sqrt(np.divide(C, 2.0)))))
+
+
+def tail_bound(t2: ArrayLike, a: ArrayLike, b: ArrayLike, cx: ArrayLike, cv: ArrayLike) -> Array:
+    """A frequency Ω with g(ω) > 0 for every ω > Ω.
+
+    g(ω) ≥ t2·L(ω) with L(ω) = ω⁴ − Aω² − Bω − C (:func:`tail_coefficients`).  L has
+    one positive root ω* (Descartes); Newton's method from Fujiwara's bound
+    (:func:`fujiwara_bound`) decreases monotonically to it (L is convex beyond ω*),
+    and every iterate is ≥ ω*, so the iteration may stop at any step.
+
+    Parameters
+    ----------
+    t2, a, b, cx, cv : array_like
+        Coefficients of g (:func:`coefficients`).
+
+    Returns
+    -------
+    ndarray
+        Ω ≥ 1e-3, elementwise.
+
+    Examples
+    --------
+    >>> co = coefficients(np.array([0.9]), -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
+    >>> W = tail_bound(*co)
+    >>> w = np.linspace(W[0], 50 * W[0], 10_000)
+    >>> bool(np.all(g(w, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1) > 0))
+    True
+    """
+    A, B, C = tail_coefficients(t2, a, b, cx, cv)
+    w = np.maximum(fujiwara_bound(A, B, C), 1e-3)
+    for _ in range(30):
+        L = ((w * w - A) * w - B) * w - C
+        dL = (4.0 * w * w - 2.0 * A) * w - B
+        step = np.where(dL > 0, L / np.where(dL > 0, dL, 1.0), 0.0)
+        # iterates stay >= the root; stop shrinking below the floor
+        w = np.maximum(w - step, 1e-3)
+        if np.all(step <= 1e-6 * w):  # any iterate is a valid bound: stop when settled
+            break
+    W = w * (1.0 + 1e-9) + 1e-12
+    Lw = ((W * W - A) * W - B) * W - C
+    bad = ~(Lw > 0) & ((A > 0) | (B > 0) | (C > 0))
+    if bad.any():  # pragma: no cover - defensive: fall back to the raw Fujiwara bound
+        W = np.where(bad, fujiwara_bound(A, B, C) + 1.0, W)
+    return np.asarray(W)
+
+
+# --------------------------------------------------------------------------- dips
+def local_minima(K: ArrayLike, *, tau: float, delta: float, headway: float, threshold: float,
+                 n: int = 384, max_minima: int = 12) -> tuple[float, list[float]]:
+    """Cheap scan of g(·; K): (minimum found, refined local minimisers with g < threshold).
+
+    A dense grid on [0, max(Ω_F, 1)], Ω_F Fujiwara's bound beyond which g > 0
+    (:func:`fujiwara_bound`), then the ``max_minima`` lowest local minima of the grid
+    (including the end point ω = 0) are zoomed into (a 9-point grid, shrunk ×4, six
+    times) and those below ``threshold`` returned.  A heuristic to pick frequencies and
+    detect violations; it never certifies anything.
+
+    Examples
+    --------
+    >>> gmin, dips = local_minima([0.9, -0.5, 1.1], tau=0.1, delta=0.2, headway=1.1, threshold=0.0)
+    >>> gmin < 0, [round(w, 3) for w in dips]
+    (True, [2.709])
+    """
+    kx, kv, ka = (float(v) for v in np.asarray(K, dtype=float))
+    co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
+    A, B, C = (float(v) for v in tail_coefficients(*co))
+    om_max = max(float(fujiwara_bound(A, B, C)), 1.0)
+    W = np.linspace(0.0, om_max, n)
+    Gv = g_from_coefficients(W, co, delta)
+    gmin = float(Gv.min())
+    # local minima of the grid, the lowest first; a dip narrower than the grid spacing can
+    # hide between samples, so all are refined
+    left = np.concatenate([[np.inf], Gv[:-1]])
+    right = np.concatenate([Gv[1:], [np.inf]])
+    idx = np.flatnonzero((Gv <= left) & (Gv <= right))
+    idx = idx[np.argsort(Gv[idx])[:max_minima]]
+    centres = W[idx]
+    half = np.full(idx.size, om_max / (n - 1))
+    v = np.linspace(-1.0, 1.0, 9)
+    for _ in range(6):
+        Wl = np.maximum(centres[:, None] + half[:, None] * v[None, :], 0.0)
+        Gl = g_from_coefficients(Wl, co, delta)
+        jl = np.argmin(Gl, axis=1)
+        centres = Wl[np.arange(idx.size), jl]
+        half = half / 4.0
+    gl = g_from_coefficients(centres, co, delta)
+    gmin = min(gmin, float(gl.min()))
+    return gmin, [float(c) for c, gv in zip(centres, gl) if gv < threshold]
