@@ -8,19 +8,33 @@ maps, gain repair, a platoon simulator and a compact policy trainer.
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from typing import Any
 
+from ._version import __version__
 from .certificate import Certificate, CertificateBatch, certify, certify_batch, certify_pade
 from .criteria import hurwitz, stability_type, taylor_criteria
-from .errata import Erratum, errata
 from .errors import StringStabError
 from .frequency import gain, gamma_jw, margin_g
 from .io.gains import GainTable, parse_triple, read_gains
 from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Params
 
-# The simulator (stringstab.traffic, stringstab.metrics), the region maps
-# (stringstab.regions, stringstab.plots) and the gain repair (stringstab.tuning)
-# are imported on demand: they pull in gymnasium, matplotlib and CasADi.
+# Importing stringstab (and certifying) loads NumPy only: no SymPy, matplotlib, CasADi,
+# python-control or gymnasium (tests/test_house.py checks it).  The errata (SymPy) are
+# loaded on first use of their names below; the simulator (stringstab.traffic,
+# stringstab.metrics), the region maps (stringstab.regions, stringstab.plots) and the
+# gain repair (stringstab.tuning) are imported on demand.
+_LAZY = {"Erratum": "errata", "errata": "errata"}
+
+
+def __getattr__(name: str) -> Any:
+    """The names of :data:`_LAZY`, imported on first use (they pull in SymPy)."""
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "DEFAULT_DELTA",

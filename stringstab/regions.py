@@ -695,7 +695,7 @@ def region_map(
     >>> m.disagreements()["exact vs printed"]
     2
     """
-    from . import __version__
+    from ._version import __version__
 
     p = Params(tau, delta, headway)
     coords, fixed_ = _check_axes(axes, fixed)
