@@ -2,7 +2,8 @@
 
 The import graph is read from the source (``ast``), so it includes the imports made inside
 functions (lazy imports), which Python would otherwise only reveal at run time.  An edge
-A → B means module A names module B in an ``import`` statement; importing a submodule also
+A → B means module A names module B in an ``import`` statement run at run time (imports for
+type hints only, under ``if TYPE_CHECKING:``, are not edges); importing a submodule also
 runs its parents' ``__init__``, but that implicit step is not an edge (as in pylint's
 ``cyclic-import`` and import-linter).  *Upward* means a module importing a package that
 contains it (``from .. import __version__`` inside ``stringstab.io``: the façade at the top
@@ -63,12 +64,26 @@ def _resolve(module: str, level: int, target: str | None) -> str:
     return ".".join(base + ([target] if target else []))
 
 
+def _runtime_nodes(tree: ast.AST) -> list[ast.AST]:
+    """Every node, except inside ``if TYPE_CHECKING:`` (imports for type hints only)."""
+    out: list[ast.AST] = []
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        out.append(node)
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            todo.extend(node.orelse)
+            continue
+        todo.extend(ast.iter_child_nodes(node))
+    return out
+
+
 def import_graph() -> dict[str, set[str]]:
     """Module → the package modules it imports (explicit imports anywhere in the file)."""
     graph: dict[str, set[str]] = {m: set() for m in MODULES}
     for mod, path in MODULES.items():
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-        for node in ast.walk(tree):
+        for node in _runtime_nodes(tree):
             if isinstance(node, ast.Import):
                 for alias in node.names:
                     if alias.name == ROOT or alias.name.startswith(ROOT + "."):
@@ -139,6 +154,8 @@ def test_the_graph_sees_lazy_and_relative_imports():
     assert "stringstab.criteria" in g["stringstab.certificate"]  # top-level relative import
     assert "stringstab.criteria" in g["stringstab.symbolic"]  # inside lambdify_psi
     assert "stringstab.symbolic" in g["stringstab.codegen"]  # "from . import symbolic as S"
+    assert "stringstab.regions.report" in g["stringstab.regions.result"]  # lazy, in a method
+    assert "stringstab.regions.result" not in g["stringstab.regions.report"]  # TYPE_CHECKING
     # the checks below can fail: a made-up cycle and upward import are found
     fake = {**g, "stringstab.margin": g["stringstab.margin"] | {"stringstab.certificate"}}
     assert any("stringstab.margin" in c for c in cycles(fake))

@@ -1,0 +1,71 @@
+"""The file formats of a region map: a compressed NPZ archive and a CSV table.
+
+``npz``
+    ``axis_<gain>`` coordinates, one array per per-point field and ``metadata``, a JSON
+    string whose ``format`` is :data:`FORMAT`: everything needed to rebuild the map
+    (:func:`stringstab.regions.load_npz`).
+``csv``
+    ``#`` lines (the tool and the metadata as JSON), then one row per grid point, written
+    column by column by :mod:`stringstab.io`'s result writer.
+
+Both are written atomically (a temporary file renamed into place).  This module knows the
+formats, not the map: :class:`stringstab.regions.RegionMap` hands it arrays and columns.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import StringStabError
+from ..io import atomic_path, atomic_write_text, format_results
+
+__all__ = ["FORMAT", "read_npz", "write_csv", "write_npz"]
+
+#: The ``format`` entry of a region map's metadata.
+FORMAT = "stringstab-region-map/1"
+
+
+def write_npz(path: str | os.PathLike[str], axes: Mapping[str, npt.NDArray[Any]],
+              fields: Mapping[str, npt.NDArray[Any]], metadata: Mapping[str, Any]) -> Path:
+    """Write ``axis_<gain>`` coordinates, the fields and the metadata (JSON) to ``path``."""
+    arrays: dict[str, npt.NDArray[Any]] = {f"axis_{n}": a for n, a in axes.items()}
+    arrays.update(fields)
+    arrays["metadata"] = np.array(json.dumps(metadata))
+    with atomic_path(path, what="region map") as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
+    return Path(path)
+
+
+def read_npz(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
+    """(metadata, arrays) of a file written by :func:`write_npz`.
+
+    Raises
+    ------
+    StringStabError
+        If the file is not a stringstab region map.
+    """
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except (OSError, ValueError) as e:
+        raise StringStabError(f"{path}: expected a region-map NPZ file; could not read it ({e})") from e
+    if "metadata" not in data:
+        raise StringStabError(f"{path}: expected a region-map NPZ with a 'metadata' entry; found {sorted(data)}")
+    meta = json.loads(str(data["metadata"]))
+    if meta.get("format") != FORMAT:
+        raise StringStabError(f"{path}: expected format {FORMAT!r}; found {meta.get('format')!r}")
+    return meta, data
+
+
+def write_csv(path: str | os.PathLike[str], comments: Sequence[str],
+              columns: Mapping[str, npt.NDArray[Any]]) -> Path:
+    """Write ``# comment`` lines, then the columns as CSV (one row per element), atomically."""
+    head = "".join(f"# {c}\n" for c in comments)
+    return atomic_write_text(path, head + format_results(columns, "csv"), what="region map CSV")

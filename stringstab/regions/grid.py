@@ -1,0 +1,329 @@
+"""Evaluating a region map: the grid, its blocks, and every method on each block.
+
+:func:`region_map` checks the axes and methods, splits the grid into blocks (memory bounded
+by the block size), evaluates each (:func:`stringstab.regions.pool.run_blocks`, in this
+process or a pool of workers) and assembles a :class:`~stringstab.regions.RegionMap`.  On a
+block, the Taylor quantities are evaluated as polynomials in one gain with coefficients on
+the plane of the other two (Horner's rule, coefficients generated from the SymPy expressions,
+:func:`stringstab._generated.psi_polynomials`), the exact verdicts by
+:func:`stringstab.certificate.certify_batch`.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import _generated as _gen
+from .._version import __version__
+from ..criteria import hurwitz, proposition1, stability_type
+from ..errors import StringStabError
+from ..params import Params
+from .pool import cpu_count, in_daemon, run_blocks
+from .result import GAIN_NAMES, INCONCLUSIVE, METHODS, STABLE, UNSTABLE, RegionMap
+
+__all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
+
+Array = npt.NDArray[np.float64]
+
+#: Grid points per block: with the exact certificate, and with the Taylor criteria only.
+EXACT_BLOCK = 16_384
+TAYLOR_BLOCK = 1 << 19
+#: Maps estimated to take less than this many seconds run in one process.
+_PARALLEL_SECONDS = 0.5
+_EXACT_SECONDS_PER_POINT = 2e-5
+_TAYLOR_SECONDS_PER_POINT = 1.5e-7
+
+
+# --------------------------------------------------------------------------- Taylor on a grid
+def _psi_grid(
+    source: str, names: tuple[str, str, str], x0: Array, x1: Array, x2: Array, p: Params
+) -> tuple[Array, Array, Array, Array]:
+    """Ψ1, Ψ2, Ψ3, Λ on the grid x0 × x1 × x2 (shape (n0, n1, n2)), by Horner in x0.
+
+    The coefficients of each Ψ as a polynomial in the gain ``names[0]`` are generated
+    from the SymPy expressions (:func:`stringstab._generated.psi_polynomials`).
+    """
+    shape = (x0.size, x1.size, x2.size)
+    a0 = x0.reshape(-1, 1, 1)
+    polys = _gen.psi_polynomials(
+        source, names[0], **{names[1]: x1.reshape(1, -1, 1), names[2]: x2.reshape(1, 1, -1)},
+        tau=p.tau, delta=p.delta, headway=p.headway)
+    res = []
+    for coeffs in polys:
+        r = np.empty(shape)
+        r[...] = coeffs[0]
+        for c in coeffs[1:]:
+            r *= a0
+            r += c
+        res.append(r)
+    return res[0], res[1], res[2], res[3]
+
+
+
+# --------------------------------------------------------------------------- blocks
+@dataclass(frozen=True)
+class _Spec:
+    """What a worker needs to evaluate a block (picklable)."""
+
+    names: tuple[str, str, str]  # gain on internal axis 0, 1, 2
+    coords: tuple[Array, Array, Array]
+    params: Params
+    methods: tuple[str, ...]
+
+
+def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, Any]:
+    """All fields on the block [i0:i1, j0:j1, :] of the internal 3-D grid."""
+    x0 = spec.coords[0][i0:i1]
+    x1 = spec.coords[1][j0:j1]
+    x2 = spec.coords[2]
+    p = spec.params
+    shape = (x0.size, x1.size, x2.size)
+    gains = {
+        spec.names[0]: x0.reshape(-1, 1, 1),
+        spec.names[1]: x1.reshape(1, -1, 1),
+        spec.names[2]: x2.reshape(1, 1, -1),
+    }
+    out: dict[str, Any] = {}
+    hz = np.broadcast_to(hurwitz(gains["k_x"], gains["k_v"], tau=p.tau, headway=p.headway), shape)
+    out["hurwitz"] = hz
+    sources = [("derived", "taylor")]
+    if "printed" in spec.methods:
+        sources.append(("printed", "printed"))
+    for source, method in sources:
+        psi1, psi2, psi3, lam = _psi_grid(source, spec.names, x0, x1, x2, p)
+        out["type" if source == "derived" else "type_printed"] = stability_type(psi2, psi3, lam)
+        if method in spec.methods:
+            ok = proposition1(psi1, psi2, psi3, lam, source=source)
+            out[f"prop1_{method}"] = ok
+            out[f"verdict_{method}"] = np.where(ok & hz, STABLE, UNSTABLE).astype(np.int8)
+    if "exact" in spec.methods:
+        from ..certificate import certify_batch
+
+        full = [np.broadcast_to(gains[g], shape).ravel() for g in GAIN_NAMES]
+        b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
+        code = np.full(b.verdict.shape, INCONCLUSIVE, dtype=np.int8)
+        code[b.verdict == "certified"] = STABLE
+        code[b.verdict == "not_certified"] = UNSTABLE
+        out["verdict_exact"] = code.reshape(shape)
+        out["sup_gain"] = b.sup_gain.reshape(shape)
+        out["margin"] = b.margin.reshape(shape)
+    return out
+
+
+def _blocks(n0: int, n1: int, n2: int, target: int) -> list[tuple[int, int, int, int]]:
+    """Split the (n0, n1, n2) grid into blocks [i0:i1, j0:j1, :] of about ``target`` points."""
+    row = n1 * n2
+    if row <= target:
+        step = max(1, target // row)
+        return [(i, min(i + step, n0), 0, n1) for i in range(0, n0, step)]
+    jstep = max(1, target // n2)
+    return [(i, i + 1, j, min(j + jstep, n1)) for i in range(n0) for j in range(0, n1, jstep)]
+
+
+
+def _warm(spec: _Spec) -> None:
+    """Run the certificate once (imports and caches; forked workers inherit them)."""
+    if "exact" in spec.methods:
+        from ..certificate import certify_batch
+
+        certify_batch([1.0], [0.5], [0.2], tau=0.1, delta=0.2, headway=1.1)
+
+
+# --------------------------------------------------------------------------- validation
+def _check_axes(
+    axes: Mapping[str, npt.ArrayLike], fixed: Mapping[str, float] | None
+) -> tuple[dict[str, Array], dict[str, float]]:
+    if not isinstance(axes, Mapping):
+        raise StringStabError(
+            f"axes must map gain names to grid coordinates, e.g. {{'k_x': [...], 'k_v': [...]}}; "
+            f"got {type(axes).__name__}"
+        )
+    names = list(axes)
+    for n in names:
+        if n not in GAIN_NAMES:
+            raise StringStabError(f"axis gains must be among {list(GAIN_NAMES)}; got {n!r}")
+    if len(names) not in (2, 3):
+        raise StringStabError(f"expected 2 or 3 axis gains; got {len(names)}: {names}")
+    out: dict[str, Array] = {}
+    for n in names:
+        try:
+            a = np.asarray(axes[n], dtype=float)
+        except (TypeError, ValueError) as e:
+            raise StringStabError(f"axis {n} must be numeric grid coordinates; got {axes[n]!r}") from e
+        if a.ndim != 1 or a.size < 2:
+            raise StringStabError(f"axis {n} must be a 1-D grid of at least 2 points; got shape {a.shape}")
+        if not np.all(np.isfinite(a)):
+            raise StringStabError(f"axis {n} must be finite; got {a[~np.isfinite(a)][0]!r}")
+        if not np.all(np.diff(a) > 0):
+            raise StringStabError(f"axis {n} must be strictly increasing; got {a[:5].tolist()}...")
+        out[n] = a
+    fixed = dict(fixed or {})
+    missing = [g for g in GAIN_NAMES if g not in out]
+    if len(out) == 3:
+        if fixed:
+            raise StringStabError(f"a 3-D map fixes no gain; got fixed={fixed}")
+        return out, {}
+    if list(fixed) != missing:
+        raise StringStabError(
+            f"a 2-D map over {names} needs the third gain fixed, e.g. fixed={{'{missing[0]}': 0.5}}; "
+            f"got fixed={fixed}"
+        )
+    try:
+        v = float(fixed[missing[0]])
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"fixed {missing[0]} must be a number; got {fixed[missing[0]]!r}") from e
+    if not math.isfinite(v):
+        raise StringStabError(f"fixed {missing[0]} must be finite; got {v!r}")
+    return out, {missing[0]: v}
+
+
+def _check_methods(methods: str | Sequence[str]) -> tuple[str, ...]:
+    ms = tuple(m.strip() for m in methods.split(",")) if isinstance(methods, str) else tuple(methods)
+    if not ms:
+        raise StringStabError(f"expected at least one method of {list(METHODS)}; got none")
+    for m in ms:
+        if m not in METHODS:
+            raise StringStabError(f"methods must be among {list(METHODS)}; got {m!r}")
+    if len(set(ms)) != len(ms):
+        raise StringStabError(f"each method may be given once; got {list(ms)}")
+    return ms
+
+
+
+# --------------------------------------------------------------------------- entry point
+def region_map(
+    axes: Mapping[str, npt.ArrayLike],
+    fixed: Mapping[str, float] | None = None,
+    *,
+    tau: float,
+    delta: float,
+    headway: float,
+    methods: str | Sequence[str] = METHODS,
+    workers: int | None = None,
+    block: int | None = None,
+    progress: bool | None = None,
+) -> RegionMap:
+    """Evaluate every method on a grid of gains (see the module docstring).
+
+    Parameters
+    ----------
+    axes : mapping of str to array_like
+        Two or three of ``"k_x", "k_v", "k_a"``, in axis order, each with
+        strictly increasing grid coordinates (at least 2), e.g.
+        ``{"k_x": np.linspace(-2, 2, 401), "k_v": np.linspace(-2, 2, 401)}``.
+    fixed : mapping of str to float, optional
+        For a 2-D map, the value of the third gain, e.g. ``{"k_a": 0.5}``.
+    tau, delta, headway : float
+        Actuator lag τ > 0, delay δ ≥ 0 and desired headway T* ≥ 0 (seconds).
+    methods : str or sequence of str
+        Subset of ``("exact", "taylor", "printed")`` (or ``"exact,taylor"``).
+        The derived types are always computed.
+    workers : int, optional
+        Worker processes.  Default: all available cores, or 1 when the map is
+        estimated to take under half a second.  ``1`` runs in this process.
+    block : int, optional
+        Grid points per block (bounds the working memory); default 16 384 with
+        ``exact``, 2¹⁹ otherwise.
+    progress : bool, optional
+        tqdm progress bar on standard error; default: on for maps estimated to
+        take more than 5 s.
+
+    Returns
+    -------
+    RegionMap
+
+    Raises
+    ------
+    StringStabError
+        On bad axes, a missing or extra fixed gain, unknown methods or
+        parameters out of range.
+
+    Examples
+    --------
+    The triple K = (0.9, −0.5, 1.1) is not string stable, yet the printed
+    Proposition 1 accepts it:
+
+    >>> m = region_map({"k_x": [0.9, 1.3], "k_v": [-0.5, 0.0]}, {"k_a": 1.1},
+    ...                tau=0.1, delta=0.2, headway=1.1)
+    >>> m.shape
+    (2, 2)
+    >>> m.stable("exact").tolist(), m.stable("printed").tolist()
+    ([[False, False], [False, False]], [[True, False], [True, False]])
+    >>> m.disagreements()["exact vs printed"]
+    2
+    """
+    p = Params(tau, delta, headway)
+    coords, fixed_ = _check_axes(axes, fixed)
+    ms = _check_methods(methods)
+    names = tuple(coords) + tuple(fixed_)
+    internal = tuple(coords.values()) + tuple(np.array([v]) for v in fixed_.values())
+    n0, n1, n2 = (a.size for a in internal)
+    n = n0 * n1 * n2
+    exact = "exact" in ms
+    target = int(block) if block is not None else (EXACT_BLOCK if exact else TAYLOR_BLOCK)
+    if target < 1:
+        raise StringStabError(f"block must be >= 1 grid points; got {block!r}")
+    blocks = _blocks(n0, n1, n2, target)
+    seconds = n * (_EXACT_SECONDS_PER_POINT if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
+    if workers is None:
+        workers = 1 if seconds < _PARALLEL_SECONDS else cpu_count()
+    if int(workers) < 1:
+        raise StringStabError(f"workers must be >= 1; got {workers!r}")
+    workers = min(int(workers), len(blocks))
+    if in_daemon():  # e.g. inside another pool: no children allowed
+        workers = 1
+    if progress is None:
+        progress = seconds / workers > 5.0
+    spec = _Spec(names, internal, p, ms)  # type: ignore[arg-type]
+
+    shape3 = (n0, n1, n2)
+    res: dict[str, np.ndarray] = {
+        "hurwitz": np.empty(shape3, dtype=bool),
+        "type": np.empty(shape3, dtype=np.int8),
+    }
+    if "printed" in ms:
+        res["type_printed"] = np.empty(shape3, dtype=np.int8)
+    for m in ms:
+        res[f"verdict_{m}"] = np.empty(shape3, dtype=np.int8)
+        if m != "exact":
+            res[f"prop1_{m}"] = np.empty(shape3, dtype=bool)
+    if exact:
+        res["sup_gain"] = np.empty(shape3)
+        res["margin"] = np.empty(shape3)
+
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=n, desc="region map", unit="pt", unit_scale=True, file=sys.stderr)
+    try:
+        for (i0, i1, j0, j1), out in run_blocks(_eval_block, spec, blocks, workers, warm=_warm):
+            for k, v in out.items():
+                res[k][i0:i1, j0:j1] = v
+            if bar is not None:
+                bar.update((i1 - i0) * (j1 - j0) * n2)
+    finally:
+        if bar is not None:
+            bar.close()
+
+    grid_shape = tuple(a.size for a in coords.values())
+
+    def get(key: str) -> Any:
+        return res[key].reshape(grid_shape) if key in res else None
+
+    return RegionMap(
+        axes=coords, fixed=fixed_, params=p, methods=ms,
+        hurwitz=get("hurwitz"), type=get("type"),
+        verdict={m: get(f"verdict_{m}") for m in ms},
+        prop1={m: get(f"prop1_{m}") for m in ms if m != "exact"},
+        type_printed=get("type_printed"), sup_gain=get("sup_gain"), margin=get("margin"),
+        version=__version__,
+    )
+

@@ -1,0 +1,69 @@
+"""Evaluating the blocks of a region map, in this process or in a pool of worker processes.
+
+Knows nothing of what a block holds: :func:`run_blocks` calls the evaluation function it is
+given on each block and yields the results as they finish, with at most two blocks per
+worker in flight (memory bounded by the block size, not the grid).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing
+import os
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+__all__ = ["Block", "cpu_count", "in_daemon", "run_blocks"]
+
+#: A block [i0:i1, j0:j1, :] of the internal 3-D grid.
+Block = tuple[int, int, int, int]
+
+
+def cpu_count() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def in_daemon() -> bool:
+    """Whether this process is a daemon (e.g. a multiprocessing.Pool worker: no children)."""
+    return bool(multiprocessing.current_process().daemon)
+
+
+def run_blocks(
+    evaluate: Callable[..., dict[str, Any]], spec: Any, blocks: Sequence[Block], workers: int,
+    warm: Callable[[Any], None] | None = None,
+) -> Iterator[tuple[Block, dict[str, Any]]]:
+    """``evaluate(spec, *block)`` for every block, yielding ``(block, result)`` as they finish.
+
+    With ``workers`` > 1 the blocks go to a pool of forked processes (``warm(spec)`` runs
+    first here, so the workers inherit its imports and caches, and once in each worker).
+    """
+    if workers <= 1:
+        for b in blocks:
+            yield b, evaluate(spec, *b)
+        return
+    if warm is not None:
+        warm(spec)
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else None)
+    init: Any = warm
+    args: Any = (spec,) if warm is not None else ()
+    with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init,
+                                initargs=args) as ex:
+        pending: dict[cf.Future[dict[str, Any]], Block] = {}
+        it = iter(blocks)
+        for b in it:
+            pending[ex.submit(evaluate, spec, *b)] = b
+            if len(pending) >= 2 * workers:
+                break
+        while pending:
+            done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+            for fut in done:
+                b = pending.pop(fut)
+                yield b, fut.result()
+                nxt = next(it, None)
+                if nxt is not None:
+                    pending[ex.submit(evaluate, spec, *nxt)] = nxt

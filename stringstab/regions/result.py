@@ -1,0 +1,395 @@
+"""The result of a region map: :class:`RegionMap`, its classes, shares, columns and files.
+
+A :class:`RegionMap` holds every per-point verdict of :func:`stringstab.regions.region_map`
+and owns what is computed from them (class maps, shares, disagreements, the per-point
+columns, the summary) and its files (:meth:`RegionMap.save_npz`, :meth:`RegionMap.save_csv`,
+:func:`load_npz`, in the formats of :mod:`stringstab.regions.files`).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from itertools import combinations
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..criteria import TYPE_NAMES
+from ..errors import StringStabError
+from ..io import dumps_json
+from ..params import Params
+from .files import FORMAT, read_npz, write_csv, write_npz
+
+__all__ = [
+    "EXACT_CLASSES",
+    "GAIN_NAMES",
+    "INCONCLUSIVE",
+    "METHODS",
+    "STABLE",
+    "TYPE_CLASSES",
+    "UNSTABLE",
+    "VERDICT_LABELS",
+    "RegionMap",
+    "load_npz",
+]
+
+Array = npt.NDArray[np.float64]
+
+#: The gains, in the order of K = [k_x, k_v, k_a] (IDL eq 4).
+GAIN_NAMES: tuple[str, str, str] = ("k_x", "k_v", "k_a")
+#: The methods a map can evaluate.
+METHODS: tuple[str, str, str] = ("exact", "taylor", "printed")
+#: Labels of the verdict codes 0, 1, 2 per method (code 0 means "says string stable").
+VERDICT_LABELS: dict[str, tuple[str, str, str]] = {
+    "exact": ("certified", "not_certified", "inconclusive"),
+    "taylor": ("stable", "unstable", "inconclusive"),
+    "printed": ("stable", "unstable", "inconclusive"),
+}
+#: Classes of the ``taylor`` and ``printed`` class maps, by code 0-4.
+TYPE_CLASSES: tuple[str, ...] = (
+    "not internally stable", "type III", "type IV", "type I", "type II",
+)
+#: Classes of the ``exact`` class map, by code 0-3.
+EXACT_CLASSES: tuple[str, ...] = (
+    "not internally stable", "not certified", "inconclusive", "certified",
+)
+
+#: Verdict codes: says string stable, says not, cannot tell (exact certificate only).
+STABLE, UNSTABLE, INCONCLUSIVE = 0, 1, 2
+# stability_type code (1 = I, ..., 4 = IV) -> TYPE_CLASSES code
+_TYPE_TO_CLASS = np.array([0, 3, 4, 1, 2], dtype=np.int8)
+
+
+@dataclass(frozen=True, eq=False)
+class RegionMap:
+    """Verdicts of each method on a grid of gains (see the module docstring).
+
+    Every per-point array has the grid's shape ``tuple(len(a) for a in
+    axes.values())``: index ``[i, j]`` (or ``[i, j, k]``) is the point whose
+    first axis gain is ``axes[first][i]``, and so on.
+
+    Attributes
+    ----------
+    axes : dict of str to ndarray
+        The gains varied, in axis order (two or three of ``k_x, k_v, k_a``),
+        each with its increasing grid coordinates.
+    fixed : dict of str to float
+        The gain held fixed on a 2-D slice (empty for a 3-D map).
+    params : Params
+        τ, δ, T*.
+    methods : tuple of str
+        The methods evaluated, a subset of :data:`METHODS`.
+    hurwitz : ndarray of bool
+        Γ internally stable.
+    type : ndarray of int8
+        Stability type 1-4 (I-IV) from the derived Ψ.
+    type_printed : ndarray of int8 or None
+        Stability type from the printed Ψ (when ``printed`` is evaluated).
+    verdict : dict of str to ndarray of int8
+        Per method, codes into :data:`VERDICT_LABELS` (0 = says string stable).
+    prop1 : dict of str to ndarray of bool
+        Proposition 1 alone (without Hurwitz) for ``taylor`` and ``printed``.
+    sup_gain, margin : ndarray of float or None
+        ‖Γ‖_{H∞} and min_ω g(ω) from the exact certificate (when evaluated).
+    version : str
+        ``stringstab.__version__`` of the tool that computed the map.
+    """
+
+    axes: dict[str, Array]
+    fixed: dict[str, float]
+    params: Params
+    methods: tuple[str, ...]
+    hurwitz: npt.NDArray[np.bool_]
+    type: npt.NDArray[np.int8]
+    verdict: dict[str, npt.NDArray[np.int8]]
+    prop1: dict[str, npt.NDArray[np.bool_]] = field(default_factory=dict)
+    type_printed: npt.NDArray[np.int8] | None = None
+    sup_gain: Array | None = None
+    margin: Array | None = None
+    version: str = ""
+
+    # ---------------------------------------------------------------- shape and points
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """The grid shape."""
+        return tuple(a.size for a in self.axes.values())
+
+    @property
+    def ndim(self) -> int:
+        """2 for a slice, 3 for a volume."""
+        return len(self.axes)
+
+    @property
+    def size(self) -> int:
+        """Number of grid points."""
+        return int(np.prod(self.shape))
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        """Names of the gains on the axes, in order."""
+        return tuple(self.axes)
+
+    def gains(self) -> tuple[Array, Array, Array]:
+        """k_x, k_v, k_a at every grid point, each of the grid's shape."""
+        grids = np.meshgrid(*self.axes.values(), indexing="ij")
+        by_name = dict(zip(self.axes, grids))
+        for name, v in self.fixed.items():
+            by_name[name] = np.full(self.shape, v)
+        return by_name["k_x"], by_name["k_v"], by_name["k_a"]
+
+    # ---------------------------------------------------------------- classes and shares
+    def _check_method(self, method: str) -> None:
+        if method not in self.methods:
+            raise StringStabError(
+                f"method must be one of those evaluated in this map {list(self.methods)}; got {method!r}"
+            )
+
+    def stable(self, method: str) -> npt.NDArray[np.bool_]:
+        """Where ``method`` says string stable (certified, or Hurwitz ∧ Proposition 1)."""
+        self._check_method(method)
+        return np.asarray(self.verdict[method] == STABLE)
+
+    def class_names(self, method: str) -> tuple[str, ...]:
+        """Names of the class codes of :meth:`classes` for ``method``."""
+        self._check_method(method)
+        return EXACT_CLASSES if method == "exact" else TYPE_CLASSES
+
+    def classes(self, method: str) -> npt.NDArray[np.int8]:
+        """Class code of every point for the class map of ``method``.
+
+        ``exact``: 0 not internally stable, 1 not certified, 2 inconclusive,
+        3 certified (:data:`EXACT_CLASSES`).  ``taylor`` / ``printed``: 0 not
+        internally stable, then 1 type III, 2 type IV, 3 type I, 4 type II of
+        that method's Ψ (:data:`TYPE_CLASSES`).
+        """
+        self._check_method(method)
+        if method == "exact":
+            v = self.verdict["exact"]
+            c = np.full(self.shape, 3, dtype=np.int8)
+            c[v == UNSTABLE] = 1
+            c[(v == UNSTABLE) & ~self.hurwitz] = 0
+            c[v == INCONCLUSIVE] = 2
+            return c
+        t = self.type if method == "taylor" else self.type_printed
+        assert t is not None
+        c = _TYPE_TO_CLASS[t]
+        return np.where(self.hurwitz, c, np.int8(0)).astype(np.int8)
+
+    def class_shares(self) -> dict[str, dict[str, float]]:
+        """Share of grid points in each class of each method's class map.
+
+        Examples
+        --------
+        >>> from stringstab.regions import region_map
+        >>> m = region_map({"k_x": np.linspace(-1, 1, 5), "k_v": np.linspace(-1, 1, 5)},
+        ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods=("taylor",))
+        >>> m.class_shares()["taylor"]["not internally stable"]
+        0.72
+        """
+        out = {}
+        for m in self.methods:
+            counts = np.bincount(self.classes(m).ravel(), minlength=len(self.class_names(m)))
+            out[m] = {name: float(c) / self.size for name, c in zip(self.class_names(m), counts)}
+        return out
+
+    def verdict_shares(self) -> dict[str, dict[str, float]]:
+        """Share of grid points of each verdict of each method."""
+        out = {}
+        for m in self.methods:
+            counts = np.bincount(self.verdict[m].ravel(), minlength=3)
+            out[m] = {lab: float(c) / self.size for lab, c in zip(VERDICT_LABELS[m], counts)
+                      if m == "exact" or lab != "inconclusive"}
+        return out
+
+    def disagreements(self) -> dict[str, int]:
+        """Number of points where methods disagree on string stability.
+
+        One entry ``"a vs b"`` per pair of evaluated methods (points where both
+        decide and they differ), ``"any"`` (points where no method is
+        inconclusive and not all agree) and ``"inconclusive"`` (points where the
+        exact certificate is inconclusive).
+        """
+        out: dict[str, int] = {}
+        decided = np.ones(self.shape, dtype=bool)
+        for m in self.methods:
+            decided &= self.verdict[m] != INCONCLUSIVE
+        for a, b in combinations(self.methods, 2):
+            out[f"{a} vs {b}"] = int(np.count_nonzero(decided & (self.stable(a) != self.stable(b))))
+        st = [self.stable(m) for m in self.methods]
+        differ = np.zeros(self.shape, dtype=bool)
+        for s in st[1:]:
+            differ |= s != st[0]
+        out["any"] = int(np.count_nonzero(decided & differ))
+        out["inconclusive"] = int(np.count_nonzero(~decided))
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """Metadata, class shares, verdict shares and disagreements, JSON-ready."""
+        return {
+            **self.metadata(),
+            "n": self.size,
+            "class_shares": self.class_shares(),
+            "verdict_shares": self.verdict_shares(),
+            "disagreements": self.disagreements(),
+        }
+
+    def report(self) -> str:
+        """A few lines for people: the grid, class shares per method, disagreements.
+
+        See :func:`stringstab.regions.report.render_report`.
+        """
+        from .report import render_report
+
+        return render_report(self)
+
+    def title(self) -> str:
+        """A one-line description: the fixed gain and the parameters."""
+        parts = [f"{k} = {v:g}" for k, v in self.fixed.items()]
+        p = self.params
+        parts.append(f"τ = {p.tau:g} s, δ = {p.delta:g} s, T* = {p.headway:g} s")
+        return "; ".join(parts)
+
+    # ---------------------------------------------------------------- slicing
+    def slice(self, gain: str, value: float) -> RegionMap:
+        """The 2-D slice of a 3-D map at the grid coordinate of ``gain`` nearest ``value``.
+
+        Raises
+        ------
+        StringStabError
+            If the map is not 3-D or ``gain`` is not one of its axes.
+        """
+        if self.ndim != 3:
+            raise StringStabError(f"slice needs a 3-D map; got a {self.ndim}-D map")
+        if gain not in self.axes:
+            raise StringStabError(f"gain must be one of {list(self.axes)}; got {gain!r}")
+        ax = list(self.axes).index(gain)
+        k = int(np.argmin(np.abs(self.axes[gain] - value)))
+
+        def take(a: Any) -> Any:
+            return None if a is None else np.take(a, k, axis=ax)
+
+        return RegionMap(
+            axes={n: a for n, a in self.axes.items() if n != gain},
+            fixed={gain: float(self.axes[gain][k])}, params=self.params, methods=self.methods,
+            hurwitz=take(self.hurwitz), type=take(self.type),
+            verdict={m: take(v) for m, v in self.verdict.items()},
+            prop1={m: take(v) for m, v in self.prop1.items()},
+            type_printed=take(self.type_printed), sup_gain=take(self.sup_gain),
+            margin=take(self.margin), version=self.version,
+        )
+
+    # ---------------------------------------------------------------- files
+    def metadata(self) -> dict[str, Any]:
+        """Parameters, axes, methods, code tables and the tool version (for files)."""
+        return {
+            "format": FORMAT,
+            "stringstab_version": self.version,
+            "params": self.params.as_dict(),
+            "axes": {n: {"min": float(a[0]), "max": float(a[-1]), "n": int(a.size)}
+                     for n, a in self.axes.items()},
+            "fixed": dict(self.fixed),
+            "methods": list(self.methods),
+            "verdict_labels": {m: list(VERDICT_LABELS[m]) for m in self.methods},
+            "type_names": {str(k): v for k, v in TYPE_NAMES.items()},
+        }
+
+    def fields(self) -> dict[str, npt.NDArray[Any]]:
+        """The per-point arrays by name (``hurwitz``, ``type``, ``verdict_<method>``, ...)."""
+        f: dict[str, npt.NDArray[Any]] = {"hurwitz": self.hurwitz, "type": self.type}
+        if self.type_printed is not None:
+            f["type_printed"] = self.type_printed
+        for m, code in self.verdict.items():
+            f[f"verdict_{m}"] = code
+        for m, ok in self.prop1.items():
+            f[f"prop1_{m}"] = ok
+        if self.sup_gain is not None:
+            f["sup_gain"] = self.sup_gain
+        if self.margin is not None:
+            f["margin"] = self.margin
+        return f
+
+    _fields = fields  # the name used before RegionMap owned its columns
+
+    def columns(self) -> dict[str, npt.NDArray[Any]]:
+        """One column per field, one row per grid point (flattened in C order), for people.
+
+        ``k_x, k_v, k_a``, ``hurwitz``, ``type`` (I-IV), ``type_printed``, one verdict
+        column per method (its labels, :data:`VERDICT_LABELS`), ``sup_gain`` and
+        ``margin`` (when evaluated): the columns of :meth:`save_csv`.
+
+        Examples
+        --------
+        >>> from stringstab.regions import region_map
+        >>> m = region_map({"k_x": [0.9, 1.3], "k_v": [-0.5, 0.0]}, {"k_a": 1.1},
+        ...                tau=0.1, delta=0.2, headway=1.1, methods="taylor")
+        >>> list(m.columns()), m.columns()["taylor"].tolist()
+        (['k_x', 'k_v', 'k_a', 'hurwitz', 'type', 'taylor'], ['unstable', 'unstable', 'unstable', 'unstable'])
+        """
+        kx, kv, ka = (g.ravel() for g in self.gains())
+        names = np.array(["", *TYPE_NAMES.values()])
+        cols: dict[str, npt.NDArray[Any]] = {"k_x": kx, "k_v": kv, "k_a": ka,
+                                             "hurwitz": self.hurwitz.ravel(),
+                                             "type": names[self.type.ravel()]}
+        if self.type_printed is not None:
+            cols["type_printed"] = names[self.type_printed.ravel()]
+        for m in self.methods:
+            cols[m] = np.array(VERDICT_LABELS[m])[self.verdict[m].ravel()]
+        if self.sup_gain is not None:
+            cols["sup_gain"] = self.sup_gain.ravel()
+        if self.margin is not None:
+            cols["margin"] = self.margin.ravel()
+        return cols
+
+    def records(self) -> list[dict[str, Any]]:
+        """:meth:`columns` as one dict per grid point (small maps; use the columns for large)."""
+        cols = self.columns()
+        return [dict(zip(cols, row)) for row in zip(*(c.tolist() for c in cols.values()))]
+
+    def save_npz(self, path: str | os.PathLike[str]) -> Path:
+        """Write the map to a compressed NPZ file with its metadata.
+
+        The archive holds ``axis_<gain>`` coordinates, one array per field
+        (``hurwitz``, ``type``, ``verdict_<method>``, ...) and ``metadata``, a
+        JSON string with the parameters and the tool version.  Read it back with
+        :func:`load_npz`.
+        """
+        return write_npz(path, self.axes, self.fields(), self.metadata())
+
+    def save_csv(self, path: str | os.PathLike[str]) -> Path:
+        """Write one CSV row per grid point, after ``#`` lines with the metadata.
+
+        Columns: :meth:`columns`.  The first line is ``# stringstab <version> region
+        map``, the second ``# `` followed by :meth:`metadata` as JSON; then the header
+        and the rows, written column by column (:mod:`stringstab.io`'s writer: numbers
+        in their shortest round-trip form, booleans ``True``/``False``, a non-finite
+        number, such as ``sup_gain`` where Γ is not internally stable, as an empty field).
+        """
+        return write_csv(path, [f"stringstab {self.version} region map",
+                                dumps_json(self.metadata(), indent=None).rstrip("\n")],
+                         self.columns())
+
+
+def load_npz(path: str | os.PathLike[str]) -> RegionMap:
+    """Read a map written by :meth:`RegionMap.save_npz`.
+
+    Raises
+    ------
+    StringStabError
+        If the file is not a stringstab region map.
+    """
+    meta, data = read_npz(path)
+    methods = tuple(meta["methods"])
+    return RegionMap(
+        axes={n: data[f"axis_{n}"] for n in meta["axes"]},
+        fixed={k: float(v) for k, v in meta["fixed"].items()},
+        params=Params(**meta["params"]), methods=methods,
+        hurwitz=data["hurwitz"], type=data["type"],
+        verdict={m: data[f"verdict_{m}"] for m in methods},
+        prop1={m: data[f"prop1_{m}"] for m in methods if f"prop1_{m}" in data},
+        type_printed=data.get("type_printed"), sup_gain=data.get("sup_gain"),
+        margin=data.get("margin"), version=meta["stringstab_version"],
+    )
+
