@@ -1,9 +1,10 @@
 """Figures of stability-region maps (:mod:`stringstab.regions`), with matplotlib.
 
-Every function takes ``ax=None`` (or ``axes=None`` / ``fig=None`` for
-multi-panel figures), draws into it or into a new figure, and returns a dict
-of what it drew (``"ax"`` plus the artists: ``"image"``, ``"legend"``,
-``"contour"``, ...), so figures can be composed and tested.
+Every function takes a :class:`~stringstab.regions.RegionMap` computed beforehand and
+``ax=None`` (or ``axes=None`` / ``fig=None`` for multi-panel figures), draws into it or
+into a new figure, and returns a :class:`~stringstab.plots.PlotResult` (``result["ax"]``
+and the artists: ``"image"``, ``"legend"``, ``"contour"``, ...), so figures can be composed
+and tested.
 
 Colours are the Okabe-Ito palette (safe for the common colour-vision
 deficiencies); marker shapes repeat the information of marker colours.
@@ -29,7 +30,7 @@ https://jfly.uni-koeln.de/color/.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from itertools import product
 from pathlib import Path
 from typing import Any
@@ -37,13 +38,25 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .errors import StringStabError
-from .regions import METHODS, RegionMap
+from ..errors import StringStabError
+from ..regions import METHODS, RegionMap
+from ._common import (
+    CLASS_COLORS,
+    GAIN_LABELS,
+    OKABE_ITO,
+    PlotResult,
+    categorical,
+    legend_below,
+    new_ax,
+    patch,
+    pct,
+    pyplot,
+)
 
 __all__ = [
-    "CLASS_COLORS",
     "FIGURE_FORMATS",
-    "GAIN_LABELS",
+    "draw_figure",
+    "figure_stems",
     "plot_boundaries",
     "plot_class_map",
     "plot_comparison",
@@ -53,32 +66,9 @@ __all__ = [
     "plot_sup_gain",
     "plot_trajectory",
     "save_figures",
+    "trajectory_verdicts",
 ]
 
-#: Okabe-Ito colours.
-_OI = {
-    "orange": "#E69F00", "sky": "#56B4E9", "green": "#009E73", "yellow": "#F0E442",
-    "blue": "#0072B2", "vermillion": "#D55E00", "purple": "#CC79A7", "black": "#000000",
-    "grey": "#BBBBBB",
-}
-#: Colour of each class of :data:`stringstab.regions.TYPE_CLASSES` / ``EXACT_CLASSES``.
-CLASS_COLORS: dict[str, str] = {
-    "not internally stable": _OI["grey"],
-    "type III": _OI["vermillion"],
-    "type IV": _OI["orange"],
-    "type I": _OI["blue"],
-    "type II": _OI["sky"],
-    "not certified": _OI["vermillion"],
-    "inconclusive": _OI["black"],
-    "certified": _OI["blue"],
-}
-#: Axis labels of the gains, with units (u = k_x Δp + k_v Δv + k_a a in m/s²).
-GAIN_LABELS: dict[str, str] = {
-    "k_x": r"$k_x$ (s$^{-2}$)",
-    "k_v": r"$k_v$ (s$^{-1}$)",
-    "k_a": r"$k_a$ (–)",
-}
-#: File formats :func:`save_figures` can write.
 FIGURE_FORMATS: tuple[str, ...] = ("png", "pdf", "svg")
 _METHOD_TITLES = {
     "exact": "exact certificate",
@@ -87,29 +77,16 @@ _METHOD_TITLES = {
 }
 _AGREE_STABLE = "#BFE1F5"  # light tint of sky blue
 _AGREE_UNSTABLE = "#E4E4E4"
-_UNSAFE = [_OI["vermillion"], _OI["purple"], _OI["orange"]]
-_CONSERVATIVE = [_OI["blue"], _OI["green"], _OI["yellow"]]
+_UNSAFE = [OKABE_ITO["vermillion"], OKABE_ITO["purple"], OKABE_ITO["orange"]]
+_CONSERVATIVE = [OKABE_ITO["blue"], OKABE_ITO["green"], OKABE_ITO["yellow"]]
 _VERDICT_MARKERS = {
     "certified": dict(marker="o", facecolor="white", edgecolor="black"),
     "not_certified": dict(marker="X", facecolor="black", edgecolor="white"),
-    "inconclusive": dict(marker="D", facecolor=_OI["yellow"], edgecolor="black"),
+    "inconclusive": dict(marker="D", facecolor=OKABE_ITO["yellow"], edgecolor="black"),
 }
 
 
 # --------------------------------------------------------------------------- helpers
-def _plt() -> Any:
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _new_ax(ax: Any, figsize: tuple[float, float] = (6.4, 7.0)) -> Any:
-    if ax is not None:
-        return ax
-    fig = _plt().figure(figsize=figsize, layout="constrained")
-    return fig.add_subplot()
-
-
 def _need_2d(rmap: RegionMap, what: str) -> None:
     if not isinstance(rmap, RegionMap):
         raise StringStabError(f"{what} needs a RegionMap; got {type(rmap).__name__}")
@@ -143,39 +120,11 @@ def _label_axes(ax: Any, rmap: RegionMap) -> None:
     ax.set_box_aspect(1.0)
 
 
-def _categorical(colors: Sequence[str]) -> tuple[Any, Any]:
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-
-    cmap = ListedColormap(list(colors))
-    norm = BoundaryNorm(np.arange(len(colors) + 1) - 0.5, len(colors))
-    return cmap, norm
-
-
-def _pct(count: int, n: int) -> str:
-    share = 100.0 * count / n if n else float("nan")
-    if 0 < share < 0.1:
-        return "<0.1 %"
-    return f"{share:.1f} %"
-
-
-def _legend(ax: Any, handles: list[Any], title: str | None = None, ncol: int = 2) -> Any:
-    """A legend under the axes (below the x label), so it never covers the map."""
-    return ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.12),
-                     ncol=ncol, frameon=False, fontsize="small", title_fontsize="small",
-                     columnspacing=1.2, handlelength=1.6)
-
-
-def _patch(color: str, label: str) -> Any:
-    from matplotlib.patches import Patch
-
-    return Patch(facecolor=color, edgecolor="#555555", linewidth=0.5, label=label)
-
-
 # --------------------------------------------------------------------------- class map
 def plot_class_map(
     rmap: RegionMap, method: str = "exact", *, ax: Any = None, legend: bool = True,
     title: bool = True,
-) -> dict[str, Any]:
+) -> PlotResult:
     """Draw a 2-D map coloured by the classes of one method.
 
     ``exact``: not internally stable / not certified / inconclusive /
@@ -196,7 +145,7 @@ def plot_class_map(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``image`` (the AxesImage or QuadMesh), ``legend`` (or None) and
         ``handles`` (one legend patch per class).
 
@@ -211,24 +160,26 @@ def plot_class_map(
     >>> m = region_map({"k_x": np.linspace(-2, 2, 21), "k_v": np.linspace(-2, 2, 21)},
     ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods="taylor")
     >>> out = plot_class_map(m, "taylor")
-    >>> sorted(out)
-    ['ax', 'handles', 'image', 'legend']
+    >>> out.keys()
+    ['fig', 'axes', 'ax', 'image', 'legend', 'handles']
+    >>> out.ax is out["ax"] and out.legend is out["legend"]
+    True
     >>> import matplotlib.pyplot as plt; plt.close("all")
     """
     _need_2d(rmap, "plot_class_map")
     names = rmap.class_names(method)
-    ax = _new_ax(ax)
+    ax = new_ax(ax)
     codes = rmap.classes(method)
     colors = [CLASS_COLORS[n] for n in names]
-    cmap, norm = _categorical(colors)
+    cmap, norm = categorical(colors)
     im = _draw_field(ax, rmap, codes, cmap=cmap, norm=norm)
     _label_axes(ax, rmap)
     counts = np.bincount(codes.ravel(), minlength=len(names))
-    handles = [_patch(c, f"{n} ({_pct(k, rmap.size)})") for n, c, k in zip(names, colors, counts)]
-    leg = _legend(ax, handles, title=f"{rmap.size:,} grid points") if legend else None
+    handles = [patch(c, f"{n} ({pct(k, rmap.size)})") for n, c, k in zip(names, colors, counts)]
+    leg = legend_below(ax, handles, title=f"{rmap.size:,} grid points") if legend else None
     if title:
         ax.set_title(f"{_METHOD_TITLES[method]}\n{rmap.title()}", fontsize="medium")
-    return {"ax": ax, "image": im, "legend": leg, "handles": handles}
+    return PlotResult.of({"ax": ax, "image": im, "legend": leg, "handles": handles})
 
 
 # --------------------------------------------------------------------------- comparison
@@ -277,7 +228,7 @@ def _comparison_codes(
 def plot_comparison(
     rmap: RegionMap, methods: Sequence[str] | None = None, *, ax: Any = None,
     legend: bool = True, title: bool = True,
-) -> dict[str, Any]:
+) -> PlotResult:
     """Draw where methods agree and disagree on string stability, counting each case.
 
     Each point is coloured by the pattern of verdicts (✓ = says string stable:
@@ -302,7 +253,7 @@ def plot_comparison(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``image``, ``legend``, ``counts`` (label → number of points)
         and ``disagreements`` (total number of disagreeing points).
 
@@ -318,30 +269,30 @@ def plot_comparison(
     for m in ms:
         if m not in rmap.methods:
             raise StringStabError(f"method {m!r} was not evaluated in this map (methods {list(rmap.methods)})")
-    ax = _new_ax(ax)
+    ax = new_ax(ax)
     codes, labels, colors, disagree = _comparison_codes(rmap, ms)
-    cmap, norm = _categorical(colors)
+    cmap, norm = categorical(colors)
     im = _draw_field(ax, rmap, codes, cmap=cmap, norm=norm)
     _label_axes(ax, rmap)
     counts_arr = np.bincount(codes.ravel(), minlength=len(labels))
     counts = {lab: int(c) for lab, c in zip(labels, counts_arr)}
     n_dis = int(sum(c for c, d in zip(counts_arr, disagree) if d))
     handles = [
-        _patch(col, f"{lab} (n = {c:,})")
+        patch(col, f"{lab} (n = {c:,})")
         for lab, col, c, d in zip(labels, colors, counts_arr, disagree)
         if c > 0 or not d
     ]
-    leg = _legend(ax, handles, title=f"disagreements: {n_dis:,} of {rmap.size:,} points") if legend else None
+    leg = legend_below(ax, handles, title=f"disagreements: {n_dis:,} of {rmap.size:,} points") if legend else None
     if title:
         ax.set_title(f"{' vs '.join(ms)}: where the verdicts differ\n{rmap.title()}", fontsize="medium")
-    return {"ax": ax, "image": im, "legend": leg, "counts": counts, "disagreements": n_dis}
+    return PlotResult.of({"ax": ax, "image": im, "legend": leg, "counts": counts, "disagreements": n_dis})
 
 
 # --------------------------------------------------------------------------- sup gain
 def plot_sup_gain(
     rmap: RegionMap, *, ax: Any = None, vmax: float | None = None, colorbar: bool = True,
     title: bool = True, cmap: str = "cividis",
-) -> dict[str, Any]:
+) -> PlotResult:
     """Heat map of ‖Γ‖_{H∞} = sup_ω |Γ(jω)| on a log colour scale, with the ≤ 1 boundary.
 
     Points where Γ is not internally stable (‖Γ‖∞ = ∞) are drawn in light
@@ -365,7 +316,7 @@ def plot_sup_gain(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``image``, ``contour`` (the boundary, or None when the region
         is empty or everything), ``colorbar`` and ``legend``.
 
@@ -381,7 +332,7 @@ def plot_sup_gain(
     from matplotlib.colors import LogNorm
     from matplotlib.lines import Line2D
 
-    ax = _new_ax(ax)
+    ax = new_ax(ax)
     sup = np.asarray(rmap.sup_gain, dtype=float)
     finite = np.isfinite(sup)
     if vmax is None:
@@ -392,27 +343,27 @@ def plot_sup_gain(
                      cmap=cm, norm=LogNorm(vmin=1.0, vmax=vmax))
     cert = rmap.stable("exact").astype(float)
     contour = None
-    handles = [_patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)")]
+    handles = [patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)")]
     if 0 < cert.sum() < cert.size:
         x, y = rmap.axes.values()
-        contour = ax.contour(x, y, cert.T, levels=[0.5], colors=[_OI["vermillion"]], linewidths=1.6)
-        handles.append(Line2D([], [], color=_OI["vermillion"], lw=1.6,
-                              label=f"boundary of sup|Γ| ≤ 1 (certified, {_pct(int(cert.sum()), cert.size)})"))
-    leg = _legend(ax, handles, ncol=1)
+        contour = ax.contour(x, y, cert.T, levels=[0.5], colors=[OKABE_ITO["vermillion"]], linewidths=1.6)
+        handles.append(Line2D([], [], color=OKABE_ITO["vermillion"], lw=1.6,
+                              label=f"boundary of sup|Γ| ≤ 1 (certified, {pct(int(cert.sum()), cert.size)})"))
+    leg = legend_below(ax, handles, ncol=1)
     cb = None
     if colorbar:
         cb = ax.figure.colorbar(im, ax=ax, extend="max", label=r"$\sup_\omega |\Gamma(j\omega)|$")
     _label_axes(ax, rmap)
     if title:
         ax.set_title(f"sup|Γ(jω)| (exact delay)\n{rmap.title()}", fontsize="medium")
-    return {"ax": ax, "image": im, "contour": contour, "colorbar": cb, "legend": leg}
+    return PlotResult.of({"ax": ax, "image": im, "contour": contour, "colorbar": cb, "legend": leg})
 
 
 # --------------------------------------------------------------------------- 3-D
 def plot_slices(
     rmap: RegionMap, method: str = "exact", *, gain: str | None = None, n: int = 9,
     fig: Any = None, ncols: int | None = None,
-) -> dict[str, Any]:
+) -> PlotResult:
     """A 3-D map as a montage of 2-D class maps over one gain.
 
     Parameters
@@ -432,7 +383,7 @@ def plot_slices(
 
     Returns
     -------
-    dict
+    PlotResult
         ``fig``, ``axes`` (list), ``images`` (list), ``values`` (the slice
         coordinates) and ``legend``.
 
@@ -453,7 +404,7 @@ def plot_slices(
     ncols = ncols or int(np.ceil(np.sqrt(idx.size)))
     nrows = int(np.ceil(idx.size / ncols))
     if fig is None:
-        fig = _plt().figure(figsize=(2.5 * ncols + 2.6, 2.4 * nrows + 0.7), layout="constrained")
+        fig = pyplot().figure(figsize=(2.5 * ncols + 2.6, 2.4 * nrows + 0.7), layout="constrained")
     axs = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
     images, used = [], []
     handles: list[Any] = []
@@ -470,16 +421,16 @@ def plot_slices(
     for ax in axs[idx.size:]:
         ax.set_visible(False)
     names = rmap.class_names(method)
-    handles = [_patch(CLASS_COLORS[c], c) for c in names]
+    handles = [patch(CLASS_COLORS[c], c) for c in names]
     leg = fig.legend(handles=handles, loc="outside right upper", frameon=False, fontsize="small")
     fig.suptitle(f"{_METHOD_TITLES[method]}, slices over {gain}\n{rmap.title()}", fontsize="medium")
-    return {"fig": fig, "axes": used, "images": images, "values": coords[idx], "legend": leg}
+    return PlotResult.of({"fig": fig, "axes": used, "images": images, "values": coords[idx], "legend": leg})
 
 
 def plot_region_3d(
     rmap: RegionMap, method: str = "exact", *, ax: Any = None, kind: str = "surface",
     max_points: int = 40_000, title: bool = True,
-) -> dict[str, Any]:
+) -> PlotResult:
     """The string-stable region of a 3-D map, drawn in 3-D.
 
     ``kind="surface"`` (default): for every grid point of the first two axis
@@ -508,7 +459,7 @@ def plot_region_3d(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``artists`` (the surfaces or the scatter; empty when the region
         is empty), ``n_gapped`` (surface) or ``n_boundary`` (points), and
         ``legend`` or ``colorbar``.
@@ -524,7 +475,7 @@ def plot_region_3d(
         raise StringStabError(f"kind must be 'surface' or 'points'; got {kind!r}")
     st = rmap.stable(method)
     if ax is None:
-        fig = _plt().figure(figsize=(7.2, 6.4), layout="constrained")
+        fig = pyplot().figure(figsize=(7.2, 6.4), layout="constrained")
         ax = fig.add_subplot(projection="3d")
     names = rmap.axis_names
     a0, a1, a2 = rmap.axes.values()
@@ -542,8 +493,8 @@ def plot_region_3d(
         stride = max(1, int(np.ceil(max(a0.size, a1.size) / 80)))
         handles = []
         if anyst.any():
-            for Z, col, lab in ((lower, _OI["blue"], f"lowest {names[2]}"),
-                                (upper, _OI["orange"], f"highest {names[2]}")):
+            for Z, col, lab in ((lower, OKABE_ITO["blue"], f"lowest {names[2]}"),
+                                (upper, OKABE_ITO["orange"], f"highest {names[2]}")):
                 surf = ax.plot_surface(X, Y, np.ma.masked_invalid(Z), color=col, rstride=stride,
                                        cstride=stride, linewidth=0.15, edgecolor="#333333",
                                        alpha=0.85, shade=True)
@@ -583,7 +534,7 @@ def plot_region_3d(
         what = "certified" if method == "exact" else f"{method}-stable"
         ax.set_title(f"the {what} region ({100 * st.mean():.1f} % of the box)\n{rmap.title()}",
                      fontsize="medium")
-    return out
+    return PlotResult.of(out)
 
 
 # --------------------------------------------------------------------------- several maps
@@ -616,7 +567,7 @@ def _check_same_axes(maps: Sequence[RegionMap], what: str) -> None:
 def plot_facets(
     maps: Sequence[RegionMap], method: str = "exact", *, axes: Sequence[Any] | None = None,
     kind: str = "class",
-) -> dict[str, Any]:
+) -> PlotResult:
     """One panel per map (e.g. per τ or δ), side by side, to show how the region changes.
 
     Parameters
@@ -632,7 +583,7 @@ def plot_facets(
 
     Returns
     -------
-    dict
+    PlotResult
         ``fig``, ``axes``, ``images``, ``legend`` (a shared legend or colour bar
         owner) and ``shares`` (share of stable points per map).
 
@@ -647,7 +598,7 @@ def plot_facets(
         raise StringStabError(f"kind must be 'class' or 'sup_gain'; got {kind!r}")
     vary = _varying(maps)
     if axes is None:
-        fig = _plt().figure(figsize=(3.4 * len(maps) + 2.4, 3.9), layout="constrained")
+        fig = pyplot().figure(figsize=(3.4 * len(maps) + 2.4, 3.9), layout="constrained")
         axes = list(fig.subplots(1, len(maps), sharex=True, sharey=True, squeeze=False).ravel())
     else:
         axes = list(axes)
@@ -675,15 +626,15 @@ def plot_facets(
             ax.set_ylabel("")
     if kind == "class":
         names = maps[0].class_names(method)
-        leg = fig.legend(handles=[_patch(CLASS_COLORS[c], c) for c in names],
+        leg = fig.legend(handles=[patch(CLASS_COLORS[c], c) for c in names],
                          loc="outside right upper", frameon=False, fontsize="small")
     else:
         from matplotlib.lines import Line2D
 
         fig.colorbar(images[-1], ax=axes, extend="max", shrink=0.9,
                      label=r"$\sup_\omega |\Gamma(j\omega)|$")
-        leg = fig.legend(handles=[_patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)"),
-                                  Line2D([], [], color=_OI["vermillion"], lw=1.6,
+        leg = fig.legend(handles=[patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)"),
+                                  Line2D([], [], color=OKABE_ITO["vermillion"], lw=1.6,
                                          label="boundary of sup|Γ| ≤ 1 (certified)")],
                          loc="outside lower center", ncol=2, frameon=False, fontsize="small")
     fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
@@ -692,12 +643,12 @@ def plot_facets(
                       if k not in vary)
     what = _METHOD_TITLES[method] if kind == "class" else "sup|Γ(jω)|"
     fig.suptitle(f"{what}; {fixed}; {const}", fontsize="medium")
-    return {"fig": fig, "axes": axes, "images": images, "legend": leg, "shares": shares}
+    return PlotResult.of({"fig": fig, "axes": axes, "images": images, "legend": leg, "shares": shares})
 
 
 def plot_boundaries(
     maps: Sequence[RegionMap], method: str = "exact", *, ax: Any = None, title: bool = True,
-) -> dict[str, Any]:
+) -> PlotResult:
     """The boundaries of the string-stable regions of several maps on one axes.
 
     Parameters
@@ -713,16 +664,16 @@ def plot_boundaries(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``contours`` (one ContourSet or None per map), ``legend`` and
         ``shares``.
     """
     _check_same_axes(maps, "plot_boundaries")
     from matplotlib.lines import Line2D
 
-    ax = _new_ax(ax, figsize=(6.4, 7.4))
+    ax = new_ax(ax, figsize=(6.4, 7.4))
     vary = _varying(maps)
-    colors = [_OI["blue"], _OI["vermillion"], _OI["green"], _OI["purple"], _OI["orange"], _OI["sky"]]
+    colors = [OKABE_ITO["blue"], OKABE_ITO["vermillion"], OKABE_ITO["green"], OKABE_ITO["purple"], OKABE_ITO["orange"], OKABE_ITO["sky"]]
     styles = ["-", "--", "-.", ":"]
     contours, handles, shares = [], [], []
     for i, m in enumerate(maps):
@@ -744,7 +695,7 @@ def plot_boundaries(
     ax.grid(True, lw=0.4, alpha=0.5)
     _label_axes(ax, maps[0])
     word = "certified" if method == "exact" else f"{method}-stable"
-    leg = _legend(ax, handles, title=f"boundary of the {word} region", ncol=1)
+    leg = legend_below(ax, handles, title=f"boundary of the {word} region", ncol=1)
     if title:
         fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
         p = maps[0].params.as_dict()
@@ -753,14 +704,44 @@ def plot_boundaries(
         sym = {"tau": "τ", "delta": "δ", "headway": "T*"}
         ax.set_title(f"boundary of the {word} region for several {', '.join(sym[v] for v in vary)}\n"
                      f"{fixed}; {const}", fontsize="medium")
-    return {"ax": ax, "contours": contours, "legend": leg, "shares": shares}
+    return PlotResult.of({"ax": ax, "contours": contours, "legend": leg, "shares": shares})
 
 
 # --------------------------------------------------------------------------- trajectory
+def _gain_rows(gains: Any) -> tuple[npt.NDArray[np.float64], Any]:
+    """(K of shape (n, 3), vehicle ids or None) of a gain table or an (n, 3) array."""
+    table_K = getattr(gains, "K", None)
+    if table_K is not None:  # a gain table (stringstab.gainio.GainTable)
+        return np.asarray(table_K, dtype=float), getattr(gains, "vehicle", None)
+    K = np.asarray(gains, dtype=float)
+    if K.ndim != 2 or K.shape[1] != 3 or K.shape[0] == 0:
+        raise StringStabError(f"gains must be an (n, 3) array of k_x, k_v, k_a; got shape {K.shape}")
+    return K, None
+
+
+def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
+    """The exact verdict of each triple of ``gains`` at the map's τ, δ, T* (compute step).
+
+    Examples
+    --------
+    >>> from stringstab.regions import region_map
+    >>> m = region_map({"k_x": [0.5, 1.5], "k_v": [0.0, 1.0]}, {"k_a": 0.2}, tau=0.1, delta=0.2,
+    ...                headway=1.1, methods="taylor")
+    >>> trajectory_verdicts(m, [[1.5, 0.3, -0.1], [0.9, -0.5, 1.1]])
+    ['certified', 'not_certified']
+    """
+    from ..certificate import certify_batch
+
+    K, _ = _gain_rows(gains)
+    p = rmap.params
+    return certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta,
+                         headway=p.headway).verdict.tolist()
+
+
 def plot_trajectory(
-    rmap: RegionMap, gains: Any, *, ax: Any = None, verdicts: Sequence[str] | None = None,
+    rmap: RegionMap, gains: Any, *, ax: Any = None, verdicts: Any = None,
     legend: bool = True, label: str = "policy gains",
-) -> dict[str, Any]:
+) -> PlotResult:
     """Overlay a gain trajectory (e.g. from a policy rollout) on a 2-D map.
 
     The trajectory is projected on the map's two axis gains; each point is
@@ -768,19 +749,23 @@ def plot_trajectory(
     map's τ, δ, T*), which need not equal the map's fixed gain.  Points of one
     vehicle are joined in order; the first point of each is labelled.
 
+    Compute, then draw: pass the verdicts computed beforehand
+    (:func:`stringstab.certificate.certify_batch` of the triples, or its ``.verdict``).
+    Without them, as python-control's ``bode_plot(sys)`` computes the response it draws,
+    they are computed here first (one :func:`~stringstab.certificate.certify_batch`
+    call); the toolkit's own callers always pass them.
+
     Parameters
     ----------
     rmap : RegionMap
         The 2-D map it is drawn over (gives the axes and the parameters).
     gains : GainTable or array_like of shape (n, 3)
-        The triples k_x, k_v, k_a in time order (a
-        :class:`stringstab.gainio.GainTable`, e.g. from
+        The triples k_x, k_v, k_a in time order (a gain table, e.g. from
         :func:`stringstab.gainio.read_gains`, adds ``t`` and ``vehicle``).
     ax : matplotlib Axes, optional
         Usually the axes of a class map; a new figure when None.
-    verdicts : sequence of str, optional
-        Precomputed verdicts per row; default
-        :func:`stringstab.certificate.certify_batch` on each triple.
+    verdicts : CertificateBatch or sequence of str, optional
+        The exact verdict of each row, computed beforehand.
     legend : bool
         Add the trajectory's entries to the axes' legend (under the axes).
     label : str
@@ -788,36 +773,23 @@ def plot_trajectory(
 
     Returns
     -------
-    dict
+    PlotResult
         ``ax``, ``lines`` (one per vehicle), ``markers`` (verdict → the
         PathCollection), ``verdicts`` (list) and ``legend``.
 
     Raises
     ------
     StringStabError
-        If ``rmap`` is not 2-D or the gains are not n × 3.
+        If ``rmap`` is not 2-D, the gains are not n × 3 or the verdicts are not one per row.
     """
     _need_2d(rmap, "plot_trajectory")
-    from .gainio import GainTable
-
-    if isinstance(gains, GainTable):
-        K = gains.K
-        vehicle = gains.vehicle
-    else:
-        K = np.asarray(gains, dtype=float)
-        vehicle = None
-        if K.ndim != 2 or K.shape[1] != 3 or K.shape[0] == 0:
-            raise StringStabError(f"gains must be an (n, 3) array of k_x, k_v, k_a; got shape {K.shape}")
+    K, vehicle = _gain_rows(gains)
     if verdicts is None:
-        from .certificate import certify_batch
-
-        p = rmap.params
-        verdicts = certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta,
-                                 headway=p.headway).verdict.tolist()
-    verdicts = list(verdicts)
+        verdicts = trajectory_verdicts(rmap, K)
+    verdicts = list(getattr(verdicts, "verdict", verdicts))
     if len(verdicts) != K.shape[0]:
         raise StringStabError(f"expected one verdict per gain triple ({K.shape[0]}); got {len(verdicts)}")
-    ax = _new_ax(ax)
+    ax = new_ax(ax)
     col = {"k_x": 0, "k_v": 1, "k_a": 2}
     xn, yn = rmap.axis_names
     x, y = K[:, col[xn]], K[:, col[yn]]
@@ -851,47 +823,87 @@ def plot_trajectory(
             for h, t in zip(old.legend_handles, old.get_texts()):
                 h.set_label(t.get_text())
             title = f"{old.get_title().get_text()}; {title}"
-        leg = _legend(ax, handles, title=title)
-    return {"ax": ax, "lines": lines, "markers": markers, "verdicts": verdicts, "legend": leg}
+        leg = legend_below(ax, handles, title=title)
+    return PlotResult.of({"ax": ax, "lines": lines, "markers": markers, "verdicts": verdicts, "legend": leg})
 
 
 # --------------------------------------------------------------------------- files
+def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
+    """The names (without prefix and format) of the standard figures of ``rmap``.
+
+    2-D map: ``class_<method>`` for each method, ``compare`` (two or more methods),
+    ``sup_gain`` (``exact``) and, with ``overlay``, ``overlay``.  3-D map:
+    ``slices_<method>`` and ``3d_<method>`` for each method.
+    """
+    if rmap.ndim == 2:
+        stems = [f"class_{m}" for m in rmap.methods]
+        if len(rmap.methods) >= 2:
+            stems.append("compare")
+        if "exact" in rmap.methods:
+            stems.append("sup_gain")
+        if overlay:
+            stems.append("overlay")
+        return stems
+    return [s for m in rmap.methods for s in (f"slices_{m}", f"3d_{m}")]
+
+
+def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = None) -> Any:
+    """Draw the standard figure ``stem`` (:func:`figure_stems`) of ``rmap``; returns its Figure."""
+    if stem.startswith("class_"):
+        return plot_class_map(rmap, stem[len("class_"):]).figure
+    if stem == "compare":
+        return plot_comparison(rmap).figure
+    if stem == "sup_gain":
+        return plot_sup_gain(rmap).figure
+    if stem == "overlay":
+        ax = plot_class_map(rmap, rmap.methods[0]).ax
+        plot_trajectory(rmap, gains, ax=ax, verdicts=verdicts)
+        return ax.figure
+    if stem.startswith("slices_"):
+        return plot_slices(rmap, stem[len("slices_"):]).figure
+    if stem.startswith("3d_"):
+        return plot_region_3d(rmap, stem[len("3d_"):]).figure
+    raise StringStabError(f"unknown figure {stem!r}; expected one of {figure_stems(rmap, True)}")
+
+
 def save_figures(
-    rmap: RegionMap, out: str | Path, *, prefix: str = "region",
-    formats: Sequence[str] = ("png", "pdf"), gains: Any = None, dpi: int = 150,
+    rmap: RegionMap, out: Any, *, prefix: str = "region",
+    formats: Sequence[str] = ("png", "pdf"), gains: Any = None, verdicts: Any = None,
+    dpi: int = 150, workers: int = 1,
 ) -> list[Path]:
     """Draw the standard figures of a map and save each in every format.
 
     Each file carries the tool version and :meth:`RegionMap.metadata` (τ, δ,
     T*, axes, methods) as JSON in its own metadata: PNG ``Software`` and
     ``Description`` text chunks, PDF ``Creator`` and ``Subject``, SVG
-    ``Creator`` and ``Description``.
-
-    2-D map: ``<prefix>_class_<method>`` for each method,
-    ``<prefix>_compare`` (two or more methods), ``<prefix>_sup_gain``
-    (``exact``) and, with ``gains``, ``<prefix>_overlay`` (the trajectory over
-    the class map of the first method).  3-D map: ``<prefix>_slices_<method>``
-    and ``<prefix>_3d_<method>`` for each method.
+    ``Creator`` and ``Description``.  The figures are :func:`figure_stems`, saved as
+    ``<prefix>_<stem>.<format>``.
 
     Parameters
     ----------
     rmap : RegionMap
         The map.
-    out : path
-        An existing directory.
+    out : path or OutputDir
+        An existing folder, or a :class:`stringstab.io.OutputDir` (the files are
+        staged in it and appear when its run succeeds).
     prefix : str
         File name stem.
     formats : sequence of str
         Among :data:`FIGURE_FORMATS`.
     gains : GainTable or array_like, optional
         A gain trajectory to overlay (2-D maps only).
+    verdicts : CertificateBatch or sequence of str, optional
+        The exact verdicts of ``gains``, computed beforehand (else computed here once:
+        :func:`trajectory_verdicts`).
     dpi : int
         Resolution of raster formats.
+    workers : int
+        Processes drawing the figures (forked; 1 draws them here, one after another).
 
     Returns
     -------
     list of Path
-        The files written.
+        The files written (their final paths).
 
     Raises
     ------
@@ -903,40 +915,72 @@ def save_figures(
             raise StringStabError(f"figure formats must be among {list(FIGURE_FORMATS)}; got {f!r}")
     if gains is not None and rmap.ndim != 2:
         raise StringStabError(f"a gain trajectory can be overlaid on a 2-D map only; got a {rmap.ndim}-D map")
-    plt = _plt()
-    out = Path(out)
-    written: list[Path] = []
-
-    import json
-
-    meta = json.dumps(rmap.metadata(), ensure_ascii=False)
-    software = f"stringstab {rmap.version}"
-    file_meta = {
-        "png": {"Software": software, "Description": meta},
-        "pdf": {"Creator": software, "Subject": meta},
-        "svg": {"Creator": software, "Description": meta},
-    }
-
-    def save(fig: Any, stem: str) -> None:
-        for f in formats:
-            path = out / f"{prefix}_{stem}.{f}"
-            fig.savefig(path, dpi=dpi, metadata=file_meta[f], bbox_inches="tight", pad_inches=0.1)
-            written.append(path)
-        plt.close(fig)
-
-    if rmap.ndim == 2:
-        for m in rmap.methods:
-            save(plot_class_map(rmap, m)["ax"].figure, f"class_{m}")
-        if len(rmap.methods) >= 2:
-            save(plot_comparison(rmap)["ax"].figure, "compare")
-        if "exact" in rmap.methods:
-            save(plot_sup_gain(rmap)["ax"].figure, "sup_gain")
-        if gains is not None:
-            ax = plot_class_map(rmap, rmap.methods[0])["ax"]
-            plot_trajectory(rmap, gains, ax=ax)
-            save(ax.figure, "overlay")
+    if gains is not None and verdicts is None:
+        verdicts = trajectory_verdicts(rmap, gains)
+    stems = figure_stems(rmap, gains is not None)
+    stage: Callable[[str], Path]
+    final: Callable[[str], Path]
+    if hasattr(out, "path") and hasattr(out, "final"):  # an OutputDir
+        stage, final = out.path, out.final
     else:
-        for m in rmap.methods:
-            save(plot_slices(rmap, m)["fig"], f"slices_{m}")
-            save(plot_region_3d(rmap, m)["ax"].figure, f"3d_{m}")
-    return written
+        stage = final = Path(out).joinpath
+    jobs = [(stem, [(f, stage(f"{prefix}_{stem}.{f}")) for f in formats]) for stem in stems]
+    job = _FigureJob(rmap, gains, verdicts, dpi)
+    if workers > 1 and len(jobs) > 1:
+        _run_parallel(job, jobs, workers)
+    else:
+        for j in jobs:
+            job(j)
+    return [final(f"{prefix}_{stem}.{f}") for stem in stems for f in formats]
+
+
+class _FigureJob:
+    """Draw one standard figure and save it in its formats (picklable for a forked pool)."""
+
+    def __init__(self, rmap: RegionMap, gains: Any, verdicts: Any, dpi: int) -> None:
+        import json
+
+        self.rmap, self.gains, self.verdicts, self.dpi = rmap, gains, verdicts, dpi
+        meta = json.dumps(rmap.metadata(), ensure_ascii=False)
+        software = f"stringstab {rmap.version}"
+        self.file_meta = {
+            "png": {"Software": software, "Description": meta},
+            "pdf": {"Creator": software, "Subject": meta},
+            "svg": {"Creator": software, "Description": meta},
+        }
+
+    def __call__(self, job: tuple[str, list[tuple[str, Path]]]) -> None:
+        stem, targets = job
+        fig = draw_figure(self.rmap, stem, self.gains, self.verdicts)
+        try:
+            for f, path in targets:
+                fig.savefig(path, dpi=self.dpi, metadata=self.file_meta[f], bbox_inches="tight",
+                            pad_inches=0.1)
+        finally:
+            pyplot().close(fig)
+
+
+def _run_parallel(job: _FigureJob, jobs: list[tuple[str, list[tuple[str, Path]]]],
+                  workers: int) -> None:
+    """Draw the figures in ``workers`` forked processes (the map is inherited, not sent)."""
+    import multiprocessing
+
+    if "fork" not in multiprocessing.get_all_start_methods() or multiprocessing.current_process().daemon:
+        for j in jobs:
+            job(j)
+        return
+    global _JOB
+    _JOB = job
+    try:
+        with multiprocessing.get_context("fork").Pool(min(workers, len(jobs))) as pool:
+            pool.map(_run_job, jobs, chunksize=1)
+    finally:
+        _JOB = None
+
+
+_JOB: _FigureJob | None = None
+
+
+def _run_job(j: tuple[str, list[tuple[str, Path]]]) -> None:
+    assert _JOB is not None
+    _JOB(j)

@@ -1,0 +1,78 @@
+"""Every figure of the toolkit, under one roof, in python-control's pattern.
+
+Compute a result object first, then draw it: each plot function takes the result
+(:class:`~stringstab.regions.RegionMap`, :class:`~stringstab.tuning.TuneResult`,
+:class:`~stringstab.traffic.PlatoonResult`, ...) and ``ax=None`` (``axes=None``/``fig=None``
+for several panels), and returns a :class:`PlotResult` (the figure, the axes and the named
+artists), so figures can be composed and tested.
+
+=============================  ===============================================================
+module / function              shows
+=============================  ===============================================================
+**region maps**                (:mod:`stringstab.plots.regions`)
+:func:`plot_class_map`         classes of one method (types, or exact verdicts)
+:func:`plot_comparison`        where exact, taylor and printed agree and disagree
+:func:`plot_sup_gain`          sup_ω |Γ(jω)| (log scale), with the certified boundary
+:func:`plot_slices`            a 3-D map as a montage of slices over one gain
+:func:`plot_region_3d`         the boundary of the certified region in 3-D
+:func:`plot_facets`            one class map per τ (or δ): how the region shrinks
+:func:`plot_boundaries`        the certified boundaries of several maps on one axes
+:func:`plot_trajectory`        a policy's gain trajectory over a map, by verdict
+:func:`save_figures`           the standard figures of a map, in every format
+**gain repair**                (:mod:`stringstab.plots.tuning`)
+:func:`plot_moves`             repairs K0 → K over the certified region
+**platoons**                   (:mod:`stringstab.plots.traffic`)
+:func:`plot_vehicles`          one line per vehicle, coloured by position
+:func:`plot_platoon`           speed, acceleration, spacing, headway (IDL Figs 7-8)
+:func:`plot_damping_ratios`    m_p of each follower (IDL eq 29)
+=============================  ===============================================================
+
+matplotlib is imported on first use.  ``stringstab.tuning.plot_moves`` and
+``stringstab.traffic.plots`` re-export their functions from here.
+"""
+
+from __future__ import annotations
+
+from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult
+from .regions import (
+    FIGURE_FORMATS,
+    draw_figure,
+    figure_stems,
+    plot_boundaries,
+    plot_class_map,
+    plot_comparison,
+    plot_facets,
+    plot_region_3d,
+    plot_slices,
+    plot_sup_gain,
+    plot_trajectory,
+    save_figures,
+    trajectory_verdicts,
+)
+from .traffic import plot_damping_ratios, plot_platoon, plot_vehicles
+from .tuning import moves_region, plot_moves
+
+__all__ = [
+    "CLASS_COLORS",
+    "FIGURE_FORMATS",
+    "GAIN_LABELS",
+    "OKABE_ITO",
+    "PlotResult",
+    "draw_figure",
+    "figure_stems",
+    "moves_region",
+    "plot_boundaries",
+    "plot_class_map",
+    "plot_comparison",
+    "plot_damping_ratios",
+    "plot_facets",
+    "plot_moves",
+    "plot_platoon",
+    "plot_region_3d",
+    "plot_slices",
+    "plot_sup_gain",
+    "plot_trajectory",
+    "plot_vehicles",
+    "save_figures",
+    "trajectory_verdicts",
+]

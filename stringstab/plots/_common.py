@@ -1,0 +1,177 @@
+"""What every figure of the toolkit shares: the result object, the palette, small helpers.
+
+Every plot function takes ``ax=None`` (``axes=None``/``fig=None`` for several panels), draws
+into it or a new figure, and returns a :class:`PlotResult`, a small fixed object in the
+pattern of python-control's ``ControlPlot``: the figure, the axes and the named artists (and
+the few numbers the figure shows, e.g. the counts of a comparison).
+
+Colours are the Okabe-Ito palette (safe for the common colour-vision deficiencies).
+
+References
+----------
+M. Okabe and K. Ito, "Color Universal Design (CUD)", 2008,
+https://jfly.uni-koeln.de/color/.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "CLASS_COLORS",
+    "GAIN_LABELS",
+    "OKABE_ITO",
+    "PlotResult",
+    "categorical",
+    "legend_below",
+    "new_ax",
+    "patch",
+    "pct",
+    "pyplot",
+]
+
+
+@dataclass(frozen=True)
+class PlotResult:
+    """What a plot function drew: its figure, its axes and its named artists.
+
+    Attributes
+    ----------
+    figure : matplotlib Figure
+        The figure drawn in.
+    axes : tuple of Axes
+        The axes drawn in (one for most functions).
+    artists : dict
+        The artists by name (``"image"``, ``"legend"``, ``"contour"``, ``"lines"``, ...)
+        and the numbers the figure shows (``"counts"``, ``"shares"``, ``"verdicts"``, ...).
+
+    Notes
+    -----
+    ``result["name"]`` reads an artist (``"ax"``, ``"fig"`` and ``"axes"`` read the
+    figure's axes and the figure), as the dicts returned before did; ``fig, axes = result``
+    unpacks like :func:`matplotlib.pyplot.subplots`.
+    """
+
+    figure: Any
+    axes: tuple[Any, ...]
+    artists: Mapping[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, drawn: Mapping[str, Any]) -> PlotResult:
+        """From the named things a plot function drew (``"ax"``/``"axes"``, ``"fig"``, ...)."""
+        axes = drawn.get("axes")
+        ax = drawn.get("ax")
+        axs: tuple[Any, ...] = (tuple(np.ravel(np.asarray(axes, dtype=object))) if axes is not None
+                                else (ax,) if ax is not None else ())
+        fig = drawn.get("fig")
+        if fig is None and axs:
+            fig = axs[0].figure
+        rest = {k: v for k, v in drawn.items() if k not in ("ax", "axes", "fig")}
+        return cls(fig, axs, rest)
+
+    @property
+    def ax(self) -> Any:
+        """The first (usually the only) axes."""
+        return self.axes[0] if self.axes else None
+
+    @property
+    def legend(self) -> Any:
+        """The legend drawn, or None."""
+        return self.artists.get("legend")
+
+    def __getitem__(self, key: str) -> Any:
+        if key == "ax":
+            return self.ax
+        if key in ("fig", "figure"):
+            return self.figure
+        if key == "axes":
+            return list(self.axes)
+        return self.artists[key]
+
+    def __contains__(self, key: object) -> bool:
+        return key in ("ax", "fig", "figure", "axes") or key in self.artists
+
+    def keys(self) -> list[str]:
+        """The names :meth:`__getitem__` accepts."""
+        return ["fig", "axes", "ax", *self.artists]
+
+    def __iter__(self) -> Iterator[Any]:
+        """``fig, axes = result``."""
+        return iter((self.figure, self.axes))
+
+
+#: The Okabe-Ito colours.
+OKABE_ITO = {
+    "orange": "#E69F00", "sky": "#56B4E9", "green": "#009E73", "yellow": "#F0E442",
+    "blue": "#0072B2", "vermillion": "#D55E00", "purple": "#CC79A7", "black": "#000000",
+    "grey": "#BBBBBB",
+}
+#: Colour of each class of :data:`stringstab.regions.TYPE_CLASSES` / ``EXACT_CLASSES``.
+CLASS_COLORS: dict[str, str] = {
+    "not internally stable": OKABE_ITO["grey"],
+    "type III": OKABE_ITO["vermillion"],
+    "type IV": OKABE_ITO["orange"],
+    "type I": OKABE_ITO["blue"],
+    "type II": OKABE_ITO["sky"],
+    "not certified": OKABE_ITO["vermillion"],
+    "inconclusive": OKABE_ITO["black"],
+    "certified": OKABE_ITO["blue"],
+}
+#: Axis labels of the gains, with units (u = k_x Δp + k_v Δv + k_a a in m/s²).
+GAIN_LABELS: dict[str, str] = {
+    "k_x": r"$k_x$ (s$^{-2}$)",
+    "k_v": r"$k_v$ (s$^{-1}$)",
+    "k_a": r"$k_a$ (–)",
+}
+#: File formats :func:`save_figures` can write.
+
+
+def pyplot() -> Any:
+    """matplotlib.pyplot, imported on first use."""
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def new_ax(ax: Any, figsize: tuple[float, float] = (6.4, 7.0)) -> Any:
+    """``ax``, or the axes of a new figure (constrained layout) when it is None."""
+    if ax is not None:
+        return ax
+    fig = pyplot().figure(figsize=figsize, layout="constrained")
+    return fig.add_subplot()
+
+
+def categorical(colors: Sequence[str]) -> tuple[Any, Any]:
+    """A colormap and norm that map the integer codes 0, 1, ... to ``colors``."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    cmap = ListedColormap(list(colors))
+    norm = BoundaryNorm(np.arange(len(colors) + 1) - 0.5, len(colors))
+    return cmap, norm
+
+
+def pct(count: int, n: int) -> str:
+    """``count`` of ``n`` as a percentage (one decimal; ``<0.1 %`` when tiny)."""
+    share = 100.0 * count / n if n else float("nan")
+    if 0 < share < 0.1:
+        return "<0.1 %"
+    return f"{share:.1f} %"
+
+
+def legend_below(ax: Any, handles: list[Any], title: str | None = None, ncol: int = 2) -> Any:
+    """A legend under the axes (below the x label), so it never covers the map."""
+    return ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.12),
+                     ncol=ncol, frameon=False, fontsize="small", title_fontsize="small",
+                     columnspacing=1.2, handlelength=1.6)
+
+
+def patch(color: str, label: str) -> Any:
+    """A legend patch of ``color``."""
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor=color, edgecolor="#555555", linewidth=0.5, label=label)
+

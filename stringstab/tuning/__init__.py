@@ -1,0 +1,63 @@
+"""Repairing gains that are not string stable: region growing and a nearest-point projection.
+
+In the IDL strategy every action K = [k_x, k_v, k_a] proposed by the agent goes
+through a *parameter tuning* step that replaces gains that are not string
+stable by nearby gains that are (IDL paper §3.3).  Two methods are offered;
+both report whether their output is certified by the exact certificate
+(:func:`stringstab.certificate.certify`, or its verdict-only form
+:func:`stringstab.certificate.check`: the same sound decision), never by a
+Taylor formula alone.
+
+:func:`region_growing`
+    The paper's region-growing grid search (§3.3, Steps 1-6) as written: its
+    candidate test is the Taylor Proposition 1 (types I-IV), so its output may
+    fail the exact certificate.  Choices made where the paper is silent are
+    listed in the function's docstring and in ``docs/tuning.md``.
+:func:`project` (and the stateful :class:`Projector` for a control loop)
+    The certified gains nearest to K0 in a weighted Euclidean distance, solved
+    with CasADi/IPOPT under the internal-stability conditions with a margin
+    and the exact frequency condition g(ω_j) ≥ ε on a finite set of
+    frequencies, refined by exchange until the exact certificate certifies;
+    first, a Newton predictor on the KKT system of a small active set
+    (usually one constraint) answers without IPOPT when the exact
+    certificate certifies its point.
+
+Both return a :class:`TuneResult` (:class:`TuneResults` for many, owning their
+records, columns and summary).  Gains that the exact certificate already
+certifies are returned unchanged, without any search or solve.
+
+Modules: :mod:`~stringstab.tuning.result` (the result types),
+:mod:`~stringstab.tuning.inputs` (input checks),
+:mod:`~stringstab.tuning.region_growing`, :mod:`~stringstab.tuning.projection` (the NLP,
+the exchange and the :class:`Projector`), :mod:`~stringstab.tuning.predictor` (the Newton
+predictor) and :mod:`~stringstab.tuning.methods` (:func:`tune`); the figure
+:func:`plot_moves` lives in :mod:`stringstab.plots.tuning`.
+
+References
+----------
+IDL paper, §3.3 "Parameter tuning method" (types I-IV, eqs 25-26, Steps 1-6);
+Table 2 (gain bounds [-2, 2]).
+R. Hettich, K. O. Kortanek, "Semi-infinite programming: theory, methods, and
+applications", SIAM Review 35 (1993) 380-429 (the exchange method).
+"""
+
+from __future__ import annotations
+
+from ..plots.tuning import plot_moves
+from .methods import METHODS, tune
+from .predictor import _g_and_grad as _g_and_grad  # for tests: the predictor's derivatives
+from .predictor import _g_full as _g_full
+from .projection import Projector, project
+from .region_growing import region_growing
+from .result import TuneResult, TuneResults
+
+__all__ = [
+    "METHODS",
+    "Projector",
+    "TuneResult",
+    "TuneResults",
+    "plot_moves",
+    "project",
+    "region_growing",
+    "tune",
+]

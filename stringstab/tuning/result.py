@@ -1,0 +1,260 @@
+"""What a repair returns: :class:`TuneResult` for one triple, :class:`TuneResults` for many.
+
+Each result type owns its records, columns and summary, which every command writes through
+:mod:`stringstab.io`'s result writer.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..certificate import Certificate
+from ..io import TableColumn
+
+__all__ = [
+    "CERTIFIED",
+    "TABLE_COLUMNS",
+    "TuneResult",
+    "TuneResults",
+    "Verdict",
+    "make_result",
+    "triple",
+    "wdist",
+]
+
+Array = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class TuneResult:
+    """The outcome of repairing one gain triple.
+
+    Attributes
+    ----------
+    method : str
+        ``"region-growing"`` or ``"projection"``.
+    k_in : tuple of float
+        The input gains K0 = (k_x, k_v, k_a).
+    k : tuple of float
+        The output gains (K0 itself when unchanged or when no solution was found).
+    certified : bool
+        The output is certified string stable by the exact certificate.
+    verdict : str
+        The exact certificate's verdict on the output
+        (``"certified"``, ``"not_certified"`` or ``"inconclusive"``).
+    status : str
+        ``"unchanged"`` (the input was already certified), ``"repaired"`` (a new
+        output was found), ``"taylor_stable"`` (region growing only: the
+        paper's Taylor test calls the input stable, so the paper's method does
+        not act), ``"no_solution"`` (the paper's "No optimized solution found")
+        or ``"failed"`` (projection only; never observed, see ``docs/tuning.md``).
+    distance : float
+        Weighted Euclidean distance ‖K − K0‖_W = sqrt(Σ w_i (K_i − K0_i)²).
+    iterations : int
+        Region growing: the index k of the last region R_k searched.
+        Projection: the number of NLP solves (exchange iterations); an output of
+        the Newton predictor counts as one solve (``details["predictor"]``).
+    seconds : float
+        Wall-clock time of the call.
+    message : str
+        A one-line human-readable account of what happened.
+    sup_gain : float
+        ‖Γ‖_{H∞} of the output (``inf`` when not internally stable).
+    details : dict
+        Method-specific numbers (grid points evaluated, frequencies used, ...).
+    """
+
+    method: str
+    k_in: tuple[float, float, float]
+    k: tuple[float, float, float]
+    certified: bool
+    verdict: str
+    status: str
+    distance: float
+    iterations: int
+    seconds: float
+    message: str
+    sup_gain: float = float("nan")
+    details: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def changed(self) -> bool:
+        """The output differs from the input."""
+        return self.k != self.k_in
+
+    def as_dict(self) -> dict[str, Any]:
+        """A flat JSON-ready row (non-finite numbers are left to the writer)."""
+        return {
+            "method": self.method,
+            "k_x_in": self.k_in[0],
+            "k_v_in": self.k_in[1],
+            "k_a_in": self.k_in[2],
+            "k_x": self.k[0],
+            "k_v": self.k[1],
+            "k_a": self.k[2],
+            "certified": self.certified,
+            "verdict": self.verdict,
+            "status": self.status,
+            "distance": self.distance,
+            "iterations": self.iterations,
+            "time_ms": 1e3 * self.seconds,
+            "sup_gain": self.sup_gain,
+            "message": self.message,
+        }
+
+
+#: Columns of the human table of :class:`TuneResults` (``stringstab tune``), with units.
+TABLE_COLUMNS: tuple[TableColumn, ...] = (
+    TableColumn("t [s]", "t", "%.6g"),
+    TableColumn("vehicle", "vehicle", "%d"),
+    TableColumn("method", "method", "%s"),
+    TableColumn("k_x_in [1/s²]", "k_x_in", "%.6g"),
+    TableColumn("k_v_in [1/s]", "k_v_in", "%.6g"),
+    TableColumn("k_a_in [-]", "k_a_in", "%.6g"),
+    TableColumn("k_x [1/s²]", "k_x", "%.6g"),
+    TableColumn("k_v [1/s]", "k_v", "%.6g"),
+    TableColumn("k_a [-]", "k_a", "%.6g"),
+    TableColumn("certified", "certified", "%s"),
+    TableColumn("status", "status", "%s"),
+    TableColumn("distance", "distance", "%.4g"),
+    TableColumn("iter", "iterations", "%d"),
+    TableColumn("time [ms]", "time_ms", "%.3g"),
+)
+
+
+@dataclass(frozen=True)
+class TuneResults:
+    """The repairs of many triples (one :class:`TuneResult` per input and method).
+
+    Attributes
+    ----------
+    results : tuple of TuneResult
+        In input order, the methods of one input together.
+    meta : dict of str to ndarray
+        Per-result columns carried from the input (``t``, ``vehicle``), or empty.
+    methods : tuple of str
+        The methods run, in the order of their rows.
+    """
+
+    results: tuple[TuneResult, ...]
+    meta: Mapping[str, npt.NDArray[Any]] = field(default_factory=dict)
+    methods: tuple[str, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.results)
+
+    def __iter__(self) -> Iterator[TuneResult]:
+        return iter(self.results)
+
+    def __getitem__(self, i: int) -> TuneResult:
+        return self.results[i]
+
+    @property
+    def certified(self) -> npt.NDArray[np.bool_]:
+        """Whether each output is certified by the exact certificate."""
+        return np.array([r.certified for r in self.results], dtype=bool)
+
+    def columns(self) -> dict[str, npt.NDArray[Any]]:
+        """One column per field of :meth:`TuneResult.as_dict`, after the ``meta`` columns.
+
+        Examples
+        --------
+        >>> from stringstab.tuning import project
+        >>> rs = TuneResults((project([0.9, -0.5, 1.1], tau=0.1, delta=0.2, headway=1.1),))
+        >>> list(rs.columns())[:4], bool(rs.columns()["certified"][0])
+        (['method', 'k_x_in', 'k_v_in', 'k_a_in'], True)
+        """
+        cols: dict[str, npt.NDArray[Any]] = {k: np.asarray(v) for k, v in self.meta.items()}
+        rows = [r.as_dict() for r in self.results]
+        keys = list(rows[0]) if rows else list(TuneResult.__dataclass_fields__)
+        for k in keys:
+            cols[k] = np.array([row[k] for row in rows])
+        return cols
+
+    def records(self) -> list[dict[str, Any]]:
+        """One dict per result: the ``meta`` values, then :meth:`TuneResult.as_dict`."""
+        meta = {k: np.asarray(v).tolist() for k, v in self.meta.items()}
+        return [{**{k: v[i] for k, v in meta.items()}, **r.as_dict()}
+                for i, r in enumerate(self.results)]
+
+    def summary(self) -> dict[str, dict[str, Any]]:
+        """Per method: how many outputs, certified, repaired, unchanged, not certified, and the
+        median distance moved by the repaired ones."""
+        out: dict[str, dict[str, Any]] = {}
+        methods = self.methods or tuple(dict.fromkeys(r.method for r in self.results))
+        for m in methods:
+            rs = [r for r in self.results if r.method == m]
+            moved = [r.distance for r in rs if r.status == "repaired"]
+            out[m] = {
+                "n": len(rs),
+                "certified": sum(r.certified for r in rs),
+                "repaired": len(moved),
+                "unchanged": sum(r.status == "unchanged" for r in rs),
+                "not_certified": sum(not r.certified for r in rs),
+                "median_distance_moved": float(np.median(moved)) if moved else 0.0,
+            }
+        return out
+
+    @classmethod
+    def collect(cls, results: Sequence[TuneResult], meta: Mapping[str, Any] | None = None,
+                methods: Sequence[str] = ()) -> TuneResults:
+        """Results (and per-result ``meta`` columns) as a :class:`TuneResults`."""
+        return cls(tuple(results), {k: np.asarray(v) for k, v in (meta or {}).items()},
+                   tuple(methods))
+
+
+def wdist(K: Array, K0: Array, w: Array) -> Array:
+    """Weighted Euclidean distance(s) of the row(s) of K from K0."""
+    d = np.asarray(K, dtype=float) - K0
+    return np.asarray(np.sqrt(np.sum(w * d * d, axis=-1)))
+
+
+def triple(k: Array) -> tuple[float, float, float]:
+    """The three gains as Python floats."""
+    return float(k[0]), float(k[1]), float(k[2])
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
+
+    Built from a full :class:`~stringstab.certificate.Certificate` or, in the
+    projection's fast path, from :func:`stringstab.certificate.check` (the same
+    sound decision without the reporting extras).  A certified triple has
+    ‖Γ‖_{H∞} = 1 exactly (Γ(0) = 1 and |Γ(jω)| ≤ 1), which is what
+    :func:`~stringstab.certificate.certify` reports for it too, so no peak
+    search is needed; for any other verdict the full certificate is computed.
+    """
+
+    verdict: str
+    sup_gain: float
+
+    @property
+    def certified(self) -> bool:
+        return self.verdict == "certified"
+
+    @classmethod
+    def of(cls, cert: Certificate) -> Verdict:
+        return cls(cert.verdict, float(cert.sup_gain))
+
+
+#: The verdict of a triple that :func:`stringstab.certificate.check` certified.
+CERTIFIED = Verdict("certified", 1.0)
+
+
+def make_result(method: str, K0: Array, K: Array, cert: Certificate | Verdict, status: str,
+                w: Array, iterations: int, t0: float, message: str, **details: Any) -> TuneResult:
+    """A :class:`TuneResult` of ``method`` that moved ``K0`` to ``K``, timed from ``t0``."""
+    v = cert if isinstance(cert, Verdict) else Verdict.of(cert)
+    return TuneResult(
+        method=method, k_in=triple(K0), k=triple(K), certified=v.certified,
+        verdict=v.verdict, status=status, distance=float(wdist(K, K0, w)),
+        iterations=iterations, seconds=time.perf_counter() - t0, message=message,
+        sup_gain=v.sup_gain, details=details,
+    )
