@@ -1,15 +1,18 @@
-"""``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions."""
+"""``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions.
+
+SymPy is imported when the command runs, not when it is registered.  ``--out`` is checked
+before anything is derived and written atomically; a bad path is one line and exit code 2.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from typing import Any
 
-import sympy as sp
-
 from ..errors import StringStabError
-from ..symbolic import derive_all, parse_substitutions
+from ..io import atomic_write_text, check_output_file
 
 __all__ = ["add_parser", "derive_document", "run"]
 
@@ -75,6 +78,8 @@ def derive_document(
     delay_order: int | None = None, substitute: str | None = None, with_errata: bool = False
 ) -> dict[str, Any]:
     """The JSON document of ``stringstab derive --format json`` (strings parse with ``sympify``)."""
+    from ..symbolic import derive_all, parse_substitutions
+
     subs = parse_substitutions(substitute)
     exprs = derive_all(delay_order, subs)
     doc: dict[str, Any] = {}
@@ -96,10 +101,31 @@ def derive_document(
     return doc
 
 
+_IMPACT_WORDS = {
+    "sign_disagreement": "the sign (the verdict) differs",
+    "hurwitz_disagreement": "the Hurwitz verdict differs",
+    "verdict_disagreement_printed_vs_derived": "the printed and the derived Proposition 1 disagree",
+    "verdict_disagreement_logic_only": "the printed logic on the derived Ψ disagrees",
+}
+
+
+def _impact(impact: dict[str, Any]) -> str:
+    """An erratum's practical impact in words: shares of the grid in %, parameters in s."""
+    p = impact.get("params", {})
+    where = impact.get("grid", "the grid")
+    if {"tau", "delta", "headway"} <= set(p):
+        where += f"; τ = {p['tau']:g} s, δ = {p['delta']:g} s, T* = {p['headway']:g} s"
+    parts = [f"{_IMPACT_WORDS.get(k, k.replace('_', ' '))} on {100 * float(v):.2f} %"
+             for k, v in impact.items() if k not in ("grid", "params")]
+    return "; ".join(parts) + f" of the points ({where})"
+
+
 def _text(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
     lines = ["# stringstab derive: derived from the IDL model (eqs 3-9)"]
     if doc["substitute"]:
-        lines.append("# substituted: " + ", ".join(f"{k}={v}" for k, v in doc["substitute"].items()))
+        unit = {"tau": " s", "delta": " s", "headway": " s", "k_x": " 1/s²", "k_v": " 1/s"}
+        lines.append("# substituted: " + ", ".join(f"{k}={v}{unit.get(k, '')}"
+                                                    for k, v in doc["substitute"].items()))
     lines.append(f"# delay in Psi: {doc['delay_order']}")
     for key, (label, _) in _LABELS.items():
         val = exprs[key]
@@ -118,11 +144,13 @@ def _text(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
                 lines.append(f"      printed - derived = {e['difference']}")
                 lines.append(f"      {e['explanation']}")
                 if e["impact"]:
-                    lines.append(f"      impact: {json.dumps(e['impact'])}")
+                    lines.append(f"      impact: {_impact(e['impact'])}")
     return "\n".join(lines) + "\n"
 
 
 def _latex(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
+    import sympy as sp
+
     syms = {sp.Symbol("headway", positive=True): sp.Symbol("T^*")}
     out = ["% stringstab derive --format latex (needs amsmath)", r"\begin{align*}"]
     rows = []
@@ -148,17 +176,20 @@ def _latex(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``derive``."""
+    """Run ``derive``; ``--out`` is checked before any derivation."""
     delay_order = _delay_order(args.delay_order)
+    out = check_output_file(args.out, what="--out") if args.out else None
     doc = derive_document(delay_order, args.substitute, args.errata)
     if args.format == "json":
         text = json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
     else:
+        from ..symbolic import derive_all, parse_substitutions
+
         exprs = derive_all(delay_order, parse_substitutions(args.substitute))
         text = _text(exprs, doc) if args.format == "text" else _latex(exprs, doc)
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            fh.write(text)
+    if out is not None:
+        atomic_write_text(out, text, what="--out")
+        print(f"stringstab derive: wrote {args.format} to {out}", file=sys.stderr)
     else:
         print(text, end="")
     return 0

@@ -178,7 +178,14 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``region``; returns 0, or raises StringStabError (exit 2) before writing anything."""
+    """Run ``region``; returns 0, or raises StringStabError (exit 2) before writing anything.
+
+    The output folder is checked before the map is computed and written all-or-nothing
+    (:class:`stringstab.io.OutputDir`): the files of an earlier ``region`` run there are
+    replaced, never mixed with the new ones.  The figures are drawn in a forked process
+    while the NPZ and CSV files are written.
+    """
+    from ..io import OutputDir
     from ..plots import FIGURE_FORMATS
     from ..regions import region_map
 
@@ -192,9 +199,6 @@ def run(args: argparse.Namespace) -> int:
     workers = None if args.workers is None else _int(args.workers, "--workers", 1)
     if not args.prefix or "/" in args.prefix or args.prefix.startswith("."):
         raise StringStabError(f"--prefix must be a plain file name stem; got {args.prefix!r}")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     gains = None
     if args.overlay is not None:
         if args.three_d:
@@ -202,22 +206,47 @@ def run(args: argparse.Namespace) -> int:
         from ..gainio import read_gains
 
         gains = read_gains(args.overlay)
+    if Path(args.out).is_file():
+        raise StringStabError(f"--out {args.out}: expected a directory; found a file")
+    out = OutputDir(args.out, command="region", what="--out")
 
     # region_map validates the methods before computing anything
     rmap = region_map(axes, fixed or None, tau=tau, delta=delta, headway=headway, methods=args.method,
                       workers=workers, progress=False if args.no_progress else None)
+    verdicts = None
+    if gains is not None:  # compute, then draw: the overlay's own exact verdicts
+        from ..plots import trajectory_verdicts
 
+        verdicts = trajectory_verdicts(rmap, gains)
+
+    from ..plots import figure_stems
+    from ..regions.pool import in_background
+
+    names = [f"{args.prefix}.npz", *([f"{args.prefix}.csv"] if rmap.ndim == 2 else []),
+             *(f"{args.prefix}_{stem}.{f}" for stem in figure_stems(rmap, gains is not None)
+               for f in formats)]
+    with out:
+        for name in names:  # every output is registered here, whichever process writes it
+            out.path(name)
+        join = in_background(_draw_figures, rmap, out, args.prefix, formats, gains, verdicts, dpi)
+        try:
+            rmap.save_npz(out.path(f"{args.prefix}.npz"))
+            if rmap.ndim == 2:
+                rmap.save_csv(out.path(f"{args.prefix}.csv"))
+        finally:
+            join()
+    print(rmap.report())
+    print(f"wrote {len(names)} files to {out.root}: " + ", ".join(names))
+    return 0
+
+
+def _draw_figures(rmap: Any, out: Any, prefix: str, formats: list[str], gains: Any, verdicts: Any,
+                  dpi: int) -> None:
+    """The standard figures of the map, with a non-interactive backend (see run)."""
     import matplotlib
 
     if "matplotlib.pyplot" not in sys.modules:
         matplotlib.use("Agg")
     from ..plots import save_figures
 
-    out.mkdir(parents=True, exist_ok=True)
-    written = [rmap.save_npz(out / f"{args.prefix}.npz")]
-    if rmap.ndim == 2:
-        written.append(rmap.save_csv(out / f"{args.prefix}.csv"))
-    written += save_figures(rmap, out, prefix=args.prefix, formats=formats, gains=gains, dpi=dpi)
-    print(rmap.report())
-    print(f"wrote {len(written)} files to {out}: " + ", ".join(p.name for p in written))
-    return 0
+    save_figures(rmap, out, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts, dpi=dpi)

@@ -12,19 +12,19 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import StringStabError
-from ..gainio import FORMATS, format_results, write_text
+from ..io import check_output_file, format_results, write_text
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ._common import add_gain_arguments, add_model_arguments, gains_from_args, model_params
 
 __all__ = ["add_parser", "run"]
 
 _METHODS = ("region-growing", "projection", "both")
+_FORMATS = ("table", "json", "csv")
 
 _EPILOG = f"""\
 examples:
@@ -87,7 +87,7 @@ def add_parser(sub: Any) -> None:
                    help="margin m in k_x >= m, k_v + (T* - tau) k_x >= m (default: 1e-3)")
     q.add_argument("--eps", default="1e-4", metavar="E",
                    help="margin of the frequency constraints g(omega_j) >= E (default: 1e-4)")
-    p.add_argument("--format", choices=FORMATS, default="table", help="output format (default: table)")
+    p.add_argument("--format", choices=_FORMATS, default="table", help="output format (default: table)")
     p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
     p.set_defaults(func=run)
 
@@ -124,64 +124,6 @@ def _integer(text: str | None, option: str) -> int | None:
     return n
 
 
-
-
-_TABLE = [
-    # header, key, format
-    ("t", "t", ".6g"),
-    ("vehicle", "vehicle", ""),
-    ("method", "method", ""),
-    ("k_x_in", "k_x_in", ".6g"),
-    ("k_v_in", "k_v_in", ".6g"),
-    ("k_a_in", "k_a_in", ".6g"),
-    ("k_x", "k_x", ".6g"),
-    ("k_v", "k_v", ".6g"),
-    ("k_a", "k_a", ".6g"),
-    ("certified", "certified", ""),
-    ("status", "status", ""),
-    ("distance", "distance", ".4g"),
-    ("iter", "iterations", "d"),
-    ("ms", "time_ms", ".3g"),
-]
-
-
-def _cell(v: Any, spec: str) -> str:
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, (int, float)) and spec:
-        return format(v, spec)
-    return str(v)
-
-
-def _table(records: list[dict[str, Any]], params: dict[str, Any], summary: dict[str, Any]) -> str:
-    cols = [c for c in _TABLE if any(c[1] in r for r in records)]
-    body = [[_cell(r[k], spec) if k in r else "" for _, k, spec in cols] for r in records]
-    widths = [max([len(h), *(len(row[j]) for row in body)]) for j, (h, _, _) in enumerate(cols)]
-    lines = ["# " + ", ".join(f"{k} = {v}" for k, v in params.items())]
-    lines.append("  ".join(h.ljust(w) for (h, _, _), w in zip(cols, widths)).rstrip())
-    lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in body]
-    for m, s in summary.items():
-        lines.append(f"# {m}: " + ", ".join(
-            f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in s.items()))
-    return "\n".join(lines) + "\n"
-
-
-def _summary(records: list[dict[str, Any]], methods: list[str]) -> dict[str, dict[str, Any]]:
-    out: dict[str, dict[str, Any]] = {}
-    for m in methods:
-        rs = [r for r in records if r["method"] == m]
-        moved = [r["distance"] for r in rs if r["status"] == "repaired"]
-        out[m] = {
-            "n": len(rs),
-            "certified": sum(r["certified"] for r in rs),
-            "repaired": len(moved),
-            "unchanged": sum(r["status"] == "unchanged" for r in rs),
-            "not_certified": sum(not r["certified"] for r in rs),
-            "median_distance_moved": float(np.median(moved)) if moved else 0.0,
-        }
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     """Run ``tune``; returns 0 (every output certified), 1 (some not) or raises on bad input."""
     tau, delta, headway = model_params(args)
@@ -202,20 +144,19 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(
             f"--hurwitz-margin must be >= 0 and --eps > 0; got {args.hurwitz_margin!r}, {args.eps!r}"
         )
-    if args.out:
-        out = Path(args.out)
-        if out.is_dir() or not out.resolve().parent.is_dir():
-            raise StringStabError(f"--out {args.out}: expected a file path in an existing directory")
+    out = check_output_file(args.out, what="--out") if args.out else None
     table = gains_from_args(args)
 
-    from ..tuning import Projector, region_growing
+    from ..tuning import Projector, TuneResults, region_growing
+    from ..tuning.result import TABLE_COLUMNS
 
     methods = ["region-growing", "projection"] if args.method == "both" else [args.method]
     projector = None
     if "projection" in methods:
         projector = Projector(tau=tau, delta=delta, headway=headway, weights=weights,
                               bounds=(lo, hi), hurwitz_margin=margin, eps=eps, cache_size=0)
-    records: list[dict[str, Any]] = []
+    results = []
+    rows = []
     K = table.K
     for i in range(len(table)):
         for m in methods:
@@ -227,7 +168,11 @@ def run(args: argparse.Namespace) -> int:
             else:
                 assert projector is not None
                 r = projector(K[i], use_state=False)
-            records.append({**table.meta(i), **r.as_dict()})
+            results.append(r)
+            rows.append(i)
+    meta = {k: np.asarray(getattr(table, k))[rows] for k in ("t", "vehicle")
+            if getattr(table, k, None) is not None}
+    repaired = TuneResults.collect(results, meta=meta, methods=methods)
     params: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway,
                               "method": args.method, "bounds": [lo, hi], "weights": weights}
     if "region-growing" in methods:
@@ -235,20 +180,27 @@ def run(args: argparse.Namespace) -> int:
                       check_hurwitz=args.check_hurwitz, grow_ka=args.grow_ka)
     if "projection" in methods:
         params.update(hurwitz_margin=margin, eps=eps)
-    summary = _summary(records, methods)
-    if args.format == "table":
-        flat = {k: (",".join(f"{x:g}" for x in v) if isinstance(v, list) else v)
-                for k, v in params.items()}
-        text = _table(records, flat, summary)
-    elif args.format == "csv":  # lists as "lo,hi" cells
-        flat = {k: (",".join(f"{x:g}" for x in v) if isinstance(v, list) else v)
-                for k, v in params.items()}
-        text = format_results(records, "csv", params=flat)
+    summary = repaired.summary()
+    if args.format == "table":  # for people: units on the numbers
+        shown = {k: f"{v:g} s" if k in ("tau", "delta", "headway") else v for k, v in params.items()}
+        text = format_results(repaired.columns(), "table", params=shown, table=TABLE_COLUMNS,
+                              summary={m: _with_units(s) for m, s in summary.items()})
+    elif args.format == "csv":
+        text = format_results(repaired.columns(), "csv", params=params)
     else:
-        text = format_results(records, "json", params=params, summary=summary)
-    write_text(text, args.out if args.out else sys.stdout)
-    if args.out:
-        n_cert = sum(r["certified"] for r in records)
-        print(f"stringstab tune: {n_cert} of {len(records)} outputs certified; "
-              f"wrote {args.format} to {args.out}", file=sys.stderr)
-    return 0 if all(r["certified"] for r in records) else 1
+        text = format_results(repaired.columns(), "json", params=params, summary=summary)
+    write_text(text, out if out is not None else sys.stdout, what="--out")
+    n_cert = int(repaired.certified.sum())
+    if out is not None:
+        print(f"stringstab tune: {n_cert} of {len(repaired)} outputs certified; "
+              f"wrote {args.format} to {out}", file=sys.stderr)
+    return 0 if n_cert == len(repaired) else 1
+
+
+def _with_units(s: dict[str, Any]) -> dict[str, Any]:
+    """A method's summary for the table: the median distance moved with its unit."""
+    out = dict(s)
+    d = out.pop("median_distance_moved", None)
+    if d is not None:
+        out["median distance moved"] = f"{d:.4g} (weighted gain units)"
+    return out

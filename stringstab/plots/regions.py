@@ -954,8 +954,10 @@ class _FigureJob:
         fig = draw_figure(self.rmap, stem, self.gains, self.verdicts)
         try:
             for f, path in targets:
-                fig.savefig(path, dpi=self.dpi, metadata=self.file_meta[f], bbox_inches="tight",
-                            pad_inches=0.1)
+                # constrained layout keeps titles, labels and legends of 2-D axes inside the
+                # figure, so no tight bounding box (a second drawing per file) but for 3-D axes
+                tight = {"bbox_inches": "tight", "pad_inches": 0.1} if stem.startswith("3d_") else {}
+                fig.savefig(path, dpi=self.dpi, metadata=self.file_meta[f], **tight)
         finally:
             pyplot().close(fig)
 

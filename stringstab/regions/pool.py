@@ -13,7 +13,9 @@ import os
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
-__all__ = ["Block", "cpu_count", "in_daemon", "run_blocks"]
+from ..errors import StringStabError
+
+__all__ = ["Block", "cpu_count", "in_background", "in_daemon", "run_blocks"]
 
 #: A block [i0:i1, j0:j1, :] of the internal 3-D grid.
 Block = tuple[int, int, int, int]
@@ -67,3 +69,44 @@ def run_blocks(
                 nxt = next(it, None)
                 if nxt is not None:
                     pending[ex.submit(evaluate, spec, *nxt)] = nxt
+
+
+def in_background(fn: Callable[..., Any], *args: Any) -> Callable[[], None]:
+    """Start ``fn(*args)`` in a forked process; returns ``join()``, to call when it must be done.
+
+    ``join()`` waits for the process and raises :class:`StringStabError` with the child's
+    error (one line) if it failed.  Where processes cannot be forked (no ``fork`` start
+    method, or this process is a daemon), ``fn(*args)`` runs here, now, and ``join()`` does
+    nothing.  Used to draw a map's figures while its data files are written.
+    """
+    if "fork" not in multiprocessing.get_all_start_methods() or in_daemon():
+        fn(*args)
+        return lambda: None
+    ctx = multiprocessing.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(send, fn, args), daemon=False)
+    proc.start()
+    send.close()
+
+    def join() -> None:
+        try:
+            error = recv.recv()
+        except EOFError:  # the child died without a word
+            error = None
+        proc.join()
+        recv.close()
+        if error is not None or proc.exitcode != 0:
+            raise StringStabError(error or f"a background process ended with exit code {proc.exitcode}")
+
+    return join
+
+
+def _child(send: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
+    try:
+        fn(*args)
+        send.send(None)
+    except BaseException as e:  # reported by join() in the parent
+        msg = str(e) if isinstance(e, StringStabError) else f"{type(e).__name__}: {e}"
+        send.send(msg.replace("\n", " "))
+    finally:
+        send.close()
