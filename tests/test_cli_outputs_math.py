@@ -119,3 +119,20 @@ def test_background_process_reports_its_failure(tmp_path):
     join = in_background(_fails)
     with pytest.raises(StringStabError, match="ValueError: the figure could not be drawn"):
         join()
+
+
+@pytest.mark.parametrize("processes", [1, 2])
+def test_region_outputs_shared_by_two_processes_equal_one(tmp_path, processes):
+    import numpy as np
+
+    from stringstab.plots import save_region_outputs
+    from stringstab.regions import load_npz, region_map
+
+    g = np.linspace(-2, 2, 23)
+    m = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1)
+    written = save_region_outputs(m, tmp_path, formats=("png",), dpi=20, processes=processes)
+    assert [p.name for p in written][:2] == ["region.npz", "region.csv"]
+    assert all(p.is_file() and p.stat().st_size > 0 for p in written)
+    assert (tmp_path / "region.csv").read_text(encoding="utf-8") == m.csv_text()
+    assert (load_npz(tmp_path / "region.npz").verdict["exact"] == m.verdict["exact"]).all()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in written)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -182,8 +181,8 @@ def run(args: argparse.Namespace) -> int:
 
     The output folder is checked before the map is computed and written all-or-nothing
     (:class:`stringstab.io.OutputDir`): the files of an earlier ``region`` run there are
-    replaced, never mixed with the new ones.  The figures are drawn in a forked process
-    while the NPZ and CSV files are written.
+    replaced, never mixed with the new ones.  The files are written by
+    :func:`stringstab.plots.save_region_outputs` (two processes share the work).
     """
     from ..io import OutputDir
     from ..plots import FIGURE_FORMATS
@@ -219,34 +218,11 @@ def run(args: argparse.Namespace) -> int:
 
         verdicts = trajectory_verdicts(rmap, gains)
 
-    from ..plots import figure_stems
-    from ..regions.pool import in_background
+    from ..plots import save_region_outputs
 
-    names = [f"{args.prefix}.npz", *([f"{args.prefix}.csv"] if rmap.ndim == 2 else []),
-             *(f"{args.prefix}_{stem}.{f}" for stem in figure_stems(rmap, gains is not None)
-               for f in formats)]
     with out:
-        for name in names:  # every output is registered here, whichever process writes it
-            out.path(name)
-        join = in_background(_draw_figures, rmap, out, args.prefix, formats, gains, verdicts, dpi)
-        try:
-            rmap.save_npz(out.path(f"{args.prefix}.npz"))
-            if rmap.ndim == 2:
-                rmap.save_csv(out.path(f"{args.prefix}.csv"))
-        finally:
-            join()
+        written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
+                                      verdicts=verdicts, dpi=dpi)
     print(rmap.report())
-    print(f"wrote {len(names)} files to {out.root}: " + ", ".join(names))
+    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
     return 0
-
-
-def _draw_figures(rmap: Any, out: Any, prefix: str, formats: list[str], gains: Any, verdicts: Any,
-                  dpi: int) -> None:
-    """The standard figures of the map, with a non-interactive backend (see run)."""
-    import matplotlib
-
-    if "matplotlib.pyplot" not in sys.modules:
-        matplotlib.use("Agg")
-    from ..plots import save_figures
-
-    save_figures(rmap, out, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts, dpi=dpi)

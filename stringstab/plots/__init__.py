@@ -19,6 +19,7 @@ module / function              shows
 :func:`plot_boundaries`        the certified boundaries of several maps on one axes
 :func:`plot_trajectory`        a policy's gain trajectory over a map, by verdict
 :func:`save_figures`           the standard figures of a map, in every format
+:func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
 **gain repair**                (:mod:`stringstab.plots.tuning`)
 :func:`plot_moves`             repairs K0 → K over the certified region
 **platoons**                   (:mod:`stringstab.plots.traffic`)
@@ -34,6 +35,7 @@ matplotlib is imported on first use.  ``stringstab.tuning.plot_moves`` and
 from __future__ import annotations
 
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult
+from .outputs import save_region_outputs
 from .regions import (
     FIGURE_FORMATS,
     draw_figure,
@@ -74,5 +76,6 @@ __all__ = [
     "plot_trajectory",
     "plot_vehicles",
     "save_figures",
+    "save_region_outputs",
     "trajectory_verdicts",
 ]

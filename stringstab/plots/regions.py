@@ -869,7 +869,7 @@ def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = N
 def save_figures(
     rmap: RegionMap, out: Any, *, prefix: str = "region",
     formats: Sequence[str] = ("png", "pdf"), gains: Any = None, verdicts: Any = None,
-    dpi: int = 150, workers: int = 1,
+    dpi: int = 150, workers: int = 1, stems: Sequence[str] | None = None,
 ) -> list[Path]:
     """Draw the standard figures of a map and save each in every format.
 
@@ -899,6 +899,8 @@ def save_figures(
         Resolution of raster formats.
     workers : int
         Processes drawing the figures (forked; 1 draws them here, one after another).
+    stems : sequence of str, optional
+        Draw only these of :func:`figure_stems`.
 
     Returns
     -------
@@ -917,7 +919,11 @@ def save_figures(
         raise StringStabError(f"a gain trajectory can be overlaid on a 2-D map only; got a {rmap.ndim}-D map")
     if gains is not None and verdicts is None:
         verdicts = trajectory_verdicts(rmap, gains)
-    stems = figure_stems(rmap, gains is not None)
+    every = figure_stems(rmap, gains is not None)
+    if stems is None:
+        stems = every
+    elif any(s not in every for s in stems):
+        raise StringStabError(f"figures must be among {every}; got {list(stems)}")
     stage: Callable[[str], Path]
     final: Callable[[str], Path]
     if hasattr(out, "path") and hasattr(out, "final"):  # an OutputDir

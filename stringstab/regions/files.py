@@ -8,7 +8,7 @@
     ``#`` lines (the tool and the metadata as JSON), then one row per grid point, written
     column by column by :mod:`stringstab.io`'s result writer.
 
-Both are written atomically (a temporary file renamed into place).  This module knows the
+Both are written atomically (a temporary file renamed into place) by the map's methods.  This module knows the
 formats, not the map: :class:`stringstab.regions.RegionMap` hands it arrays and columns.
 """
 
@@ -24,9 +24,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..io import atomic_path, atomic_write_text, format_results
+from ..io import atomic_path, format_results
 
-__all__ = ["FORMAT", "read_npz", "write_csv", "write_npz"]
+__all__ = ["FORMAT", "csv_text", "read_npz", "write_npz"]
 
 #: The ``format`` entry of a region map's metadata.
 FORMAT = "stringstab-region-map/1"
@@ -64,8 +64,15 @@ def read_npz(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np
     return meta, data
 
 
-def write_csv(path: str | os.PathLike[str], comments: Sequence[str],
-              columns: Mapping[str, npt.NDArray[Any]]) -> Path:
-    """Write ``# comment`` lines, then the columns as CSV (one row per element), atomically."""
-    head = "".join(f"# {c}\n" for c in comments)
-    return atomic_write_text(path, head + format_results(columns, "csv"), what="region map CSV")
+def csv_text(columns: Mapping[str, npt.NDArray[Any]], comments: Sequence[str] | None) -> str:
+    """``# comment`` lines and the header, then one CSV row per element of the columns.
+
+    Every cell is formatted by :func:`stringstab.io.format_results` (shortest round-trip
+    numbers, ``True``/``False``, a non-finite number as an empty field).  With
+    ``comments=None``, the rows alone (no header): the texts of consecutive row ranges
+    concatenate to the text of the whole.
+    """
+    text = format_results(columns, "csv")
+    if comments is None:
+        return text[text.index("\n") + 1:]
+    return "".join(f"# {c}\n" for c in comments) + text

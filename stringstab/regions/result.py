@@ -8,6 +8,7 @@ columns, the summary) and its files (:meth:`RegionMap.save_npz`, :meth:`RegionMa
 
 from __future__ import annotations
 
+import builtins
 import os
 from dataclasses import dataclass, field
 from itertools import combinations
@@ -19,9 +20,9 @@ import numpy.typing as npt
 
 from ..criteria import TYPE_NAMES
 from ..errors import StringStabError
-from ..io import dumps_json
+from ..io import atomic_write_text, dumps_json
 from ..params import Params
-from .files import FORMAT, read_npz, write_csv, write_npz
+from .files import FORMAT, csv_text, read_npz, write_npz
 
 __all__ = [
     "EXACT_CLASSES",
@@ -328,6 +329,9 @@ class RegionMap:
         >>> list(m.columns()), m.columns()["taylor"].tolist()
         (['k_x', 'k_v', 'k_a', 'hurwitz', 'type', 'taylor'], ['unstable', 'unstable', 'unstable', 'unstable'])
         """
+        cached = self.__dict__.get("_columns")
+        if cached is not None:
+            return dict(cached)
         kx, kv, ka = (g.ravel() for g in self.gains())
         names = np.array(["", *TYPE_NAMES.values()])
         cols: dict[str, npt.NDArray[Any]] = {"k_x": kx, "k_v": kv, "k_a": ka,
@@ -341,7 +345,8 @@ class RegionMap:
             cols["sup_gain"] = self.sup_gain.ravel()
         if self.margin is not None:
             cols["margin"] = self.margin.ravel()
-        return cols
+        object.__setattr__(self, "_columns", cols)  # computed once (the map is immutable)
+        return dict(cols)
 
     def records(self) -> list[dict[str, Any]]:
         """:meth:`columns` as one dict per grid point (small maps; use the columns for large)."""
@@ -367,9 +372,28 @@ class RegionMap:
         in their shortest round-trip form, booleans ``True``/``False``, a non-finite
         number, such as ``sup_gain`` where Γ is not internally stable, as an empty field).
         """
-        return write_csv(path, [f"stringstab {self.version} region map",
-                                dumps_json(self.metadata(), indent=None).rstrip("\n")],
-                         self.columns())
+        return atomic_write_text(path, self.csv_text(), what="region map CSV")
+
+    def csv_text(self, rows: builtins.slice | None = None, *, head: bool = True) -> str:
+        """The text of :meth:`save_csv`, or of the grid points ``rows`` only (C order).
+
+        ``head=False`` leaves out the ``#`` lines and the header, so that the texts of
+        consecutive row ranges concatenate to the whole file (two processes can write one).
+
+        Examples
+        --------
+        >>> from stringstab.regions import region_map
+        >>> m = region_map({"k_x": [0.9, 1.3], "k_v": [-0.5, 0.0]}, {"k_a": 1.1},
+        ...                tau=0.1, delta=0.2, headway=1.1, methods="taylor")
+        >>> m.csv_text(slice(0, 2)) + m.csv_text(slice(2, None), head=False) == m.csv_text()
+        True
+        """
+        comments = [f"stringstab {self.version} region map",
+                    dumps_json(self.metadata(), indent=None).rstrip("\n")] if head else None
+        cols = self.columns()
+        if rows is not None:
+            cols = {k: v[rows] for k, v in cols.items()}
+        return csv_text(cols, comments)
 
 
 def load_npz(path: str | os.PathLike[str]) -> RegionMap:
