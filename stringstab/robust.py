@@ -64,9 +64,10 @@ import numpy as np
 import numpy.typing as npt
 
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound
-from .certificate import _curvature_bound, _hurwitz_bands, tail_bound
+from .certificate import _hurwitz_bands, tail_bound
 from .errors import StringStabError, show
 from .frequency import gain_squared, margin_g_coefficients
+from .margin import curvature_bound
 from .params import Params, as_gains, positive
 from .sampled import (
     VERDICTS,
@@ -360,8 +361,10 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
         G, _, _, _, mag = _robust_g(X, col(kx, idx), col(kv, idx), col(ka, idx), box)
-        M = _curvature_bound(X[:, 1:], np.asarray(t_hi * t_hi), col(a_absmax, idx),
-                             col(cx, idx), col(cv, idx), np.asarray(d_hi))
+        # M ≥ |g''| of every member: the bound of stringstab.margin with its largest
+        # coefficients (t2 at τ_hi, |a| over the box; b does not enter) and δ_hi
+        M = curvature_bound(X[:, 1:], (t_hi * t_hi, col(a_absmax, idx), 0.0, col(cx, idx),
+                                       col(cv, idx)), d_hi)
         return G, G, _SLACK * mag, M
 
     bb = branch_and_bound(n, evaluate, right=Om, n_grid=n_grid, max_rounds=max_rounds,

@@ -48,7 +48,7 @@ def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     """
     ax = _ax(ax)
     lc = plot_vehicles(run.t, run.speed[i, 1:], ax=ax, first_position=1,
-                       n_positions=run.n_followers)
+                       n_positions=run.n_followers)["lines"]
     (lead,) = ax.plot(run.t, run.speed[i, 0], color="k", lw=0.9, ls="--", label="leader")
     lo, hi = float(run.speed[i].min()), float(run.speed[i].max())
     pad = 0.05 * (hi - lo) or 0.5
@@ -76,7 +76,7 @@ def plot_jerk(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     out = np.concatenate([np.full((run.n_followers, 1), a0), run.output[i]], axis=-1)
     jerk = np.diff(out, axis=-1) / run.dt
     lc = plot_vehicles(run.t, jerk, ax=ax, first_position=1, n_positions=run.n_followers,
-                       max_points=run.t.size)
+                       max_points=run.t.size)["lines"]
     J = run.configs[i].jerk_limit
     paper = 2.0 * run.params["accel_max"] / run.dt
     lines = [ax.axhline(s * J, color="r", ls="--", lw=1.0, label="±J" if s > 0 else None)

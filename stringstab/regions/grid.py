@@ -21,7 +21,6 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import _generated as _gen
-from .._version import __version__
 from ..criteria import hurwitz, proposition1, stability_type
 from ..errors import StringStabError
 from ..params import Params
@@ -259,6 +258,8 @@ def region_map(
     >>> m.disagreements()["exact vs printed"]
     2
     """
+    from .. import __version__  # the package's one version (a constant, not a layer)
+
     p = Params(tau, delta, headway)
     coords, fixed_ = _check_axes(axes, fixed)
     ms = _check_methods(methods)
