@@ -221,15 +221,15 @@ def _proposition1_row(params: dict[str, float]) -> Erratum:
     derived_c = proposition1_conditions(p1, p2, p3, lam, printed=False)
     # impact: verdict disagreement between printed logic on printed Ψ and
     # corrected logic on derived Ψ (criteria.taylor_criteria), on the grid
-    from .criteria import taylor_criteria
+    from .criteria import proposition1, taylor_criteria
 
     kx, kv, ka = _grid()
     kw = {"tau": params["tau"], "delta": params["delta"], "headway": params["headway"]}
     ok_p = taylor_criteria(kx, kv, ka, source="printed", **kw).stable
     derived = taylor_criteria(kx, kv, ka, source="derived", **kw)
     ok_d = derived.stable
-    vd = (derived.psi1, derived.psi2, derived.psi3, derived.lam)
-    ok_printed_logic_on_derived = ((vd[0] >= 0) & (vd[1] >= 0) & (vd[2] >= 0)) | (vd[3] <= 0)
+    ok_printed_logic_on_derived = proposition1(derived.psi1, derived.psi2, derived.psi3,
+                                               derived.lam, source="printed")
     return Erratum(
         equation="Proposition 1",
         name="Proposition 1 (logic)",
