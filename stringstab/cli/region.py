@@ -209,9 +209,21 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     out = OutputDir(args.out, command="region", what="--out")
 
-    # region_map validates the methods before computing anything
-    rmap = region_map(axes, fixed or None, tau=tau, delta=delta, headway=headway, methods=args.method,
-                      workers=workers, progress=False if args.no_progress else None)
+    # while the map is computed (in worker processes), a thread here imports the plotting code
+    # and draws once (fonts, mathtext), so the figures do not pay for it afterwards
+    import threading
+
+    from ..plots._common import warm_up
+
+    warm = threading.Thread(target=warm_up, name="stringstab-plot-warm-up", daemon=True)
+    warm.start()
+    try:
+        # region_map validates the methods before computing anything
+        rmap = region_map(axes, fixed or None, tau=tau, delta=delta, headway=headway,
+                          methods=args.method, workers=workers,
+                          progress=False if args.no_progress else None)
+    finally:
+        warm.join()
     verdicts = None
     if gains is not None:  # compute, then draw: the overlay's own exact verdicts
         from ..plots import trajectory_verdicts

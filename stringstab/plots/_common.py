@@ -32,6 +32,7 @@ __all__ = [
     "patch",
     "pct",
     "pyplot",
+    "warm_up",
 ]
 
 
@@ -175,3 +176,30 @@ def patch(color: str, label: str) -> Any:
 
     return Patch(facecolor=color, edgecolor="#555555", linewidth=0.5, label=label)
 
+
+
+def warm_up() -> None:
+    """Import pyplot (Agg unless a backend is chosen) and draw one small figure off-screen.
+
+    The first figure of a process pays for the imports, the font cache and the mathtext
+    parser of the gain labels (about a second of CPU); a command that knows it will draw can
+    pay it earlier, e.g. in a thread while its map is computed in worker processes (processes
+    forked later inherit the warm state).
+    """
+    import io
+    import sys
+
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    plt = pyplot()
+    fig = plt.figure(figsize=(2.0, 2.0), layout="constrained")
+    ax = fig.add_subplot()
+    ax.imshow(np.zeros((2, 2)), interpolation="nearest")
+    ax.set_xlabel(GAIN_LABELS["k_x"])
+    ax.set_ylabel(GAIN_LABELS["k_v"])
+    ax.set_title("τ = 0.1 s\nwarm-up")
+    ax.legend(handles=[patch(OKABE_ITO["blue"], "x")], loc="upper center", title="t")
+    fig.savefig(io.BytesIO(), format="png", dpi=20)
+    plt.close(fig)

@@ -29,7 +29,7 @@ __all__ = ["save_region_outputs"]
 #: column; per figure file; importing pyplot in a process.  Only their ratios matter.
 _NPZ_PER_POINT = 0.35e-6
 _CSV_PER_CELL = 0.25e-6
-_FIGURE_FILE = {"png": 0.35, "pdf": 0.45, "svg": 0.6}
+_FIGURE_FILE = {"png": 0.25, "pdf": 0.35, "svg": 0.5}
 _PYPLOT = 0.3
 _CSV_CHUNKS = 16
 
@@ -47,10 +47,12 @@ def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
     tasks += [(sum(_FIGURE_FILE[f] for f in formats), ("fig", s)) for s in stems]
     load = [0.0] * processes
     plan: list[list[tuple[Any, ...]]] = [[] for _ in range(processes)]
+    cold = "matplotlib.pyplot" not in sys.modules  # else forked processes inherit it
+
     def cost_in(k: int, cost: float, task: tuple[Any, ...]) -> float:
         # the first figure of a process also pays for importing pyplot there
         first = task[0] == "fig" and not any(t[0] == "fig" for t in plan[k])
-        return cost + (_PYPLOT if first else 0.0)
+        return cost + (_PYPLOT if first and cold else 0.0)
 
     for cost, task in sorted(tasks, key=lambda t: -t[0]):
         k = min(range(processes), key=lambda i: load[i] + cost_in(i, cost, task))

@@ -48,7 +48,7 @@ _LADDER: tuple[float, ...] = tuple(float(v) for v in np.geomspace(0.2, 5.0, 16))
 _CLUSTER = 0.05
 #: Multipliers of the violating frequencies of K0 in the first solve.
 _K0_CLUSTER = (1.0, 0.95, 0.9)
-#: Multipliers of the predicted dips of the solution (:func:`_predict_dips`) in the first solve.
+#: Multipliers of the predicted dips of the solution (:func:`~stringstab.tuning.predictor.predict_dips`) in the first solve.
 _PRED_CLUSTER = (1.0, 0.98, 1.02)
 
 
