@@ -29,16 +29,14 @@ ROLLOUT = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
 
 def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     """Derive Γ(s), Ψ1-Ψ3, Λ and compare with the printed formulas."""
-    # The text, LaTeX and JSON renderings of the derivation live with the derive command.
-    from .cli import derive as rendering
-    from .io import atomic_write_text, dumps_json
-    from .symbolic import derive_all
+    from .derivation import derivation
+    from .io import atomic_write_text
 
-    doc = rendering.derive_document(None, None, with_errata=True)
-    exprs = derive_all(None, {})
-    atomic_write_text(out / "derive.json", dumps_json(doc))
-    atomic_write_text(out / "derive.tex", rendering._latex(exprs, doc))
-    atomic_write_text(out / "derive.txt", rendering._text(exprs, doc))
+    d = derivation(None, None, with_errata=True)
+    doc = d.document
+    atomic_write_text(out / "derive.json", d.json())
+    atomic_write_text(out / "derive.tex", d.latex())
+    atomic_write_text(out / "derive.txt", d.text())
     wrong = [f"eq {e['equation']} ({e['key']})" for e in doc["errata"] if not e["matches"]]
     log(f"derived Γ(s) = {doc['gamma']}")
     log(f"errata: {len(wrong)} printed formulas differ from the derivation: {', '.join(wrong)}")

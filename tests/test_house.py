@@ -30,7 +30,7 @@ HEAVY = ("sympy", "matplotlib", "casadi", "control", "gymnasium", "torch")
 KNOWN_UPWARD: set[tuple[str, str]] = set()
 #: Library modules that still run the command line (helper B: "the demo calls the library,
 #: not the CLI"); strict in the same way.
-KNOWN_CLI_USERS = {"stringstab.demo"}
+KNOWN_CLI_USERS: set[str] = set()
 
 
 def _modules() -> dict[str, Path]:
