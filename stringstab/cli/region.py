@@ -176,6 +176,14 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
     return axes, fixed
 
 
+def _warm_up_outputs() -> None:
+    from ..io.results import warm_up as warm_up_writer
+    from ..plots._common import warm_up as warm_up_plots
+
+    warm_up_plots()
+    warm_up_writer()
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``region``; returns 0, or raises StringStabError (exit 2) before writing anything.
 
@@ -210,12 +218,11 @@ def run(args: argparse.Namespace) -> int:
     out = OutputDir(args.out, command="region", what="--out")
 
     # while the map is computed (in worker processes), a thread here imports the plotting code
-    # and draws once (fonts, mathtext), so the figures do not pay for it afterwards
+    # and draws once (fonts, mathtext), and imports the CSV writer's pyarrow, so the outputs
+    # (here and in the process forked to share them) do not pay for it afterwards
     import threading
 
-    from ..plots._common import warm_up
-
-    warm = threading.Thread(target=warm_up, name="stringstab-plot-warm-up", daemon=True)
+    warm = threading.Thread(target=_warm_up_outputs, name="stringstab-output-warm-up", daemon=True)
     warm.start()
     try:
         # region_map validates the methods before computing anything

@@ -33,6 +33,7 @@ from .plain import dumps_json, to_plain
 from .results import (
     BINARY_FORMATS,
     RESULT_FORMATS,
+    Categorical,
     TableColumn,
     columns_from_records,
     flatten_columns,
@@ -50,6 +51,7 @@ __all__ = [
     "MANIFEST",
     "OPTIONAL_COLUMNS",
     "RESULT_FORMATS",
+    "Categorical",
     "GainTable",
     "OutputDir",
     "TableColumn",

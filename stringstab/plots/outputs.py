@@ -3,22 +3,19 @@
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
 CSV table (2-D maps) and the standard figures (:func:`~stringstab.plots.save_figures`) — and
 splits that work between this process and one forked process (on a machine with two cores,
-writing is then about half as long): the tasks (the NPZ, the CSV in row ranges, one task per
-figure) are dealt out by their estimated cost, the larger first, each to the process with
-less work so far (the longest-processing-time rule); the CSV's row ranges are joined in order
-here.  Files are staged in a :class:`stringstab.io.OutputDir` or written into a folder.
+writing is then about half as long): the tasks (the NPZ, the CSV, one task per figure) are
+dealt out by their estimated cost, the larger first, each to the process with less work so
+far (the longest-processing-time rule); each task writes its own file.  Files are staged in a
+:class:`stringstab.io.OutputDir` or written into a folder.
 """
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Sequence
-from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
-from ..io import atomic_write_text
 from ..regions import RegionMap
 from ..regions.pool import in_background
 from .regions import FIGURE_FORMATS, figure_stems, save_figures, trajectory_verdicts
@@ -28,10 +25,9 @@ __all__ = ["save_region_outputs"]
 #: Estimated costs (s) on one core: per grid point of the NPZ archive and per CSV row and
 #: column; per figure file; importing pyplot in a process.  Only their ratios matter.
 _NPZ_PER_POINT = 0.35e-6
-_CSV_PER_CELL = 0.25e-6
-_FIGURE_FILE = {"png": 0.25, "pdf": 0.35, "svg": 0.5}
+_CSV_PER_CELL = 0.075e-6
+_FIGURE_FILE = {"png": 0.3, "pdf": 0.4, "svg": 0.55}
 _PYPLOT = 0.3
-_CSV_CHUNKS = 16
 
 
 def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
@@ -39,11 +35,7 @@ def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
     """The tasks of each process (0 is this one), dealt out by estimated cost."""
     tasks: list[tuple[float, tuple[Any, ...]]] = [(_NPZ_PER_POINT * rmap.size, ("npz",))]
     if rmap.ndim == 2:
-        n = rmap.size
-        cells = len(rmap.columns())
-        edges = [n * i // _CSV_CHUNKS for i in range(_CSV_CHUNKS + 1)]
-        tasks += [(_CSV_PER_CELL * cells * (b - a), ("csv", i, a, b))
-                  for i, (a, b) in enumerate(pairwise(edges)) if b > a]
+        tasks.append((_CSV_PER_CELL * rmap.n_columns * rmap.size, ("csv",)))
     tasks += [(sum(_FIGURE_FILE[f] for f in formats), ("fig", s)) for s in stems]
     load = [0.0] * processes
     plan: list[list[tuple[Any, ...]]] = [[] for _ in range(processes)]
@@ -62,16 +54,14 @@ def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
 
 
 def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: str,
-         formats: Sequence[str], gains: Any, verdicts: Any, dpi: int, parts: Path) -> dict[int, str]:
-    """Do ``tasks``; CSV row ranges are returned (this process) or left in ``parts`` files."""
-    texts: dict[int, str] = {}
+         formats: Sequence[str], gains: Any, verdicts: Any, dpi: int) -> None:
+    """Do ``tasks`` (in this process or a forked one): each writes its own staged file."""
     stems = [t[1] for t in tasks if t[0] == "fig"]
     for t in tasks:
         if t[0] == "npz":
             rmap.save_npz(_stage(out, f"{prefix}.npz"))
         elif t[0] == "csv":
-            _, i, a, b = t
-            texts[i] = rmap.csv_text(slice(a, b), head=False)
+            rmap.save_csv(_stage(out, f"{prefix}.csv"))
     if stems:
         import matplotlib
 
@@ -79,13 +69,6 @@ def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: st
             matplotlib.use("Agg")
         save_figures(rmap, out, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
                      dpi=dpi, stems=stems)
-    return texts
-
-
-def _child(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: str,
-           formats: Sequence[str], gains: Any, verdicts: Any, dpi: int, parts: Path) -> None:
-    for i, text in _run(tasks, rmap, out, prefix, formats, gains, verdicts, dpi, parts).items():
-        (parts / f"{i}.csv").write_text(text, encoding="utf-8")
 
 
 def _stage(out: Any, name: str) -> Path:
@@ -146,31 +129,12 @@ def save_region_outputs(
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]
     for name in names:  # register every output here, whichever process writes it
         _stage(out, name)
-    plan = _plan(rmap, stems, formats, max(1, int(processes)))  # (computes the CSV columns once)
-    parts = _stage(out, f"{prefix}.csv").parent / f".{prefix}.csv.parts-{os.getpid()}"
-    args = (rmap, out, prefix, formats, gains, verdicts, dpi, parts)
-    join = None
-    if len(plan) > 1 and plan[1]:
-        parts.mkdir(exist_ok=True)
-        join = in_background(_child, plan[1], *args)
+    plan = _plan(rmap, stems, formats, max(1, int(processes)))
+    args = (rmap, out, prefix, formats, gains, verdicts, dpi)
+    join = in_background(_run, plan[1], *args) if len(plan) > 1 and plan[1] else None
     try:
-        texts = _run(plan[0], *args)
+        _run(plan[0], *args)
     finally:
         if join is not None:
             join()
-    try:
-        if rmap.ndim == 2:
-            for i in range(_CSV_CHUNKS):
-                p = parts / f"{i}.csv"
-                if i not in texts and p.is_file():
-                    texts[i] = p.read_text(encoding="utf-8")
-            head = rmap.csv_text(slice(0, 0))
-            atomic_write_text(_stage(out, f"{prefix}.csv"),
-                              head + "".join(texts[i] for i in sorted(texts)),
-                              what="region map CSV")
-    finally:
-        if parts.is_dir():
-            for p in parts.iterdir():
-                p.unlink()
-            parts.rmdir()
     return [_final(out, n) for n in names]

@@ -330,22 +330,47 @@ class RegionMap:
         (['k_x', 'k_v', 'k_a', 'hurwitz', 'type', 'taylor'], ['unstable', 'unstable', 'unstable', 'unstable'])
         """
         cached = self.__dict__.get("_columns")
+        if cached is None:
+            cached = {k: np.asarray(v) for k, v in self._categorical_columns().items()}
+            object.__setattr__(self, "_columns", cached)  # computed once (the map is immutable)
+        return dict(cached)
+
+    @property
+    def n_columns(self) -> int:
+        """Number of :meth:`columns` (without forming them)."""
+        return len(self._categorical_columns())
+
+    def _categorical_columns(self) -> dict[str, Any]:
+        """:meth:`columns` with the grid coordinates and the labels as
+        :class:`~stringstab.io.Categorical` (codes into a few distinct values): what the CSV
+        writer formats fastest."""
+        cached = self.__dict__.get("_categorical")
         if cached is not None:
             return dict(cached)
-        kx, kv, ka = (g.ravel() for g in self.gains())
+        from ..io import Categorical
+
+        shape = self.shape
+        cols: dict[str, Any] = {}
+        index = np.indices(shape).reshape(len(shape), -1)
+        axis_pos = {name: i for i, name in enumerate(self.axis_names)}
+        for name in GAIN_NAMES:  # the axes' values, or the fixed value, spread over the grid
+            if name in axis_pos:
+                cols[name] = Categorical(index[axis_pos[name]], np.asarray(self.axes[name], float))
+            else:
+                cols[name] = Categorical(np.zeros(self.size, dtype=np.intp),
+                                         np.asarray([self.fixed[name]], dtype=float))
         names = np.array(["", *TYPE_NAMES.values()])
-        cols: dict[str, npt.NDArray[Any]] = {"k_x": kx, "k_v": kv, "k_a": ka,
-                                             "hurwitz": self.hurwitz.ravel(),
-                                             "type": names[self.type.ravel()]}
+        cols["hurwitz"] = self.hurwitz.ravel()
+        cols["type"] = Categorical(self.type.ravel(), names)
         if self.type_printed is not None:
-            cols["type_printed"] = names[self.type_printed.ravel()]
+            cols["type_printed"] = Categorical(self.type_printed.ravel(), names)
         for m in self.methods:
-            cols[m] = np.array(VERDICT_LABELS[m])[self.verdict[m].ravel()]
+            cols[m] = Categorical(self.verdict[m].ravel(), np.array(VERDICT_LABELS[m]))
         if self.sup_gain is not None:
             cols["sup_gain"] = self.sup_gain.ravel()
         if self.margin is not None:
             cols["margin"] = self.margin.ravel()
-        object.__setattr__(self, "_columns", cols)  # computed once (the map is immutable)
+        object.__setattr__(self, "_categorical", cols)  # computed once (the map is immutable)
         return dict(cols)
 
     def records(self) -> list[dict[str, Any]]:
@@ -390,7 +415,7 @@ class RegionMap:
         """
         comments = [f"stringstab {self.version} region map",
                     dumps_json(self.metadata(), indent=None).rstrip("\n")] if head else None
-        cols = self.columns()
+        cols = self._categorical_columns()
         if rows is not None:
             cols = {k: v[rows] for k, v in cols.items()}
         return csv_text(cols, comments)
