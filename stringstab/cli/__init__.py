@@ -32,6 +32,8 @@ COMMANDS: list[str] = [
     "tune",
     "simulate",
     "train",
+    "evaluate",
+    "compare",
     "hcfs",
     "demo",
 ]
