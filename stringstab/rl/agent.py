@@ -8,7 +8,8 @@ One :class:`Agent` holds the actor, the critic(s), their targets and Adam optimi
   the target action, a' = clip(μ'(s') + clip(ε, −c, c)), ε ~ N(0, σ̃²) (§3.4 (2), (5));
   DDPG uses one critic and a' = μ'(s');
 * actor: every ``policy_delay`` critic updates (Table 1: 3 for TD3; 1 for DDPG), minimise
-  −mean Q1(s, μ(s)) (Table 1, "Loss actor"), then move every target network towards its network
+  −mean Q1(s, μ(s)) (Table 1, "Loss actor") plus, optionally, ``proposal_penalty`` times the
+  squared distance of μ(s) to its repair (``action_filter``; not in the paper), then move every target network towards its network
   by the soft update rate (Table 1: 0.01).
 
 Noise scales are fractions of the action half-range (the actor's ``action_scale``), so one
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import copy
 import json
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -47,8 +49,11 @@ class Agent:
     """
 
     def __init__(self, config: TD3Config, obs_dim: int, act_dim: int, *,
-                 low: npt.ArrayLike, high: npt.ArrayLike) -> None:
+                 low: npt.ArrayLike, high: npt.ArrayLike,
+                 action_filter: Callable[[npt.NDArray[np.float64]], npt.ArrayLike] | None = None
+                 ) -> None:
         self.config = config
+        self.action_filter = action_filter
         self.low = torch.as_tensor(np.asarray(low, dtype=np.float32).reshape(act_dim))
         self.high = torch.as_tensor(np.asarray(high, dtype=np.float32).reshape(act_dim))
         self.actor = Actor(obs_dim, act_dim, low=self.low.numpy(), high=self.high.numpy(),
@@ -95,7 +100,14 @@ class Agent:
         self.n_updates += 1
         out = {"critic_loss": float(q_loss.item())}
         if self.n_updates % c.policy_delay == 0:
-            actor_loss = -self.critics[0](obs, self.actor(obs)).mean()
+            mu = self.actor(obs)
+            actor_loss = -self.critics[0](obs, mu).mean()
+            if c.proposal_penalty > 0 and self.action_filter is not None:
+                with torch.no_grad():
+                    executed = torch.as_tensor(np.asarray(
+                        self.action_filter(mu.numpy().astype(np.float64)), dtype=np.float32))
+                gap = (mu - executed) / scale
+                actor_loss = actor_loss + c.proposal_penalty * (gap * gap).sum(dim=1).mean()
             self.actor_optimizer.zero_grad()
             actor_loss.backward()
             self.actor_optimizer.step()

@@ -112,6 +112,11 @@ class TD3Config:
     #: Which action the replay buffer stores: "proposed" (the actor's, before the repair; the
     #: repair is then part of the environment) or "executed" (after the repair).
     store_action: str = "proposed"
+    #: Weight λ of a penalty λ·mean ‖(μ(s) − R(μ(s)))/half-range‖² added to the actor loss, R the
+    #: repair (not in the paper).  With the proposed action stored, the repair is part of the
+    #: environment and Q is flat along the directions the projection collapses, so without it
+    #: the actor drifts to the corners of the gain box; 0 disables it (it acts only with a repair).
+    proposal_penalty: float = 1.0
     #: Actuator lag τ, s (not printed by the paper; 0.1 s as in its reference Zhou et al. 2020).
     tau: float = constants.TAU
     #: Communication delay δ, s (Table 2).
@@ -205,7 +210,7 @@ _MIN_INT = {"total_steps": 1, "seed": 0, "buffer_size": 1, "batch_size": 1, "pol
             "repair_refine": 0, "checkpoint_every": 1, "torch_threads": 1}
 _POSITIVE = ("learning_rate_actor", "learning_rate_critic", "soft_update", "repair_resolution",
              "tau", "dt", "episode_seconds")
-_NONNEG = ("exploration_noise", "target_policy_noise", "noise_clip", "delta", "headway")
+_NONNEG = ("proposal_penalty", "exploration_noise", "target_policy_noise", "noise_clip", "delta", "headway")
 
 
 def _check(c: TD3Config) -> None:

@@ -19,6 +19,7 @@ same seed (training uses the first part, testing the second).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Literal
@@ -81,11 +82,12 @@ def _synthetic(split: Split, dt: float) -> list[Trajectory]:
                 hard_braking(speed=20.0, to_speed=5.0, dt=dt),
                 hard_acceleration(speed=5.0, to_speed=20.0, dt=dt),
                 stop_and_go(waves=2, dt=dt)]
-    return [*(sinusoid(omega=w, amplitude=3.0, speed=20.0, duration=60.0, dt=dt)
+    test = [*(sinusoid(omega=w, amplitude=3.0, speed=20.0, duration=60.0, dt=dt)
               for w in (0.3, 0.8, 1.5)),
             hard_braking(speed=25.0, to_speed=0.0, dt=dt),
             hard_acceleration(speed=2.0, to_speed=25.0, dt=dt),
             stop_and_go(speed_high=20.0, waves=3, accel=2.5, decel=-3.0, dt=dt)]
+    return [dataclasses.replace(tr, name=f"{tr.name}-test") for tr in test]
 
 
 def default_leaders(split: Split, *, seconds: float = 30.0, dt: float = 0.1) -> list[Trajectory]:

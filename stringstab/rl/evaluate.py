@@ -216,6 +216,9 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         "TIT": float(tits.mean()), "TIT_total": float(tits.sum()),
         "M_CI": float(jerk.mean()),  # eq 34: the pooled mean squared jerk
         "M_effi": efficiency_index(hw),
+        # eq 35's mean is dominated by creeping near standstill (h = gap/v grows without
+        # bound as v → v_min); the median is reported beside it
+        "median_headway": float(np.nanmedian(hw)) if np.isfinite(hw).any() else None,
         "collisions": int(sum(e["collisions"] for e in episodes)),
         "collided_episodes": int(sum(e["collisions"] > 0 for e in episodes)),
         "min_gap": float(min(e["min_gap"] for e in episodes)),

@@ -216,6 +216,35 @@ class GainRepair:
                 self.stats["fallbacks"] += 1
         return out
 
+    def approximate(self, K: npt.ArrayLike) -> Array:
+        """A cheap, *uncertified* stand-in for the repair, for training signals only.
+
+        Rows that pass the cheap screen (module docstring, step 1) are returned unchanged, the
+        others are replaced by their nearest certified lattice point, without the exact check
+        or the refinement.  Used by the actor's proposal penalty
+        (``TD3Config.proposal_penalty``); never executed.
+        """
+        K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
+        if self.method == "off":
+            return K0
+        p = self.params
+        out = K0.copy()
+        ok = hurwitz(K0[:, 0], K0[:, 1], tau=p.tau, headway=p.headway)
+        if ok.any():
+            idx = np.flatnonzero(ok)
+            g = margin_g(SCREEN_OMEGA[None, :], K0[idx, 0:1], K0[idx, 1:2], K0[idx, 2:3],
+                         tau=p.tau, delta=p.delta, headway=p.headway)
+            ok[idx[g.min(axis=1) < 0.0]] = False
+        bad = np.flatnonzero(~ok)
+        if bad.size:
+            if self._tree is None:
+                from scipy.spatial import cKDTree
+
+                self._tree = cKDTree(self.lattice())
+            _, idx = self._tree.query(K0[bad])
+            out[bad] = self.lattice()[np.asarray(idx)]
+        return out
+
     # -- the call -----------------------------------------------------------------------------
     def __call__(self, K: npt.ArrayLike) -> Array:
         """Executed gains for proposed gains ``K`` (shape ``(n, 3)``; clipped to the bounds)."""

@@ -62,7 +62,8 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
              f"δ = {run['delta']} s, T* = {run['headway']} s.\n\n",
              "| metric | value |\n|---|---|\n"]
     for k in ("M_fss", "n_gains", "collisions", "collided_episodes", "min_gap", "TIT",
-              "TIT_total", "M_CI", "M_effi", "M_lss", "share_m_p_below_1", "m_p_undefined"):
+              "TIT_total", "M_CI", "M_effi", "median_headway", "M_lss", "share_m_p_below_1",
+              "m_p_undefined"):
         if k in s:
             lines.append(f"| {k} | {_fmt(s[k])} |\n")
     lines.append("\nM_fss: share of executed (episode, moment) gains certified by the exact, "
@@ -82,6 +83,12 @@ def write_evaluation(out: OutputDir, ev: Evaluation, platoons: Sequence[Mapping[
     if ev.gains is not None:
         out.write_text("gains.csv", ev.gains_csv())
     return out.written
+
+
+def _ms(v: Any) -> str:
+    if isinstance(v, Mapping):
+        return f"{v['mean']:.3g} ± {v['std']:.2g}"
+    return _fmt(v)
 
 
 def _mean_std(vals: list[Any]) -> Any:
@@ -113,17 +120,18 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         plot_ttc_distribution,
     )
 
-    keys = ("TIT", "M_CI", "M_effi", "M_lss", "M_fss", "collisions", "share_m_p_below_1")
+    keys = ("TIT", "M_CI", "M_effi", "M_lss", "M_fss", "collisions", "share_m_p_below_1",
+            "median_headway")
     summaries = {name: {k: _mean_std([e.summary.get(k) for e in evs]) for k in keys}
                  for name, evs in groups.items()}
     rows = table_rows(summaries, reference)
     md = ["# Comparison on the held-out episodes (IDL paper Table 4 layout)\n\n",
           "All metrics: lower is better. Rows 'X compared to Y': 100 (Y − X)/Y %, positive when "
           "X is better. Mean ± standard deviation over seeds where several runs are given.\n\n",
-          table_markdown(rows),
-          "\nCollisions per strategy: "
-          + ", ".join(f"{n}: {_fmt(s['collisions'] if not isinstance(s['collisions'], dict) else s['collisions']['mean'])}"
-                      for n, s in summaries.items()) + "\n"]
+          table_markdown(rows), "\n| strategy | collisions | share of m_p < 1 | median headway (s) |\n"
+          "|---|---|---|---|\n"]
+    md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
+           f"{_ms(s['median_headway'])} |\n" for n, s in summaries.items()]
     if platoons:
         md.append("\n## Platoon tests (§5.1)\n\n")
         for name, p in platoons.items():

@@ -225,7 +225,8 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     obs_dim, act_dim, low, high = _check_env(env)
     n_env = int(env.num_envs)
     repair = getattr(env, "repair", None)
-    agent = Agent(config, obs_dim, act_dim, low=low, high=high)
+    agent = Agent(config, obs_dim, act_dim, low=low, high=high,
+                  action_filter=repair.approximate if repair is not None else None)
     buffer = ReplayBuffer(config.buffer_size, obs_dim=obs_dim, act_dim=act_dim, seed=config.seed + 1)
     rng = np.random.default_rng(config.seed + 2)
     half = (high - low) / 2.0
