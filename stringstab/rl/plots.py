@@ -35,30 +35,41 @@ def _ax(ax: Any, figsize: tuple[float, float] = (6.4, 4.0)) -> Any:
 
 
 def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None,
-                        window: int = 10, label: str | None = None) -> dict[str, Any]:
+                        window: int = 10, long_window: int | None = 100,
+                        label: str | None = None) -> dict[str, Any]:
     """Rolling episode return over training episodes (Fig. 3): mean of the last ``window``.
+
+    The paper's window is 10; episodes on different leaders differ widely in return, so a
+    ``long_window`` mean is drawn too (None: only the paper's).
 
     Examples
     --------
     >>> rows = [{"return": -float(i)} for i in range(30)]
     >>> d = plot_rolling_reward(rows)
-    >>> d["line"].get_ydata()[-1]
-    np.float64(-24.5)
+    >>> float(d["line"].get_ydata()[-1]), float(d["line_long"].get_ydata()[-1])
+    (-24.5, -14.5)
     >>> import matplotlib.pyplot as plt; plt.close("all")
     """
     ax = _ax(ax)
     r = np.array([float(e["return"]) for e in episodes])
     c = np.cumsum(np.r_[0.0, r])
     n = np.arange(1, r.size + 1)
-    lo = np.maximum(n - window, 0)
-    roll = (c[n] - c[lo]) / (n - lo) if r.size else r
-    (line,) = ax.plot(n, roll, label=label)
+
+    def rolling(w: int) -> npt.NDArray[np.float64]:
+        lo = np.maximum(n - w, 0)
+        return (c[n] - c[lo]) / (n - lo) if r.size else r
+
+    name = label or "rolling return"
+    (line,) = ax.plot(n, rolling(window), lw=0.8, alpha=0.7, label=f"{name} (window {window})")
+    out = {"ax": ax, "line": line}
+    if long_window:
+        (out["line_long"],) = ax.plot(n, rolling(long_window), lw=2.0,
+                                      label=f"{name} (window {long_window})")
     ax.set_xlabel("training episode")
-    ax.set_ylabel(f"rolling episode return (window {window})")
+    ax.set_ylabel("rolling episode return")
     ax.grid(alpha=0.3)
-    if label:
-        ax.legend()
-    return {"ax": ax, "line": line}
+    ax.legend()
+    return out
 
 
 def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
