@@ -81,6 +81,17 @@ def test_repair_keeps_certified_and_moves_little():
     assert rep.stats["repaired"] == 1 and rep.stats["unchanged"] == 1
 
 
+@pytest.mark.parametrize("method", ["region-growing", "projection-exact"])
+def test_library_repairs_execute_only_certified_gains(method):
+    rep = GainRepair(method, tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25)
+    props = np.array([[0.9, -0.5, 1.1], [0.2, 0.7, 0.0], [-0.5, 1.0, 1.0], [1.3, 0.0, 0.6]])
+    K = rep(props)
+    np.testing.assert_array_equal(K[3], props[3])  # certified as proposed
+    for k in K:
+        assert independent_certified(k), k
+    assert rep.stats["repaired"] == 3
+
+
 def test_repair_off_is_the_ablation():
     rep = GainRepair("off", tau=TAU, delta=DELTA, headway=HEADWAY)
     np.testing.assert_array_equal(rep([[0.9, -0.5, 1.1]]), [[0.9, -0.5, 1.1]])
@@ -349,3 +360,39 @@ def test_package_imports_without_torch():
             "print(r.config_for('idl').buffer_size)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "10000"
+
+
+def _ngsim(path: Path, n_pairs: int = 4) -> Path:
+    """An NGSIM-format file (feet): n_pairs leader-follower pairs of 20 s each."""
+    head = "Vehicle_ID,Frame_ID,Local_Y,v_Vel,v_Acc,Preceding,v_Length\n"
+    rows = []
+    for j in range(n_pairs):
+        lead, foll = 2 * j + 1, 2 * j + 2
+        for f in range(100, 301):
+            t = (f - 100) * 0.1
+            v = 40.0 + 5.0 * math.sin(0.5 * t + j)
+            y = 1000.0 * j + 40.0 * t - 10.0 * (math.cos(0.5 * t + j) - math.cos(j))
+            a = 2.5 * math.cos(0.5 * t + j)
+            rows.append(f"{lead},{f},{y + 80.0:.4f},{v:.4f},{a:.4f},0,15\n")
+            rows.append(f"{foll},{f},{y:.4f},{v:.4f},{a:.4f},{lead},15\n")
+    path.write_text(head + "".join(rows))
+    return path
+
+
+def test_ngsim_file_gives_disjoint_train_and_test_pairs(tmp_path):
+    from stringstab.rl.episodes import leaders_from_files
+    from stringstab.rl.evaluate import evaluate
+
+    f = _ngsim(tmp_path / "ngsim.csv")
+    train_pairs = leaders_from_files([f], "train")
+    test_pairs = leaders_from_files([f], "test")
+    assert len(train_pairs) + len(test_pairs) == 4 and test_pairs
+    assert not {p.follower_id for p in train_pairs} & {p.follower_id for p in test_pairs}
+    ev = evaluate("cacc", test_pairs, tau=TAU, delta=DELTA, headway=HEADWAY)
+    assert ev.summary["episodes"] == len(test_pairs) and ev.summary["collisions"] == 0
+    # an episode starts where the recorded follower was: 80 ft minus the 15 ft leader = 65 ft
+    assert test_pairs[0].gap[0] == pytest.approx(65 * 0.3048, rel=1e-9)
+    env = BatchedCarFollowingEnv(2, train_pairs, action="accel")
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.zeros((2, 1)))
+    assert info["gap"] == pytest.approx(65 * 0.3048, abs=1.0)
