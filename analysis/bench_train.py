@@ -41,7 +41,8 @@ def main() -> None:
     args = ap.parse_args()
     base = arm("repair off", args.steps, repair="off")
     look = arm("projection (lookup)", args.steps)
-    exact = arm("projection-exact", max(args.steps // 10, 800), repair="projection-exact")
+    # shorter (it is slow), but past learning_starts so that its updates are counted too
+    exact = arm("projection-exact", max(args.steps // 4, 4000), repair="projection-exact")
     print(f"steps/s ratio lookup/off = {look['steps_per_second'] / base['steps_per_second']:.2f}, "
           f"exact/off = {exact['steps_per_second'] / base['steps_per_second']:.3f}")
     rng = np.random.default_rng(0)
