@@ -396,3 +396,21 @@ def test_ngsim_file_gives_disjoint_train_and_test_pairs(tmp_path):
     env.reset(seed=0)
     _, _, _, _, info = env.step(np.zeros((2, 1)))
     assert info["gap"] == pytest.approx(65 * 0.3048, abs=1.0)
+
+
+def test_contract_with_the_hcfs_environment(tmp_path):
+    """The HCFS helper's use of the contract, with the real trainer (6-D states, ±3 m/s²)."""
+    from stringstab.hcfs import constants as C
+    from stringstab.hcfs.ddpg import load_ddpg, save_ddpg, train_ddpg
+    from stringstab.hcfs.env import HCFSVectorEnv
+    from stringstab.traffic import stop_and_go
+
+    env = HCFSVectorEnv(1, [stop_and_go(dt=C.DT)], n_followers=2)
+    pol = train_ddpg(total_steps=120, seed=1, env=env, learning_starts=40, batch_size=16,
+                     stop_episodes=0, hidden=(16, 16))
+    save_ddpg(pol, tmp_path / "p")
+    back = load_ddpg(tmp_path / "p")
+    obs = np.random.default_rng(0).normal(size=(3, 6))
+    a = back.policy(obs)
+    assert a.shape == (3, 1) and (np.abs(a) <= 3.0).all()
+    np.testing.assert_array_equal(a, pol.policy(obs))
