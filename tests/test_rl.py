@@ -69,6 +69,21 @@ def test_repair_executes_only_certified_gains(props):
         assert independent_certified(k), k
 
 
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 3), min_size=1, max_size=6))
+def test_repair_with_sample_time_certifies_the_sampled_loop_too(props):
+    from stringstab.sampled import check_sampled
+
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                     sample_time=0.1)
+    K = rep(np.array(props))
+    v = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=TAU, delta=DELTA, headway=HEADWAY,
+                      sample_time=0.1).verdict
+    assert (v == "certified").all()
+    for k in K:
+        assert independent_certified(k), k
+
+
 def test_repair_keeps_certified_and_moves_little():
     rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=4)
     K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])

@@ -79,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
     fss = "n/a" if s["M_fss"] is None else f"{s['M_fss']:.2f}%"
     mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"
+    if s.get("M_fss_sampled") is not None:
+        fss += f" (sampled-data at dt={p['dt']} s: {s['M_fss_sampled']:.2f}%)"
     print(f"M_fss {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
           f"TIT {s['TIT']:.3f}, M_CI {s['M_CI']:.3f}, M_effi {s['M_effi']:.3f}, M_lss {mlss}")
     for q in platoons:

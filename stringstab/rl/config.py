@@ -109,6 +109,9 @@ class TD3Config:
     repair_resolution: float = 0.05
     #: Bisection steps from the lattice point towards the proposed gains (each one exact check).
     repair_refine: int = 4
+    #: Certify executed gains also for the sampled-data loop at the control step ``dt`` (zero-order
+    #: hold; :mod:`stringstab.sampled`), which is the loop the simulator runs.
+    repair_sampled: bool = True
     #: Which action the replay buffer stores: "proposed" (the actor's, before the repair; the
     #: repair is then part of the environment) or "executed" (after the repair).
     store_action: str = "proposed"
@@ -243,6 +246,8 @@ def _check(c: TD3Config) -> None:
         raise StringStabError(f"config field action must be 'gains' or 'accel'; got {c.action!r}")
     if c.repair not in REPAIRS:
         raise StringStabError(f"config field repair must be one of {list(REPAIRS)}; got {c.repair!r}")
+    if not isinstance(c.repair_sampled, bool):
+        raise StringStabError(f"config field repair_sampled must be true or false; got {show(c.repair_sampled)}")
     if c.store_action not in ("proposed", "executed"):
         raise StringStabError(
             f"config field store_action must be 'proposed' or 'executed'; got {c.store_action!r}")

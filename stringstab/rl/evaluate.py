@@ -9,9 +9,9 @@ and speed for an NGSIM pair, else the IDL equilibrium gap l_0 + T* v at the lead
 Metrics (:mod:`stringstab.metrics`): m_p of each episode (eq 29, follower over leader) and their
 mean M_lss (eq 30), TIT per episode (eqs 31-32) and its mean, M_CI (eq 34, pooled), M_effi
 (eq 35, pooled), collisions, and for gain policies M_fss (eq 27): the share of executed
-(vehicle, moment) gains certified by the exact certificate.  M_fss is computed in one place,
-:func:`fss`; the sampled-data certificate (issue 10) will be added there, at the control step
-``dt``, once it has landed.
+(vehicle, moment) gains certified by the exact certificate, and beside it M_fss_sampled, the
+share certified by the sampled-data certificate of the zero-order-hold loop at the control step
+``dt`` (:mod:`stringstab.sampled`).  Both are computed in one place, :func:`fss`.
 
 A platoon test (§5.1): 10 and 100 vehicles running the strategy behind
 :func:`stringstab.traffic.paper_mix` (held 100 s at its final speed so the disturbance reaches
@@ -55,16 +55,28 @@ BASELINES = ("cacc", "idm")
 
 def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         dt: float) -> dict[str, Any]:
-    """M_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificate.
+    """M_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
 
-    Returns ``{"M_fss": % certified by the exact continuous-time certificate, "n": triples}``.
-    ``dt`` is the control step; the sampled-data certificate (issue 10) will use it here.
+    Returns ``{"M_fss": % of triples certified by the exact continuous-time certificate
+    (:func:`stringstab.metrics.fss_ratio`), "M_fss_sampled": % certified by the sampled-data
+    certificate of the zero-order-hold loop at the control step ``dt``
+    (:func:`stringstab.sampled.check_sampled`), "n": triples}``.  The continuous certificate is
+    what the repair guarantees (and what the exit code of ``stringstab evaluate`` requires); the
+    sampled one is the loop the simulator actually runs (u held over each step of ``dt``).
     """
+    from ..sampled import check_sampled
+
     K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
     if not K.shape[0]:
         raise StringStabError("M_fss needs at least one executed gain triple")
+    uniq, inverse = np.unique(K, axis=0, return_inverse=True)
+    cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
+                       headway=headway, sample_time=dt)
+    ok_s = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
     return {"M_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
-            "n": int(K.shape[0]), "certificate": "exact (continuous time)", "dt": dt}
+            "M_fss_sampled": float(100.0 * ok_s.mean()), "n": int(K.shape[0]),
+            "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",
+            "dt": dt}
 
 
 def controller_for(strategy: Policy | str, *, headway: float,
@@ -229,6 +241,7 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         gains = np.concatenate(gains_rows)
         f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=min(dts))
         summary["M_fss"], summary["n_gains"] = f["M_fss"], f["n"]
+        summary["M_fss_sampled"] = f["M_fss_sampled"]
         summary["certificate"] = f["certificate"]
     samples = {"ttc": np.concatenate(ttc_all), "jerk_sq": jerk, "headway": hw, "m_p": mps[ok]}
     return Evaluation(label, episodes, summary, gains, samples)
@@ -253,7 +266,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     m = platoon_metrics(res, certificate=False)
     out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
            "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],
-           "TIT": m["TIT"], "M_fss": None}
+           "TIT": m["TIT"], "M_fss": None, "M_fss_sampled": None}
     if res.gains is not None and res.gains.shape[-2] == res.t.size:
-        out["M_fss"] = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt)["M_fss"]
+        f = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt)
+        out["M_fss"], out["M_fss_sampled"] = f["M_fss"], f["M_fss_sampled"]
     return out

@@ -56,7 +56,8 @@ class Policy:
             self.repair = GainRepair(
                 r.get("method", "projection"), tau=self.info["tau"], delta=self.info["delta"],
                 headway=self.info["headway"], bounds=(self.info["low"][0], self.info["high"][0]),
-                resolution=r.get("resolution", 0.05), refine=r.get("refine", 4))
+                resolution=r.get("resolution", 0.05), refine=r.get("refine", 4),
+                sample_time=r.get("sample_time"))
 
     @property
     def algo(self) -> str:

@@ -36,7 +36,10 @@ so calling them per environment step would dominate training.  The default metho
     no repair: the ablation (executed gains may be uncertified).
 
 Whatever the method, a triple is executed only if :func:`~stringstab.certificate.check` returned
-``"certified"`` for exactly that triple (``"off"`` excepted).
+``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
+:func:`stringstab.sampled.check_sampled` at H: the loop the simulator runs holds u over each
+control step, and gains on the continuous certificate's boundary need not be string stable in
+that sampled loop.
 """
 
 from __future__ import annotations
@@ -63,8 +66,12 @@ Array = npt.NDArray[np.float64]
 SCREEN_OMEGA = np.concatenate([np.linspace(0.0, 2.0, 33)[1:], np.linspace(2.25, 6.0, 16)])
 
 
-def _certified(K: Array, p: Params) -> npt.NDArray[np.bool_]:
-    """Exact-certificate verdict (``check``) for the rows of K that pass the screen."""
+def _certified(K: Array, p: Params, sample_time: float | None = None) -> npt.NDArray[np.bool_]:
+    """Exact-certificate verdict (``check``) for the rows of K that pass the screen.
+
+    With ``sample_time`` H, a row counts only if the sampled-data certificate of the
+    zero-order-hold loop at H (:func:`stringstab.sampled.check_sampled`) certifies it too.
+    """
     out = np.zeros(K.shape[0], dtype=bool)
     if not K.shape[0]:
         return out
@@ -76,14 +83,27 @@ def _certified(K: Array, p: Params) -> npt.NDArray[np.bool_]:
         idx = idx[g.min(axis=1) >= 0.0]
         if idx.size:
             c = check(K[idx, 0], K[idx, 1], K[idx, 2], tau=p.tau, delta=p.delta, headway=p.headway)
-            out[idx] = c.verdict == "certified"
+            ok = c.verdict == "certified"
+            if sample_time is not None and ok.any():
+                ok[ok] = _sampled_ok(K[idx[ok]], p, sample_time)
+            out[idx] = ok
     return out
+
+
+def _sampled_ok(K: Array, p: Params, sample_time: float) -> npt.NDArray[np.bool_]:
+    """Sampled-data certificate (zero-order hold at ``sample_time``) of every row of K."""
+    from ..sampled import check_sampled
+
+    c = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta, headway=p.headway,
+                      sample_time=sample_time)
+    return np.asarray(c.verdict == "certified")
 
 
 @lru_cache(maxsize=8)
 def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
-                      resolution: float) -> Array:
-    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``.
+                      resolution: float, sample_time: float | None = None) -> Array:
+    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
+    (and, with ``sample_time``, by the sampled-data certificate at that step).
 
     Returns
     -------
@@ -100,7 +120,7 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     n = round((hi - lo) / resolution) + 1
     g = np.linspace(lo, hi, n)
     K = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
-    pts = np.ascontiguousarray(K[_certified(K, p)])
+    pts = np.ascontiguousarray(K[_certified(K, p, sample_time)])
     if not pts.shape[0]:
         raise StringStabError(
             f"no certified gains on the {n}^3 lattice over [{lo}, {hi}]^3 at tau={tau}, "
@@ -124,6 +144,9 @@ class GainRepair:
         Lattice spacing of the lookup.
     refine : int
         Bisection steps after the lookup.
+    sample_time : float, optional
+        Also require the sampled-data certificate of the zero-order-hold loop at this step
+        (:func:`stringstab.sampled.check_sampled`) for every executed triple.
 
     Attributes
     ----------
@@ -144,7 +167,7 @@ class GainRepair:
 
     def __init__(self, method: str = "projection", *, tau: float, delta: float, headway: float,
                  bounds: tuple[float, float] = (-2.0, 2.0), resolution: float = 0.05,
-                 refine: int = 4) -> None:
+                 refine: int = 4, sample_time: float | None = None) -> None:
         if method not in REPAIRS:
             raise StringStabError(f"repair method must be one of {list(REPAIRS)}; got {method!r}")
         self.method = method
@@ -157,6 +180,8 @@ class GainRepair:
         if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 0:
             raise StringStabError(f"repair refine must be an integer >= 0; got {refine!r}")
         self.refine = int(refine)
+        self.sample_time = None if sample_time is None else positive("repair sample_time",
+                                                                      sample_time, unit=" s")
         self._tree: Any = None
         self._projector: Any = None
         self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
@@ -165,34 +190,43 @@ class GainRepair:
     def describe(self) -> dict[str, Any]:
         """The settings, for logs and JSON."""
         return {"method": self.method, **self.params.as_dict(), "bounds": list(self.bounds),
-                "resolution": self.resolution, "refine": self.refine}
+                "resolution": self.resolution, "refine": self.refine,
+                "sample_time": self.sample_time}
 
     # -- the lookup -------------------------------------------------------------------------
     def lattice(self) -> Array:
         """The certified lattice of this repair (built on first use)."""
         p = self.params
-        return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution)
+        return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                                 self.sample_time)
 
-    def _nearest(self, K0: Array) -> Array:
+    def _kdtree(self) -> Any:
         if self._tree is None:
             from scipy.spatial import cKDTree
 
             self._tree = cKDTree(self.lattice())
-        _, idx = self._tree.query(K0)
+        return self._tree
+
+    def _nearest(self, K0: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
+        """Lattice point, refined by bisection under the continuous certificate; and which rows
+        moved off the lattice (those still need the sampled-data check, if any)."""
+        _, idx = self._kdtree().query(K0)
         P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
+        moved = np.zeros(K0.shape[0], dtype=bool)
         if self.refine:
             lo = np.zeros(K0.shape[0])
             hi = np.ones(K0.shape[0])
             best = P.copy()
-            for _ in range(self.refine):
+            for _ in range(self.refine):  # bisection under the continuous certificate
                 mid = 0.5 * (lo + hi)
                 C = P + mid[:, None] * (K0 - P)
                 ok = _certified(C, self.params)
                 best[ok] = C[ok]
+                moved |= ok
                 lo = np.where(ok, mid, lo)
                 hi = np.where(ok, hi, mid)
             P = best
-        return P
+        return P, moved
 
     def _exact(self, K0: Array) -> Array:
         from ..tuning import Projector, region_growing
@@ -212,7 +246,7 @@ class GainRepair:
             if r.certified and _certified(kr[None], p)[0]:
                 out[i] = kr
             else:
-                out[i] = self._nearest(k[None])[0]
+                out[i] = self._nearest(k[None])[0][0]
                 self.stats["fallbacks"] += 1
         return out
 
@@ -237,11 +271,7 @@ class GainRepair:
             ok[idx[g.min(axis=1) < 0.0]] = False
         bad = np.flatnonzero(~ok)
         if bad.size:
-            if self._tree is None:
-                from scipy.spatial import cKDTree
-
-                self._tree = cKDTree(self.lattice())
-            _, idx = self._tree.query(K0[bad])
+            _, idx = self._kdtree().query(K0[bad])
             out[bad] = self.lattice()[np.asarray(idx)]
         return out
 
@@ -254,12 +284,28 @@ class GainRepair:
             raise StringStabError("proposed gains must be finite; found NaN or inf")
         out = K0.copy()
         if self.method != "off":
-            ok = _certified(K0, self.params)
+            p = self.params
+            ok = _certified(K0, p)  # continuous-time certificate (``check``)
             bad = np.flatnonzero(~ok)
+            pending = ok.copy()  # rows whose executed gains still need the sampled check
             if bad.size:
-                out[bad] = (self._nearest(K0[bad]) if self.method == "projection"
-                            else self._exact(K0[bad]))
-            self.stats["unchanged"] += int(ok.sum())
+                if self.method == "projection":
+                    out[bad], moved = self._nearest(K0[bad])
+                    pending[bad] = moved  # unmoved rows are lattice points: certified both ways
+                else:
+                    out[bad] = self._exact(K0[bad])
+                    pending[bad] = True
+            if self.sample_time is not None and pending.any():
+                # one sampled-data call per step; where it fails, the nearest lattice point
+                j = np.flatnonzero(pending)
+                keep = _sampled_ok(out[j], p, self.sample_time)
+                if (~keep).any():
+                    jj = j[~keep]
+                    _, idx = self._kdtree().query(K0[jj])
+                    out[jj] = self.lattice()[np.asarray(idx)]
+                    bad = np.union1d(bad, jj)
+                    self.stats["fallbacks"] += int(jj.size)
+            self.stats["unchanged"] += int(K0.shape[0] - bad.size)
             self.stats["repaired"] += int(bad.size)
         self.stats["calls"] += 1
         self.stats["rows"] += K0.shape[0]

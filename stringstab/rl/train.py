@@ -100,7 +100,8 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> Any:
     if config.action == "gains":
         repair = GainRepair(config.repair, tau=config.tau, delta=config.delta,
                             headway=config.headway, bounds=config.gain_bounds,
-                            resolution=config.repair_resolution, refine=config.repair_refine)
+                            resolution=config.repair_resolution, refine=config.repair_refine,
+                            sample_time=config.dt if config.repair_sampled else None)
     env = BatchedCarFollowingEnv(config.num_envs, leaders, action=config.action, tau=config.tau,
                                  delta=config.delta, headway=config.headway,
                                  gain_bounds=config.gain_bounds, weights=config.weights,
