@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
 
+import stringstab
 from stringstab.errors import StringStabError
 from stringstab.hcfs import constants as C
 from stringstab.hcfs.ddpg import load_ddpg, save_ddpg, train_ddpg
@@ -116,6 +117,9 @@ def test_train_ddpg_through_the_contract(monkeypatch, tmp_path):
     fake = types.ModuleType("stringstab.rl")
     fake.DDPGConfig, fake.train, fake.load_policy = DDPGConfig, train, lambda d: Policy()
     monkeypatch.setitem(sys.modules, "stringstab.rl", fake)
+    # once the real trainer has been imported (by another test in this process), the package
+    # attribute wins over sys.modules in 'import stringstab.rl as rl': fake it too
+    monkeypatch.setattr(stringstab, "rl", fake, raising=False)
     env = HCFSVectorEnv(1, [stop_and_go(dt=C.DT)], n_followers=2)
     pol = train_ddpg(total_steps=123, seed=4, env=env)
     assert seen["config"] == DDPGConfig(total_steps=123, seed=4) and seen["env"] is env

@@ -32,6 +32,8 @@ COMMANDS: list[str] = [
     "tune",
     "simulate",
     "train",
+    "evaluate",
+    "compare",
     "hcfs",
     "demo",
 ]
@@ -45,6 +47,9 @@ HELP: dict[str, str] = {
     "region": "map the string-stable gains on a 2-D slice or a 3-D grid (figures + data)",
     "tune": "repair gain triples that are not string stable (region growing or projection)",
     "simulate": "simulate a platoon behind a leader; write trajectories, metrics JSON and figures",
+    "train": "train an IDL policy (TD3 emitting certified gains) or a pure TD3/DDPG baseline",
+    "evaluate": "evaluate a trained policy on held-out leaders; certify every executed gain",
+    "compare": "compare trained runs and baselines on held-out leaders (Table 4, Figs 6, 9, 11, 12)",
     "hcfs": "the HCFS hybrid DDPG/CACC strategy: verify its jerk theorem in closed loop",
     "demo": "run a demo of the whole pipeline on bundled data",
 }

@@ -53,6 +53,10 @@ from .trajectory import Trajectory
 
 __all__ = ["SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "state_vector"]
 
+#: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).
+_PLATOON_STATE = ("position", "speed", "accel", "_buf", "collided", "collision_events",
+                  "first_collision_step", "_in_collision")
+
 Array = npt.NDArray[np.float64]
 ActionMode = Literal["gains", "accel"]
 
@@ -379,6 +383,49 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         self._core.reset_rows(rows, self._draw(self.num_envs))
         self._core.observe()
         return self._core.state(), {"leader_index": self._core.which.copy()}
+
+    def state_dict(self) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
+        """The state of every sub-environment, to continue bit for bit (a training checkpoint).
+
+        Returns ``(meta, arrays)``: JSON-ready counters and the episode-drawing RNG state, and
+        plain arrays (platoon states, delay buffers, leader indices, steps, returns).  No
+        objects: both can be stored in safe formats (JSON, safetensors).
+        """
+        if self._core.obs is None:
+            raise StringStabError("call reset() before state_dict()")
+        c, p = self._core, self._core.platoon
+        arrays = {"which": c.which, "k": c.k, "ret": c.ret}
+        arrays.update({f"platoon.{a}": getattr(p, a) for a in _PLATOON_STATE})
+        meta = {"num_envs": self.num_envs, "n_leaders": len(c.items), "step": int(p.step),
+                "any_in_collision": bool(p._any_in_collision),
+                "rng": self.np_random.bit_generator.state}
+        return meta, {k: np.array(v, copy=True) for k, v in arrays.items()}
+
+    def load_state_dict(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
+        """Restore :meth:`state_dict` output (same leaders and ``num_envs``; checked)."""
+        c, p = self._core, self._core.platoon
+        if meta.get("num_envs") != self.num_envs or meta.get("n_leaders") != len(c.items):
+            raise StringStabError(
+                f"environment state: expected {self.num_envs} environments over {len(c.items)} "
+                f"leaders; found {meta.get('num_envs')} over {meta.get('n_leaders')}")
+        try:
+            for name in ("which", "k", "ret"):
+                self._restore(getattr(c, name), arrays[name], name)
+            for a in _PLATOON_STATE:
+                self._restore(getattr(p, a), arrays[f"platoon.{a}"], f"platoon.{a}")
+        except KeyError as e:
+            raise StringStabError(f"environment state: missing array {e}") from e
+        p.step = int(meta["step"])
+        p._any_in_collision = bool(meta["any_in_collision"])
+        self.np_random.bit_generator.state = meta["rng"]
+        c.observe()
+
+    @staticmethod
+    def _restore(dst: npt.NDArray[Any], src: Any, name: str) -> None:
+        a = np.asarray(src)
+        if a.shape != dst.shape:
+            raise StringStabError(f"environment state {name}: expected shape {dst.shape}; found {a.shape}")
+        dst[...] = a
 
     def step(self, actions: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], Array,
                                                    npt.NDArray[np.bool_], npt.NDArray[np.bool_],

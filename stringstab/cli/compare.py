@@ -1,0 +1,79 @@
+"""``stringstab compare``: the IDL paper's Table 4 and figures for runs and baselines."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ..errors import StringStabError
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``compare``."""
+    p = sub.add_parser(
+        "compare",
+        help="compare trained runs and baselines on held-out leaders (Table 4, Figs 6, 9, 11, 12)",
+        description=(
+            "Evaluate every run folder and baseline on the same held-out leaders and write the "
+            "IDL paper's Table 4 (Markdown and CSV, with the improvement percentages of the "
+            "reference), the m_p histogram with CDF (Fig. 6), the TTC distribution (Fig. 9), "
+            "jerk ranges (Fig. 11), the headway CDF (Fig. 12) and the executed gains over the "
+            "certified region. Runs of the same --algo are pooled: mean ± standard deviation."),
+    )
+    p.add_argument("runs", nargs="+", metavar="RUN", help="run folders written by stringstab train")
+    p.add_argument("--baselines", default="cacc,idm", metavar="LIST",
+                   help="comma-separated baselines among cacc, idm (default cacc,idm; 'none')")
+    p.add_argument("--leaders", nargs="+", metavar="test|FILE", help="held-out leaders (default test)")
+    p.add_argument("--reference", default=None, metavar="ALGO",
+                   help="strategy whose improvements are listed (default idl when present)")
+    p.add_argument("--platoon", action="store_true", help="also run the 10-vehicle platoon test")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``compare``."""
+    from ..io import OutputDir
+    from ..rl.evaluate import BASELINES, evaluate, platoon_test
+    from ..rl.report import write_comparison
+    from ..rl.runs import open_run, test_leaders
+
+    base = [] if args.baselines.strip().lower() == "none" else [
+        b.strip() for b in args.baselines.split(",") if b.strip()]
+    bad = [b for b in base if b not in BASELINES]
+    if bad:
+        raise StringStabError(f"--baselines: expected names among {', '.join(BASELINES)}; got {bad}")
+    opened = [open_run(r) for r in args.runs]
+    params = {(p.info["tau"], p.info["delta"], p.info["headway"], p.info["dt"]) for _, p in opened}
+    if len(params) != 1:
+        raise StringStabError(f"runs must share tau, delta, headway and dt; found {sorted(params)}")
+    tau, delta, headway, dt = params.pop()
+    leaders, desc = test_leaders(args.leaders, dt=dt)
+    out = OutputDir(args.out, command="compare")
+    groups: dict[str, list[Any]] = {}
+    platoons: dict[str, Any] = {}
+    for info, pol in opened:
+        ev = evaluate(pol, leaders, tau=tau, delta=delta, headway=headway, name=pol.algo)
+        groups.setdefault(pol.algo, []).append(ev)
+        print(f"{info['folder']} ({pol.algo}): TIT {ev.summary['TIT']:.3f}, "
+              f"M_CI {ev.summary['M_CI']:.3f}, collisions {ev.summary['collisions']}, "
+              f"M_fss {ev.summary['M_fss'] if ev.summary['M_fss'] is not None else 'n/a'}")
+        if args.platoon and pol.algo not in platoons:
+            platoons[pol.algo] = {"run": info["folder"], "tests": [platoon_test(
+                pol, 10, tau=tau, delta=delta, headway=headway, dt=dt)]}
+    for b in base:
+        groups[b] = [evaluate(b, leaders, tau=tau, delta=delta, headway=headway, name=b)]
+        if args.platoon:
+            platoons[b] = {"run": None, "tests": [platoon_test(b, 10, tau=tau, delta=delta,
+                                                               headway=headway, dt=dt)]}
+    ref = args.reference or ("idl" if "idl" in groups else None)
+    if ref is not None and ref not in groups:
+        raise StringStabError(f"--reference {ref!r} is not among the strategies {sorted(groups)}")
+    with out:
+        files = write_comparison(out, groups, reference=ref, tau=tau, delta=delta,
+                                 headway=headway, platoons=platoons or None)
+    print(f"compared {', '.join(groups)} on {len(leaders)} held-out episodes ({desc})")
+    print(f"wrote {', '.join(files)} to {out.root}/")
+    return 0

@@ -1,0 +1,91 @@
+"""``stringstab evaluate``: roll a trained policy on held-out leaders and certify every gain."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..errors import StringStabError
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``evaluate``."""
+    p = sub.add_parser(
+        "evaluate",
+        help="evaluate a trained policy on held-out leaders; certify every executed gain",
+        description=(
+            "Roll the policy of a run folder on held-out leaders (the bundled test episodes, or "
+            "'t, v' CSV / NGSIM files), certify every executed gain with the exact certificate "
+            "(M_fss), compute TIT, M_CI, M_effi, m_p per episode and M_lss, collisions, and the "
+            "10- and 100-vehicle platoon test. Exit 0 when every executed gain is certified and "
+            "nothing collided, 1 otherwise (an acceleration policy has no gains to certify), "
+            "2 on bad input."),
+    )
+    p.add_argument("run", metavar="RUN", help="run folder written by stringstab train")
+    p.add_argument("--leaders", nargs="+", metavar="test|FILE",
+                   help="'test' (default: the bundled test episodes) or CSV/NGSIM files")
+    p.add_argument("--platoon", default="10,100", metavar="N,N",
+                   help="platoon sizes of the §5.1 test (default 10,100; 'none' to skip)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default RUN/evaluation)")
+    p.set_defaults(func=run)
+
+
+def _sizes(text: str) -> list[int]:
+    if text.strip().lower() == "none":
+        return []
+    try:
+        sizes = [int(s) for s in text.split(",") if s.strip()]
+    except ValueError as e:
+        raise StringStabError(f"--platoon must be sizes like 10,100 or 'none'; got {text!r}") from e
+    if not sizes or any(n < 1 for n in sizes):
+        raise StringStabError(f"--platoon sizes must be integers >= 1; got {text!r}")
+    return sizes
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``evaluate``."""
+    from ..io import OutputDir
+    from ..rl.evaluate import evaluate, platoon_test
+    from ..rl.report import write_evaluation
+    from ..rl.runs import open_run, test_leaders
+
+    sizes = _sizes(args.platoon)
+    info, policy = open_run(args.run)
+    p = policy.info
+    leaders, desc = test_leaders(args.leaders, dt=p["dt"])
+    out = OutputDir(Path(args.out) if args.out else Path(args.run) / "evaluation",
+                    command="evaluate")
+    ev = evaluate(policy, leaders, tau=p["tau"], delta=p["delta"], headway=p["headway"])
+    platoons = [platoon_test(policy, n, tau=p["tau"], delta=p["delta"], headway=p["headway"],
+                             dt=p["dt"]) for n in sizes]
+    s = ev.summary
+    gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
+        q["M_fss"] == 100.0 for q in platoons)
+    no_coll = s["collisions"] == 0 and all(q["collisions"] == 0 for q in platoons)
+    if policy.action != "gains":
+        verdict = "not certified: an acceleration policy executes no gains to certify"
+    elif gains_ok and no_coll:
+        verdict = "every executed gain certified, no collision"
+    else:
+        verdict = ("NOT every executed gain certified" if not gains_ok else "certified gains")
+        verdict += "" if no_coll else ", COLLISIONS"
+    run_doc = {**info, "leaders": desc, "tau": p["tau"], "delta": p["delta"],
+               "headway": p["headway"], "dt": p["dt"], "repair": p.get("repair")}
+    with out:
+        files = write_evaluation(out, ev, platoons, run_doc, verdict)
+    print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
+    fss = "n/a" if s["M_fss"] is None else f"{s['M_fss']:.2f}%"
+    mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"
+    if s.get("M_fss_sampled") is not None:
+        fss += f" (sampled-data at dt={p['dt']} s: {s['M_fss_sampled']:.2f}%)"
+    print(f"M_fss {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
+          f"TIT {s['TIT']:.3f}, M_CI {s['M_CI']:.3f}, M_effi {s['M_effi']:.3f}, M_lss {mlss}")
+    for q in platoons:
+        print(f"platoon of {q['n']}: max m_p {q['max_m_p']:.3f}, collisions {q['collisions']}, "
+              f"M_fss {q['M_fss'] if q['M_fss'] is not None else 'n/a'}")
+    print(f"verdict: {verdict}")
+    print(f"wrote {', '.join(files)} to {out.root}/")
+    return 0 if (policy.action == "gains" and gains_ok and no_coll) else 1

@@ -1,0 +1,98 @@
+"""A fixed-size replay memory of transitions (s, a, r, s', done) in NumPy (IDL Table 1: 10,000).
+
+Sampling uses its own seeded :class:`numpy.random.Generator`, so a run is reproducible and a
+checkpoint (:meth:`ReplayBuffer.state`, :meth:`ReplayBuffer.load_state`) restores it exactly.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import StringStabError
+
+__all__ = ["ReplayBuffer"]
+
+F32 = npt.NDArray[np.float32]
+_FIELDS = ("obs", "actions", "rewards", "next_obs", "dones")
+
+
+class ReplayBuffer:
+    """Ring buffer of ``capacity`` transitions; the oldest are overwritten first.
+
+    Examples
+    --------
+    >>> buf = ReplayBuffer(4, obs_dim=3, act_dim=1, seed=0)
+    >>> for i in range(6):
+    ...     buf.add(np.full((1, 3), i), np.zeros((1, 1)), np.array([-i]), np.zeros((1, 3)),
+    ...             np.array([False]))
+    >>> len(buf), sorted(buf.rewards[:, 0].tolist())
+    (4, [-5.0, -4.0, -3.0, -2.0])
+    >>> buf.sample(2)["obs"].shape
+    (2, 3)
+    """
+
+    def __init__(self, capacity: int, *, obs_dim: int, act_dim: int, seed: int) -> None:
+        if capacity < 1:
+            raise StringStabError(f"replay capacity must be >= 1; got {capacity}")
+        self.capacity = int(capacity)
+        self.obs = np.zeros((self.capacity, obs_dim), dtype=np.float32)
+        self.actions = np.zeros((self.capacity, act_dim), dtype=np.float32)
+        self.rewards = np.zeros((self.capacity, 1), dtype=np.float32)
+        self.next_obs = np.zeros((self.capacity, obs_dim), dtype=np.float32)
+        self.dones = np.zeros((self.capacity, 1), dtype=np.float32)
+        self.pos = 0
+        self.size = 0
+        self.rng = np.random.default_rng(seed)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def add(self, obs: npt.ArrayLike, actions: npt.ArrayLike, rewards: npt.ArrayLike,
+            next_obs: npt.ArrayLike, dones: npt.ArrayLike) -> None:
+        """Append a batch of transitions (leading axis: environments)."""
+        o = np.asarray(obs, dtype=np.float32)
+        n = o.shape[0]
+        idx = (self.pos + np.arange(n)) % self.capacity
+        self.obs[idx] = o
+        self.actions[idx] = np.asarray(actions, dtype=np.float32).reshape(n, -1)
+        self.rewards[idx, 0] = np.asarray(rewards, dtype=np.float32).reshape(n)
+        self.next_obs[idx] = np.asarray(next_obs, dtype=np.float32)
+        self.dones[idx, 0] = np.asarray(dones, dtype=np.float32).reshape(n)
+        self.pos = int((self.pos + n) % self.capacity)
+        self.size = int(min(self.size + n, self.capacity))
+
+    def sample(self, batch_size: int) -> dict[str, F32]:
+        """A uniform minibatch (with replacement), as float32 arrays."""
+        if self.size == 0:
+            raise StringStabError("cannot sample from an empty replay buffer")
+        idx = self.rng.integers(0, self.size, size=batch_size)
+        return {f: getattr(self, f)[idx] for f in _FIELDS}
+
+    # -- checkpoints ----------------------------------------------------------------------
+    def arrays(self) -> dict[str, F32]:
+        """The stored transitions (the filled part), for a checkpoint."""
+        return {f: np.ascontiguousarray(getattr(self, f)[: self.size]) for f in _FIELDS}
+
+    def state(self) -> dict[str, Any]:
+        """Counters and the sampler's RNG state (JSON-ready)."""
+        return {"capacity": self.capacity, "pos": self.pos, "size": self.size,
+                "rng": self.rng.bit_generator.state}
+
+    def load_state(self, state: dict[str, Any], arrays: dict[str, Any]) -> None:
+        """Restore from :meth:`state` and :meth:`arrays` (shapes are checked)."""
+        size = int(state["size"])
+        if int(state["capacity"]) != self.capacity or not 0 <= size <= self.capacity:
+            raise StringStabError(
+                f"replay buffer: expected capacity {self.capacity}; found {state['capacity']} "
+                f"with {size} transitions")
+        for f in _FIELDS:
+            a = np.asarray(arrays[f])
+            want = (size, getattr(self, f).shape[1])
+            if a.shape != want:
+                raise StringStabError(f"replay buffer {f}: expected shape {want}; found {a.shape}")
+            getattr(self, f)[:size] = a
+        self.pos, self.size = int(state["pos"]) % self.capacity, size
+        self.rng.bit_generator.state = state["rng"]

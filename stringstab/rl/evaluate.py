@@ -1,0 +1,273 @@
+"""Held-out evaluation of a policy or a baseline: the IDL paper's metrics per episode and pooled.
+
+Each test episode is one follower behind one leader (a test episode of
+:mod:`~stringstab.rl.episodes`, or a user's file), simulated by
+:func:`stringstab.traffic.simulate` — the same dynamics as training, but a collision does not end
+the episode (§4.1.2).  Every strategy starts from the same state: the recorded follower's gap
+and speed for an NGSIM pair, else the IDL equilibrium gap l_0 + T* v at the leader's speed.
+
+Metrics (:mod:`stringstab.metrics`): m_p of each episode (eq 29, follower over leader) and their
+mean M_lss (eq 30), TIT per episode (eqs 31-32) and its mean, M_CI (eq 34, pooled), M_effi
+(eq 35, pooled), collisions, and for gain policies M_fss (eq 27): the share of executed
+(vehicle, moment) gains certified by the exact certificate, and beside it M_fss_sampled, the
+share certified by the sampled-data certificate of the zero-order-hold loop at the control step
+``dt`` (:mod:`stringstab.sampled`).  Both are computed in one place, :func:`fss`.
+
+A platoon test (§5.1): 10 and 100 vehicles running the strategy behind
+:func:`stringstab.traffic.paper_mix` (held 100 s at its final speed so the disturbance reaches
+the tail), m_p per vehicle next to the paper's values.  The certificate holds for frozen gains;
+a learned policy switches gains every step, so this time-domain check is the evidence that the
+switching does not amplify disturbances — it is evidence, not a proof.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..constants import STANDSTILL, TTC_STAR
+from ..errors import StringStabError
+from ..metrics import (
+    efficiency_index,
+    fss_ratio,
+    jerk_squared,
+    time_integrated_ttc,
+    time_to_collision,
+)
+from .policy import Policy
+
+__all__ = ["PAPER_MP_10", "Evaluation", "controller_for", "evaluate", "fss", "platoon_test"]
+
+Array = npt.NDArray[np.float64]
+
+#: m_p per vehicle of the paper's 10-vehicle IDL platoon (§5.1).
+PAPER_MP_10 = (0.45, 0.53, 0.61, 0.68, 0.73, 0.77, 0.81, 0.83, 0.85, 0.86)
+#: The paper's 100-vehicle platoon: m_p between 0.978 and 0.989 after vehicle 39, all < 1.
+PAPER_MP_100_MAX = 0.989
+BASELINES = ("cacc", "idm")
+
+
+def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
+        dt: float) -> dict[str, Any]:
+    """M_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
+
+    Returns ``{"M_fss": % of triples certified by the exact continuous-time certificate
+    (:func:`stringstab.metrics.fss_ratio`), "M_fss_sampled": % certified by the sampled-data
+    certificate of the zero-order-hold loop at the control step ``dt``
+    (:func:`stringstab.sampled.check_sampled`), "n": triples}``.  The continuous certificate is
+    what the repair guarantees (and what the exit code of ``stringstab evaluate`` requires); the
+    sampled one is the loop the simulator actually runs (u held over each step of ``dt``).
+    """
+    from ..sampled import check_sampled
+
+    K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
+    if not K.shape[0]:
+        raise StringStabError("M_fss needs at least one executed gain triple")
+    uniq, inverse = np.unique(K, axis=0, return_inverse=True)
+    cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
+                       headway=headway, sample_time=dt)
+    ok_s = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
+    return {"M_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
+            "M_fss_sampled": float(100.0 * ok_s.mean()), "n": int(K.shape[0]),
+            "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",
+            "dt": dt}
+
+
+def controller_for(strategy: Policy | str, *, headway: float,
+                   standstill: float = STANDSTILL) -> Any:
+    """A :mod:`stringstab.traffic.controllers` controller running ``strategy``.
+
+    A gain policy runs the eq-4 law with its *executed* (repaired) gains
+    (:meth:`Policy.gains`); an acceleration policy commands its output; ``"cacc"`` is van Arem
+    et al.'s CACC with T* as time gap, ``"idm"`` the IDM (the paper's HDV row replays recorded
+    NGSIM followers; without NGSIM the IDM stands in for the human driver).
+    """
+    from ..traffic.controllers import (
+        CACCController,
+        FunctionController,
+        IDMController,
+        TimeVaryingLinearController,
+    )
+    from ..traffic.env import state_vector
+
+    if isinstance(strategy, str):
+        if strategy == "cacc":
+            return CACCController(t_system=headway, r_min=standstill)
+        if strategy == "idm":
+            return IDMController(min_gap=standstill)
+        raise StringStabError(f"baseline must be one of {', '.join(BASELINES)}; got {strategy!r}")
+    pol = strategy
+
+    def state(obs: Any) -> Array:
+        return state_vector(obs, headway=headway, standstill=standstill)
+
+    if pol.action == "gains":
+        def schedule(obs: Any) -> Array:
+            s = state(obs)
+            return pol.gains(s.reshape(-1, s.shape[-1])).reshape(*s.shape[:-1], 3)
+
+        return TimeVaryingLinearController(schedule, headway=headway, standstill=standstill)
+
+    def accel(obs: Any) -> Array:
+        s = state(obs)
+        return pol(s.reshape(-1, s.shape[-1]))[:, 0].reshape(s.shape[:-1])
+
+    return FunctionController(accel, headway=headway, standstill=standstill)
+
+
+@dataclass
+class Evaluation:
+    """The outcome of :func:`evaluate` for one strategy."""
+
+    name: str
+    episodes: list[dict[str, Any]]
+    summary: dict[str, Any]
+    gains: Array | None = None  # (rows, 5): t, episode, k_x, k_v, k_a
+    samples: dict[str, Array] = field(default_factory=dict)  # ttc, jerk_sq, headway, m_p
+
+    def gains_csv(self) -> str:
+        """The executed gains as CSV ``t,vehicle,k_x,k_v,k_a`` (``stringstab certify --file``)."""
+        if self.gains is None:
+            raise StringStabError(f"{self.name} executes no gains")
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["t", "vehicle", "k_x", "k_v", "k_a"])
+        for t, ep, kx, kv, ka in self.gains:
+            w.writerow([f"{t:.6g}", int(ep), repr(float(kx)), repr(float(kv)), repr(float(ka))])
+        return buf.getvalue()
+
+    def episodes_csv(self) -> str:
+        """One row per episode."""
+        cols = ["episode", "leader", "seconds", "m_p", "TIT", "collisions", "min_gap", "M_fss"]
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(cols)
+        for e in self.episodes:
+            w.writerow([e.get(c, "") if e.get(c) is not None else "" for c in cols])
+        return buf.getvalue()
+
+
+def _start(leader: Any, headway: float, standstill: float) -> tuple[Any, float, float]:
+    if hasattr(leader, "follower"):
+        return leader.leader, float(leader.gap[0]), float(leader.follower.speed[0])
+    v0 = float(leader.speed[0])
+    return leader, standstill + headway * v0, v0
+
+
+def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delta: float,
+             headway: float, name: str | None = None, standstill: float = STANDSTILL,
+             ttc_star: float = TTC_STAR) -> Evaluation:
+    """Run ``strategy`` (a policy, ``"cacc"`` or ``"idm"``) on every leader; see the module.
+
+    Returns
+    -------
+    Evaluation
+        ``summary``: ``episodes``, ``M_lss``, ``share_m_p_below_1``, ``TIT`` (mean per
+        episode), ``TIT_total``, ``M_CI``, ``M_effi``, ``collisions``, ``collided_episodes``,
+        ``min_gap``, and for gain policies ``M_fss`` (with ``n_gains``).
+    """
+    from ..traffic.platoon import simulate
+
+    if not leaders:
+        raise StringStabError("evaluation needs at least one leader")
+    label = name or (strategy if isinstance(strategy, str) else strategy.algo)
+    ctrl = controller_for(strategy, headway=headway, standstill=standstill)
+    starts = [_start(tr, headway, standstill) for tr in leaders]
+    groups: dict[tuple[int, float], list[int]] = {}
+    for i, (tr, _, _) in enumerate(starts):
+        groups.setdefault((tr.n_steps, tr.dt), []).append(i)
+    episodes: list[dict[str, Any]] = [{} for _ in leaders]
+    ttc_all, jerk_all, hw_all, gains_rows = [], [], [], []
+    dts: set[float] = set()
+    for (_, dt), idx in groups.items():
+        trs = [starts[i][0] for i in idx]
+        gap0 = np.array([[starts[i][1]] for i in idx])
+        v0 = np.array([[starts[i][2]] for i in idx])
+        res = simulate(trs, ctrl, 1, tau=tau, delta=delta, initial_gap=gap0, initial_speed=v0)
+        dts.add(dt)
+        assert res.speed is not None and res.accel is not None
+        gap = res.gap[:, 0, :]
+        spd = res.speed
+        ttc = time_to_collision(gap, spd[:, 1, :], spd[:, 0, :])
+        tit = time_integrated_ttc(ttc, dt, ttc_star=ttc_star)
+        mp = res.damping_ratios[:, 0]
+        hw = res.headway[:, 0, :]
+        ttc_all.append(ttc[np.isfinite(ttc)].ravel())
+        jerk_all.append(jerk_squared(res.accel[:, 1, :], dt).ravel())
+        hw_all.append(hw.ravel())
+        for j, i in enumerate(idx):
+            tr = trs[j]
+            episodes[i] = {"episode": i, "leader": tr.name, "seconds": tr.duration,
+                           "m_p": float(mp[j]) if np.isfinite(mp[j]) else None,
+                           "TIT": float(tit[j]),
+                           "collisions": int(res.collision_events[j, 0]),
+                           "min_gap": float(res.min_gap[j, 0]), "M_fss": None}
+        if res.gains is not None and res.gains.shape[2] == res.t.size:
+            G = res.gains[:, 0, :, :]
+            for j, i in enumerate(idx):
+                f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt)
+                episodes[i]["M_fss"] = f["M_fss"]
+                gains_rows.append(np.column_stack([res.t, np.full(res.t.size, i), G[j]]))
+    mps = np.array([np.nan if e["m_p"] is None else e["m_p"] for e in episodes])
+    ok = np.isfinite(mps)
+    tits = np.array([e["TIT"] for e in episodes])
+    jerk = np.concatenate(jerk_all)
+    hw = np.concatenate(hw_all)
+    summary: dict[str, Any] = {
+        "strategy": label, "episodes": len(episodes),
+        # m_p is undefined where the leader never accelerates (Σ a² = 0): left out, counted
+        "M_lss": float(mps[ok].mean()) if ok.any() else None,
+        "share_m_p_below_1": float(np.mean(mps[ok] < 1.0)) if ok.any() else None,
+        "m_p_undefined": int((~ok).sum()),
+        "TIT": float(tits.mean()), "TIT_total": float(tits.sum()),
+        "M_CI": float(jerk.mean()),  # eq 34: the pooled mean squared jerk
+        "M_effi": efficiency_index(hw),
+        # eq 35's mean is dominated by creeping near standstill (h = gap/v grows without
+        # bound as v → v_min); the median is reported beside it
+        "median_headway": float(np.nanmedian(hw)) if np.isfinite(hw).any() else None,
+        "collisions": int(sum(e["collisions"] for e in episodes)),
+        "collided_episodes": int(sum(e["collisions"] > 0 for e in episodes)),
+        "min_gap": float(min(e["min_gap"] for e in episodes)),
+        "M_fss": None,
+    }
+    gains = None
+    if gains_rows:
+        gains = np.concatenate(gains_rows)
+        f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=min(dts))
+        summary["M_fss"], summary["n_gains"] = f["M_fss"], f["n"]
+        summary["M_fss_sampled"] = f["M_fss_sampled"]
+        summary["certificate"] = f["certificate"]
+    samples = {"ttc": np.concatenate(ttc_all), "jerk_sq": jerk, "headway": hw, "m_p": mps[ok]}
+    return Evaluation(label, episodes, summary, gains, samples)
+
+
+def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: float,
+                 headway: float, dt: float = 0.1, hold: float = 100.0,
+                 standstill: float = STANDSTILL) -> dict[str, Any]:
+    """``n_vehicles`` running ``strategy`` behind the §5.1-style leader: m_p per vehicle and more.
+
+    Returns ``{"n", "m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_fss"}`` (M_fss for gain
+    policies: every vehicle's executed gains at every step).
+    """
+    from ..metrics import platoon_metrics
+    from ..traffic.leaders import paper_mix
+    from ..traffic.platoon import simulate
+
+    leader = paper_mix(dt=dt).hold(hold)
+    ctrl = controller_for(strategy, headway=headway, standstill=standstill)
+    res = simulate(leader, ctrl, n_vehicles, tau=tau, delta=delta,
+                   initial_gap=standstill + headway * float(leader.speed[0]))
+    m = platoon_metrics(res, certificate=False)
+    out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
+           "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],
+           "TIT": m["TIT"], "M_fss": None, "M_fss_sampled": None}
+    if res.gains is not None and res.gains.shape[-2] == res.t.size:
+        f = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt)
+        out["M_fss"], out["M_fss_sampled"] = f["M_fss"], f["M_fss_sampled"]
+    return out

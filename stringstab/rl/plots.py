@@ -1,0 +1,186 @@
+"""Figures of training and evaluation (IDL paper Figs 3, 6, 9, 11, 12); each takes ``ax=None``.
+
+Every function draws on ``ax`` (a new figure when None) and returns a dict of what it drew
+(``"ax"`` and the artists), like python-control's plots.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "JERK_RANGES",
+    "plot_gains_over_region",
+    "plot_headway_cdf",
+    "plot_jerk_ranges",
+    "plot_mp_histogram",
+    "plot_rolling_reward",
+    "plot_ttc_distribution",
+]
+
+#: The ranges of squared jerk c (m²/s⁶) of the IDL paper's Fig. 11.
+JERK_RANGES: tuple[tuple[float, float], ...] = ((0.0, 0.1), (0.1, 1.0), (1.0, 10.0), (10.0, 60.0))
+
+
+def _ax(ax: Any, figsize: tuple[float, float] = (6.4, 4.0)) -> Any:
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    return plt.figure(figsize=figsize).subplots()
+
+
+def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None,
+                        window: int = 10, long_window: int | None = 100,
+                        label: str | None = None) -> dict[str, Any]:
+    """Rolling episode return over training episodes (Fig. 3): mean of the last ``window``.
+
+    The paper's window is 10; episodes on different leaders differ widely in return, so a
+    ``long_window`` mean is drawn too (None: only the paper's).
+
+    Examples
+    --------
+    >>> rows = [{"return": -float(i)} for i in range(30)]
+    >>> d = plot_rolling_reward(rows)
+    >>> float(d["line"].get_ydata()[-1]), float(d["line_long"].get_ydata()[-1])
+    (-24.5, -14.5)
+    >>> import matplotlib.pyplot as plt; plt.close("all")
+    """
+    ax = _ax(ax)
+    r = np.array([float(e["return"]) for e in episodes])
+    c = np.cumsum(np.r_[0.0, r])
+    n = np.arange(1, r.size + 1)
+
+    def rolling(w: int) -> npt.NDArray[np.float64]:
+        lo = np.maximum(n - w, 0)
+        return (c[n] - c[lo]) / (n - lo) if r.size else r
+
+    name = label or "rolling return"
+    (line,) = ax.plot(n, rolling(window), lw=0.8, alpha=0.7, label=f"{name} (window {window})")
+    out = {"ax": ax, "line": line}
+    if long_window:
+        (out["line_long"],) = ax.plot(n, rolling(long_window), lw=2.0,
+                                      label=f"{name} (window {long_window})")
+    ax.set_xlabel("training episode")
+    ax.set_ylabel("rolling episode return")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    return out
+
+
+def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
+                      label: str | None = None) -> dict[str, Any]:
+    """Histogram of per-episode m_p with its CDF on a twin axis (Fig. 6); m_p = 1 marked."""
+    ax = _ax(ax)
+    x = np.asarray(m_p, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    _, _, patches = ax.hist(x, bins=bins, color="tab:orange", alpha=0.8)
+    ax2 = ax.twinx()
+    xs = np.sort(x)
+    (cdf,) = ax2.plot(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue")
+    ax2.fill_between(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue", alpha=0.15)
+    ax2.set_ylim(0, 1.02)
+    ax2.set_ylabel("CDF")
+    ax.axvline(1.0, color="k", ls="--", lw=1)
+    share = float(np.mean(x < 1.0)) if x.size else float("nan")
+    ax.set_title(f"{label + ': ' if label else ''}m_p < 1 in {100 * share:.0f}% of episodes")
+    ax.set_xlabel("m_p (eq 29)")
+    ax.set_ylabel("episodes")
+    return {"ax": ax, "ax_cdf": ax2, "patches": patches, "cdf": cdf, "share_below_1": share}
+
+
+def plot_ttc_distribution(ttc: Mapping[str, npt.ArrayLike], *, ax: Any = None,
+                          max_ttc: float = 100.0, bins: int = 50) -> dict[str, Any]:
+    """Distribution of finite TTC values in [0, max_ttc] s per strategy (Fig. 9)."""
+    ax = _ax(ax)
+    lines = {}
+    edges = np.linspace(0.0, max_ttc, bins + 1)
+    for name, v in ttc.items():
+        x = np.asarray(v, dtype=np.float64)
+        x = x[np.isfinite(x) & (x >= 0) & (x <= max_ttc)]
+        h, _ = np.histogram(x, bins=edges)
+        h = h / (h.sum() * np.diff(edges)) if h.sum() else h.astype(np.float64)
+        (lines[name],) = ax.plot(0.5 * (edges[1:] + edges[:-1]), h, label=name)
+    ax.set_xlabel("TTC (s, closing moments only)")
+    ax.set_ylabel("density")
+    ax.legend()
+    return {"ax": ax, "lines": lines}
+
+
+def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
+                     ranges: Sequence[tuple[float, float]] = JERK_RANGES) -> dict[str, Any]:
+    """Counts of squared-jerk samples c (eq 33) in the ranges of Fig. 11, per strategy."""
+    ax = _ax(ax)
+    names = list(jerk_sq)
+    width = 0.8 / max(len(names), 1)
+    bars = {}
+    counts = {}
+    for j, name in enumerate(names):
+        c = np.asarray(jerk_sq[name], dtype=np.float64)
+        counts[name] = [int(np.count_nonzero((c >= lo) & (c < hi) if k < len(ranges) - 1
+                                             else (c >= lo) & (c <= hi)))
+                        for k, (lo, hi) in enumerate(ranges)]
+        bars[name] = ax.bar(np.arange(len(ranges)) + j * width, counts[name], width, label=name)
+    ax.set_xticks(np.arange(len(ranges)) + 0.4 - width / 2,
+                  [f"[{lo:g}, {hi:g}]" for lo, hi in ranges])
+    ax.set_xlabel("squared jerk c (m²/s⁶)")
+    ax.set_ylabel("samples")
+    ax.set_yscale("log")
+    ax.legend()
+    return {"ax": ax, "bars": bars, "counts": counts}
+
+
+def plot_headway_cdf(headway: Mapping[str, npt.ArrayLike], *, ax: Any = None,
+                     max_h: float = 3.0) -> dict[str, Any]:
+    """CDF of the time headway in [0, max_h] s per strategy (Fig. 12)."""
+    ax = _ax(ax)
+    lines = {}
+    for name, v in headway.items():
+        x = np.sort(np.asarray(v, dtype=np.float64)[np.isfinite(np.asarray(v, dtype=np.float64))])
+        x = x[(x >= 0) & (x <= max_h)]
+        (lines[name],) = ax.plot(x, np.arange(1, x.size + 1) / max(x.size, 1), label=name)
+    ax.set_xlabel("time headway h (s, eq 22)")
+    ax.set_ylabel("CDF")
+    ax.set_xlim(0, max_h)
+    ax.legend()
+    return {"ax": ax, "lines": lines}
+
+
+def plot_gains_over_region(gains: Mapping[str, npt.ArrayLike], *, tau: float, delta: float,
+                           headway: float, ax: Any = None, n: int = 161,
+                           max_points: int = 4000) -> dict[str, Any]:
+    """Executed gains of each policy over the certified region in the (k_x, k_v) plane.
+
+    The region is the exact certificate's map at k_a fixed to the median executed k_a
+    (:func:`stringstab.regions.region_map`); the points are coloured by policy.
+    """
+    from ..plots import plot_class_map
+    from ..regions import region_map
+
+    ax = _ax(ax, (6.4, 6.4))
+    allk = np.concatenate([np.asarray(g, dtype=np.float64).reshape(-1, 3) for g in gains.values()])
+    ka = float(np.median(allk[:, 2])) if allk.size else 0.5
+    g = np.linspace(-2.0, 2.0, n)
+    rmap = region_map({"k_x": g, "k_v": g}, {"k_a": round(ka, 3)}, tau=tau, delta=delta,
+                      headway=headway, methods=("exact",), progress=False)
+    drawn = plot_class_map(rmap, "exact", ax=ax)
+    pts = {}
+    rng = np.random.default_rng(0)
+    colors = ["black", "magenta", "yellow", "cyan"]
+    for j, (name, v) in enumerate(gains.items()):
+        K = np.asarray(v, dtype=np.float64).reshape(-1, 3)
+        if K.shape[0] > max_points:
+            K = K[rng.choice(K.shape[0], max_points, replace=False)]
+        pts[name] = ax.scatter(K[:, 0], K[:, 1], s=5, alpha=0.6, color=colors[j % len(colors)],
+                               label=f"{name}: executed K (each at its own k_a)")
+    from matplotlib.legend import Legend
+
+    # a second legend beside the region's (which stays the axes' legend, under the map)
+    ax.add_artist(Legend(ax, list(pts.values()), [h.get_label() for h in pts.values()],
+                         loc="lower left", fontsize=8))
+    ax.set_title(f"executed gains over the exact certified region (slice k_a = {ka:.3g})")
+    return {"ax": ax, "region": drawn, "points": pts, "k_a": ka}

@@ -1,0 +1,162 @@
+"""A trained deterministic policy: NumPy in, NumPy out, saved as safetensors + JSON.
+
+``policy(obs)`` is the actor's action μ(s) in environment units (no exploration noise): the
+proposed gains K for an IDL policy, the acceleration for a pure-RL one.  For an IDL policy,
+:meth:`Policy.gains` is what the vehicle *executes*: μ(s) after the repair step
+(:class:`~stringstab.rl.repair.GainRepair`), each triple certified by the exact certificate.
+
+:meth:`Policy.save` writes ``policy.safetensors`` (the actor's weights) and ``policy.json``
+(sizes, bounds, settings and the weights file's SHA-256); :func:`load_policy` refuses a missing,
+altered, truncated or foreign file with one :class:`~stringstab.errors.StringStabError` and never
+runs code from it.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import StringStabError
+from ..io import atomic_write_text, check_output_dir, dumps_json
+from .checkpoint import read_json, read_tensors, write_tensors
+from .repair import GainRepair
+
+__all__ = ["POLICY_FORMAT", "Policy", "load_policy"]
+
+#: Format tag of ``policy.json``.
+POLICY_FORMAT = "stringstab-rl-policy/1"
+
+Array = npt.NDArray[np.float64]
+
+
+class Policy:
+    """A deterministic actor with its settings (build with :func:`load_policy` or from training).
+
+    Attributes
+    ----------
+    info : dict
+        ``algo``, ``action`` ("gains" or "accel"), ``obs_dim``, ``act_dim``, ``low``, ``high``,
+        ``hidden``, the model parameters (``tau``, ``delta``, ``headway``, ``dt``) and the
+        ``repair`` settings.
+    repair : GainRepair or None
+        The repair of a gain policy (None for an acceleration policy).
+    """
+
+    def __init__(self, actor: Any, info: dict[str, Any]) -> None:
+        self.actor = actor
+        self.actor.eval()
+        self.info = dict(info)
+        self.repair: GainRepair | None = None
+        if self.info.get("action") == "gains":
+            r = self.info.get("repair") or {}
+            self.repair = GainRepair(
+                r.get("method", "projection"), tau=self.info["tau"], delta=self.info["delta"],
+                headway=self.info["headway"], bounds=(self.info["low"][0], self.info["high"][0]),
+                resolution=r.get("resolution", 0.05), refine=r.get("refine", 4),
+                sample_time=r.get("sample_time"))
+
+    @property
+    def algo(self) -> str:
+        """The agent that trained it ("idl", "td3" or "ddpg")."""
+        return str(self.info["algo"])
+
+    @property
+    def action(self) -> str:
+        """"gains" (IDL) or "accel" (pure RL)."""
+        return str(self.info["action"])
+
+    def __call__(self, obs: npt.ArrayLike) -> Array:
+        """μ(s) for states ``obs`` of shape (n, obs_dim) (or (obs_dim,)): (n, act_dim) float64."""
+        import torch
+
+        x = np.asarray(obs, dtype=np.float32)
+        one = x.ndim == 1
+        x2 = x.reshape(1, -1) if one else x
+        if x2.ndim != 2 or x2.shape[1] != self.info["obs_dim"]:
+            raise StringStabError(
+                f"policy input: expected states of shape (n, {self.info['obs_dim']}); got {x.shape}")
+        with torch.no_grad():
+            a = self.actor(torch.as_tensor(x2)).numpy().astype(np.float64)
+        return a[0] if one else a
+
+    def gains(self, obs: npt.ArrayLike) -> Array:
+        """The executed gains of an IDL policy: μ(s) repaired (each certified unless repair off)."""
+        if self.action != "gains":
+            raise StringStabError(f"policy of {self.algo!r} outputs accelerations, not gains")
+        K = self(obs)
+        shape = K.shape
+        K2 = K.reshape(-1, 3)
+        assert self.repair is not None
+        return self.repair(K2).reshape(shape)
+
+    def save(self, directory: str | os.PathLike[str]) -> Path:
+        """Write ``policy.safetensors`` and ``policy.json`` into ``directory`` (created)."""
+        d = check_output_dir(directory, what="policy folder")
+        d.mkdir(parents=True, exist_ok=True)
+        arrays = {k: v.detach().cpu().numpy() for k, v in self.actor.state_dict().items()}
+        digest = write_tensors(d / "policy.safetensors", arrays)
+        doc = {"format": POLICY_FORMAT, **self.info, "sha256": digest}
+        atomic_write_text(d / "policy.json", dumps_json(doc))
+        return d
+
+
+def _need(doc: dict[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
+    v = doc.get(key)
+    if isinstance(v, bool) or not isinstance(v, kind):
+        raise StringStabError(f"{where}: field {key!r} must be {getattr(kind, '__name__', kind)}; "
+                              f"found {v!r}")
+    return v
+
+
+def load_policy(directory: str | os.PathLike[str]) -> Policy:
+    """Load a policy saved by :meth:`Policy.save` (or a training run folder holding one).
+
+    Raises
+    ------
+    StringStabError
+        If the folder or a file is missing, a file was altered or truncated, the JSON is not a
+        stringstab policy, or the weights do not fit the described network.
+    """
+    import torch
+
+    from .networks import Actor
+
+    d = Path(directory)
+    if not d.is_dir():
+        raise StringStabError(f"policy folder {str(d)!r} does not exist; expected a folder with "
+                              "policy.json and policy.safetensors")
+    where = str(d / "policy.json")
+    info = read_json(d / "policy.json", fmt=POLICY_FORMAT, what="policy")
+    obs_dim = _need(info, "obs_dim", int, where)
+    act_dim = _need(info, "act_dim", int, where)
+    hidden = _need(info, "hidden", list, where)
+    low, high = _need(info, "low", list, where), _need(info, "high", list, where)
+    if _need(info, "action", str, where) not in ("gains", "accel"):
+        raise StringStabError(f"{where}: action must be 'gains' or 'accel'; found {info['action']!r}")
+    if info["action"] == "gains" and act_dim != 3:
+        raise StringStabError(f"{where}: a gain policy has act_dim 3; found {act_dim}")
+    for key in ("tau", "delta", "headway", "dt"):
+        _need(info, key, (int, float), where)
+    if len(low) != act_dim or len(high) != act_dim:
+        raise StringStabError(f"{where}: low/high must have act_dim={act_dim} entries")
+    arrays = read_tensors(d / "policy.safetensors", expected_sha256=_need(info, "sha256", str, where),
+                          what="policy")
+    try:
+        actor = Actor(obs_dim, act_dim, low=low, high=high, hidden=[int(h) for h in hidden])
+        want = actor.state_dict()
+        if set(arrays) != set(want):
+            raise StringStabError(
+                f"policy: {str(d / 'policy.safetensors')!r} holds tensors {sorted(arrays)}; "
+                f"expected {sorted(want)}")
+        actor.load_state_dict({k: torch.as_tensor(np.array(v)) for k, v in arrays.items()})
+    except (RuntimeError, ValueError, TypeError) as e:
+        if isinstance(e, StringStabError):
+            raise
+        raise StringStabError(f"policy: weights do not fit the network in {where} ({e})") from e
+    info.pop("format", None)
+    info.pop("sha256", None)
+    return Policy(actor, info)

@@ -1,0 +1,314 @@
+"""The IDL repair step (§3.3) for a training loop: every executed gain triple is certified.
+
+The agent proposes K = (k_x, k_v, k_a) for every environment at every step; before the eq-4 law
+acts, :class:`GainRepair` replaces each K that the exact certificate
+(:func:`stringstab.certificate.check`) does not certify by a nearby certified triple.  The
+library's repairs (:func:`stringstab.tuning.project`, :func:`stringstab.tuning.region_growing`)
+take milliseconds per triple, and at the start of training about 90 % of the gain box is not
+certified (at τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, 9 % of a 0.05-spaced lattice over [−2, 2]³ is),
+so calling them per environment step would dominate training.  The default method is therefore a
+*certified lookup*:
+
+``"projection"`` (default)
+    1. a cheap screen drops triples that surely fail (not internally stable, k_x ≤ 0 or
+       k_v + (T* − τ)k_x ≤ 0, or g(ω) < 0 at one of 48 fixed frequencies, where g is the
+       margin of :func:`stringstab.frequency.margin_g`: |Γ(jω)| > 1 there);
+    2. the rest are checked by the exact certificate in one vectorised call; certified triples
+       are executed unchanged;
+    3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
+       points of a grid of spacing ``resolution`` over the gain box that the exact certificate
+       certifies (built once per process and parameter set, one vectorised call, about 10 s for
+       the default 81³ grid);
+    4. ``refine`` bisection steps along the segment from that point towards the proposed K keep
+       the farthest point the exact certificate certifies (one vectorised call per step).
+
+    The result is within about one lattice spacing of the true projection (the nearest certified
+    triple); ``analysis/bench_train.py`` measures the difference against
+    :func:`stringstab.tuning.project`.
+``"projection-exact"``
+    :class:`stringstab.tuning.Projector` (IPOPT, with its cache) per uncertified triple.
+``"region-growing"``
+    the paper's search, :func:`stringstab.tuning.region_growing`, per uncertified triple; its
+    candidate test is the Taylor Proposition 1, so where its output is not certified by the
+    exact certificate the ``"projection"`` result is executed instead (counted in
+    ``stats["fallbacks"]``).
+``"off"``
+    no repair: the ablation (executed gains may be uncertified).
+
+Whatever the method, a triple is executed only if :func:`~stringstab.certificate.check` returned
+``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
+:func:`stringstab.sampled.check_sampled` at H: the loop the simulator runs holds u over each
+control step, and gains on the continuous certificate's boundary need not be string stable in
+that sampled loop.
+"""
+
+from __future__ import annotations
+
+import time
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..certificate import check
+from ..criteria import hurwitz
+from ..errors import StringStabError
+from ..frequency import margin_g
+from ..params import Params, positive
+from .config import REPAIRS
+
+__all__ = ["SCREEN_OMEGA", "GainRepair", "certified_lattice"]
+
+Array = npt.NDArray[np.float64]
+
+#: Frequencies (rad/s) of the cheap screen: g(ω) < 0 at any of them means |Γ(jω)| > 1.
+SCREEN_OMEGA = np.concatenate([np.linspace(0.0, 2.0, 33)[1:], np.linspace(2.25, 6.0, 16)])
+
+
+def _certified(K: Array, p: Params, sample_time: float | None = None) -> npt.NDArray[np.bool_]:
+    """Exact-certificate verdict (``check``) for the rows of K that pass the screen.
+
+    With ``sample_time`` H, a row counts only if the sampled-data certificate of the
+    zero-order-hold loop at H (:func:`stringstab.sampled.check_sampled`) certifies it too.
+    """
+    out = np.zeros(K.shape[0], dtype=bool)
+    if not K.shape[0]:
+        return out
+    cand = hurwitz(K[:, 0], K[:, 1], tau=p.tau, headway=p.headway)
+    if cand.any():
+        idx = np.flatnonzero(cand)
+        g = margin_g(SCREEN_OMEGA[None, :], K[idx, 0:1], K[idx, 1:2], K[idx, 2:3],
+                     tau=p.tau, delta=p.delta, headway=p.headway)
+        idx = idx[g.min(axis=1) >= 0.0]
+        if idx.size:
+            c = check(K[idx, 0], K[idx, 1], K[idx, 2], tau=p.tau, delta=p.delta, headway=p.headway)
+            ok = c.verdict == "certified"
+            if sample_time is not None and ok.any():
+                ok[ok] = _sampled_ok(K[idx[ok]], p, sample_time)
+            out[idx] = ok
+    return out
+
+
+def _sampled_ok(K: Array, p: Params, sample_time: float) -> npt.NDArray[np.bool_]:
+    """Sampled-data certificate (zero-order hold at ``sample_time``) of every row of K."""
+    from ..sampled import check_sampled
+
+    c = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta, headway=p.headway,
+                      sample_time=sample_time)
+    return np.asarray(c.verdict == "certified")
+
+
+@lru_cache(maxsize=8)
+def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
+                      resolution: float, sample_time: float | None = None) -> Array:
+    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
+    (and, with ``sample_time``, by the sampled-data certificate at that step).
+
+    Returns
+    -------
+    ndarray (m, 3)
+        Read-only; columns k_x, k_v, k_a.
+
+    Examples
+    --------
+    >>> pts = certified_lattice(0.1, 0.2, 1.1, -2.0, 2.0, 0.5)
+    >>> pts.shape[1], bool((pts[:, 0] > 0).all())
+    (3, True)
+    """
+    p = Params(tau, delta, headway)
+    n = round((hi - lo) / resolution) + 1
+    g = np.linspace(lo, hi, n)
+    K = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
+    pts = np.ascontiguousarray(K[_certified(K, p, sample_time)])
+    if not pts.shape[0]:
+        raise StringStabError(
+            f"no certified gains on the {n}^3 lattice over [{lo}, {hi}]^3 at tau={tau}, "
+            f"delta={delta}, headway={headway}; expected parameters with a certified region")
+    pts.setflags(write=False)
+    return pts
+
+
+class GainRepair:
+    """Map proposed gains ``(n, 3)`` to executed gains ``(n, 3)``, each certified (see module).
+
+    Parameters
+    ----------
+    method : {"projection", "projection-exact", "region-growing", "off"}
+        The repair (module docstring).
+    tau, delta, headway : float
+        Model parameters, s.
+    bounds : (float, float)
+        Gain box (Table 2: [−2, 2]).
+    resolution : float
+        Lattice spacing of the lookup.
+    refine : int
+        Bisection steps after the lookup.
+    sample_time : float, optional
+        Also require the sampled-data certificate of the zero-order-hold loop at this step
+        (:func:`stringstab.sampled.check_sampled`) for every executed triple.
+
+    Attributes
+    ----------
+    stats : dict
+        ``calls``, ``rows``, ``unchanged`` (certified as proposed), ``repaired``, ``fallbacks``,
+        ``seconds`` (time spent in the repair).
+
+    Examples
+    --------
+    >>> rep = GainRepair(tau=0.1, delta=0.2, headway=1.1, resolution=0.25)
+    >>> K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])
+    >>> K[0].tolist(), bool((K[1] != [0.9, -0.5, 1.1]).any())
+    ([1.2, 0.5, 0.6], True)
+    >>> from stringstab.certificate import check
+    >>> check(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
+    ['certified', 'certified']
+    """
+
+    def __init__(self, method: str = "projection", *, tau: float, delta: float, headway: float,
+                 bounds: tuple[float, float] = (-2.0, 2.0), resolution: float = 0.05,
+                 refine: int = 4, sample_time: float | None = None) -> None:
+        if method not in REPAIRS:
+            raise StringStabError(f"repair method must be one of {list(REPAIRS)}; got {method!r}")
+        self.method = method
+        self.params = Params(tau, delta, headway)
+        lo, hi = (float(b) for b in bounds)
+        if not lo < hi:
+            raise StringStabError(f"bounds must be (low, high) with low < high; got {bounds!r}")
+        self.bounds = (lo, hi)
+        self.resolution = positive("repair resolution", resolution)
+        if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 0:
+            raise StringStabError(f"repair refine must be an integer >= 0; got {refine!r}")
+        self.refine = int(refine)
+        self.sample_time = None if sample_time is None else positive("repair sample_time",
+                                                                      sample_time, unit=" s")
+        self._tree: Any = None
+        self._projector: Any = None
+        self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
+                                        "fallbacks": 0, "seconds": 0.0}
+
+    def describe(self) -> dict[str, Any]:
+        """The settings, for logs and JSON."""
+        return {"method": self.method, **self.params.as_dict(), "bounds": list(self.bounds),
+                "resolution": self.resolution, "refine": self.refine,
+                "sample_time": self.sample_time}
+
+    # -- the lookup -------------------------------------------------------------------------
+    def lattice(self) -> Array:
+        """The certified lattice of this repair (built on first use)."""
+        p = self.params
+        return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                                 self.sample_time)
+
+    def _kdtree(self) -> Any:
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.lattice())
+        return self._tree
+
+    def _nearest(self, K0: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
+        """Lattice point, refined by bisection under the continuous certificate; and which rows
+        moved off the lattice (those still need the sampled-data check, if any)."""
+        _, idx = self._kdtree().query(K0)
+        P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
+        moved = np.zeros(K0.shape[0], dtype=bool)
+        if self.refine:
+            lo = np.zeros(K0.shape[0])
+            hi = np.ones(K0.shape[0])
+            best = P.copy()
+            for _ in range(self.refine):  # bisection under the continuous certificate
+                mid = 0.5 * (lo + hi)
+                C = P + mid[:, None] * (K0 - P)
+                ok = _certified(C, self.params)
+                best[ok] = C[ok]
+                moved |= ok
+                lo = np.where(ok, mid, lo)
+                hi = np.where(ok, hi, mid)
+            P = best
+        return P, moved
+
+    def _exact(self, K0: Array) -> Array:
+        from ..tuning import Projector, region_growing
+
+        out = np.empty_like(K0)
+        p = self.params
+        for i, k in enumerate(K0):
+            if self.method == "projection-exact":
+                if self._projector is None:
+                    self._projector = Projector(tau=p.tau, delta=p.delta, headway=p.headway,
+                                                bounds=self.bounds)
+                r = self._projector(k)
+            else:
+                r = region_growing(k, tau=p.tau, delta=p.delta, headway=p.headway,
+                                   bounds=self.bounds)
+            kr = np.asarray(r.k, dtype=np.float64)
+            if r.certified and _certified(kr[None], p)[0]:
+                out[i] = kr
+            else:
+                out[i] = self._nearest(k[None])[0][0]
+                self.stats["fallbacks"] += 1
+        return out
+
+    def approximate(self, K: npt.ArrayLike) -> Array:
+        """A cheap, *uncertified* stand-in for the repair, for training signals only.
+
+        Rows that pass the cheap screen (module docstring, step 1) are returned unchanged, the
+        others are replaced by their nearest certified lattice point, without the exact check
+        or the refinement.  Used by the actor's proposal penalty
+        (``TD3Config.proposal_penalty``); never executed.
+        """
+        K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
+        if self.method == "off":
+            return K0
+        p = self.params
+        out = K0.copy()
+        ok = hurwitz(K0[:, 0], K0[:, 1], tau=p.tau, headway=p.headway)
+        if ok.any():
+            idx = np.flatnonzero(ok)
+            g = margin_g(SCREEN_OMEGA[None, :], K0[idx, 0:1], K0[idx, 1:2], K0[idx, 2:3],
+                         tau=p.tau, delta=p.delta, headway=p.headway)
+            ok[idx[g.min(axis=1) < 0.0]] = False
+        bad = np.flatnonzero(~ok)
+        if bad.size:
+            _, idx = self._kdtree().query(K0[bad])
+            out[bad] = self.lattice()[np.asarray(idx)]
+        return out
+
+    # -- the call -----------------------------------------------------------------------------
+    def __call__(self, K: npt.ArrayLike) -> Array:
+        """Executed gains for proposed gains ``K`` (shape ``(n, 3)``; clipped to the bounds)."""
+        t0 = time.perf_counter()
+        K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
+        if not np.isfinite(K0).all():
+            raise StringStabError("proposed gains must be finite; found NaN or inf")
+        out = K0.copy()
+        if self.method != "off":
+            p = self.params
+            ok = _certified(K0, p)  # continuous-time certificate (``check``)
+            bad = np.flatnonzero(~ok)
+            pending = ok.copy()  # rows whose executed gains still need the sampled check
+            if bad.size:
+                if self.method == "projection":
+                    out[bad], moved = self._nearest(K0[bad])
+                    pending[bad] = moved  # unmoved rows are lattice points: certified both ways
+                else:
+                    out[bad] = self._exact(K0[bad])
+                    pending[bad] = True
+            if self.sample_time is not None and pending.any():
+                # one sampled-data call per step; where it fails, the nearest lattice point
+                j = np.flatnonzero(pending)
+                keep = _sampled_ok(out[j], p, self.sample_time)
+                if (~keep).any():
+                    jj = j[~keep]
+                    _, idx = self._kdtree().query(K0[jj])
+                    out[jj] = self.lattice()[np.asarray(idx)]
+                    bad = np.union1d(bad, jj)
+                    self.stats["fallbacks"] += int(jj.size)
+            self.stats["unchanged"] += int(K0.shape[0] - bad.size)
+            self.stats["repaired"] += int(bad.size)
+        self.stats["calls"] += 1
+        self.stats["rows"] += K0.shape[0]
+        self.stats["seconds"] += time.perf_counter() - t0
+        return out
+

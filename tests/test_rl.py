@@ -1,0 +1,431 @@
+"""The policy trainer (stringstab.rl): tiny budgets, checkpoints, safety of loading, certified gains.
+
+Independent truths: executed gains are checked by numpy.roots (internal stability) and a fine
+frequency sweep of |Γ(jω)| written out here (not the toolkit's certificate); reward terms against
+hand-computed values of eqs 20, 21 and 24.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import pickle
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stringstab.cli import main
+from stringstab.errors import StringStabError
+from stringstab.traffic import BatchedCarFollowingEnv, sinusoid
+
+torch = pytest.importorskip("torch")
+pytest.importorskip("safetensors")
+
+from stringstab.rl import config_for, load_policy, train  # noqa: E402
+from stringstab.rl.repair import GainRepair  # noqa: E402
+
+pytestmark = pytest.mark.torch
+
+TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
+
+
+def tiny(algo: str, **kw):
+    base = dict(total_steps=96, learning_starts=32, batch_size=16, buffer_size=256, num_envs=4,
+                stop_episodes=0, seed=3, hidden=(16, 16), repair_resolution=0.25,
+                checkpoint_every=10_000)
+    base.update(kw)
+    return config_for(algo, **base)
+
+
+def short_leaders():
+    return [sinusoid(omega=w, amplitude=2.0, speed=15.0, duration=2.0) for w in (0.5, 1.0, 2.0)]
+
+
+# --------------------------------------------------------------------------- independent truth
+def independent_certified(K: np.ndarray) -> bool:
+    """Internally stable (numpy.roots) and max |Γ(jω)| ≤ 1 on a fine sweep (0, 60] rad/s."""
+    kx, kv, ka = (float(v) for v in K)
+    poles = np.roots([TAU, 1.0, kv + HEADWAY * kx, kx])
+    if not (poles.real < 0).all():
+        return False
+    w = np.concatenate([np.linspace(1e-4, 10.0, 40_000), np.linspace(10.0, 60.0, 5_000)])
+    s = 1j * w
+    gam = (kx + kv * s + ka * s**2 * np.exp(-DELTA * s)) / (TAU * s**3 + s**2 + (kv + HEADWAY * kx) * s + kx)
+    return bool(np.abs(gam).max() <= 1.0 + 1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 3), min_size=1, max_size=6))
+def test_repair_executes_only_certified_gains(props):
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3)
+    K = rep(np.array(props))
+    assert K.shape == (len(props), 3)
+    for k in K:
+        assert independent_certified(k), k
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 3), min_size=1, max_size=6))
+def test_repair_with_sample_time_certifies_the_sampled_loop_too(props):
+    from stringstab.sampled import check_sampled
+
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                     sample_time=0.1)
+    K = rep(np.array(props))
+    v = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=TAU, delta=DELTA, headway=HEADWAY,
+                      sample_time=0.1).verdict
+    assert (v == "certified").all()
+    for k in K:
+        assert independent_certified(k), k
+
+
+def test_repair_keeps_certified_and_moves_little():
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=4)
+    K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])
+    np.testing.assert_array_equal(K[0], [1.2, 0.5, 0.6])  # certified: unchanged
+    from stringstab.tuning import project
+
+    exact = project([0.9, -0.5, 1.1], tau=TAU, delta=DELTA, headway=HEADWAY)
+    # the lookup is within about one lattice step of the true projection
+    assert np.linalg.norm(K[1] - [0.9, -0.5, 1.1]) <= exact.distance + 0.25 * math.sqrt(3)
+    assert rep.stats["repaired"] == 1 and rep.stats["unchanged"] == 1
+
+
+@pytest.mark.parametrize("method", ["region-growing", "projection-exact"])
+def test_library_repairs_execute_only_certified_gains(method):
+    rep = GainRepair(method, tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25)
+    props = np.array([[0.9, -0.5, 1.1], [0.2, 0.7, 0.0], [-0.5, 1.0, 1.0], [1.3, 0.0, 0.6]])
+    K = rep(props)
+    np.testing.assert_array_equal(K[3], props[3])  # certified as proposed
+    for k in K:
+        assert independent_certified(k), k
+    assert rep.stats["repaired"] == 3
+
+
+def test_repair_off_is_the_ablation():
+    rep = GainRepair("off", tau=TAU, delta=DELTA, headway=HEADWAY)
+    np.testing.assert_array_equal(rep([[0.9, -0.5, 1.1]]), [[0.9, -0.5, 1.1]])
+
+
+# --------------------------------------------------------------------------- rewards
+def lognormal(h, mu=0.4226, sigma=0.4365):
+    return math.exp(-((math.log(h) - mu) ** 2) / (2 * sigma**2)) / (h * sigma * math.sqrt(2 * math.pi))
+
+
+def test_reward_terms_match_eqs_20_21_24_in_the_environment():
+    """One env step from hand-set states: r_f (eq 20), r_j (eq 21), r_e (eq 24), r (eq 18)."""
+    env = BatchedCarFollowingEnv(1, [sinusoid(omega=0.5, amplitude=0.0, speed=20.0, duration=5.0)],
+                                 action="accel")
+    env.reset(seed=0)
+    _, r, _, _, info = env.step(np.array([[2.0]]))
+    gap, v, vp, a = info["gap"][0], info["speed"][0], 20.0, info["accel"][0]
+    ttc = gap / (v - vp) if v > vp else math.inf
+    rf = 0.0 if ttc > 3.0 else (ttc / 3.0 - 1.0 if ttc > 0 else -1.0)
+    rj = -((a - 0.0) ** 2) / (3.0 - (-7.6)) ** 2
+    h = gap / v
+    hstar = math.exp(0.4226 - 0.4365**2)
+    re = lognormal(h) / lognormal(hstar) - 1.0
+    assert info["r_f"][0] == pytest.approx(rf, abs=1e-12)
+    assert info["r_j"][0] == pytest.approx(rj, rel=1e-12)
+    assert info["r_e"][0] == pytest.approx(re, rel=1e-9)
+    assert r[0] == pytest.approx((rf + rj + re) / 3, rel=1e-9)
+
+
+@pytest.mark.parametrize(("ttc", "expected"), [(math.inf, 0.0), (4.0, 0.0), (1.5, -0.5),
+                                               (0.75, -0.75), (0.0, -1.0), (-2.0, -1.0)])
+def test_safety_reward_eq20(ttc, expected):
+    from stringstab.traffic.reward import safety_reward
+
+    assert float(safety_reward(ttc)) == pytest.approx(expected, abs=1e-12)
+
+
+def test_comfort_and_efficiency_rewards_hand_values():
+    from stringstab.traffic.reward import comfort_reward, efficiency_reward
+
+    assert float(comfort_reward(1.0, -1.0)) == pytest.approx(-4.0 / 10.6**2, rel=1e-12)
+    hstar = math.exp(0.4226 - 0.4365**2)
+    assert float(efficiency_reward(hstar)) == pytest.approx(0.0, abs=1e-12)
+    assert float(efficiency_reward(2.0)) == pytest.approx(lognormal(2.0) / lognormal(hstar) - 1, rel=1e-12)
+    assert lognormal(hstar) == pytest.approx(0.6588, abs=1e-4)  # F(h*) printed in the paper
+    assert float(efficiency_reward(0.0)) == -1.0
+
+
+# --------------------------------------------------------------------------- training
+@pytest.mark.parametrize("algo", ["idl", "td3", "ddpg"])
+def test_each_algorithm_trains_on_a_tiny_budget(algo):
+    cfg = tiny(algo)
+    torch.manual_seed(123)
+    res = train(cfg, leaders=short_leaders(), progress=False)
+    assert res.steps == 96 and res.stopped_by == "steps"
+    assert len(res.episodes) >= 4  # 20-step episodes on 4 environments
+    obs = np.zeros((5, 3))
+    act = res.policy(obs)
+    assert act.shape == (5, 3 if algo == "idl" else 1) and act.dtype == np.float64
+    lo, hi = (-2.0, 2.0) if algo == "idl" else (-7.6, 3.0)
+    assert ((act >= lo) & (act <= hi)).all()
+    again = train(cfg, leaders=short_leaders(), progress=False)  # seeded: reproducible
+    np.testing.assert_array_equal(again.policy(obs), act)
+    if algo == "idl":
+        assert res.repair is not None and res.repair["rows"] == 96
+        for k in res.policy.gains(np.random.default_rng(0).normal(size=(8, 3))):
+            assert independent_certified(k)
+
+
+def test_stop_rule_counts_collision_free_episode_ends():
+    res = train(tiny("ddpg", total_steps=10_000, stop_episodes=6), leaders=short_leaders(),
+                progress=False)
+    assert res.stopped_by == "episodes"
+    assert sum(1 - e["collision"] for e in res.episodes) >= 6
+    assert res.steps < 10_000
+
+
+def test_contract_custom_env_and_policy_save_load(tmp_path):
+    env = BatchedCarFollowingEnv(2, short_leaders(), action="accel")
+    res = train(tiny("ddpg", num_envs=2), env=env, progress=False)
+    res.policy.save(tmp_path / "pol")
+    pol = load_policy(tmp_path / "pol")
+    obs = np.random.default_rng(1).normal(size=(4, 3))
+    np.testing.assert_array_equal(pol(obs), res.policy(obs))
+
+
+def test_resume_is_bit_for_bit(tmp_path):
+    cfg = tiny("idl", total_steps=160, checkpoint_every=80)
+    full = train(cfg, leaders=short_leaders(), out=tmp_path / "full", progress=False)
+    half = train(cfg.replace(total_steps=80), leaders=short_leaders(), out=tmp_path / "half",
+                 progress=False)
+    assert half.steps == 80
+    resumed = train(cfg, leaders=short_leaders(), out=tmp_path / "half", resume=True, progress=False)
+    assert resumed.steps == 160
+    for (k, a), (_, b) in zip(full.policy.actor.state_dict().items(),
+                              resumed.policy.actor.state_dict().items()):
+        assert torch.equal(a, b), k
+    assert full.episodes == resumed.episodes
+    from stringstab.rl.checkpoint import latest_checkpoint
+
+    s1, t1 = latest_checkpoint(tmp_path / "full" / "checkpoint")
+    s2, t2 = latest_checkpoint(tmp_path / "half" / "checkpoint")
+    assert s1["rng"] == s2["rng"] and s1["env"] == s2["env"] and s1["buffer"] == s2["buffer"]
+    for f in ("agent", "buffer"):
+        assert t1[f].keys() == t2[f].keys()
+        for k in t1[f]:
+            np.testing.assert_array_equal(t1[f][k], t2[f][k], err_msg=k)
+
+
+# --------------------------------------------------------------------------- safe loading
+class _Payload:
+    """Unpickling this would create a file: the test fails if any loader runs it."""
+
+    def __init__(self, marker: Path) -> None:
+        self.marker = marker
+
+    def __reduce__(self):
+        return (Path.touch, (self.marker,))
+
+
+def _trained_run(tmp_path: Path, algo: str = "idl") -> Path:
+    out = tmp_path / f"run-{algo}"
+    train(tiny(algo, total_steps=64), leaders=short_leaders(), out=out, progress=False)
+    return out
+
+
+def test_crafted_pickle_is_refused_without_running_it(tmp_path):
+    run = _trained_run(tmp_path)
+    marker = tmp_path / "PWNED"
+    blob = pickle.dumps({"actor": _Payload(marker)})
+    (run / "policy.safetensors").write_bytes(blob)
+    # even with a matching checksum the file is parsed as safetensors, never unpickled
+    doc = json.loads((run / "policy.json").read_text())
+    import hashlib
+
+    doc["sha256"] = hashlib.sha256(blob).hexdigest()
+    (run / "policy.json").write_text(json.dumps(doc))
+    with pytest.raises(StringStabError, match="not a safetensors tensor file"):
+        load_policy(run)
+    ck = sorted((run / "checkpoint").glob("ckpt-*"))[-1]
+    (ck / "agent.safetensors").write_bytes(blob)
+    with pytest.raises(StringStabError, match="altered or truncated"):
+        train(tiny("idl", total_steps=128), leaders=short_leaders(), out=run, resume=True,
+              progress=False)
+    assert not marker.exists()
+
+
+def test_no_unsafe_loader_in_the_package():
+    import re
+
+    import stringstab.rl
+
+    src = "".join(p.read_text() for p in Path(stringstab.rl.__file__).parent.glob("*.py"))
+    for pattern in (r"torch\.load\(", r"import pickle", r"pickle\.load", r"np\.load\(",
+                    r"allow_pickle\s*=\s*True"):
+        assert not re.search(pattern, src), pattern
+
+
+def test_tampered_and_truncated_files_are_refused(tmp_path):
+    run = _trained_run(tmp_path)
+    data = (run / "policy.safetensors").read_bytes()
+    (run / "policy.safetensors").write_bytes(data[: len(data) // 2])
+    with pytest.raises(StringStabError, match="altered or truncated"):
+        load_policy(run)
+    (run / "policy.safetensors").write_bytes(data)
+    assert load_policy(run).algo == "idl"
+    (run / "policy.json").write_text('{"format": "something-else"}')
+    with pytest.raises(StringStabError, match="expected 'stringstab-rl-policy/1'"):
+        load_policy(run)
+
+
+# --------------------------------------------------------------------------- command line
+def test_cli_train_evaluate_compare(tmp_path, capsys):
+    run = tmp_path / "runs" / "idl"
+    code = main(["train", "--algo", "idl", "--steps", "64", "--seed", "1", "--out", str(run),
+                 "--num-envs", "4", "--no-progress"])
+    assert code == 0
+    for f in ("policy.json", "policy.safetensors", "train_log.csv", "rolling_reward.png",
+              "summary.json", "run.json", "config.json", "checkpoint/latest.json"):
+        assert (run / f).is_file(), f
+    leader = tmp_path / "lead.csv"
+    tr = sinusoid(omega=0.8, amplitude=2.0, speed=15.0, duration=8.0)
+    leader.write_text("t,v\n" + "".join(f"{t:.1f},{v:.6f}\n" for t, v in zip(tr.t, tr.speed)))
+    code = main(["evaluate", str(run), "--leaders", str(leader), "--platoon", "none"])
+    assert code in (0, 1)
+    doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
+    assert doc["summary"]["M_fss"] == 100.0  # the repair is on: every executed gain certified
+    assert code == (0 if doc["summary"]["collisions"] == 0 else 1)
+    from stringstab.gainio import read_gains
+
+    g = read_gains(run / "evaluation" / "gains.csv")
+    assert len(g) == doc["summary"]["n_gains"] == tr.n_steps
+    for k in g.K[:: max(1, len(g) // 10)]:
+        assert independent_certified(k)
+    assert main(["certify", "--file", str(run / "evaluation" / "gains.csv"), "--format", "json",
+                 "--out", str(tmp_path / "cert.json")]) == 0
+    cert = json.loads((tmp_path / "cert.json").read_text())
+    assert cert["summary"]["certified"] == cert["summary"]["n"] == len(g)
+    # a pure-RL run: no gains to certify -> exit 1
+    run2 = tmp_path / "runs" / "ddpg"
+    assert main(["train", "--algo", "ddpg", "--steps", "64", "--out", str(run2), "--num-envs", "4",
+                 "--no-progress"]) == 0
+    assert main(["evaluate", str(run2), "--leaders", str(leader), "--platoon", "none"]) == 1
+    out = tmp_path / "cmp"
+    assert main(["compare", str(run), str(run2), "--baselines", "cacc,idm", "--leaders",
+                 str(leader), "--out", str(out)]) == 0
+    for f in ("table.md", "table.csv", "comparison.json", "fig6_mp.png", "fig9_ttc.png",
+              "fig11_jerk.png", "fig12_headway.png", "gains_region.png"):
+        assert (out / f).is_file(), f
+    assert "idl compared to cacc" in (out / "table.md").read_text()
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_platoon_test_reports_m_p_per_vehicle():
+    from stringstab.metrics import platoon_damping_ratios
+    from stringstab.rl.evaluate import platoon_test
+    from stringstab.traffic import CACCController, paper_mix, simulate
+
+    p = platoon_test("cacc", 3, tau=TAU, delta=DELTA, headway=HEADWAY, hold=0.0)
+    res = simulate(paper_mix(), CACCController(), 3, tau=TAU, delta=DELTA,
+                   initial_gap=2.0 + HEADWAY * 20.0)
+    np.testing.assert_allclose(p["m_p"], platoon_damping_ratios(res.accel), rtol=1e-5)
+    assert p["n"] == 3 and p["collisions"] == 0 and p["M_fss"] is None
+
+
+def _bad(argv, match, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and match in err, err
+
+
+def test_cli_bad_input(tmp_path, capsys):
+    out = tmp_path / "never"
+    _bad(["train", "--algo", "ppo", "--steps", "10", "--out", str(out)], "--algo must be one of", capsys)
+    _bad(["train", "--algo", "idl", "--steps", "0", "--out", str(out)], "--steps must be an integer >= 1", capsys)
+    _bad(["train", "--algo", "idl", "--steps", "10", "--out", str(out), "--resume"], "missing file", capsys)
+    assert not out.exists()
+    _bad(["evaluate", str(tmp_path / "missing")], "does not exist", capsys)
+    (tmp_path / "empty").mkdir()
+    _bad(["evaluate", str(tmp_path / "empty")], "not a training run folder", capsys)
+    (tmp_path / "foreign").mkdir()
+    (tmp_path / "foreign" / "run.json").write_text('{"format": "other/1"}')
+    _bad(["evaluate", str(tmp_path / "foreign")], "expected 'stringstab-rl-run/1'", capsys)
+    run = _trained_run(tmp_path, "ddpg")
+    _bad(["train", "--algo", "idl", "--steps", "128", "--out", str(run), "--resume"],
+         "holds a run of --algo 'ddpg'", capsys)
+    (run / "policy.safetensors").unlink()
+    _bad(["evaluate", str(run)], "missing file", capsys)
+    run = _trained_run(tmp_path, "idl")
+    cases = {"cols.csv": ("time,speed\n0,1\n1,2\n", "expected columns 't, v'"),
+             "nan.csv": ("t,v\n0,1\n1,nan\n2,3\n", "must be finite"),
+             "neg.csv": ("t,v\n0,1\n1,-2\n2,3\n", "speed must be >= 0")}
+    for name, (text, match) in cases.items():
+        f = tmp_path / name
+        f.write_text(text)
+        _bad(["evaluate", str(run), "--leaders", str(f)], match, capsys)
+        _bad(["train", "--algo", "idl", "--steps", "10", "--out", str(tmp_path / "t"),
+              "--leaders", str(f)], match, capsys)
+        assert not (run / "evaluation").exists() and not (tmp_path / "t").exists()
+
+
+def test_package_imports_without_torch():
+    code = ("import sys; sys.modules['torch'] = None; import stringstab.rl as r; "
+            "print(r.config_for('idl').buffer_size)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "10000"
+
+
+def _ngsim(path: Path, n_pairs: int = 4) -> Path:
+    """An NGSIM-format file (feet): n_pairs leader-follower pairs of 20 s each."""
+    head = "Vehicle_ID,Frame_ID,Local_Y,v_Vel,v_Acc,Preceding,v_Length\n"
+    rows = []
+    for j in range(n_pairs):
+        lead, foll = 2 * j + 1, 2 * j + 2
+        for f in range(100, 301):
+            t = (f - 100) * 0.1
+            v = 40.0 + 5.0 * math.sin(0.5 * t + j)
+            y = 1000.0 * j + 40.0 * t - 10.0 * (math.cos(0.5 * t + j) - math.cos(j))
+            a = 2.5 * math.cos(0.5 * t + j)
+            rows.append(f"{lead},{f},{y + 80.0:.4f},{v:.4f},{a:.4f},0,15\n")
+            rows.append(f"{foll},{f},{y:.4f},{v:.4f},{a:.4f},{lead},15\n")
+    path.write_text(head + "".join(rows))
+    return path
+
+
+def test_ngsim_file_gives_disjoint_train_and_test_pairs(tmp_path):
+    from stringstab.rl.episodes import leaders_from_files
+    from stringstab.rl.evaluate import evaluate
+
+    f = _ngsim(tmp_path / "ngsim.csv")
+    train_pairs = leaders_from_files([f], "train")
+    test_pairs = leaders_from_files([f], "test")
+    assert len(train_pairs) + len(test_pairs) == 4 and test_pairs
+    assert not {p.follower_id for p in train_pairs} & {p.follower_id for p in test_pairs}
+    ev = evaluate("cacc", test_pairs, tau=TAU, delta=DELTA, headway=HEADWAY)
+    assert ev.summary["episodes"] == len(test_pairs) and ev.summary["collisions"] == 0
+    # an episode starts where the recorded follower was: 80 ft minus the 15 ft leader = 65 ft
+    assert test_pairs[0].gap[0] == pytest.approx(65 * 0.3048, rel=1e-9)
+    env = BatchedCarFollowingEnv(2, train_pairs, action="accel")
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.zeros((2, 1)))
+    assert info["gap"] == pytest.approx(65 * 0.3048, abs=1.0)
+
+
+def test_contract_with_the_hcfs_environment(tmp_path):
+    """The HCFS helper's use of the contract, with the real trainer (6-D states, ±3 m/s²)."""
+    from stringstab.hcfs import constants as C
+    from stringstab.hcfs.ddpg import load_ddpg, save_ddpg, train_ddpg
+    from stringstab.hcfs.env import HCFSVectorEnv
+    from stringstab.traffic import stop_and_go
+
+    env = HCFSVectorEnv(1, [stop_and_go(dt=C.DT)], n_followers=2)
+    pol = train_ddpg(total_steps=120, seed=1, env=env, learning_starts=40, batch_size=16,
+                     stop_episodes=0, hidden=(16, 16))
+    save_ddpg(pol, tmp_path / "p")
+    back = load_ddpg(tmp_path / "p")
+    obs = np.random.default_rng(0).normal(size=(3, 6))
+    a = back.policy(obs)
+    assert a.shape == (3, 1) and (np.abs(a) <= 3.0).all()
+    np.testing.assert_array_equal(a, pol.policy(obs))
