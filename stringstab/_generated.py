@@ -64,6 +64,30 @@ def margin_and_scale(omega: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, s_t2
     )
 
 
+def margin_separable(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """(c, h2, h0, cx, cv) with g(ω) = (τω² − c)² + h2 ω² + h0 + cx cos(δω) − cv ω sin(δω)."""
+    _x0 = 2*k_x
+    return (
+        k_v + k_x*headway,
+        1 - (k_a*k_a),
+        -_x0 - (k_v*k_v),
+        _x0*k_a,
+        2*k_a*k_v,
+    )
+
+
+def margin_separable_scales(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any) -> tuple[Any, ...]:
+    """Σ |term| of each value of :func:`margin_separable` (round-off scales)."""
+    _x0 = abs(k_x)
+    return (
+        _x0*headway + abs(k_v),
+        1 + (k_a*k_a),
+        (k_v*k_v) + 2*_x0,
+        2*abs(k_a*k_x),
+        2*abs(k_a*k_v),
+    )
+
+
 def margin_curvature_bound(r: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, delta: Any) -> Any:
     """M ≥ |g''(ω)| for every ω in [0, r], from the coefficients."""
     _x0 = (delta*delta)

@@ -1,7 +1,7 @@
 """A vectorised one-dimensional branch and bound: is f ≥ 0 on [0, Ω_i] for every item i?
 
-The engine behind the sampled-data and robust certificates (:mod:`stringstab.sampled`,
-:mod:`stringstab.robust`).  Each item i (a gain triple, or a gain triple and a cell of
+The one engine behind every certificate: continuous time (:mod:`stringstab.certificate`),
+sampled data (:mod:`stringstab.sampled`) and robust (:mod:`stringstab.robust`).  Each item i (a gain triple, or a gain triple and a cell of
 uncertain parameters) has a function f_i on [0, Ω_i] that the caller can evaluate at any
 points, returning for each point
 
@@ -36,7 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["CERTIFIED", "INCONCLUSIVE", "PENDING", "VIOLATED", "BranchAndBound", "branch_and_bound"]
+__all__ = ["CERTIFIED", "INCONCLUSIVE", "PENDING", "VIOLATED", "BranchAndBound", "branch_and_bound",
+           "verdict_codes", "zoom_max"]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
@@ -68,7 +69,8 @@ class BranchAndBound:
     argmin : ndarray
         Where it was found.
     n_evals : ndarray of int
-        Point evaluations per item.
+        Points evaluated per item (the initial grid, then the new interior points of each
+        split).
     grid_x, grid_f : ndarray
         The initial grid and the point values on it (for reporting, e.g. a peak search).
     pending_item, pending_lo, pending_hi : ndarray
@@ -86,13 +88,22 @@ class BranchAndBound:
     pending_hi: Array
 
 
-def _lower(G: Array, Glow: Array, E: Array, M: Array, X: Array) -> tuple[Array, Array, Array, Array]:
-    h = X[:, 1:] - X[:, :-1]
-    sl = np.maximum(E[:, :-1], E[:, 1:])
-    end = np.minimum(Glow[:, :-1], Glow[:, 1:])
-    curv = M * h * h / 8.0
-    low_gap = np.maximum(G[:, :-1] - Glow[:, :-1], G[:, 1:] - Glow[:, 1:])
-    return end - curv - sl, end - sl, curv, low_gap
+def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
+    """Item outcomes as verdict codes (:data:`stringstab.verdicts.VERDICTS`): certified 0,
+    violated 1 (not certified), anything else 2 (inconclusive)."""
+    v = np.full(np.shape(status), 2, dtype=np.int8)
+    v[status == CERTIFIED] = 0
+    v[status == VIOLATED] = 1
+    return v
+
+
+def _lower(Glow: Array, E: Array, M: Array, X: Array) -> tuple[Array, Array, Array]:
+    """(lower bound, end value − slack, M h²/8) on every interval; a row's grid is uniform."""
+    h = X[:, 1:2] - X[:, :1]
+    gap = np.minimum(Glow[:, :-1], Glow[:, 1:])
+    gap -= np.maximum(E[:, :-1], E[:, 1:])
+    curv = M * (h * h / 8.0)
+    return gap - curv, gap, curv
 
 
 def branch_and_bound(
@@ -145,8 +156,9 @@ def branch_and_bound(
     G, Glow, E, M = evaluate(idx, X) if idx.size else (X, X, X, X[:, 1:])
     grid_x, grid_f = (X, G) if intervals is None else (np.zeros((n, 0)), np.zeros((n, 0)))
 
+    new_points = X.shape[1]  # the first evaluation: every point; later the interior ones
     while True:
-        np.add.at(n_evals, idx, X.shape[1])
+        np.add.at(n_evals, idx, new_points)
         if idx.size:
             j = np.argmin(G, axis=1)
             rows = np.arange(idx.size)
@@ -157,18 +169,21 @@ def branch_and_bound(
             viol = np.any(G < -E, axis=1)
             if viol.any():
                 violated[np.unique(idx[viol])] = True
-        low, gap, curv, low_gap = _lower(G, Glow, E, M, X)
+        low, gap, curv = _lower(Glow, E, M, X)
         und = (low < 0) & ~violated[idx][:, None]
-        if refine is not None:
+        if refine is not None:  # the first pass only: later passes hold refined items alone
             skip = und & ~refine[idx][:, None]
             if skip.any():  # undecided but not to be refined: never certified
                 inconclusive[np.unique(idx[np.nonzero(skip)[0]])] = True
             und &= refine[idx][:, None]
+            refine = None
         ii, kk = np.nonzero(und)
         it, L, R = idx[ii], X[ii, kk], X[ii, kk + 1]
         gp, Mi = gap[ii, kk], M[ii, kk]
         if hold is not None and it.size:
-            hm = hold(it, L, R, low_gap[ii, kk], curv[ii, kk])
+            # how much the cell's width costs at the worse end: point − lower bound
+            low_gap = np.maximum(G[ii, kk] - Glow[ii, kk], G[ii, kk + 1] - Glow[ii, kk + 1])
+            hm = hold(it, L, R, low_gap, curv[ii, kk])
             if hm.any():
                 held.append((it[hm], L[hm], R[hm]))
                 keep = ~hm
@@ -194,6 +209,7 @@ def branch_and_bound(
         while split > 4 and it.size * split > 2_000_000:
             split //= 2
         v = np.linspace(0.0, 1.0, split + 1)
+        new_points = split - 1
         idx = it
         X = L[:, None] + (R - L)[:, None] * v[None, :]
         G, Glow, E, M = evaluate(idx, X)
@@ -213,3 +229,38 @@ def branch_and_bound(
     keep = ~violated[pi] & ~inconclusive[pi]
     return BranchAndBound(status, minimum, argmin, n_evals, grid_x, grid_f,
                           pi[keep], pl[keep], ph[keep])
+
+
+def zoom_max(
+    f: Callable[[Array], Array], x: Array, fx: Array, half: Array, *, lo: float = 0.0,
+    hi: float = math.inf, rounds: int = 8,
+) -> tuple[Array, Array]:
+    """Refine the maximum of f near ``x`` (one per row): a 9-point grid, shrunk ×4 each round.
+
+    For *reporting* a peak (sup |Γ| or sup |H| and where): it never certifies anything.
+    ``f`` maps an (n, 9) array of points (clipped to [lo, hi]) to values (NaN counts as
+    +inf, a pole on the axis); ``fx`` are the values at ``x`` and ``half`` the initial
+    half-widths.  Returns the best values and their points.
+
+    Examples
+    --------
+    >>> v, x = zoom_max(lambda t: -(t - 0.3) ** 2, np.array([0.0]), np.array([-0.09]),
+    ...                 np.array([0.5]))
+    >>> round(float(x[0]), 6)
+    0.3
+    """
+    rows = np.arange(x.size)
+    best, bx = np.asarray(fx, dtype=float).copy(), np.asarray(x, dtype=float).copy()
+    half = np.asarray(half, dtype=float)
+    v = np.linspace(-1.0, 1.0, 9)
+    for _ in range(rounds):
+        X = np.clip(bx[:, None] + half[:, None] * v[None, :], lo, hi)
+        F = f(X)
+        F = np.where(np.isnan(F), np.inf, F)
+        j = np.argmax(F, axis=1)
+        fj = F[rows, j]
+        upd = fj > best
+        best = np.where(upd, fj, best)
+        bx = np.where(upd, X[rows, j], bx)
+        half = half / 4.0
+    return best, bx

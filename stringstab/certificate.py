@@ -45,22 +45,37 @@ algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 import numpy.typing as npt
 
 from . import _generated as _gen
 from . import margin as _margin
-from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz, hurwitz_margin, taylor_criteria
+from .branch_bound import branch_and_bound, verdict_codes, zoom_max
+from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
 from .frequency import gain_squared
-from .io.results import TableColumn, columns_from_records, records_from_columns
+from .io.results import TableColumn, columns_from_records
 from .margin import tail_bound
-from .params import Params, as_gains
+from .params import Box, Params, as_gains, parameter_model
+from .params import sample_time as _sample_time
+from .verdicts import (
+    VERDICTS,
+    BatchResult,
+    Check,
+    SingleResult,
+    chunks,
+    names,
+    num,
+    one_triple,
+)
+
+if TYPE_CHECKING:
+    from .robust import RobustCertificate, RobustCertificateBatch
+    from .sampled import SampledCertificate, SampledCertificateBatch
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -78,12 +93,8 @@ __all__ = [
 
 Array = npt.NDArray[np.float64]
 
-#: The three possible verdicts.
-VERDICTS = ("certified", "not_certified", "inconclusive")
 _CERT, _NOT, _INC = 0, 1, 2
-
 _SLACK = 1e-13  # relative round-off slack on g
-_HURWITZ_RTOL = 1e-12  # relative band around the Hurwitz boundary left inconclusive
 
 
 # ---------------------------------------------------------------------------
@@ -105,7 +116,7 @@ def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
 
 
 # ---------------------------------------------------------------------------
-# Step 2: branch and bound on g over [0, Omega]
+# Step 2: branch and bound on g over [0, Omega] (stringstab.branch_bound, the one engine)
 # ---------------------------------------------------------------------------
 @dataclass
 class _Exact:
@@ -120,7 +131,7 @@ class _Exact:
 
 def _exact_chunk(
     kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float,
-    *, n_grid: int, max_rounds: int, split_min: int, max_intervals: int,
+    *, n_grid: int, max_rounds: int, max_intervals: int,
     refine: npt.NDArray[np.bool_] | None = None,
 ) -> _Exact:
     n = kx.size
@@ -132,83 +143,14 @@ def _exact_chunk(
         Q[i] = v
     Om = tail_bound(*Q[:5])
 
-    u = np.linspace(0.0, 1.0, n_grid + 1)
-    W = Om[:, None] * u[None, :]
-    Qc = Q[:, :, None]
-    G, E = _g_and_slack(W, Qc)
-    violated = np.any(G < -E, axis=1)
-    imin = np.argmin(G, axis=1)
-    margin = G[np.arange(n), imin]
-    worst = W[np.arange(n), imin]
-    n_evals = np.full(n, n_grid + 1, dtype=np.int64)
+    def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
+        Qt = Q[:, idx, None]
+        G, E = _g_and_slack(X, Qt)
+        return G, G, E, _margin.curvature_bound(X[:, 1:], Qt[:5], Qt[10])
 
-    # interval lower bounds
-    h = (Om / n_grid)[:, None]
-    M = _margin.curvature_bound(W[:, 1:], Qc[:5], Qc[10])
-    Gl, Gr = G[:, :-1], G[:, 1:]
-    slack = np.maximum(E[:, :-1], E[:, 1:])
-    lower = np.minimum(Gl, Gr) - M * h * h / 8.0 - slack
-    undecided = (lower < 0) & ~violated[:, None]
-    if refine is not None:  # e.g. skip triples already known not to be internally stable
-        undecided &= refine[:, None]
-    tri, k = np.nonzero(undecided)
-    L = W[tri, k]
-    R = W[tri, k + 1]
-    # what an interval needs: min(g(l), g(r)) against its curvature bound
-    gap = np.minimum(Gl, Gr)[tri, k] - slack[tri, k]
-    Mi = M[tri, k]
-    inconclusive = np.zeros(n, dtype=bool)
-
-    for _ in range(max_rounds):
-        if tri.size == 0:
-            break
-        # budget, per triple (so a verdict never depends on the other triples
-        # of its chunk): too many undecided intervals → inconclusive
-        counts = np.bincount(tri, minlength=n)
-        over = counts > max_intervals
-        if over.any():
-            inconclusive |= over
-            sel = ~over[tri]
-            tri, L, R, gap, Mi = tri[sel], L[sel], R[sel], gap[sel], Mi[sel]
-            if tri.size == 0:
-                break
-        # adaptive split: enough pieces that M h²/8 ≤ gap/2 where the endpoints
-        # are clearly positive (one round instead of several near a shallow dip);
-        # the bound is re-checked on every piece, so this only saves rounds
-        with np.errstate(divide="ignore", invalid="ignore"):
-            need = np.where(gap > 0, (R - L) * np.sqrt(Mi / (4.0 * gap)), split_min)
-        split = int(min(max(split_min, 2 ** math.ceil(math.log2(max(float(np.max(need)), 1.0)))), 64))
-        while split > split_min and tri.size * split > 2_000_000:
-            split //= 2
-        v = np.linspace(0.0, 1.0, split + 1)
-        Wn = L[:, None] + (R - L)[:, None] * v[None, :]
-        Qt = Q[:, tri, None]
-        Gn, En = _g_and_slack(Wn, Qt)
-        np.add.at(n_evals, tri, split - 1)
-        # track the minimum found and violations
-        jmin = np.argmin(Gn, axis=1)
-        gmin = Gn[np.arange(tri.size), jmin]
-        np.minimum.at(margin, tri, gmin)
-        better = gmin <= margin[tri]
-        worst[tri[better]] = Wn[np.arange(tri.size), jmin][better]
-        viol_int = np.any(Gn < -En, axis=1)
-        if viol_int.any():
-            violated[np.unique(tri[viol_int])] = True
-        hn = ((R - L) / split)[:, None]
-        Mn = _margin.curvature_bound(Wn[:, 1:], Qt[:5], Qt[10])
-        lowern = np.minimum(Gn[:, :-1], Gn[:, 1:]) - Mn * hn * hn / 8.0 - np.maximum(En[:, :-1], En[:, 1:])
-        und = (lowern < 0) & ~violated[tri][:, None]
-        ii, kk = np.nonzero(und)
-        gap = (np.minimum(Gn[:, :-1], Gn[:, 1:]) - np.maximum(En[:, :-1], En[:, 1:]))[ii, kk]
-        Mi = Mn[ii, kk]
-        tri, L, R = tri[ii], Wn[ii, kk], Wn[ii, kk + 1]
-    if tri.size:
-        inconclusive[np.unique(tri)] = True
-
-    verdict = np.full(n, _CERT, dtype=np.int8)
-    verdict[inconclusive] = _INC
-    verdict[violated] = _NOT
-    return _Exact(verdict, margin, Om, worst, n_evals, W, G)
+    bb = branch_and_bound(n, evaluate, right=Om, n_grid=n_grid, max_rounds=max_rounds,
+                          max_intervals=max_intervals, refine=refine)
+    return _Exact(verdict_codes(bb.status), bb.minimum, Om, bb.argmin, bb.n_evals, bb.grid_x, bb.grid_f)
 
 
 # ---------------------------------------------------------------------------
@@ -250,30 +192,18 @@ def _peak(
     best_w = Wall[rows, j]
     best = Gall[rows, j]
     # local refinement around the best sample: grid spacing, then /4 each round
-    half = Om / (W.shape[1] - 1)
-    v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(8):
-        Wl = np.maximum(best_w[:, None] + half[:, None] * v[None, :], 0.0)
-        Gl = gain_squared(Wl, col(kx), col(kv), col(ka), tau=tau, delta=delta, headway=headway)
-        Gl = np.where(np.isnan(Gl), np.inf, Gl)
-        jl = np.argmax(Gl, axis=1)
-        gl = Gl[rows, jl]
-        upd = gl > best
-        best = np.where(upd, gl, best)
-        best_w = np.where(upd, Wl[rows, jl], best_w)
-        half = half / 4.0
+    best, best_w = zoom_max(
+        lambda Wl: gain_squared(Wl, col(kx), col(kv), col(ka), tau=tau, delta=delta,
+                                headway=headway),
+        best_w, best, Om / (W.shape[1] - 1))
     return np.sqrt(best), best_w
 
 
 # ---------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------
-def _num(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
-
 @dataclass(frozen=True)
-class Certificate:
+class Certificate(SingleResult):
     """The certificate of one gain triple.
 
     Attributes
@@ -332,11 +262,6 @@ class Certificate:
     n_evals: int = 0
     pade: dict[str, Any] | None = None
 
-    @property
-    def certified(self) -> bool:
-        """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
-
     def as_dict(self) -> dict[str, Any]:
         """The JSON row of ``stringstab certify`` (non-finite numbers become None)."""
         d: dict[str, Any] = {
@@ -344,14 +269,14 @@ class Certificate:
             "k_v": self.k_v,
             "k_a": self.k_a,
             "hurwitz": self.hurwitz,
-            "hurwitz_margin": _num(self.hurwitz_margin),
+            "hurwitz_margin": num(self.hurwitz_margin),
             "verdict": self.verdict,
             "type": self.type,
-            "sup_gain": _num(self.sup_gain),
-            "linf_gain": _num(self.linf_gain),
-            "peak_omega": _num(self.peak_omega),
-            "margin": _num(self.margin),
-            "omega_max": _num(self.omega_max),
+            "sup_gain": num(self.sup_gain),
+            "linf_gain": num(self.linf_gain),
+            "peak_omega": num(self.peak_omega),
+            "margin": num(self.margin),
+            "omega_max": num(self.omega_max),
             "taylor_derived": self.taylor_derived,
             "taylor_printed": self.taylor_printed,
             "method": self.method,
@@ -362,7 +287,7 @@ class Certificate:
 
 
 @dataclass(frozen=True)
-class CertificateBatch:
+class CertificateBatch(BatchResult):
     """Certificates of many triples, as arrays (see :class:`Certificate` for fields)."""
 
     k_x: Array
@@ -383,14 +308,6 @@ class CertificateBatch:
     taylor_printed: TaylorCriteria
     method: str = "exact"
     pade: list[dict[str, Any]] | None = field(default=None)
-
-    def __len__(self) -> int:
-        return int(self.k_x.size)
-
-    @property
-    def certified(self) -> npt.NDArray[np.bool_]:
-        """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
 
     def __getitem__(self, i: int) -> Certificate:
         return Certificate(
@@ -433,19 +350,13 @@ class CertificateBatch:
             cols["pade"] = columns_from_records(self.pade)
         return cols
 
-    def records(self) -> list[dict[str, Any]]:
-        """One JSON row per triple (:meth:`Certificate.as_dict`; non-finite numbers are None)."""
-        return records_from_columns(self.columns())
-
     def summary(self) -> dict[str, Any]:
         """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27).
 
         ``m_fss`` is eq 27's M_fss without its ×100 % (docs/conventions.md): every M_fss of
         the toolkit is a fraction; the simulator's metrics keep a percentage under an old key.
         """
-        n = len(self)
-        counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
-        return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+        return super().summary()
 
 
 def _taylor_columns(tc: TaylorCriteria) -> dict[str, Any]:
@@ -476,82 +387,156 @@ TABLE_COLUMNS: list[TableColumn] = [
 ]
 
 
-def _hurwitz_bands(kx: Array, kv: Array, p: Params) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
-    """(surely Hurwitz, surely not Hurwitz); neither within 1e-12 of the boundary."""
-    hz_sure = hurwitz(kx, kv, tau=p.tau, headway=p.headway, rtol=_HURWITZ_RTOL)
-    hz_fail = ~hurwitz(kx, kv, tau=p.tau, headway=p.headway, rtol=-_HURWITZ_RTOL)
-    return hz_sure, hz_fail
+# ---------------------------------------------------------------------------
+# The loop a caller asks for: continuous or sampled, point parameters or a box
+# ---------------------------------------------------------------------------
+_LOOP_DOC = """tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it."""
 
 
-@dataclass(frozen=True)
-class Check:
-    """Verdicts only (see :func:`check`).
+def _loop(tau: Any, delta: Any, headway: Any, sample_time: Any, tau_prev: Any,
+          method: str = "exact") -> tuple[Params | Box, float | None]:
+    """The parameters (a point or a box) and the sample time, checked."""
+    model = parameter_model(tau, delta, headway)
+    H = None if sample_time is None else _sample_time(sample_time)
+    if tau_prev is not None and (H is None or isinstance(model, Box)):
+        raise StringStabError(
+            "tau_prev (the predecessor's lag) is for the sampled loop at point parameters; "
+            f"got it with {'a box' if isinstance(model, Box) else 'sample_time=None'}")
+    if method not in ("exact", "pade"):
+        raise StringStabError(f"method must be 'exact' or 'pade'; got {method!r}")
+    if method == "pade" and (H is not None or isinstance(model, Box)):
+        raise StringStabError(
+            "method='pade' (python-control's cross-check) is for the continuous loop at one τ, δ, "
+            f"T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
+    return model, H
 
-    Attributes
-    ----------
-    verdict : ndarray of str
-        ``"certified"``, ``"not_certified"`` or ``"inconclusive"``.
-    hurwitz : ndarray of bool
-        Internally stable (surely, outside the 1e-12 boundary band).
-    margin : ndarray
-        Smallest g(ω) found.
-    witness_omega : ndarray
-        Where it was found: for an internally stable, not-certified triple,
-        a frequency with |Γ(jω)| > 1.
-    """
 
-    verdict: npt.NDArray[np.str_]
-    hurwitz: npt.NDArray[np.bool_]
-    margin: Array
-    witness_omega: Array
+def _gains(k_x: Any, k_v: Any, k_a: Any) -> tuple[Array, Array, Array]:
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    return (np.ascontiguousarray(kx, dtype=float).ravel(),
+            np.ascontiguousarray(kv, dtype=float).ravel(),
+            np.ascontiguousarray(ka, dtype=float).ravel())
+
+
+def _continuous_check(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int,
+                      max_rounds: int, max_intervals: int) -> Check:
+    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
+    ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
+                      max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
+    v = ex.verdict.copy()
+    v[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
+    return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
 
 
 def check(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: float, delta: float, headway: float,
-    n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 1024,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
 ) -> Check:
-    """The exact certificate's verdicts alone, for inner loops (e.g. gain repair).
+    """The certificate's verdicts alone, for inner loops (e.g. gain repair).
 
-    The same sound decision as :func:`certify_batch` (same branch and bound,
-    same verdicts) without the reporting extras — no peak search, no Taylor
-    criteria, no pole margins — so one triple costs a fraction of a
-    millisecond.
-
-    Examples
-    --------
-    >>> check([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
-    ['certified', 'not_certified']
-    """
-    p = Params(tau, delta, headway)
-    kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
-    hz_sure, hz_fail = _hurwitz_bands(kx, kv, p)
-    ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
-                      max_rounds=max_rounds, split_min=4, max_intervals=max_intervals,
-                      refine=~hz_fail)
-    v = ex.verdict.copy()
-    v[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
-    return Check(np.array(VERDICTS)[v], hz_sure, ex.margin, ex.worst_omega)
-
-
-def certify_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: float, delta: float, headway: float, method: str = "exact",
-    pade_order: int = 5, progress: bool = False, chunk: int = 4096,
-    n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 1024,
-) -> CertificateBatch:
-    """Certify many gain triples at once (exact delay, sound; see the module docstring).
+    The same sound decision as :func:`certify_batch` (same branch and bound, same
+    verdicts) without the reporting extras — no peak search, no Taylor criteria, no pole
+    margins — so one triple costs a fraction of a millisecond in continuous time.
 
     Parameters
     ----------
     k_x, k_v, k_a : array_like
         Gains, broadcast together and flattened.
-    tau, delta, headway : float
-        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).
-    method : {"exact", "pade"}
+    {loop}
+    n_grid, max_rounds, max_intervals : int
+        As for :func:`certify_batch`.
+
+    Returns
+    -------
+    Check
+        With ``sample_time`` and ``witness_theta`` when sampled
+        (:class:`stringstab.sampled.SampledCheck`), and the witness member
+        (``witness_tau``, ``witness_delta``, ...) over a box.
+
+    Examples
+    --------
+    >>> check([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
+    ['certified', 'not_certified']
+    >>> c = check([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2, headway=1.1,
+    ...           sample_time=0.1)
+    >>> c.verdict.tolist(), c.sample_time
+    (['certified', 'not_certified'], 0.1)
+    """
+    model, H = _loop(tau, delta, headway, sample_time, tau_prev)
+    kx, kv, ka = _gains(k_x, k_v, k_a)
+    if isinstance(model, Box):
+        from .robust import check_robust
+
+        return check_robust(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
+                            sample_time=H, heterogeneous=heterogeneous, n_grid=n_grid,
+                            max_rounds=max_rounds, max_intervals=max_intervals)
+    if H is not None:
+        from .sampled import check_sampled
+
+        return check_sampled(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
+                             sample_time=H, tau_prev=tau_prev, n_grid=n_grid,
+                             max_rounds=max_rounds, max_intervals=max_intervals)
+    return _continuous_check(kx, kv, ka, model, n_grid=n_grid or 64, max_rounds=max_rounds,
+                             max_intervals=max_intervals)
+
+
+@overload
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: float, delta: float, headway: float, sample_time: None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: None = None, heterogeneous: bool = True,
+) -> CertificateBatch: ...
+
+
+@overload
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
+
+
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    """Certify many gain triples at once (exact delay, sound; see the module docstring).
+
+    With point parameters and no sample time this is the continuous-time certificate of
+    this module; ``sample_time`` certifies the sampled-data loop
+    (:func:`stringstab.sampled.certify_sampled_batch`) and any interval the whole box
+    (:func:`stringstab.robust.certify_robust_batch`), with the same three verdicts.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains, broadcast together and flattened.
+    {loop}
+    method : {{"exact", "pade"}}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`certify_pade`) per triple and warns where it disagrees; the
-        verdict is always the exact one.
+        verdict is always the exact one (continuous loop, point parameters only).
     pade_order : int
         Padé order for the cross-check.
     progress : bool
@@ -559,18 +544,22 @@ def certify_batch(
     chunk : int
         Triples per vectorised chunk (bounds memory).
     n_grid, max_rounds, max_intervals : int
-        Initial intervals on [0, Ω], refinement rounds, and the cap on undecided
-        intervals *per triple* beyond which that triple is declared inconclusive
-        (per triple, so a verdict never depends on the rest of the batch).
+        Initial intervals on [0, Ω] (default 64; sampled: on [0, π], 64 + 8m), refinement
+        rounds, and the cap on undecided intervals *per triple* beyond which that triple is
+        declared inconclusive (per triple, so a verdict never depends on the rest of the
+        batch).
 
     Returns
     -------
-    CertificateBatch
+    CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
+        The last two carry ``sample_time`` and the parameter box in their columns, rows and
+        summary.
 
     Raises
     ------
     StringStabError
-        On non-finite gains or parameters out of range.
+        On non-finite gains, parameters out of range, a malformed interval (lo > hi, a
+        negative end, τ reaching 0), or a sample time that is not a finite number > 0.
 
     Examples
     --------
@@ -579,11 +568,36 @@ def certify_batch(
     ['certified', 'not_certified']
     >>> b.summary()["m_fss"]
     0.5
+    >>> r = certify_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta="0.1:0.3",
+    ...                   headway=1.1)
+    >>> r.verdict.tolist(), r.summary()["box"]["tau"]
+    (['certified', 'not_certified'], [0.1, 0.3])
     """
-    p = Params(tau, delta, headway)
-    if method not in ("exact", "pade"):
-        raise StringStabError(f"method must be 'exact' or 'pade'; got {method!r}")
-    kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
+    model, H = _loop(tau, delta, headway, sample_time, tau_prev, method)
+    kx, kv, ka = _gains(k_x, k_v, k_a)
+    if isinstance(model, Box):
+        from .robust import certify_robust_batch
+
+        return certify_robust_batch(
+            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
+            heterogeneous=heterogeneous, progress=progress, chunk=chunk, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals)
+    if H is not None:
+        from .sampled import certify_sampled_batch
+
+        return certify_sampled_batch(
+            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
+            tau_prev=tau_prev, progress=progress, chunk=chunk, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals)
+    return _continuous_batch(kx, kv, ka, model, method=method, pade_order=pade_order,
+                             progress=progress, chunk=chunk, n_grid=n_grid or 64,
+                             max_rounds=max_rounds, max_intervals=max_intervals)
+
+
+def _continuous_batch(
+    kx: Array, kv: Array, ka: Array, p: Params, *, method: str, pade_order: int, progress: bool,
+    chunk: int, n_grid: int, max_rounds: int, max_intervals: int,
+) -> CertificateBatch:
     n = kx.size
     verdict = np.empty(n, dtype=np.int8)
     margin = np.empty(n)
@@ -593,19 +607,13 @@ def certify_batch(
     peak_w = np.empty(n)
 
     # internal stability, with an inconclusive band around the boundary
-    hz_sure, hz_fail = _hurwitz_bands(kx, kv, p)
+    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
     hz_margin = hurwitz_margin(kx, kv, tau=p.tau, headway=p.headway)
 
-    starts = range(0, n, chunk)
-    if progress:
-        from tqdm.auto import tqdm
-
-        starts = tqdm(starts, total=math.ceil(n / chunk), desc="certify", unit="chunk")
-    for s0 in starts:
-        sl = slice(s0, min(s0 + chunk, n))
+    for sl in chunks(n, chunk, progress=progress):
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
-                          n_grid=n_grid, max_rounds=max_rounds, split_min=4,
-                          max_intervals=max_intervals, refine=~hz_fail[sl])
+                          n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals,
+                          refine=~hz_fail[sl])
         verdict[sl], margin[sl], omega_max[sl], n_evals[sl] = ex.verdict, ex.margin, ex.omega_max, ex.n_evals
         # certified ⇒ sup |Γ| = 1 at ω = 0: only the others need a peak search
         need = ex.verdict != _CERT
@@ -624,7 +632,7 @@ def certify_batch(
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")
     tp = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="printed")
-    names = np.array(VERDICTS)[verdict]
+    vnames = names(verdict)
     pade_rows = None
     if method == "pade":
         pade_rows = []
@@ -633,10 +641,10 @@ def certify_batch(
             pr = certify_pade(kx[i], kv[i], ka[i], tau=p.tau, delta=p.delta, headway=p.headway,
                               order=pade_order)
             row = pr.as_dict()
-            row["agrees"] = pr.verdict == names[i] or names[i] == "inconclusive"
+            row["agrees"] = pr.verdict == vnames[i] or vnames[i] == "inconclusive"
             if not row["agrees"]:
                 disagree.append(
-                    f"K=({kx[i]:g}, {kv[i]:g}, {ka[i]:g}): exact {names[i]} (sup {hinf[i]:.9g}), "
+                    f"K=({kx[i]:g}, {kv[i]:g}, {ka[i]:g}): exact {vnames[i]} (sup {hinf[i]:.9g}), "
                     f"Padé {pr.verdict} (norm {pr.hinf:.9g})"
                 )
             pade_rows.append(row)
@@ -645,21 +653,51 @@ def certify_batch(
             warnings.warn(
                 f"Padé({pade_order}) cross-check disagrees with the exact certificate on "
                 f"{len(disagree)} of {n} triples: " + "; ".join(disagree[:3]) + more,
-                stacklevel=2,
+                stacklevel=3,
             )
     return CertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, hurwitz=np.asarray(hz_sure),
-        hurwitz_margin=hz_margin, verdict=names, type=np.array([TYPE_NAMES[int(t)] for t in td.type]) if n else np.array([], dtype=str),
+        hurwitz_margin=hz_margin, verdict=vnames, type=np.array([TYPE_NAMES[int(t)] for t in td.type]) if n else np.array([], dtype=str),
         sup_gain=hinf, linf_gain=sup, peak_omega=peak_w, margin=margin, omega_max=omega_max,
         n_evals=n_evals, taylor_derived=td, taylor_printed=tp, method=method, pade=pade_rows,
     )
 
 
+@overload
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
-    method: str = "exact", pade_order: int = 5,
-) -> Certificate:
+    sample_time: None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: None = None, heterogeneous: bool = True,
+) -> Certificate: ...
+
+
+@overload
+def certify(
+    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
+    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> Certificate | SampledCertificate | RobustCertificate: ...
+
+
+def certify(
+    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
+    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> Certificate | SampledCertificate | RobustCertificate:
     """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        The gains.
+    {loop}
+    method, pade_order
+        As for :func:`certify_batch`.
+
+    Returns
+    -------
+    Certificate, SampledCertificate or RobustCertificate
+        The continuous, sampled-data or robust certificate of the triple.
 
     Examples
     --------
@@ -669,12 +707,19 @@ def certify(
     >>> c = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
     >>> c.verdict, c.type, c.taylor_printed["verdict"]
     ('not_certified', 'IV', 'stable')
+    >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)
+    ('not_certified', 1.0911, 1.379, 0.1379)
     """
-    for name, v in (("k_x", k_x), ("k_v", k_v), ("k_a", k_a)):
-        if np.ndim(v) != 0:
-            raise StringStabError(f"certify takes one triple; {name} has shape {np.shape(v)}; use certify_batch")
+    one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     return certify_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
-                         method=method, pade_order=pade_order)[0]
+                         sample_time=sample_time, method=method, pade_order=pade_order,
+                         tau_prev=tau_prev, heterogeneous=heterogeneous)[0]
+
+
+for _f in (check, certify_batch, certify):
+    _f.__doc__ = (_f.__doc__ or "").replace("{loop}", _LOOP_DOC).replace("{{", "{").replace("}}", "}")
+del _f
 
 
 # ---------------------------------------------------------------------------
@@ -692,8 +737,8 @@ class PadeResult:
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
-        return {"order": self.order, "stable": self.stable, "hinf": _num(self.hinf),
-                "linf": _num(self.linf), "verdict": self.verdict}
+        return {"order": self.order, "stable": self.stable, "hinf": num(self.hinf),
+                "linf": num(self.linf), "verdict": self.verdict}
 
 
 def certify_pade(

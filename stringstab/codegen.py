@@ -36,7 +36,7 @@ from sympy.printing.str import StrPrinter
 from . import symbolic as S
 from .printed import printed_psi
 
-__all__ = ["MARGIN_BASIS", "TARGET", "generate", "main", "margin_basis"]
+__all__ = ["MARGIN_BASIS", "TARGET", "generate", "main", "margin_basis", "margin_separable"]
 
 #: The committed file this module writes.
 TARGET = Path(__file__).with_name("_generated.py")
@@ -219,6 +219,34 @@ def margin_basis() -> dict[str, sp.Expr]:
     return {name: sp.expand(sign * found[(t, k)]) for name, sign, t, k in MARGIN_BASIS}
 
 
+def margin_separable() -> dict[str, sp.Expr]:
+    """g(ω) split as (τω² − c)² + h2 ω² + h0 + c_x cos(δω) − c_v ω sin(δω).
+
+    The robust certificate (:mod:`stringstab.robust`) minimises g over a box of τ, δ, T*
+    in closed form because only the square depends on τ and T* (through τ and
+    c = k_v + T*k_x) and only the trigonometric terms on δ.  Everything is derived from
+    :func:`margin_basis`: t2 = τ², c = −½ ∂a/∂τ (a is affine in τ), h2 = a + 2τc,
+    h0 = b − c².
+
+    Raises
+    ------
+    AssertionError
+        When the split does not hold (h2, h0, c_x, c_v depend on τ, δ or T*).
+    """
+    basis = margin_basis()
+    tau, headway, delta = S.tau, S.headway, S.delta
+    a, b = basis["a"], basis["b"]
+    c = sp.expand(-sp.diff(a, tau) / 2)
+    out = {"c": c, "h2": sp.expand(a + 2 * tau * c), "h0": sp.expand(b - c**2),
+           "cx": basis["cx"], "cv": basis["cv"]}
+    ok = (sp.expand(basis["t2"] - tau**2) == 0 and sp.diff(a, tau, 2) == 0
+          and not (out["c"].free_symbols & {tau, delta})
+          and all(not (out[k].free_symbols & {tau, headway, delta}) for k in ("h2", "h0", "cx", "cv")))
+    if not ok:  # pragma: no cover - only when the model changes
+        raise AssertionError(f"g does not split as (τω² − c)² + h(ω) + trig terms: {out}")
+    return out
+
+
 def _abs_terms(e: sp.Expr) -> sp.Expr:
     """Σ |term| over the terms of the expanded ``e`` (a round-off scale of ``e``)."""
     return sp.Add(*[sp.Abs(t) for t in sp.Add.make_args(sp.expand(e))])
@@ -283,6 +311,15 @@ def _source() -> str:
         "margin_and_scale", ["omega", *names, *(f"s_{n}" for n in names), "delta"],
         [g_basis, scale],
         "(g(ω), Σ |term of g(ω)| bound) from the coefficients and their scales.", trig=True,
+    ))
+    split = margin_separable()
+    blocks.append(_function(
+        "margin_separable", gain_args, list(split.values()),
+        "(c, h2, h0, cx, cv) with g(ω) = (τω² − c)² + h2 ω² + h0 + cx cos(δω) − cv ω sin(δω).",
+    ))
+    blocks.append(_function(
+        "margin_separable_scales", gain_args, [_abs_terms(e) for e in split.values()],
+        "Σ |term| of each value of :func:`margin_separable` (round-off scales).",
     ))
     r = sp.Symbol("r", nonnegative=True)
     blocks.append(_function(

@@ -37,9 +37,11 @@ from .params import as_gains, check_params
 
 __all__ = [
     "HURWITZ_LABELS",
+    "HURWITZ_RTOL",
     "TYPE_NAMES",
     "TaylorCriteria",
     "hurwitz",
+    "hurwitz_bands",
     "hurwitz_conditions",
     "hurwitz_gradients",
     "hurwitz_margin",
@@ -144,6 +146,28 @@ def hurwitz(
     else:
         ok = [c > 0 for c in conds]
     return np.asarray(np.logical_and.reduce(ok) & np.ones(kx.shape, dtype=bool))
+
+
+#: Relative band around the Hurwitz boundary that the certificates leave inconclusive.
+HURWITZ_RTOL = 1e-12
+
+
+def hurwitz_bands(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float,
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+    """(surely Hurwitz, surely not Hurwitz): neither within a relative 10⁻¹² of the boundary.
+
+    The certificates' internal-stability decision (:data:`HURWITZ_RTOL`): a triple in
+    neither set is left inconclusive.
+
+    Examples
+    --------
+    >>> [v.tolist() for v in hurwitz_bands([1.0, -1.0, 0.0], 0.5, tau=0.1, headway=1.1)]
+    [[True, False, False], [False, True, True]]
+    """
+    sure = hurwitz(k_x, k_v, tau=tau, headway=headway, rtol=HURWITZ_RTOL)
+    fail = ~hurwitz(k_x, k_v, tau=tau, headway=headway, rtol=-HURWITZ_RTOL)
+    return sure, fail
 
 
 def hurwitz_margin(

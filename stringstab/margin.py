@@ -54,6 +54,7 @@ __all__ = [
     "gradient",
     "local_minima",
     "newton_terms",
+    "separable",
     "tail_bound",
     "tail_coefficients",
 ]
@@ -97,6 +98,28 @@ def coefficient_scales(
     """Σ |term| of each coefficient: the scale of its round-off (≥ its absolute value)."""
     kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
     return MarginCoefficients(*_gen.margin_coefficient_scales(kx, kv, ka, tau, delta, headway))
+
+
+def separable(
+    k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, headway: ArrayLike,
+) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+    """g split as (τω² − c)² + h2 ω² + h0 + cx cos δω − cv ω sin δω, and round-off scales.
+
+    Returns ((c, h2, h0, cx, cv), their Σ |term| scales); only c depends on the parameters
+    (on T*), so the minimum of g over a box of τ, δ, T* has a closed form
+    (:mod:`stringstab.robust`).  Generated from the derivation (:func:`stringstab.codegen.margin_separable`).
+
+    Examples
+    --------
+    >>> (c, h2, h0, cx, cv), _ = separable(1.0, 0.5, 0.2, headway=1.1)
+    >>> w, tau, delta = 2.0, 0.1, 0.2
+    >>> split = (tau * w * w - c) ** 2 + h2 * w * w + h0 + cx * np.cos(delta * w) - cv * w * np.sin(delta * w)
+    >>> bool(np.isclose(split, g(w, 1.0, 0.5, 0.2, tau=tau, delta=delta, headway=1.1)))
+    True
+    """
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
+    return (_gen.margin_separable(kx, kv, ka, 0.0, 0.0, headway),
+            _gen.margin_separable_scales(kx, kv, ka, 0.0, 0.0, headway))
 
 
 def g_from_coefficients(omega: ArrayLike, co: _Coefficients,

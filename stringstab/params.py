@@ -9,6 +9,11 @@ The three parameters of the IDL paper's vehicle model (eqs 3-9):
 ``headway``
     desired time headway T* in seconds, ≥ 0 (eq 3).
 
+Each may also be uncertain: an interval ``(lo, hi)`` (or ``"LO:HI"`` on the command line),
+and the three intervals form a :class:`Box` (the robust certificate,
+:mod:`stringstab.robust`, holds for every member).  :func:`parameter_model` turns what a
+caller gives into :class:`Params` (every value a point) or a :class:`Box`.
+
 Defaults follow the IDL paper's Table 2 (δ = 0.2 s, T* = 1.1 s); the paper does
 not print τ, and τ = 0.1 s is the value used in its reference Zhou et al. (2020)
 and throughout this toolkit's examples.
@@ -30,16 +35,26 @@ __all__ = [
     "DEFAULT_DELTA",
     "DEFAULT_HEADWAY",
     "DEFAULT_TAU",
+    "Box",
+    "Interval",
     "Params",
     "as_gains",
+    "as_interval",
+    "check_box",
     "check_params",
     "count",
+    "parameter_model",
+    "parse_interval",
     "positive",
+    "sample_time",
 ]
 
 DEFAULT_TAU = constants.TAU
 DEFAULT_DELTA = constants.DELTA
 DEFAULT_HEADWAY = constants.HEADWAY
+
+#: A closed interval (lo, hi) of a parameter, s.
+Interval = tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -179,3 +194,210 @@ def as_gains(
             where = f" at index {tuple(int(i) for i in idx)}" if a.ndim else ""
             raise StringStabError(f"{name} must be finite{where}; got {show(float(a[tuple(idx)]))}")
     return arrs[0], arrs[1], arrs[2]
+
+
+def sample_time(value: Any) -> float:
+    """The sampling period H (``sample_time``) as a float: finite and > 0 s.
+
+    Raises
+    ------
+    StringStabError
+        Saying what was expected and what was found.
+
+    Examples
+    --------
+    >>> sample_time("0.1")
+    0.1
+    >>> sample_time(0)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: sample_time (sampling period H) must be a finite number > 0 s; got 0
+    """
+    return positive("sample_time (sampling period H)", value, unit=" s")
+
+
+# ---------------------------------------------------------------------------
+# Intervals and boxes of uncertain parameters
+# ---------------------------------------------------------------------------
+def _interval_error(name: str, text: Any) -> StringStabError:
+    return StringStabError(
+        f"{name} must be a number or an interval LO:HI (e.g. 0.1:0.5); got {show(text)}")
+
+
+def parse_interval(text: str, name: str = "value") -> Interval:
+    """Parse ``"LO:HI"`` (or a plain number, a point interval) into ``(lo, hi)``.
+
+    For the command line (``--tau 0.1:0.5``); range checks (τ > 0, δ ≥ 0) are
+    :class:`Box`'s.
+
+    Parameters
+    ----------
+    text : str
+        ``"0.1:0.5"`` or ``"0.2"``.
+    name : str
+        What the interval is, for the error message.
+
+    Returns
+    -------
+    (float, float)
+
+    Raises
+    ------
+    StringStabError
+        On a malformed or non-finite end, or lo > hi.
+
+    Examples
+    --------
+    >>> parse_interval("0.1:0.5"), parse_interval("0.2")
+    ((0.1, 0.5), (0.2, 0.2))
+    >>> parse_interval("0.5:0.1", "tau")
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: tau interval must have lo <= hi; got '0.5:0.1'
+    """
+    parts = str(text).strip().split(":")
+    if len(parts) not in (1, 2) or not all(p.strip() for p in parts):
+        raise _interval_error(name, text)
+    try:
+        ends = [float(p) for p in parts]
+    except ValueError as e:
+        raise _interval_error(name, text) from e
+    if not all(math.isfinite(v) for v in ends):
+        raise StringStabError(f"{name} interval ends must be finite numbers; got {show(text)}")
+    lo, hi = ends[0], ends[-1]
+    if lo > hi:
+        raise StringStabError(f"{name} interval must have lo <= hi; got {show(text)}")
+    return lo, hi
+
+
+def as_interval(value: Any, name: str = "value") -> Interval:
+    """A number, a ``(lo, hi)`` pair or a ``"LO:HI"`` string as a checked ``(lo, hi)``.
+
+    Raises
+    ------
+    StringStabError
+        On a value that is none of these, a non-finite end, or lo > hi.
+
+    Examples
+    --------
+    >>> as_interval(0.1), as_interval((0.1, 0.3)), as_interval("0:0.2")
+    ((0.1, 0.1), (0.1, 0.3), (0.0, 0.2))
+    """
+    if isinstance(value, str):
+        return parse_interval(value, name)
+    if isinstance(value, (tuple, list, np.ndarray)):
+        if len(value) != 2:
+            raise StringStabError(
+                f"{name} must be a number or a (lo, hi) pair; got {len(value)} values")
+        lo, hi = (_finite(f"{name} interval end", v) for v in value)
+        if lo > hi:
+            raise StringStabError(f"{name} interval must have lo <= hi; got {show(value)}")
+        return lo, hi
+    v = _finite(name, value)
+    return v, v
+
+
+@dataclass(frozen=True)
+class Box:
+    """A box of model parameters, each a ``(lo, hi)`` interval in seconds.
+
+    Examples
+    --------
+    >>> Box((0.1, 0.5), (0.2, 0.2), (1.1, 1.1)).is_point
+    False
+    >>> Box((0.0, 0.5), (0.2, 0.2), (1.1, 1.1))
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: tau (actuator lag) interval must stay > 0 s; got [0.0, 0.5]
+    """
+
+    tau: Interval
+    delta: Interval
+    headway: Interval
+
+    def __post_init__(self) -> None:
+        for name, (lo, hi) in (("tau (actuator lag)", self.tau),
+                               ("delta (communication delay)", self.delta),
+                               ("headway (desired time headway T*)", self.headway)):
+            if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+                raise StringStabError(f"{name} interval must be finite with lo <= hi; got [{lo}, {hi}]")
+        if not self.tau[0] > 0:
+            raise StringStabError(
+                f"tau (actuator lag) interval must stay > 0 s; got [{self.tau[0]}, {self.tau[1]}]")
+        if self.delta[0] < 0:
+            raise StringStabError(
+                f"delta (communication delay) interval must be >= 0 s; got [{self.delta[0]}, {self.delta[1]}]")
+        if self.headway[0] < 0:
+            raise StringStabError(
+                f"headway (desired time headway T*) interval must be >= 0 s; "
+                f"got [{self.headway[0]}, {self.headway[1]}]")
+
+    @property
+    def is_point(self) -> bool:
+        """Every interval is a single value."""
+        return all(lo == hi for lo, hi in (self.tau, self.delta, self.headway))
+
+    def as_dict(self) -> dict[str, list[float]]:
+        """``{"tau": [lo, hi], "delta": [lo, hi], "headway": [lo, hi]}`` (for JSON)."""
+        return {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}
+
+    def columns(self, n: int) -> dict[str, npt.NDArray[np.float64]]:
+        """``tau_lo, tau_hi, delta_lo, ...``: the box repeated on ``n`` result rows."""
+        return {f"{k}_{e}": np.full(n, float(v)) for k, iv in self.as_dict().items()
+                for e, v in zip(("lo", "hi"), iv)}
+
+    @classmethod
+    def of(cls, p: Params | Box) -> Box:
+        """The box of a :class:`Params` (a point box), or ``p`` itself."""
+        if isinstance(p, Box):
+            return p
+        return cls((p.tau, p.tau), (p.delta, p.delta), (p.headway, p.headway))
+
+
+def check_box(tau: Any, delta: Any, headway: Any) -> Box:
+    """Validate three numbers, pairs or ``"LO:HI"`` strings into a :class:`Box`.
+
+    Raises
+    ------
+    StringStabError
+        On a malformed interval, lo > hi, a negative end, or a τ interval reaching 0.
+
+    Examples
+    --------
+    >>> check_box("0.1:0.3", 0.2, (1.0, 1.2))
+    Box(tau=(0.1, 0.3), delta=(0.2, 0.2), headway=(1.0, 1.2))
+    >>> check_box(0.1, "-0.1:0.2", 1.1)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: delta (communication delay) interval must be >= 0 s; got [-0.1, 0.2]
+    """
+    return Box(as_interval(tau, "tau"), as_interval(delta, "delta"),
+               as_interval(headway, "headway"))
+
+
+def _is_number(v: Any) -> bool:
+    return not isinstance(v, (str, tuple, list, np.ndarray, Box)) or (
+        isinstance(v, np.ndarray) and v.ndim == 0)
+
+
+def parameter_model(tau: Any, delta: Any, headway: Any) -> Params | Box:
+    """:class:`Params` when τ, δ, T* are numbers (or intervals of one point), else a :class:`Box`.
+
+    Numbers are checked by :func:`check_params` (so their errors are the point ones); any
+    interval (``(lo, hi)`` or ``"LO:HI"``) makes the whole a box, checked by :func:`check_box`.
+
+    Examples
+    --------
+    >>> parameter_model(0.1, 0.2, 1.1)
+    Params(tau=0.1, delta=0.2, headway=1.1)
+    >>> parameter_model(0.1, (0.2, 0.2), 1.1)
+    Params(tau=0.1, delta=0.2, headway=1.1)
+    >>> parameter_model("0.1:0.3", 0.2, 1.1)
+    Box(tau=(0.1, 0.3), delta=(0.2, 0.2), headway=(1.1, 1.1))
+    """
+    if all(_is_number(v) for v in (tau, delta, headway)):
+        return Params(tau, delta, headway)
+    box = check_box(tau, delta, headway)
+    if box.is_point:
+        return Params(box.tau[0], box.delta[0], box.headway[0])
+    return box

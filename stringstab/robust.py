@@ -56,210 +56,53 @@ R. E. Moore, R. B. Kearfott, M. J. Cloud, *Introduction to Interval Analysis*, S
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import numpy.typing as npt
 
-from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound
-from .certificate import _hurwitz_bands, tail_bound
-from .errors import StringStabError, show
+from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max
+from .criteria import hurwitz_bands
 from .frequency import gain_squared, margin_g_coefficients
-from .margin import curvature_bound
-from .params import Params, as_gains, positive
+from .io.results import TableColumn
+from .margin import curvature_bound, separable, tail_bound
+from .params import Box, Interval, as_gains, as_interval, check_box, parse_interval
+from .params import sample_time as _sample_time
 from .sampled import (
-    VERDICTS,
     _Ad,
     _cell_coefficients,
     _coefficients,
     _Coeffs,
     _curvature,
     _eval_cells,
-    _num,
-    _one_triple,
     _part,
     _peak,
-    _Results,
     _schur_terms,
     _spread,
-    _Verdict,
     split_delay,
 )
+from .verdicts import BatchResult, Check, SingleResult, chunks, names, one_triple
 
 __all__ = [
+    "TABLE_COLUMNS",
     "Box",
+    "Interval",
     "RobustCertificate",
     "RobustCertificateBatch",
     "as_interval",
     "certify_robust",
     "certify_robust_batch",
     "check_box",
+    "check_robust",
     "parse_interval",
     "robust_margin",
 ]
 
 Array = npt.NDArray[np.float64]
-Interval = tuple[float, float]
 _CERT, _NOT, _INC = 0, 1, 2
 _SLACK = 1e-13
 _SCHUR_RTOL = 1e-12
-
-
-# ---------------------------------------------------------------------------
-# Intervals and boxes
-# ---------------------------------------------------------------------------
-def parse_interval(text: str, name: str = "value") -> Interval:
-    """Parse ``"LO:HI"`` (or a plain number, a point interval) into ``(lo, hi)``.
-
-    For the command line (``--tau 0.1:0.5``); range checks (τ > 0, δ ≥ 0) are
-    :func:`check_box`'s.
-
-    Parameters
-    ----------
-    text : str
-        ``"0.1:0.5"`` or ``"0.2"``.
-    name : str
-        What the interval is, for the error message.
-
-    Returns
-    -------
-    (float, float)
-
-    Raises
-    ------
-    StringStabError
-        On a malformed or non-finite end, or lo > hi.
-
-    Examples
-    --------
-    >>> parse_interval("0.1:0.5"), parse_interval("0.2")
-    ((0.1, 0.5), (0.2, 0.2))
-    >>> parse_interval("0.5:0.1", "tau")
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: tau interval must have lo <= hi; got '0.5:0.1'
-    """
-    s = str(text).strip()
-    parts = s.split(":")
-    if len(parts) not in (1, 2) or not all(p.strip() for p in parts):
-        raise StringStabError(
-            f"{name} must be a number or an interval LO:HI (e.g. 0.1:0.5); got {text!r}")
-    try:
-        ends = [float(p) for p in parts]
-    except ValueError as e:
-        raise StringStabError(
-            f"{name} must be a number or an interval LO:HI (e.g. 0.1:0.5); got {text!r}") from e
-    if not all(math.isfinite(v) for v in ends):
-        raise StringStabError(f"{name} interval ends must be finite numbers; got {text!r}")
-    lo, hi = ends[0], ends[-1]
-    if lo > hi:
-        raise StringStabError(f"{name} interval must have lo <= hi; got {text!r}")
-    return lo, hi
-
-
-def as_interval(value: Any, name: str = "value") -> Interval:
-    """A number, a ``(lo, hi)`` pair or a ``"LO:HI"`` string as a checked ``(lo, hi)``.
-
-    Raises
-    ------
-    StringStabError
-        On a value that is none of these, a non-finite end, or lo > hi.
-
-    Examples
-    --------
-    >>> as_interval(0.1), as_interval((0.1, 0.3)), as_interval("0:0.2")
-    ((0.1, 0.1), (0.1, 0.3), (0.0, 0.2))
-    """
-    if isinstance(value, str):
-        return parse_interval(value, name)
-    if isinstance(value, (tuple, list, np.ndarray)):
-        if len(value) != 2:
-            raise StringStabError(
-                f"{name} must be a number or a (lo, hi) pair; got {len(value)} values")
-        try:
-            lo, hi = float(value[0]), float(value[1])
-        except (TypeError, ValueError) as e:
-            raise StringStabError(f"{name} interval ends must be numbers; got {show(value)}") from e
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise StringStabError(f"{name} interval ends must be finite numbers; got {show(value)}")
-        if lo > hi:
-            raise StringStabError(f"{name} interval must have lo <= hi; got {show(value)}")
-        return lo, hi
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as e:
-        raise StringStabError(f"{name} must be a number or a (lo, hi) pair; got {show(value)}") from e
-    if not math.isfinite(v):
-        raise StringStabError(f"{name} must be a finite number; got {show(value)}")
-    return v, v
-
-
-@dataclass(frozen=True)
-class Box:
-    """A box of model parameters, each a ``(lo, hi)`` interval in seconds.
-
-    Examples
-    --------
-    >>> Box((0.1, 0.5), (0.2, 0.2), (1.1, 1.1)).is_point
-    False
-    >>> Box((0.0, 0.5), (0.2, 0.2), (1.1, 1.1))
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: tau (actuator lag) interval must stay > 0 s; got [0.0, 0.5]
-    """
-
-    tau: Interval
-    delta: Interval
-    headway: Interval
-
-    def __post_init__(self) -> None:
-        for name, (lo, hi) in (("tau (actuator lag)", self.tau),
-                               ("delta (communication delay)", self.delta),
-                               ("headway (desired time headway T*)", self.headway)):
-            if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
-                raise StringStabError(f"{name} interval must be finite with lo <= hi; got [{lo}, {hi}]")
-        if not self.tau[0] > 0:
-            raise StringStabError(
-                f"tau (actuator lag) interval must stay > 0 s; got [{self.tau[0]}, {self.tau[1]}]")
-        if self.delta[0] < 0:
-            raise StringStabError(
-                f"delta (communication delay) interval must be >= 0 s; got [{self.delta[0]}, {self.delta[1]}]")
-        if self.headway[0] < 0:
-            raise StringStabError(
-                f"headway (desired time headway T*) interval must be >= 0 s; "
-                f"got [{self.headway[0]}, {self.headway[1]}]")
-
-    @property
-    def is_point(self) -> bool:
-        """Every interval is a single value."""
-        return all(lo == hi for lo, hi in (self.tau, self.delta, self.headway))
-
-    def as_dict(self) -> dict[str, list[float]]:
-        """``{"tau": [lo, hi], "delta": [lo, hi], "headway": [lo, hi]}`` (for JSON)."""
-        return {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}
-
-
-def check_box(tau: Any, delta: Any, headway: Any) -> Box:
-    """Validate three numbers, pairs or ``"LO:HI"`` strings into a :class:`Box`.
-
-    Raises
-    ------
-    StringStabError
-        On a malformed interval, lo > hi, a negative end, or a τ interval reaching 0.
-
-    Examples
-    --------
-    >>> check_box("0.1:0.3", 0.2, (1.0, 1.2))
-    Box(tau=(0.1, 0.3), delta=(0.2, 0.2), headway=(1.0, 1.2))
-    >>> check_box(0.1, "-0.1:0.2", 1.1)
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: delta (communication delay) interval must be >= 0 s; got [-0.1, 0.2]
-    """
-    return Box(as_interval(tau, "tau"), as_interval(delta, "delta"),
-               as_interval(headway, "headway"))
 
 
 # ---------------------------------------------------------------------------
@@ -268,23 +111,28 @@ def check_box(tau: Any, delta: Any, headway: Any) -> Box:
 def _robust_g(
     w: Array, kx: Array, kv: Array, ka: Array, box: Box,
 ) -> tuple[Array, Array, Array, Array, Array]:
-    """(min_box g(ω), τ*, δ*, T*, magnitude) at ω ≥ 0; gains broadcast against ω."""
+    """(min_box g(ω), τ*, δ*, T*, magnitude) at ω ≥ 0; gains broadcast against ω.
+
+    g = (τω² − c)² + h2 ω² + h0 + cx cos δω − cv ω sin δω
+    (:func:`stringstab.margin.separable`, generated from the derivation): only the square
+    depends on τ and T* (c = k_v + T*k_x is affine in T*), only the trigonometric terms on δ.
+    """
     (t_lo, t_hi), (d_lo, d_hi), (h_lo, h_hi) = box.tau, box.delta, box.headway
+    (c_a, h2, h0, cx, cv), (s_ca, s_h2, s_h0, s_cx, s_cv) = separable(kx, kv, ka, headway=h_lo)
+    (c_b, *_), (s_cb, *_) = separable(kx, kv, ka, headway=h_hi)
     w2 = w * w
-    hk_a, hk_b = h_lo * kx, h_hi * kx
-    hk_min, hk_max = np.minimum(hk_a, hk_b), np.maximum(hk_a, hk_b)
-    h_at_max = np.where(hk_b >= hk_a, h_hi, h_lo)
-    h_at_min = np.where(hk_b >= hk_a, h_lo, h_hi)
-    e_lo = t_lo * w2 - kv - hk_max  # at (τ_lo, argmax T*k_x)
-    e_hi = t_hi * w2 - kv - hk_min  # at (τ_hi, argmin T*k_x)
+    c_max, c_min = np.maximum(c_a, c_b), np.minimum(c_a, c_b)
+    h_at_max = np.where(c_b >= c_a, h_hi, h_lo)
+    h_at_min = np.where(c_b >= c_a, h_lo, h_hi)
+    e_lo = t_lo * w2 - c_max  # at (τ_lo, argmax c)
+    e_hi = t_hi * w2 - c_min  # at (τ_hi, argmin c)
     S = np.where(e_lo > 0, e_lo * e_lo, np.where(e_hi < 0, e_hi * e_hi, 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
         s = np.clip(np.where(e_hi > e_lo, e_lo / (e_lo - e_hi), 0.0), 0.0, 1.0)
     s = np.where(e_lo > 0, 0.0, np.where(e_hi < 0, 1.0, s))
     tau_w = np.clip(t_lo + s * (t_hi - t_lo), t_lo, t_hi)
     h_w = np.clip(h_at_max + s * (h_at_min - h_at_max), h_lo, h_hi)
-    cx, cv = 2.0 * kx * ka, 2.0 * kv * ka
-    r0 = (1.0 - ka * ka) * w2 - 2.0 * kx - kv * kv
+    r0 = h2 * w2 + h0
 
     def trig(d: float) -> Array:
         return np.asarray(cx * np.cos(d * w) - cv * w * np.sin(d * w))
@@ -302,8 +150,8 @@ def _robust_g(
         d_in = np.clip((crit - phi) / w, d_lo, d_hi)
     d_w = np.where(inside, d_in, np.where(t_a <= t_b, d_lo, d_hi))
     G = S + r0 + T
-    e_mag = t_hi * w2 + np.abs(kv) + np.maximum(np.abs(hk_a), np.abs(hk_b))
-    mag = e_mag * e_mag + np.abs(1.0 - ka * ka) * w2 + 2.0 * np.abs(kx) + kv * kv + np.abs(cx) + np.abs(cv) * w
+    e_mag = t_hi * w2 + np.maximum(s_ca, s_cb)
+    mag = e_mag * e_mag + s_h2 * w2 + s_h0 + s_cx + s_cv * w
     return G, tau_w, d_w, h_w, mag
 
 
@@ -347,7 +195,7 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
     n = kx.size
     (t_lo, t_hi), (d_lo, d_hi), (h_lo, h_hi) = box.tau, box.delta, box.headway
     # internal stability: the worst member is (τ_hi, h_lo) (module docstring)
-    sure, fail = _hurwitz_bands(kx, kv, Params(t_hi, d_lo, h_lo))
+    sure, fail = hurwitz_bands(kx, kv, tau=t_hi, headway=h_lo)
     a_min, a_absmax = _corner_values(kx, kv, ka, box)
     c_lo = np.minimum(kv + h_lo * kx, kv + h_hi * kx)
     c_hi = np.maximum(kv + h_lo * kx, kv + h_hi * kx)
@@ -369,9 +217,7 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
 
     bb = branch_and_bound(n, evaluate, right=Om, n_grid=n_grid, max_rounds=max_rounds,
                           max_intervals=max_intervals, refine=~fail)
-    v = np.full(n, _INC, dtype=np.int8)
-    v[bb.status == CERTIFIED] = _CERT
-    v[bb.status == VIOLATED] = _NOT
+    v = verdict_codes(bb.status)
     v[~sure] = np.where(fail[~sure], _NOT, _INC)
     w = bb.argmin
     _, tw, dw, hw, _ = _robust_g(w, kx, kv, ka, box)
@@ -409,19 +255,9 @@ def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array,
         return np.where(np.isnan(v), np.inf, v)
 
     A = g2(W)
-    rows = np.arange(kx.size)
     j = np.argmax(A, axis=1)
-    best, bw = A[rows, j], W[rows, j]
-    half = Om / 512.0
-    v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(10):
-        Wl = np.maximum(bw[:, None] + half[:, None] * v[None, :], 0.0)
-        Al = g2(Wl)
-        jl = np.argmax(Al, axis=1)
-        upd = Al[rows, jl] > best
-        best = np.where(upd, Al[rows, jl], best)
-        bw = np.where(upd, Wl[rows, jl], bw)
-        half = half / 4.0
+    rows = np.arange(kx.size)
+    best, bw = zoom_max(g2, W[rows, j], A[rows, j], Om / 512.0, rounds=10)
     return np.sqrt(best), bw
 
 
@@ -699,7 +535,7 @@ def _robust_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *, hete
 # Results
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
-class RobustCertificate(_Verdict):
+class RobustCertificate(SingleResult):
     """The robust certificate of one gain triple over a parameter box.
 
     Attributes
@@ -749,21 +585,34 @@ class RobustCertificate(_Verdict):
     witness_theta: float
     n_evals: int = 0
 
-    def as_dict(self) -> dict[str, Any]:
-        """A JSON row (non-finite numbers become None)."""
-        return {
-            "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "box": self.box.as_dict(),
-            "sample_time": self.sample_time, "heterogeneous": self.heterogeneous,
-            "stable": self.stable, "verdict": self.verdict, "sup_gain": _num(self.sup_gain),
-            "margin": _num(self.margin),
-            "witness": {k: _num(getattr(self, f"witness_{k}"))
-                        for k in ("tau", "tau_prev", "delta", "headway", "omega", "theta")},
-        }
+
+#: The columns of the human table of robust certificates (``stringstab certify`` with an
+#: interval).
+TABLE_COLUMNS: list[TableColumn] = [
+    TableColumn("t", "t"),
+    TableColumn("vehicle", "vehicle"),
+    TableColumn("k_x", "k_x"),
+    TableColumn("k_v", "k_v"),
+    TableColumn("k_a", "k_a"),
+    TableColumn("stable", "stable"),
+    TableColumn("verdict", "verdict"),
+    TableColumn("sup gain at witness", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("ω[rad/s]", "witness.omega", "%.4g"),
+    TableColumn("θ[rad/sample]", "witness.theta", "%.4g"),
+    TableColumn("τ", "witness.tau", "%.4g"),
+    TableColumn("τ_prev", "witness.tau_prev", "%.4g"),
+    TableColumn("δ", "witness.delta", "%.4g"),
+    TableColumn("T*", "witness.headway", "%.4g"),
+    TableColumn("margin", "margin", "%.3g"),
+]
 
 
 @dataclass(frozen=True)
-class RobustCertificateBatch(_Results):
+class RobustCertificateBatch(BatchResult):
     """Robust certificates of many triples, as arrays (fields of :class:`RobustCertificate`)."""
+
+    SINGLE: ClassVar[type[RobustCertificate]] = RobustCertificate
+    SHARED: ClassVar[tuple[str, ...]] = ("box", "sample_time", "heterogeneous")
 
     k_x: Array
     k_v: Array
@@ -784,18 +633,39 @@ class RobustCertificateBatch(_Results):
     n_evals: npt.NDArray[np.int64]
 
     def __getitem__(self, i: int) -> RobustCertificate:
-        return RobustCertificate(
-            k_x=float(self.k_x[i]), k_v=float(self.k_v[i]), k_a=float(self.k_a[i]),
-            box=self.box, sample_time=self.sample_time, heterogeneous=self.heterogeneous,
-            stable=bool(self.stable[i]), verdict=str(self.verdict[i]),
-            sup_gain=float(self.sup_gain[i]), margin=float(self.margin[i]),
-            witness_tau=float(self.witness_tau[i]), witness_tau_prev=float(self.witness_tau_prev[i]),
-            witness_delta=float(self.witness_delta[i]),
-            witness_headway=float(self.witness_headway[i]),
-            witness_omega=float(self.witness_omega[i]), witness_theta=float(self.witness_theta[i]),
-            n_evals=int(self.n_evals[i]),
-        )
+        return super().__getitem__(i)  # type: ignore[no-any-return]
 
+    def columns(self) -> dict[str, Any]:
+        """The result columns: gains, stability over the box, verdict, sup gain and margin,
+        the ``witness`` group (``tau``, ``tau_prev``, ``delta``, ``headway``, ``omega``,
+        ``theta``), then ``sample_time`` (NaN in continuous time), ``heterogeneous`` and the
+        ``box`` group (``tau_lo``, ``tau_hi``, ...).
+
+        Examples
+        --------
+        >>> b = certify_robust_batch([1.2], [0.5], [0.6], tau=(0.1, 0.3), delta=0.2, headway=1.1)
+        >>> c = b.columns()
+        >>> c["verdict"].tolist(), c["box"]["tau_hi"].tolist(), c["sample_time"].tolist()
+        (['certified'], [0.3], [nan])
+        """
+        n = len(self)
+        return {
+            "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "stable": self.stable,
+            "verdict": self.verdict, "sup_gain": self.sup_gain, "margin": self.margin,
+            "witness": {k: getattr(self, f"witness_{k}")
+                        for k in ("tau", "tau_prev", "delta", "headway", "omega", "theta")},
+            "sample_time": np.full(n, np.nan if self.sample_time is None else self.sample_time),
+            "heterogeneous": np.full(n, self.heterogeneous),
+            "box": self.box.columns(n),
+        }
+
+    def summary_extra(self) -> dict[str, Any]:
+        """The sample time (None in continuous time), heterogeneity and the box."""
+        return {"sample_time": self.sample_time, "heterogeneous": self.heterogeneous,
+                "box": self.box.as_dict()}
+
+
+RobustCertificate.BATCH = RobustCertificateBatch
 
 
 def certify_robust_batch(
@@ -803,7 +673,7 @@ def certify_robust_batch(
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
     heterogeneous: bool = True, chunk: int = 4096, n_grid: int | None = None,
     max_rounds: int = 30, max_intervals: int = 1024, max_splits: int = 48,
-    max_cells: int = 4096,
+    max_cells: int = 4096, progress: bool = False,
 ) -> RobustCertificateBatch:
     """Certify gain triples for every τ, δ, T* in a box (module docstring).
 
@@ -826,6 +696,8 @@ def certify_robust_batch(
     max_splits, max_cells : int
         Sampled only: bisection passes of the parameter cells, and cells per triple,
         before the triple is inconclusive.
+    progress : bool
+        Show a tqdm progress bar over chunks.
 
     Returns
     -------
@@ -847,15 +719,13 @@ def certify_robust_batch(
     (True, True)
     """
     box = check_box(tau, delta, headway)
-    H = None if sample_time is None else positive("sample_time (sampling period H)", sample_time,
-                                                   unit=" s")
+    H = None if sample_time is None else _sample_time(sample_time)
     kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
     n = kx.size
     keys = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev", "delta",
             "headway", "n_evals", "sup_gain")
     acc: dict[str, list[Array]] = {k: [] for k in keys}
-    for s0 in range(0, n, chunk):
-        sl = slice(s0, min(s0 + chunk, n))
+    for sl in chunks(n, chunk, progress=progress, desc="certify (robust)"):
         if H is None:
             r = _robust_continuous(kx[sl], kv[sl], ka[sl], box, n_grid=n_grid or 64,
                                    max_rounds=max_rounds, max_intervals=max_intervals)
@@ -872,7 +742,7 @@ def certify_robust_batch(
 
     return RobustCertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, box=box, sample_time=H, heterogeneous=bool(heterogeneous),
-        stable=cat("stable", bool), verdict=np.array(VERDICTS)[cat("verdict", np.int8)],
+        stable=cat("stable", bool), verdict=names(cat("verdict", np.int8)),
         sup_gain=cat("sup_gain"), margin=cat("margin"), witness_tau=cat("tau"),
         witness_tau_prev=cat("tau_prev"), witness_delta=cat("delta"),
         witness_headway=cat("headway"), witness_omega=cat("omega"),
@@ -902,6 +772,33 @@ def certify_robust(
     >>> c.verdict
     'certified'
     """
-    _one_triple("certify_robust", "certify_robust_batch", k_x=k_x, k_v=k_v, k_a=k_a)
+    one_triple("certify_robust", "certify_robust_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     return certify_robust_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
                                 sample_time=sample_time, heterogeneous=heterogeneous)[0]
+
+
+def check_robust(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *, tau: Any, delta: Any,
+    headway: Any, sample_time: float | None = None, heterogeneous: bool = True,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+) -> Check:
+    """The robust certificate's verdicts and witnesses, as a :class:`~stringstab.verdicts.Check`.
+
+    The decision of :func:`certify_robust_batch`; ``hurwitz`` is stability of every member,
+    and the witness member (τ, τ_prev, δ, T*) and frequency (ω, and θ when sampled) of each
+    triple are those of the batch.
+
+    Examples
+    --------
+    >>> c = check_robust([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta=0.2,
+    ...                  headway=1.1)
+    >>> c.verdict.tolist(), bool(0.1 <= c.witness_tau[1] <= 0.3)
+    (['certified', 'not_certified'], True)
+    """
+    b = certify_robust_batch(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway,
+                             sample_time=sample_time, heterogeneous=heterogeneous, n_grid=n_grid,
+                             max_rounds=max_rounds, max_intervals=max_intervals)
+    return Check(b.verdict, b.stable, b.margin, b.witness_omega, sample_time=b.sample_time,
+                 witness_theta=None if b.sample_time is None else b.witness_theta,
+                 witness_tau=b.witness_tau, witness_tau_prev=b.witness_tau_prev,
+                 witness_delta=b.witness_delta, witness_headway=b.witness_headway)

@@ -64,16 +64,30 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import numpy.typing as npt
 
-from .branch_bound import CERTIFIED, VIOLATED, BranchAndBound, Evaluate, branch_and_bound
-from .errors import StringStabError
-from .params import Params, as_gains, check_params, positive
+from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes, zoom_max
+from .io.results import TableColumn
+from .params import Box, Params, as_gains, check_params, positive
+from .params import sample_time as _sample_time
+from .verdicts import CERTIFIED as CERTIFIED_CODE
+from .verdicts import (
+    INCONCLUSIVE,
+    NOT_CERTIFIED,
+    VERDICTS,
+    BatchResult,
+    Check,
+    SingleResult,
+    chunks,
+    names,
+    one_triple,
+)
 
 __all__ = [
+    "TABLE_COLUMNS",
     "VERDICTS",
     "SampledCertificate",
     "SampledCertificateBatch",
@@ -90,11 +104,7 @@ __all__ = [
 
 Array = npt.NDArray[np.float64]
 
-#: The three verdicts, the same vocabulary as :data:`stringstab.certificate.VERDICTS`
-#: (not imported from there so that this module stays free of SymPy; a test asserts
-#: the two are equal).
-VERDICTS = ("certified", "not_certified", "inconclusive")
-_CERT, _NOT, _INC = 0, 1, 2
+_CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
 
 _SLACK = 1e-13  # relative round-off slack on g_H (per unit of the magnitude companion)
 _SCHUR_RTOL = 1e-12  # relative band around the Schur boundary left inconclusive
@@ -524,7 +534,7 @@ def split_delay(delta: float, sample_time: float) -> tuple[int, float]:
 def _validate(tau: Any, delta: Any, headway: Any, sample_time: Any,
               tau_prev: Any) -> tuple[Params, float, float]:
     p = Params(*check_params(tau, delta, headway))
-    H = positive("sample_time (sampling period H)", sample_time, unit=" s")
+    H = _sample_time(sample_time)
     tp = p.tau if tau_prev is None else positive("tau_prev (predecessor's actuator lag)",
                                                   tau_prev, unit=" s")
     return p, H, tp
@@ -709,7 +719,7 @@ def _loop_delta(k_x: Any, k_v: Any, tau: Any, headway: Any,
                 sample_time: Any) -> tuple[list[_Iv], tuple[int, ...]]:
     """δ0, δ1, δ2 of the follower's loop (flattened) and the gains' shape."""
     p = Params(*check_params(tau, 0.0, headway))
-    H = positive("sample_time (sampling period H)", sample_time, unit=" s")
+    H = _sample_time(sample_time)
     kx, kv, _ = as_gains(k_x, k_v, 0.0)
     shape = kx.shape
     kx, kv = kx.ravel(), kv.ravel()
@@ -853,42 +863,32 @@ def _bnb_points(
                             max_rounds=max_rounds, max_intervals=max_intervals, refine=refine)
 
 
-def _verdicts(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
-    v = np.full(status.shape, _INC, dtype=np.int8)
-    v[status == CERTIFIED] = _CERT
-    v[status == VIOLATED] = _NOT
-    return v
-
-
 # ---------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------
-def _num(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
-
 @dataclass(frozen=True)
-class SampledCheck:
-    """Verdicts only (see :func:`check_sampled`).
+class SampledCheck(Check):
+    """Verdicts only (see :func:`check_sampled`): a :class:`~stringstab.verdicts.Check` whose
+    ``hurwitz`` is Schur stability of Δ(z), with ``sample_time`` and ``witness_theta``.
 
     Attributes
     ----------
     verdict : ndarray of str
         ``"certified"``, ``"not_certified"`` or ``"inconclusive"``.
-    schur : ndarray of bool
-        Internally stable (Δ Schur, surely, outside the 10⁻¹² boundary band).
+    hurwitz : ndarray of bool
+        Internally stable (Δ Schur, surely, outside the 10⁻¹² boundary band); also
+        :attr:`schur`.
     margin : ndarray
         Smallest g_H(θ) found.
-    witness_theta, witness_omega : ndarray
-        Where (θ in rad/sample, ω = θ/H in rad/s): for a Schur, not-certified triple a
+    witness_omega, witness_theta : ndarray
+        Where (ω = θ/H in rad/s, θ in rad/sample): for a Schur, not-certified triple a
         frequency with |H(e^{jθ})| > 1.
     """
 
-    verdict: npt.NDArray[np.str_]
-    schur: npt.NDArray[np.bool_]
-    margin: Array
-    witness_theta: Array
-    witness_omega: Array
+    @property
+    def schur(self) -> npt.NDArray[np.bool_]:
+        """Δ(z) is Schur (internal stability of the sampled loop)."""
+        return self.hurwitz
 
 
 def _prepare(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any,
@@ -927,6 +927,10 @@ def check_sampled(
         Initial intervals on [0, π] (default 64 + 8m), refinement rounds, and the cap on
         undecided intervals per triple beyond which it is inconclusive.
 
+    Returns
+    -------
+    SampledCheck
+
     Examples
     --------
     >>> check_sampled([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2, headway=1.1,
@@ -938,9 +942,10 @@ def check_sampled(
     sure, fail = _schur_bands(co.delta)
     bb = _bnb_points(co, m, n_grid=n_grid or _default_grid(m), max_rounds=max_rounds,
                      max_intervals=max_intervals, refine=~fail)
-    v = _verdicts(bb.status)
+    v = verdict_codes(bb.status)
     v[~sure] = np.where(fail[~sure], _NOT, _INC)
-    return SampledCheck(np.array(VERDICTS)[v], sure, bb.minimum, bb.argmin, bb.argmin / H)
+    return SampledCheck(names(v), sure, bb.minimum, bb.argmin / H, sample_time=H,
+                        witness_theta=bb.argmin)
 
 
 def _peak(co: _Coeffs, m: int, ka: Array, W: Array, worst: Array) -> tuple[Array, Array]:
@@ -960,35 +965,12 @@ def _peak(co: _Coeffs, m: int, ka: Array, W: Array, worst: Array) -> tuple[Array
     A = absH(Wall)
     A[:, 0] = np.where(co.delta[0].lo != 0, 1.0, A[:, 0])  # H(1) = 1 exactly
     j = np.argmax(A, axis=1)
-    best_w = Wall[rows, j]
-    best = A[rows, j]
-    half = np.full(n, np.pi / (W.shape[1] - 1))
-    v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(8):
-        Wl = np.clip(best_w[:, None] + half[:, None] * v[None, :], 0.0, np.pi)
-        Al = absH(Wl)
-        jl = np.argmax(Al, axis=1)
-        al = Al[rows, jl]
-        upd = al > best
-        best = np.where(upd, al, best)
-        best_w = np.where(upd, Wl[rows, jl], best_w)
-        half = half / 4.0
-    return best, best_w
-
-
-class _Verdict:
-    """``certified``, shared by the single-triple result classes."""
-
-    verdict: str
-
-    @property
-    def certified(self) -> bool:
-        """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
+    return zoom_max(absH, Wall[rows, j], A[rows, j], np.full(n, np.pi / (W.shape[1] - 1)),
+                    hi=np.pi)
 
 
 @dataclass(frozen=True)
-class SampledCertificate(_Verdict):
+class SampledCertificate(SingleResult):
     """The sampled-data certificate of one gain triple.
 
     Attributes
@@ -1035,57 +1017,30 @@ class SampledCertificate(_Verdict):
     margin: float
     n_evals: int = 0
 
-    def as_dict(self) -> dict[str, Any]:
-        """A JSON row (non-finite numbers become None)."""
-        return {
-            "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a,
-            "sample_time": self.sample_time, "tau_prev": self.tau_prev,
-            "schur": self.schur, "spectral_radius": _num(self.spectral_radius),
-            "verdict": self.verdict, "sup_gain": _num(self.sup_gain),
-            "linf_gain": _num(self.linf_gain), "peak_theta": _num(self.peak_theta),
-            "peak_omega": _num(self.peak_omega), "margin": _num(self.margin),
-        }
 
-
-class _Results:
-    """The batch protocol shared by the result classes: len, ``certified``, rows, summary."""
-
-    k_x: Array
-    verdict: npt.NDArray[np.str_]
-
-    def __len__(self) -> int:
-        return int(self.k_x.size)
-
-    def __getitem__(self, i: int) -> Any:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-    @property
-    def certified(self) -> npt.NDArray[np.bool_]:
-        """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
-
-    def records(self) -> list[dict[str, Any]]:
-        """One JSON row per triple (non-finite numbers as None)."""
-        return [self[i].as_dict() for i in range(len(self))]
-
-    def summary(self) -> dict[str, Any]:
-        """Counts per verdict and m_fss, the share certified (IDL eq 27)."""
-        n = len(self)
-        counts = {v: int(np.count_nonzero(self.verdict == v)) for v in VERDICTS}
-        return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
-
-
-def _one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
-    """Refuse arrays where a single-triple function takes scalars."""
-    for name, v in gains.items():
-        if np.ndim(v) != 0:
-            raise StringStabError(
-                f"{fn} takes one triple; {name} has shape {np.shape(v)}; use {batch_fn}")
+#: The columns of the human table of sampled certificates (``stringstab certify --sample-time``).
+TABLE_COLUMNS: list[TableColumn] = [
+    TableColumn("t", "t"),
+    TableColumn("vehicle", "vehicle"),
+    TableColumn("k_x", "k_x"),
+    TableColumn("k_v", "k_v"),
+    TableColumn("k_a", "k_a"),
+    TableColumn("schur", "schur"),
+    TableColumn("ρ(Δ)", "spectral_radius", "%.4g"),
+    TableColumn("verdict", "verdict"),
+    TableColumn("sup|H|", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
+    TableColumn("θ_peak[rad/sample]", "peak_theta", "%.4g"),
+    TableColumn("margin", "margin", "%.3g"),
+]
 
 
 @dataclass(frozen=True)
-class SampledCertificateBatch(_Results):
+class SampledCertificateBatch(BatchResult):
     """Sampled certificates of many triples, as arrays (fields of :class:`SampledCertificate`)."""
+
+    SINGLE: ClassVar[type[SampledCertificate]] = SampledCertificate
+    SHARED: ClassVar[tuple[str, ...]] = ("params", "sample_time", "tau_prev")
 
     k_x: Array
     k_v: Array
@@ -1104,23 +1059,51 @@ class SampledCertificateBatch(_Results):
     n_evals: npt.NDArray[np.int64]
 
     def __getitem__(self, i: int) -> SampledCertificate:
-        return SampledCertificate(
-            k_x=float(self.k_x[i]), k_v=float(self.k_v[i]), k_a=float(self.k_a[i]),
-            params=self.params, sample_time=self.sample_time, tau_prev=self.tau_prev,
-            schur=bool(self.schur[i]), spectral_radius=float(self.spectral_radius[i]),
-            verdict=str(self.verdict[i]), sup_gain=float(self.sup_gain[i]),
-            linf_gain=float(self.linf_gain[i]), peak_theta=float(self.peak_theta[i]),
-            peak_omega=float(self.peak_omega[i]), margin=float(self.margin[i]),
-            n_evals=int(self.n_evals[i]),
-        )
+        return super().__getitem__(i)  # type: ignore[no-any-return]
 
+    @property
+    def box(self) -> Box:
+        """The parameters as a (point) box."""
+        return Box.of(self.params)
+
+    def columns(self) -> dict[str, Any]:
+        """The result columns: gains, Schur stability, verdict, peak (ω and θ), margin, then
+        ``sample_time``, ``tau_prev`` and the ``box`` group (``tau_lo``, ``tau_hi``, ...).
+
+        Non-finite numbers stay as they are (``sup_gain`` is ``inf`` when Δ is not Schur).
+
+        Examples
+        --------
+        >>> b = certify_sampled_batch([1.2], [0.5], [0.6], tau=0.1, delta=0.2, headway=1.1,
+        ...                           sample_time=0.1)
+        >>> c = b.columns()
+        >>> c["verdict"].tolist(), c["sample_time"].tolist(), c["box"]["delta_hi"].tolist()
+        (['certified'], [0.1], [0.2])
+        """
+        n = len(self)
+        return {
+            "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "schur": self.schur,
+            "spectral_radius": self.spectral_radius, "verdict": self.verdict,
+            "sup_gain": self.sup_gain, "linf_gain": self.linf_gain,
+            "peak_omega": self.peak_omega, "peak_theta": self.peak_theta, "margin": self.margin,
+            "sample_time": np.full(n, self.sample_time), "tau_prev": np.full(n, self.tau_prev),
+            "box": self.box.columns(n),
+        }
+
+    def summary_extra(self) -> dict[str, Any]:
+        """The sample time, the predecessor's lag and the (point) box."""
+        return {"sample_time": self.sample_time, "tau_prev": self.tau_prev,
+                "box": self.box.as_dict()}
+
+
+SampledCertificate.BATCH = SampledCertificateBatch
 
 
 def certify_sampled_batch(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
     *, tau: float, delta: float, headway: float, sample_time: float,
     tau_prev: float | None = None, chunk: int = 4096, n_grid: int | None = None,
-    max_rounds: int = 30, max_intervals: int = 1024,
+    max_rounds: int = 30, max_intervals: int = 1024, progress: bool = False,
 ) -> SampledCertificateBatch:
     """Certify many gain triples for the sampled-data loop (sound; module docstring).
 
@@ -1138,6 +1121,8 @@ def certify_sampled_batch(
         Triples per vectorised chunk.
     n_grid, max_rounds, max_intervals : int
         See :func:`check_sampled`.
+    progress : bool
+        Show a tqdm progress bar over chunks.
 
     Returns
     -------
@@ -1165,13 +1150,12 @@ def certify_sampled_batch(
     peak = np.zeros(n)
     sure = np.empty(n, dtype=bool)
     rad = np.empty(n)
-    for s0 in range(0, n, chunk):
-        sl = slice(s0, min(s0 + chunk, n))
+    for sl in chunks(n, chunk, progress=progress, desc="certify (sampled)"):
         co, m = _point_coeffs(kx[sl], kv[sl], ka[sl], p, H, tp)
         s_sure, s_fail = _schur_bands(co.delta)
         bb = _bnb_points(co, m, n_grid=n_grid or _default_grid(m), max_rounds=max_rounds,
                          max_intervals=max_intervals, refine=~s_fail)
-        v = _verdicts(bb.status)
+        v = verdict_codes(bb.status)
         v[~s_sure] = np.where(s_fail[~s_sure], _NOT, _INC)
         verdict[sl], margin[sl], n_evals[sl], sure[sl] = v, bb.minimum, bb.n_evals, s_sure
         rad[sl] = _spectral_radius([d.lo for d in co.delta])
@@ -1182,12 +1166,11 @@ def certify_sampled_batch(
             sp_, pw = _peak(sub, m, ka[sl][idx], bb.grid_x[idx], bb.argmin[idx])
             sup[sl][idx] = sp_
             peak[sl][idx] = pw
-    names = np.array(VERDICTS)[verdict]
     hinf = np.where(sure, sup, np.inf)
     return SampledCertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, sample_time=H, tau_prev=tp, schur=sure,
-        spectral_radius=rad, verdict=names, sup_gain=hinf, linf_gain=sup, peak_theta=peak,
-        peak_omega=peak / H, margin=margin, n_evals=n_evals,
+        spectral_radius=rad, verdict=names(verdict), sup_gain=hinf, linf_gain=sup,
+        peak_theta=peak, peak_omega=peak / H, margin=margin, n_evals=n_evals,
     )
 
 
@@ -1212,6 +1195,6 @@ def certify_sampled(
     >>> c.verdict, c.sup_gain, c.schur
     ('certified', 1.0, True)
     """
-    _one_triple("certify_sampled", "certify_sampled_batch", k_x=k_x, k_v=k_v, k_a=k_a)
+    one_triple("certify_sampled", "certify_sampled_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     return certify_sampled_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
                                  sample_time=sample_time, tau_prev=tau_prev)[0]

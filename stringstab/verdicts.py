@@ -1,0 +1,229 @@
+"""The verdicts of every certificate and the protocol of their results: one home.
+
+Every certificate of the toolkit — continuous time (:mod:`stringstab.certificate`), sampled
+data (:mod:`stringstab.sampled`) and robust over a parameter box (:mod:`stringstab.robust`) —
+answers with the same three verdicts, :data:`VERDICTS`, and returns its results in the same
+shape:
+
+* a *batch* (one array per field, one row per gain triple) that owns its columns
+  (``columns()``, written by :func:`stringstab.io.write_results`), its rows (``records()``)
+  and its totals (``summary()``: counts per verdict and m_fss, IDL eq 27), and
+* a *single* result (one triple; ``batch[i]``) whose ``as_dict()`` is that triple's row.
+
+:class:`BatchResult` and :class:`SingleResult` implement this protocol once; :class:`Check`
+is the verdict-only answer of the ``check`` functions (for inner loops such as gain repair).
+This module imports NumPy and the writer's column helpers only (no SymPy), so every
+certificate imports it at no cost.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import StringStabError
+from .io.results import records_from_columns
+
+__all__ = [
+    "CERTIFIED",
+    "INCONCLUSIVE",
+    "NOT_CERTIFIED",
+    "VERDICTS",
+    "BatchResult",
+    "Check",
+    "SingleResult",
+    "chunks",
+    "names",
+    "num",
+    "one_triple",
+    "verdict_summary",
+]
+
+Array = npt.NDArray[np.float64]
+
+#: The three possible verdicts, by code: 0 certified, 1 not certified, 2 inconclusive.
+VERDICTS: tuple[str, str, str] = ("certified", "not_certified", "inconclusive")
+CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE = 0, 1, 2
+
+
+def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:
+    """Verdict codes (0, 1, 2) as their names.
+
+    Examples
+    --------
+    >>> names([0, 2]).tolist()
+    ['certified', 'inconclusive']
+    """
+    return np.array(VERDICTS)[np.asarray(codes, dtype=np.intp)]
+
+
+def num(x: float) -> float | None:
+    """``x`` as a float, or None when it is not finite (a JSON row's ``null``)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
+    """``n``, the count of each verdict and ``m_fss`` = certified / n (IDL eq 27, a fraction).
+
+    Examples
+    --------
+    >>> verdict_summary(np.array(["certified", "inconclusive"]))
+    {'n': 2, 'certified': 1, 'not_certified': 0, 'inconclusive': 1, 'm_fss': 0.5}
+    """
+    n = int(np.size(verdict))
+    counts = {v: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
+    return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+
+
+def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
+    """Refuse arrays where a single-triple function takes scalars.
+
+    Raises
+    ------
+    StringStabError
+        Naming the gain that is an array and the batch function to use instead.
+    """
+    for name, v in gains.items():
+        if np.ndim(v) != 0:
+            raise StringStabError(
+                f"{fn} takes one triple; {name} has shape {np.shape(v)}; use {batch_fn}")
+
+
+def chunks(n: int, chunk: int, *, progress: bool = False, desc: str = "certify") -> Iterable[slice]:
+    """Consecutive slices of ``chunk`` rows covering ``range(n)`` (a tqdm bar with ``progress``)."""
+    starts: Iterable[int] = range(0, n, chunk)
+    if progress:
+        from tqdm.auto import tqdm
+
+        starts = tqdm(starts, total=math.ceil(n / chunk), desc=desc, unit="chunk")
+    for s0 in starts:
+        yield slice(s0, min(s0 + chunk, n))
+
+
+class SingleResult:
+    """The certificate of one gain triple: ``certified`` and ``as_dict()`` (its batch row).
+
+    A subclass is a frozen dataclass with the fields of its batch class (scalars where the
+    batch has arrays), named by ``BATCH``.
+    """
+
+    verdict: str
+    BATCH: ClassVar[type[BatchResult]]
+
+    @property
+    def certified(self) -> bool:
+        """True iff the verdict is ``"certified"``."""
+        return self.verdict == "certified"
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON row of this triple: the batch's columns, non-finite numbers as None."""
+        return self.BATCH.of_single(self).records()[0]
+
+
+class BatchResult:
+    """Certificates of many triples, as arrays: the protocol every batch result follows.
+
+    A subclass is a frozen dataclass whose fields are per-triple arrays, except those named in
+    ``SHARED`` (the same for every triple: parameters, sample time, box); ``SINGLE`` is the
+    class of one row.  It defines :meth:`columns`; the rows and the totals follow.
+    """
+
+    k_x: Array
+    verdict: npt.NDArray[np.str_]
+    SINGLE: ClassVar[type[Any]]
+    SHARED: ClassVar[tuple[str, ...]] = ()
+
+    def __len__(self) -> int:
+        return int(self.k_x.size)
+
+    @property
+    def certified(self) -> npt.NDArray[np.bool_]:
+        """Boolean array: verdict == "certified"."""
+        return np.asarray(self.verdict == "certified")
+
+    def __getitem__(self, i: int) -> Any:
+        values = {}
+        for f in dataclasses.fields(self.SINGLE):
+            v = getattr(self, f.name)
+            values[f.name] = v if f.name in self.SHARED else np.asarray(v)[i].item()
+        return self.SINGLE(**values)
+
+    @classmethod
+    def of_single(cls, row: Any) -> Any:
+        """The batch of one row (so that a single result renders through :meth:`columns`)."""
+        values = {}
+        for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+            v = getattr(row, f.name)
+            values[f.name] = v if f.name in cls.SHARED else np.asarray([v])
+        return cls(**values)
+
+    def columns(self) -> dict[str, Any]:  # pragma: no cover - every subclass defines it
+        """The result columns (groups as nested mappings), for :func:`stringstab.io.write_results`."""
+        raise NotImplementedError
+
+    def records(self) -> list[dict[str, Any]]:
+        """One JSON row per triple (non-finite numbers are None)."""
+        return records_from_columns(self.columns())
+
+    def summary_extra(self) -> dict[str, Any]:
+        """What the summary adds to the counts (the sample time and the box, for example)."""
+        return {}
+
+    def summary(self) -> dict[str, Any]:
+        """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27)."""
+        return {**verdict_summary(self.verdict), **self.summary_extra()}
+
+
+@dataclass(frozen=True)
+class Check:
+    """Verdicts only, with the witness of each triple that is not certified.
+
+    Returned by :func:`stringstab.certificate.check` for every loop (continuous, sampled,
+    robust); the sampled and robust forms fill the optional fields.
+
+    Attributes
+    ----------
+    verdict : ndarray of str
+        ``"certified"``, ``"not_certified"`` or ``"inconclusive"``.
+    hurwitz : ndarray of bool
+        Internally stable, surely (outside the 10⁻¹² boundary band): Γ Hurwitz, the sampled
+        Δ(z) Schur, or every member of the box so.
+    margin : ndarray
+        Smallest margin found (g(ω), or g_H(θ) when sampled).
+    witness_omega : ndarray
+        Where it was found, rad/s: for an internally stable, not-certified triple a
+        frequency with |Γ(jω)| > 1 (|H(e^{jωH})| > 1 when sampled).
+    sample_time : float or None
+        H, s, for the sampled loop.
+    witness_theta : ndarray or None
+        The same frequency in rad/sample (θ = ωH), when sampled.
+    witness_tau, witness_tau_prev, witness_delta, witness_headway : ndarray or None
+        For a box: the member where the margin was found (or an unstable member).
+    """
+
+    verdict: npt.NDArray[np.str_]
+    hurwitz: npt.NDArray[np.bool_]
+    margin: Array
+    witness_omega: Array
+    sample_time: float | None = None
+    witness_theta: Array | None = None
+    witness_tau: Array | None = None
+    witness_tau_prev: Array | None = None
+    witness_delta: Array | None = None
+    witness_headway: Array | None = None
+
+    @property
+    def stable(self) -> npt.NDArray[np.bool_]:
+        """Internally stable (the same as :attr:`hurwitz`, named for every loop)."""
+        return self.hurwitz
+
+    @property
+    def certified(self) -> npt.NDArray[np.bool_]:
+        """Boolean array: verdict == "certified"."""
+        return np.asarray(self.verdict == "certified")
