@@ -12,15 +12,18 @@ __version__ = "0.1.0"
 
 from typing import Any
 
-from .certificate import Certificate, CertificateBatch, certify, certify_batch, certify_pade
+from .certificate import Certificate, CertificateBatch, certify, certify_batch, certify_pade, check
 from .criteria import hurwitz, stability_type, taylor_criteria
 from .errors import StringStabError
 from .frequency import gain, gamma_jw, margin_g
 from .io.gains import GainTable, parse_triple, read_gains
-from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Params
+from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box, Params
+from .verdicts import VERDICTS, Check
 
 # Importing stringstab (and certifying) loads NumPy only: no SymPy, matplotlib, CasADi,
-# python-control or gymnasium (tests/test_house.py checks it).  The errata (SymPy) are
+# python-control or gymnasium (tests/test_house.py checks it), and the sampled-data and
+# robust certificates (stringstab.sampled, stringstab.robust) only when certify, certify_batch
+# or check is asked for a sample time or a parameter interval.  The errata (SymPy) are
 # loaded on first use of their names below; the simulator (stringstab.traffic,
 # stringstab.metrics), the region maps (stringstab.regions, stringstab.plots) and the
 # gain repair (stringstab.tuning) are imported on demand.
@@ -41,8 +44,11 @@ __all__ = [
     "DEFAULT_DELTA",
     "DEFAULT_HEADWAY",
     "DEFAULT_TAU",
+    "VERDICTS",
+    "Box",
     "Certificate",
     "CertificateBatch",
+    "Check",
     "Erratum",
     "GainTable",
     "Params",
@@ -51,6 +57,7 @@ __all__ = [
     "certify",
     "certify_batch",
     "certify_pade",
+    "check",
     "errata",
     "gain",
     "gamma_jw",

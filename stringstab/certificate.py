@@ -309,6 +309,11 @@ class CertificateBatch(BatchResult):
     method: str = "exact"
     pade: list[dict[str, Any]] | None = field(default=None)
 
+    @property
+    def stable(self) -> npt.NDArray[np.bool_]:  # type: ignore[override]
+        """Internally stable (Γ Hurwitz, surely): :attr:`hurwitz`, the protocol's name."""
+        return self.hurwitz
+
     def __getitem__(self, i: int) -> Certificate:
         return Certificate(
             k_x=float(self.k_x[i]), k_v=float(self.k_v[i]), k_a=float(self.k_a[i]),

@@ -2,15 +2,19 @@
 
 :func:`derivation` derives everything once (:func:`stringstab.symbolic.derive_all`) and returns a
 :class:`Derivation` that renders itself as JSON-ready data, text or LaTeX; ``stringstab derive``
-and the demo print or write these renderings.  SymPy is imported when a derivation is made.
+and the demo print or write these renderings.  :func:`sampled_derivation` does the same for the
+sampled-data loop (``stringstab derive --sample-time H``: H(z), the characteristic polynomial
+Δ(z) and its Schur conditions, from :mod:`stringstab.sampled_symbolic`).  SymPy is imported when
+a derivation is made.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Any
 
-__all__ = ["Derivation", "derivation"]
+__all__ = ["Derivation", "derivation", "sampled_derivation"]
 
 _LABELS = {
     "gamma": ("Γ(s)", r"\Gamma(s)"),
@@ -24,6 +28,17 @@ _LABELS = {
     "grad_psi3": ("∇_K Ψ3", r"\nabla_K \Psi_3"),
     "hurwitz": ("Hurwitz (each > 0)", r"\text{Hurwitz}"),
 }
+_SAMPLED_LABELS = {
+    "H": ("H(z)", r"H(z)"),
+    "H_numerator_direct": ("N_0(z)", r"N_0(z)"),
+    "H_numerator_delayed": ("N_1(z)", r"N_1(z)"),
+    "H_denominator": ("D(z)", r"D(z)"),
+    "characteristic_polynomial": ("Δ(z) (characteristic polynomial)", r"\Delta(z)"),
+    "w_coefficients": ("w-coefficients (w = z - 1)", r"\text{w-coefficients}"),
+    "schur_conditions": ("Schur (each > 0, in delta0, delta1, delta2)", r"\text{Schur}"),
+    "schur_conditions_gains": ("Schur (each > 0, in the gains)", r"\text{Schur}"),
+    "dc_margin": ("c2 (θ² coefficient of |D|² - |N|²; H² φ1⁴ Ψ3 when tau_prev = tau)", r"c_2"),
+}
 
 
 
@@ -33,14 +48,15 @@ class Derivation:
 
     exprs: dict[str, Any]
     document: dict[str, Any]
+    labels: dict[str, tuple[str, str]] = field(default_factory=lambda: dict(_LABELS))
 
     def text(self) -> str:
         """Plain-text rendering (``stringstab derive --format text``)."""
-        return _text(self.exprs, self.document)
+        return _text(self.exprs, self.document, self.labels)
 
     def latex(self) -> str:
         """LaTeX rendering (``stringstab derive --format latex``; needs amsmath)."""
-        return _latex(self.exprs, self.document)
+        return _latex(self.exprs, self.document, self.labels)
 
     def json(self) -> str:
         """JSON rendering (``stringstab derive --format json``)."""
@@ -112,18 +128,28 @@ def _impact(impact: dict[str, Any]) -> str:
     return "; ".join(parts) + f" of the points ({where})"
 
 
-def _text(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
-    lines = ["# stringstab derive: derived from the IDL model (eqs 3-9)"]
+def _text(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[str, str]]) -> str:
+    if "sample_time" in doc:
+        lines = [f"# stringstab derive --sample-time {doc['sample_time']}: the sampled-data loop "
+                 "(zero-order hold, exact lag and delay), derived from the IDL model (eqs 3-9)",
+                 f"# delay: {doc['delay']}"]
+    else:
+        lines = ["# stringstab derive: derived from the IDL model (eqs 3-9)"]
     if doc["substitute"]:
-        unit = {"tau": " s", "delta": " s", "headway": " s", "k_x": " 1/s²", "k_v": " 1/s"}
+        unit = {"tau": " s", "tau_prev": " s", "delta": " s", "headway": " s",
+                "sample_time": " s", "k_x": " 1/s²", "k_v": " 1/s"}
         lines.append("# substituted: " + ", ".join(f"{k}={v}{unit.get(k, '')}"
                                                     for k, v in doc["substitute"].items()))
-    lines.append(f"# delay in Psi: {doc['delay_order']}")
-    for key, (label, _) in _LABELS.items():
+    if "delay_order" in doc:
+        lines.append(f"# delay in Psi: {doc['delay_order']}")
+    for key, (label, _) in labels.items():
         val = exprs[key]
         if isinstance(val, list):
             lines.append(f"{label}:")
             lines.extend(f"    {v}" for v in val)
+        elif isinstance(val, dict):
+            lines.append(f"{label}:")
+            lines.extend(f"    {k} = {v}" for k, v in val.items())
         else:
             lines.append(f"{label} = {val}")
     if "errata" in doc:
@@ -140,15 +166,20 @@ def _text(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _latex(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
+def _latex(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[str, str]]) -> str:
     import sympy as sp
 
-    syms = {sp.Symbol("headway", positive=True): sp.Symbol("T^*")}
+    syms = {sp.Symbol("headway", positive=True): sp.Symbol("T^*"),
+            sp.Symbol("sample_time", positive=True): sp.Symbol("H"),
+            sp.Symbol("tau_prev", positive=True): sp.Symbol(r"\tau_p")}
     out = ["% stringstab derive --format latex (needs amsmath)", r"\begin{align*}"]
-    rows = []
-    for key, (_, tex) in _LABELS.items():
+    rows: list[str] = []
+    for key, (_, tex) in labels.items():
         val = exprs[key]
-        if key == "hurwitz":
+        if isinstance(val, dict):
+            rows.extend(sp.latex(sp.Symbol(k)) + " &= " + sp.latex(sp.sympify(v).subs(syms))
+                        for k, v in val.items())
+        elif key in ("hurwitz", "schur_conditions", "schur_conditions_gains"):
             rows.append(tex + r" &:\ " + r",\quad ".join(sp.latex(v.subs(syms)) + " > 0" for v in val))
         elif isinstance(val, list):
             rows.append(
@@ -165,3 +196,94 @@ def _latex(exprs: dict[str, Any], doc: dict[str, Any]) -> str:
             if not e["matches"]:
                 out.append(f"% eq {e['equation']} {e['name']}: {e['difference']}")
     return "\n".join(out) + "\n"
+
+
+def sampled_derivation(sample_time: float, substitute: str | None = None) -> Derivation:
+    """Derive the sampled-data loop's H(z), Δ(z) and Schur conditions (``derive --sample-time``).
+
+    Every vehicle samples with period H and holds its command (zero-order hold); the lag is
+    discretised exactly and the delay δ = (m + ε)H is exact for any δ ≥ 0
+    (:mod:`stringstab.sampled_symbolic`).  H is substituted exactly (as the decimal it is
+    written as); when δ is substituted too, so are m = ⌊δ/H⌋ and ε = δ/H − m.  The
+    predecessor's lag ``tau_prev`` is τ (a homogeneous platoon) unless substituted.
+
+    Parameters
+    ----------
+    sample_time : float
+        H > 0, s.
+    substitute : str, optional
+        ``"tau=0.1,delta=0.2,headway=1.1"``-style specialisation (also the gains and
+        ``tau_prev``).
+
+    Returns
+    -------
+    Derivation
+        Keys ``H``, ``H_numerator_direct``, ``H_numerator_delayed``, ``H_denominator``,
+        ``characteristic_polynomial``, ``w_coefficients``, ``schur_conditions`` (in δ0, δ1,
+        δ2), ``schur_conditions_gains`` (the same in the gains) and ``dc_margin``.
+
+    Raises
+    ------
+    StringStabError
+        On a sample time that is not a finite number > 0 or a bad substitution.
+
+    Examples
+    --------
+    >>> d = sampled_derivation(0.1, "tau=0.1,delta=0.25,headway=1.1,k_x=1,k_v=0.5,k_a=0.2")
+    >>> d.document["m"], d.document["epsilon"], len(d.document["schur_conditions_gains"])
+    (2, '1/2', 5)
+    """
+    import sympy as sp
+
+    from . import sampled_symbolic as SS
+    from .params import sample_time as check_sample_time
+    from .symbolic import SUBSTITUTABLE, parse_substitutions
+
+    H = check_sample_time(sample_time)
+    H_exact = sp.Rational(str(Fraction(repr(H))))
+    subs = parse_substitutions(substitute, {**SUBSTITUTABLE, "tau_prev": SS.tau_prev})
+    given = {str(k): str(v) for k, v in subs.items()}
+    subs.setdefault(SS.tau_prev, subs.get(SUBSTITUTABLE["tau"], SUBSTITUTABLE["tau"]))
+    subs[SS.sample_time] = H_exact
+    delta = SUBSTITUTABLE["delta"]
+    m_val: Any = "m"
+    eps_val: Any = "epsilon"
+    if delta in subs:
+        q = sp.Rational(subs[delta]) / H_exact
+        m_val, eps_val = int(sp.floor(q)), q - sp.floor(q)
+        subs[SS.m], subs[SS.epsilon] = sp.Integer(m_val), eps_val
+    exprs: dict[str, Any] = dict(SS.derive_sampled_all(subs))
+    m_expr = subs.get(SS.m, SS.m)
+    delay = SS.z ** (-(m_expr + 1))
+    full = (exprs["H_numerator_direct"] + delay * exprs["H_numerator_delayed"]) / exprs["H_denominator"]
+    N0, N1, D = (sp.Function(f)(SS.z) for f in ("N_0", "N_1", "D"))
+    exprs["H"] = (N0 + delay * N1) / D  # the form; the parts follow (the document has the whole)
+    w = exprs["w_coefficients"]
+    d0, d1, d2 = sp.symbols("delta0 delta1 delta2", real=True)
+    exprs["schur_conditions_gains"] = [
+        sp.expand(c.subs({d0: w["delta0"], d1: w["delta1"], d2: w["delta2"]}))
+        for c in exprs["schur_conditions"]]
+    exprs = {k: exprs[k] for k in _SAMPLED_LABELS}
+    doc: dict[str, Any] = {}
+    for key, val in exprs.items():
+        if isinstance(val, dict):
+            doc[key] = {k: str(v) for k, v in val.items()}
+        else:
+            doc[key] = [str(v) for v in val] if isinstance(val, list) else str(val)
+    doc["H"] = str(full)
+    doc["sample_time"] = H
+    doc["m"] = m_val
+    doc["epsilon"] = str(eps_val)
+    doc["delay"] = (f"delta = (m + epsilon) sample_time with m = {m_val}, epsilon = {eps_val}"
+                    if delta in subs else "delta = (m + epsilon) sample_time, m integer, 0 <= epsilon < 1")
+    doc["symbols"] = ["k_x", "k_v", "k_a", "tau", "tau_prev", "delta", "headway", "sample_time",
+                      "m", "epsilon", "z", "delta0", "delta1", "delta2"]
+    doc["substitute"] = given
+    doc["conventions"] = {
+        "H": "A_i(z)/A_{i-1}(z): predecessor's to follower's acceleration samples, "
+             "zero-order hold on every vehicle's command",
+        "schur_conditions": "each expression must be > 0 for internal stability (all roots of "
+                            "Delta(z) inside the unit circle)",
+        "tau_prev": "the predecessor's actuator lag; tau unless substituted (homogeneous platoon)",
+    }
+    return Derivation(exprs, doc, dict(_SAMPLED_LABELS))

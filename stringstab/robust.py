@@ -146,7 +146,7 @@ def _robust_g(
     crit = np.pi + 2.0 * np.pi * k
     inside = (crit <= b + 1e-12 * (1.0 + np.abs(b))) & (d_hi > d_lo) & (w > 0)
     T = np.where(inside, -R, np.minimum(t_a, t_b))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         d_in = np.clip((crit - phi) / w, d_lo, d_hi)
     d_w = np.where(inside, d_in, np.where(t_a <= t_b, d_lo, d_hi))
     G = S + r0 + T
@@ -638,8 +638,8 @@ class RobustCertificateBatch(BatchResult):
     def columns(self) -> dict[str, Any]:
         """The result columns: gains, stability over the box, verdict, sup gain and margin,
         the ``witness`` group (``tau``, ``tau_prev``, ``delta``, ``headway``, ``omega``,
-        ``theta``), then ``sample_time`` (NaN in continuous time), ``heterogeneous`` and the
-        ``box`` group (``tau_lo``, ``tau_hi``, ...).
+        ``theta``), then ``sample_time`` (NaN in continuous time), ``heterogeneous`` (sampled
+        only) and the ``box`` group (``tau_lo``, ``tau_hi``, ...).
 
         Examples
         --------
@@ -649,20 +649,24 @@ class RobustCertificateBatch(BatchResult):
         (['certified'], [0.3], [nan])
         """
         n = len(self)
-        return {
+        cols: dict[str, Any] = {
             "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "stable": self.stable,
             "verdict": self.verdict, "sup_gain": self.sup_gain, "margin": self.margin,
             "witness": {k: getattr(self, f"witness_{k}")
                         for k in ("tau", "tau_prev", "delta", "headway", "omega", "theta")},
             "sample_time": np.full(n, np.nan if self.sample_time is None else self.sample_time),
-            "heterogeneous": np.full(n, self.heterogeneous),
-            "box": self.box.columns(n),
         }
+        if self.sample_time is not None:
+            cols["heterogeneous"] = np.full(n, self.heterogeneous)
+        cols["box"] = self.box.columns(n)
+        return cols
 
     def summary_extra(self) -> dict[str, Any]:
-        """The sample time (None in continuous time), heterogeneity and the box."""
-        return {"sample_time": self.sample_time, "heterogeneous": self.heterogeneous,
-                "box": self.box.as_dict()}
+        """The sample time (None in continuous time), heterogeneity (sampled) and the box."""
+        out: dict[str, Any] = {"sample_time": self.sample_time}
+        if self.sample_time is not None:
+            out["heterogeneous"] = self.heterogeneous
+        return {**out, "box": self.box.as_dict()}
 
 
 RobustCertificate.BATCH = RobustCertificateBatch

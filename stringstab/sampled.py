@@ -98,6 +98,7 @@ __all__ = [
     "sampled_margin",
     "sampled_response",
     "schur",
+    "schur_margins",
     "spectral_radius",
     "split_delay",
 ]
@@ -760,6 +761,36 @@ def schur(
     return _schur_bands(delta)[0].reshape(shape)
 
 
+def schur_margins(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float, sample_time: float,
+) -> Array:
+    """The five Schur conditions of Δ(z), each divided by its leading order in H (> 0 iff Schur).
+
+    The conditions of :func:`stringstab.sampled_symbolic.schur_conditions` (b0, b1, b2, b3 and
+    the Hurwitz determinant h2) divided by H²φ1, 2Hφ1, 4φ1, 8 and 8τx³ (x = H/τ, φ1 = 1 − e^{−x}),
+    so that as H → 0 they tend to k_x, c = k_v + T*k_x, 1, 1 and k_v + (T* − τ)k_x: the
+    continuous Hurwitz conditions and the same margins (the gain repair of
+    :mod:`stringstab.tuning` asks each to be ≥ a margin).  Each is a polynomial of degree ≤ 2
+    in the gains.
+
+    Returns
+    -------
+    ndarray, shape (5,) + the gains' shape
+
+    Examples
+    --------
+    >>> np.round(schur_margins(1.2, 0.5, tau=0.1, headway=1.1, sample_time=1e-4), 3).tolist()
+    [1.2, 1.82, 1.0, 1.0, 1.7]
+    """
+    delta, shape = _loop_delta(k_x, k_v, tau, headway, sample_time)
+    H = float(sample_time)
+    x = H / float(tau)
+    f1 = float(_phi(x)[0])
+    scale = np.array([H * H * f1, 2.0 * H * f1, 4.0 * f1, 8.0, 8.0 * float(tau) * x**3])
+    terms = np.stack([t.lo for t in _schur_terms(delta)])
+    return np.asarray(terms / scale[:, None]).reshape((5, *shape))
+
+
 def _z_coeffs(delta: list[Array]) -> tuple[Array, Array, Array]:
     d0, d1, d2 = delta
     # Δ(z) = (z−1)³ + δ2 (z−1)² + δ1 (z−1) + δ0 = z³ + a2 z² + a1 z + a0
@@ -1060,6 +1091,11 @@ class SampledCertificateBatch(BatchResult):
 
     def __getitem__(self, i: int) -> SampledCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]
+
+    @property
+    def stable(self) -> npt.NDArray[np.bool_]:  # type: ignore[override]
+        """Internally stable (Δ(z) Schur, surely): :attr:`schur`, the protocol's name."""
+        return self.schur
 
     @property
     def box(self) -> Box:

@@ -464,8 +464,12 @@ def lambdify_psi(
 SUBSTITUTABLE: dict[str, sp.Symbol] = {str(x): x for x in (*GAINS, *PARAMS)}
 
 
-def parse_substitutions(text: str | None) -> dict[sp.Symbol, sp.Expr]:
+def parse_substitutions(text: str | None,
+                        allowed: dict[str, sp.Symbol] | None = None) -> dict[sp.Symbol, sp.Expr]:
     """Parse ``"tau=0.1,delta=0.2,headway=1.1"`` into exact SymPy rationals.
+
+    ``allowed`` names the substitutable symbols (default :data:`SUBSTITUTABLE`; the sampled
+    derivation adds ``tau_prev``).
 
     Raises
     ------
@@ -481,6 +485,7 @@ def parse_substitutions(text: str | None) -> dict[sp.Symbol, sp.Expr]:
     from .errors import StringStabError
 
     out: dict[sp.Symbol, sp.Expr] = {}
+    names = SUBSTITUTABLE if allowed is None else allowed
     if not text:
         return out
     for item in text.split(","):
@@ -491,9 +496,9 @@ def parse_substitutions(text: str | None) -> dict[sp.Symbol, sp.Expr]:
         name = name.strip()
         if not sep:
             raise StringStabError(f"--substitute expects NAME=VALUE pairs; got {item!r}")
-        if name not in SUBSTITUTABLE:
+        if name not in names:
             raise StringStabError(
-                f"--substitute: unknown symbol {name!r}; expected one of {sorted(SUBSTITUTABLE)}"
+                f"--substitute: unknown symbol {name!r}; expected one of {sorted(names)}"
             )
         try:
             v = sp.Rational(value.strip())
@@ -501,11 +506,11 @@ def parse_substitutions(text: str | None) -> dict[sp.Symbol, sp.Expr]:
             raise StringStabError(
                 f"--substitute: value of {name} must be a finite number; got {value!r}"
             ) from e
-        if name == "tau" and not v > 0:
-            raise StringStabError(f"tau (actuator lag) must be > 0 s; got {value!r}")
+        if name in ("tau", "tau_prev") and not v > 0:
+            raise StringStabError(f"{name} (actuator lag) must be > 0 s; got {value!r}")
         if name in ("delta", "headway") and v < 0:
             raise StringStabError(f"{name} must be >= 0 s; got {value!r}")
-        out[SUBSTITUTABLE[name]] = v
+        out[names[name]] = v
     return out
 
 

@@ -136,6 +136,8 @@ class BatchResult:
 
     k_x: Array
     verdict: npt.NDArray[np.str_]
+    #: Internal stability of each triple's loop (Hurwitz, Schur, or every member of a box).
+    stable: npt.NDArray[np.bool_]
     SINGLE: ClassVar[type[Any]]
     SHARED: ClassVar[tuple[str, ...]] = ()
 

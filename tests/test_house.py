@@ -184,9 +184,9 @@ def test_no_library_module_imports_the_cli_or_the_demo():
     assert KNOWN_CLI_USERS - users == set(), "fixed: remove them from KNOWN_CLI_USERS"
 
 
-def _heavy_after(code: str) -> list[str]:
+def _heavy_after(code: str, heavy: tuple[str, ...] = HEAVY) -> list[str]:
     script = (f"import sys, json\n{code}\n"
-              f"print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))")
+              f"print(json.dumps([m for m in {heavy!r} if m in sys.modules]))")
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          check=True, timeout=120)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -214,3 +214,24 @@ def test_cli_certify_loads_no_heavy_module():
         "from stringstab.cli import main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    assert main(['certify', '1,0.5,0.5']) == 0") == []
+
+
+#: The certificates of other loops, imported only when a caller asks for them.
+OTHER_LOOPS = ("stringstab.sampled", "stringstab.robust", "stringstab.sampled_symbolic")
+
+
+def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one():
+    code = ("import contextlib, io\n"
+            "import stringstab\n"
+            "from stringstab.cli import main\n"
+            "stringstab.certify(1, 0.5, 0.5, tau=0.1, delta=0.2, headway=1.1)\n"
+            "stringstab.check([1], [0.5], [0.5], tau=0.1, delta=0.2, headway=1.1)\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(['certify', '1,0.5,0.5']) == 0\n")
+    assert _heavy_after(code, OTHER_LOOPS) == []
+    # the check above can fail: asking for the sampled loop loads it (and no heavy module)
+    sampled = code + "stringstab.certify(1, 0.5, 0.5, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)\n"
+    assert _heavy_after(sampled, OTHER_LOOPS) == ["stringstab.sampled"]
+    robust = code + "stringstab.certify(1, 0.5, 0.5, tau=(0.1, 0.2), delta=0.2, headway=1.1)\n"
+    assert _heavy_after(robust, OTHER_LOOPS) == ["stringstab.sampled", "stringstab.robust"]
+    assert _heavy_after(robust) == []

@@ -7,6 +7,8 @@ import re
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..errors import StringStabError, show
 from ..io import (
     BINARY_FORMATS,
@@ -16,7 +18,16 @@ from ..io import (
     parse_triple,
     read_gains,
 )
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ..params import (
+    DEFAULT_DELTA,
+    DEFAULT_HEADWAY,
+    DEFAULT_TAU,
+    Box,
+    Params,
+    check_params,
+    parameter_model,
+    positive,
+)
 
 __all__ = [
     "NEGATIVE_NUMBER",
@@ -24,9 +35,11 @@ __all__ = [
     "add_gain_arguments",
     "add_model_arguments",
     "add_output_arguments",
+    "check_horizon",
     "check_output",
     "gains_from_args",
-    "model_params",
+    "loop_params",
+    "shown_params",
 ]
 
 #: argparse (< 3.13) reads "-0.5,1,1" or "-2,2" as an unknown option; anything that
@@ -36,18 +49,65 @@ NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
 def add_model_arguments(p: argparse.ArgumentParser) -> None:
-    """``--tau --delta --headway`` with the documented defaults (IDL Table 2)."""
-    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S",
-                   help=f"actuator lag τ in s, > 0 (default: {DEFAULT_TAU})")
-    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S",
-                   help=f"communication delay δ in s, >= 0 (default: {DEFAULT_DELTA})")
-    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S",
-                   help=f"desired time headway T* in s, >= 0 (default: {DEFAULT_HEADWAY})")
+    """``--tau --delta --headway`` (numbers or ``LO:HI`` intervals) and ``--sample-time``."""
+    p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S|LO:HI",
+                   help=f"actuator lag τ in s, > 0, or an interval LO:HI (default: {DEFAULT_TAU})")
+    p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S|LO:HI",
+                   help=f"communication delay δ in s, >= 0, or an interval LO:HI (default: {DEFAULT_DELTA})")
+    p.add_argument("--headway", default=str(DEFAULT_HEADWAY), metavar="S|LO:HI",
+                   help=f"desired time headway T* in s, >= 0, or an interval LO:HI "
+                        f"(default: {DEFAULT_HEADWAY})")
+    p.add_argument("--sample-time", metavar="H",
+                   help="certify the sampled-data loop: every vehicle samples with period H s and "
+                        "holds its command (zero-order hold); default: the continuous-time loop")
 
 
-def model_params(args: argparse.Namespace) -> tuple[float, float, float]:
-    """Validated (τ, δ, T*) from ``--tau --delta --headway``."""
-    return check_params(args.tau, args.delta, args.headway)
+def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
+    """The loop asked for: (τ, δ, T*) as :class:`Params` or, with any ``LO:HI``, a :class:`Box`;
+    and the sample time H (None: continuous time), each checked."""
+    values = (args.tau, args.delta, args.headway)
+    if any(":" in str(v) for v in values):
+        model: Params | Box = parameter_model(*(str(v) for v in values))
+    else:  # numbers: the point checks and messages ('tau ... must be ... > 0 s; got '0'')
+        model = Params(*check_params(*values))
+    H = None if args.sample_time is None else positive(
+        "--sample-time (sampling period H)", args.sample_time, unit=" s")
+    return model, H
+
+
+def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
+    """τ, δ, T* (a number, or [lo, hi] for an interval) and the sample time, for outputs.
+
+    Examples
+    --------
+    >>> shown_params(Box((0.1, 0.5), (0.2, 0.2), (1.1, 1.1)), 0.1)
+    {'tau': [0.1, 0.5], 'delta': 0.2, 'headway': 1.1, 'sample_time': 0.1}
+    """
+    out: dict[str, Any] = {}
+    for k, (lo, hi) in Box.of(model).as_dict().items():
+        out[k] = lo if lo == hi else [lo, hi]
+    out["sample_time"] = H
+    return out
+
+
+def check_horizon(H: float | None, table: GainTable) -> None:
+    """Refuse a sample time longer than the time span of a gain time series (its ``t`` column).
+
+    Raises
+    ------
+    StringStabError
+        When H exceeds max(t) − min(t): no sampled loop of period H fits in the data.
+    """
+    t = getattr(table, "t", None)
+    if H is None or t is None or len(t) == 0:
+        return
+    t = np.asarray(t, dtype=float)
+    span = float(t.max() - t.min())
+    if H > span:
+        raise StringStabError(
+            f"--sample-time must not exceed the horizon of the data; the t column of "
+            f"{table.source} spans {span:g} s ({len(t)} row(s), from {t.min():g} to {t.max():g} s); "
+            f"got --sample-time {H:g} s")
 
 
 def add_gain_arguments(p: argparse.ArgumentParser) -> None:

@@ -1,9 +1,11 @@
 """``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
 
 Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
-certifies them with :func:`stringstab.certificate.certify_batch` and writes the
-batch's columns (:meth:`~stringstab.certificate.CertificateBatch.columns`) as a
-table, JSON, CSV, Parquet or NPZ (:func:`stringstab.io.write_results`).  Exit code 0
+certifies them with :func:`stringstab.certificate.certify_batch` — the continuous-time loop,
+the sampled-data loop (``--sample-time``) or every member of a box of parameters (``--tau``,
+``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
+(:meth:`~stringstab.certificate.CertificateBatch.columns`) as a table, JSON, CSV, Parquet or
+NPZ (:func:`stringstab.io.write_results`).  Exit code 0
 when every triple is certified, 1 when any is not (``not_certified`` or
 ``inconclusive``), 2 on bad input (nothing printed, no file written).
 """
@@ -16,14 +18,16 @@ import warnings
 from typing import Any
 
 from ..errors import StringStabError, show
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
 from ._common import (
     add_gain_arguments,
     add_model_arguments,
     add_output_arguments,
+    check_horizon,
     check_output,
     gains_from_args,
-    model_params,
+    loop_params,
+    shown_params,
 )
 
 __all__ = ["PROGRESS_ROWS", "add_parser", "run"]
@@ -38,14 +42,17 @@ examples:
   stringstab certify --file rollout.csv --format json --out certificates.json
   stringstab certify --file big.npz --format parquet --out certificates.parquet
   stringstab certify 0.9,-0.5,1.1 --method pade         # also python-control's Padé numbers
+  stringstab certify 1.2,0.5,0.6 --sample-time 0.1       # the loop sampled every 0.1 s (ZOH)
+  stringstab certify 1.2,0.5,0.6 --tau 0.1:0.5 --delta 0.1:0.3   # every τ, δ in the box
 
 input files: CSV with a header k_x,k_v,k_a (a gain time series adds t and
 optionally vehicle), JSON (a list of {{"k_x","k_v","k_a"}} objects or of triples,
 bare or under "gains"), NPZ (arrays k_x, k_v, k_a [, t, vehicle] or K (n,3)) or
 Parquet (columns k_x, k_v, k_a [, t, vehicle]).
 
-output: table (for people: sup|Γ| and margin rounded, ω_peak in rad/s), or every
-column in json, csv, parquet or npz (the last two need --out).
+output: table (for people: sup|Γ| and margin rounded, ω_peak in rad/s; sampled:
+also θ_peak in rad/sample; a box: the witness member), or every column in json, csv,
+parquet or npz (the last two need --out); sample_time and the box are in every format.
 
 exit status: 0 every triple certified; 1 some triple not_certified or
 inconclusive; 2 bad input (no verdicts printed, no file written).
@@ -63,7 +70,9 @@ def add_parser(sub: Any) -> None:
             "(IDL eq 11, derived) is internally stable and sup_ω |Γ(jω)| ≤ 1 with the exact "
             "delay e^{-jδω}. Reports the verdict (certified / not_certified / inconclusive), "
             "sup|Γ|, its frequency, the margin, and the Taylor Proposition 1 (derived and "
-            "printed Ψ) for comparison."
+            "printed Ψ) for comparison. With --sample-time H: the same for the sampled-data "
+            "loop H(z) (zero-order hold, exact lag and delay); with LO:HI intervals: for every "
+            "τ, δ, T* in the box, with a witness member when not certified."
         ),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -115,12 +124,17 @@ def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input."""
-    tau, delta, headway = model_params(args)
+    model, H = loop_params(args)
     order = _pade_order(args.pade_order)
+    if args.method == "pade" and (H is not None or isinstance(model, Box)):
+        raise StringStabError(
+            "--method pade (python-control's cross-check) is for the continuous loop at one τ, δ, "
+            f"T*; got {'--sample-time ' + args.sample_time if H is not None else 'an interval'}")
     out = check_output(args)
     table = gains_from_args(args)
+    check_horizon(H, table)
 
-    from ..certificate import TABLE_COLUMNS, certify_batch
+    from ..certificate import certify_batch
     from ..io import write_results
 
     n = len(table)
@@ -129,15 +143,27 @@ def run(args: argparse.Namespace) -> int:
         # Padé disagreements are reported once, below, instead of per row.
         warnings.simplefilter("ignore")
         batch = certify_batch(
-            table.k_x, table.k_v, table.k_a, tau=tau, delta=delta, headway=headway,
-            method=args.method, pade_order=order, progress=progress,
+            table.k_x, table.k_v, table.k_a, tau=model.tau, delta=model.delta,
+            headway=model.headway, sample_time=H, method=args.method, pade_order=order,
+            progress=progress,
         )
-    params: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "method": args.method}
+    if H is None and not isinstance(model, Box):  # the continuous loop at one τ, δ, T*
+        from ..certificate import TABLE_COLUMNS as columns
+
+        params: dict[str, Any] = {"tau": model.tau, "delta": model.delta,
+                                  "headway": model.headway, "method": args.method}
+    else:
+        if isinstance(model, Box):
+            from ..robust import TABLE_COLUMNS as columns
+        else:
+            from ..sampled import TABLE_COLUMNS as columns
+        params = {**shown_params(model, H), "method": args.method}
     if args.method == "pade":
         params["pade_order"] = order
     summary = batch.summary()
-    write_results({**table.meta_columns(), **batch.columns()}, out, args.format, params=params,
-                  summary=summary, table=TABLE_COLUMNS, what="--out")
+    write_results({**table.meta_columns(), **batch.columns()}, out, args.format,
+                  params=_for_table(params) if args.format == "table" else params,
+                  summary=summary, table=columns, what="--out")
     if args.method == "pade":
         _warn_disagreements([{**table.meta(i), **r} for i, r in enumerate(batch.records())], order)
     if out is not None:
@@ -147,3 +173,8 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return 0 if summary["certified"] == summary["n"] else 1
+
+
+def _for_table(params: dict[str, Any]) -> dict[str, Any]:
+    """Intervals as the command line writes them (``0.1:0.5``) in the table's header line."""
+    return {k: f"{v[0]:g}:{v[1]:g}" if isinstance(v, list) else v for k, v in params.items()}

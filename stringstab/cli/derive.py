@@ -1,5 +1,8 @@
 """``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions.
 
+With ``--sample-time H``: the sampled-data loop instead (H(z), the characteristic polynomial
+Δ(z) and its Schur conditions; :func:`stringstab.derivation.sampled_derivation`).
+
 SymPy is imported when the command runs, not when it is registered.  ``--out`` is checked
 before anything is derived and written atomically; a bad path is one line and exit code 2.
 """
@@ -23,7 +26,9 @@ def add_parser(sub: Any) -> None:
         description=(
             "Derive, from the IDL vehicle model (eqs 3-9), the transfer function Γ(s) "
             "(eq 11), the Taylor coefficients Ψ1-Ψ3 and Λ of |D(jω)|²−|N(jω)|² (eqs 12-15), "
-            "their gradients (eqs 25-26) and the Hurwitz conditions of Γ's denominator."
+            "their gradients (eqs 25-26) and the Hurwitz conditions of Γ's denominator. "
+            "With --sample-time H: the sampled-data loop's H(z) (zero-order hold, exact lag and "
+            "delay), its characteristic polynomial Δ(z) and the Schur conditions."
         ),
     )
     p.add_argument("--format", choices=("text", "latex", "json"), default="text")
@@ -43,6 +48,9 @@ def add_parser(sub: Any) -> None:
         metavar="N|exact",
         help="Taylor order of e^{-δs} used for Ψ (default: exact delay; the paper's Ψ1 is 3)",
     )
+    p.add_argument("--sample-time", metavar="H",
+                   help="derive the sampled-data loop with period H s instead (H(z), Δ(z), Schur "
+                        "conditions); --substitute may also set tau_prev")
     p.add_argument("--out", metavar="FILE", help="write to FILE instead of standard output")
     p.set_defaults(func=run)
 
@@ -61,11 +69,20 @@ def _delay_order(text: str) -> int | None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``derive``; ``--out`` is checked before any derivation."""
-    from ..derivation import derivation
+    from ..derivation import derivation, sampled_derivation
+    from ..params import positive
 
     delay_order = _delay_order(args.delay_order)
+    H = None
+    if args.sample_time is not None:
+        H = positive("--sample-time (sampling period H)", args.sample_time, unit=" s")
+        if args.errata or delay_order is not None:
+            raise StringStabError(
+                "--errata and --delay-order are about the continuous loop's Ψ (IDL eqs 12-15); "
+                f"expected neither with --sample-time; got {'--errata' if args.errata else '--delay-order ' + args.delay_order}")
     out = check_output_file(args.out, what="--out") if args.out else None
-    d = derivation(delay_order, args.substitute, args.errata)
+    d = (sampled_derivation(H, args.substitute) if H is not None
+         else derivation(delay_order, args.substitute, args.errata))
     text = {"json": d.json, "text": d.text, "latex": d.latex}[args.format]()
     if out is not None:
         atomic_write_text(out, text, what="--out")

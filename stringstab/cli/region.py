@@ -18,8 +18,8 @@ import numpy as np
 
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from ..regions import GAIN_NAMES, METHODS
-from ._common import add_model_arguments, model_params
+from ..regions import CONTINUOUS, GAIN_NAMES
+from ._common import add_model_arguments, loop_params
 
 __all__ = ["add_parser", "run"]
 
@@ -33,6 +33,8 @@ examples:
   stringstab region --x k_x --y k_a --fix k_v=0.5 --method exact,printed --tau 0.2
   stringstab region --3d --n 81 --method exact --out maps3d/
   stringstab region --fix k_a=0.3 --range k_x=0,1.5 --range k_v=-1,1 --overlay rollout.csv
+  stringstab region --fix k_a=0.5 --sample-time 0.1 --compare continuous --out maps_dt01/
+  stringstab region --fix k_a=0.5 --tau 0.1:0.3 --delta 0.1:0.3 --n 101 --out maps_box/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
 in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
@@ -40,6 +42,9 @@ in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<metho
 <prefix>_slices_<method>, <prefix>_3d_<method> (3-D).
 classes: exact = not internally stable / not certified / inconclusive / certified;
 taylor, printed = not internally stable / type III / type IV / type I / type II.
+with --sample-time or a LO:HI interval, exact is the sampled or robust certificate (the
+only method; the Taylor criteria are of the continuous loop at one tau, delta, headway);
+--compare continuous adds the continuous certificate and the band where they differ.
 defaults: range {DEFAULT_RANGE[0]:g},{DEFAULT_RANGE[1]:g}, n {DEFAULT_N_2D} (2-D) or {DEFAULT_N_3D} (3-D),
 tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/regions.md.
 """
@@ -70,8 +75,12 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--n", metavar="N[,N2[,N3]]",
                    help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
     add_model_arguments(p)
-    p.add_argument("--method", default=",".join(METHODS), metavar="M[,M...]",
-                   help="methods among exact, taylor, printed (default: all three)")
+    p.add_argument("--method", metavar="M[,M...]",
+                   help="methods among exact, taylor, printed (default: all three; exact alone "
+                        "with --sample-time or an interval)")
+    p.add_argument("--compare", choices=(CONTINUOUS,),
+                   help="with --sample-time: also map the continuous-time certificate and draw the "
+                        "band certified in continuous time but not when sampled")
     p.add_argument("--overlay", metavar="FILE",
                    help="gain trajectory (.csv/.json/.npz as for certify) drawn on the 2-D map")
     p.add_argument("--out", "-o", default="maps", metavar="DIR", help="output directory (default: maps)")
@@ -197,7 +206,14 @@ def run(args: argparse.Namespace) -> int:
     from ..regions import region_map
 
     axes, fixed = _grid(args)
-    tau, delta, headway = model_params(args)
+    model, H = loop_params(args)
+    methods = args.method
+    if args.compare is not None:
+        if H is None:
+            raise StringStabError(
+                "--compare continuous draws the gains certified in continuous time but not when "
+                "sampled; expected --sample-time H with it, got none")
+        methods = f"{methods or 'exact'},{CONTINUOUS}"
     formats = [f.strip() for f in args.format.split(",")]
     for f in formats:
         if f not in FIGURE_FORMATS:
@@ -226,9 +242,9 @@ def run(args: argparse.Namespace) -> int:
     warm.start()
     try:
         # region_map validates the methods before computing anything
-        rmap = region_map(axes, fixed or None, tau=tau, delta=delta, headway=headway,
-                          methods=args.method, workers=workers,
-                          progress=False if args.no_progress else None)
+        rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
+                          headway=model.headway, sample_time=H, methods=methods,
+                          workers=workers, progress=False if args.no_progress else None)
     finally:
         warm.join()
     verdicts = None

@@ -18,8 +18,15 @@ import numpy as np
 
 from ..errors import StringStabError
 from ..io import check_output_file, format_results, write_text
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from ._common import add_gain_arguments, add_model_arguments, gains_from_args, model_params
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
+from ._common import (
+    add_gain_arguments,
+    add_model_arguments,
+    check_horizon,
+    gains_from_args,
+    loop_params,
+    shown_params,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -32,9 +39,15 @@ examples:
   stringstab tune 0.9,-0.5,1.1 --method both          # and the IDL paper's region growing
   stringstab tune --file rollout.csv --format json --out repaired.json
   stringstab tune 0.2,0.7,0 --method region-growing --r0 0.05 --criterion printed
+  stringstab tune 0.9,-0.5,1.1 --sample-time 0.1      # certified for the loop sampled at 10 Hz
+  stringstab tune 0.9,-0.5,1.1 --tau 0.1:0.2 --delta 0.15:0.25   # for every τ, δ in the box
 
 input files: as for `stringstab certify` (CSV with a header k_x,k_v,k_a and
 optional t, vehicle; JSON; NPZ).
+
+with --sample-time or a LO:HI interval the projection repairs to gains certified for
+that loop (sampled, or every member of the box); region growing (a continuous-time
+Taylor test at one tau, delta, headway) takes neither.
 
 output: per input and method, the input gains (k_x_in, ...), the output gains,
 whether the output is certified by the exact certificate, the status
@@ -126,7 +139,13 @@ def _integer(text: str | None, option: str) -> int | None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``tune``; returns 0 (every output certified), 1 (some not) or raises on bad input."""
-    tau, delta, headway = model_params(args)
+    model, H = loop_params(args)
+    general = H is not None or isinstance(model, Box)
+    if general and args.method != "projection":
+        raise StringStabError(
+            "region growing tests candidates with the Taylor Proposition 1 of the continuous loop "
+            f"at one tau, delta, headway; expected --method projection with "
+            f"{'--sample-time' if H is not None else 'an interval'}, got --method {args.method}")
     lo, hi = _numbers(args.bounds, 2, "--bounds")
     if not lo < hi:
         raise StringStabError(f"--bounds expects LO,HI with LO < HI; got {args.bounds!r}")
@@ -146,6 +165,7 @@ def run(args: argparse.Namespace) -> int:
         )
     out = check_output_file(args.out, what="--out") if args.out else None
     table = gains_from_args(args)
+    check_horizon(H, table)
 
     from ..tuning import Projector, TuneResults, region_growing
     from ..tuning.result import TABLE_COLUMNS
@@ -153,15 +173,18 @@ def run(args: argparse.Namespace) -> int:
     methods = ["region-growing", "projection"] if args.method == "both" else [args.method]
     projector = None
     if "projection" in methods:
-        projector = Projector(tau=tau, delta=delta, headway=headway, weights=weights,
-                              bounds=(lo, hi), hurwitz_margin=margin, eps=eps, cache_size=0)
+        projector = Projector(tau=model.tau, delta=model.delta, headway=model.headway,
+                              sample_time=H, weights=weights, bounds=(lo, hi),
+                              hurwitz_margin=margin, eps=eps, cache_size=0)
     results = []
     rows = []
     K = table.K
     for i in range(len(table)):
         for m in methods:
             if m == "region-growing":
-                r = region_growing(K[i], tau=tau, delta=delta, headway=headway, r0=r0,
+                assert not isinstance(model, Box)
+                r = region_growing(K[i], tau=model.tau, delta=model.delta,
+                                   headway=model.headway, r0=r0,
                                    grid=grid or 2, bounds=(lo, hi), max_iter=max_iter,
                                    criterion=args.criterion, weights=weights,
                                    grow_ka=args.grow_ka, check_hurwitz=args.check_hurwitz)
@@ -173,8 +196,10 @@ def run(args: argparse.Namespace) -> int:
     meta = {k: np.asarray(getattr(table, k))[rows] for k in ("t", "vehicle")
             if getattr(table, k, None) is not None}
     repaired = TuneResults.collect(results, meta=meta, methods=methods)
-    params: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway,
-                              "method": args.method, "bounds": [lo, hi], "weights": weights}
+    params: dict[str, Any] = {**shown_params(model, H), "method": args.method,
+                              "bounds": [lo, hi], "weights": weights}
+    if not general:
+        del params["sample_time"]  # the continuous loop at one τ, δ, T*: as before
     if "region-growing" in methods:
         params.update(r0=r0, grid=grid, max_iter=max_iter, criterion=args.criterion,
                       check_hurwitz=args.check_hurwitz, grow_ka=args.grow_ka)
@@ -182,7 +207,8 @@ def run(args: argparse.Namespace) -> int:
         params.update(hurwitz_margin=margin, eps=eps)
     summary = repaired.summary()
     if args.format == "table":  # for people: units on the numbers
-        shown = {k: f"{v:g} s" if k in ("tau", "delta", "headway") else v for k, v in params.items()}
+        shown = {k: _seconds(v) if k in ("tau", "delta", "headway", "sample_time") else v
+                 for k, v in params.items()}
         text = format_results(repaired.columns(), "table", params=shown, table=TABLE_COLUMNS,
                               summary={m: _with_units(s) for m, s in summary.items()})
     elif args.format == "csv":
@@ -195,6 +221,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"stringstab tune: {n_cert} of {len(repaired)} outputs certified; "
               f"wrote {args.format} to {out}", file=sys.stderr)
     return 0 if n_cert == len(repaired) else 1
+
+
+def _seconds(v: Any) -> str:
+    """A parameter in seconds for the table: ``0.1 s``, ``0.1:0.2 s``, or ``-`` (none)."""
+    if v is None:
+        return "-"
+    return f"{v[0]:g}:{v[1]:g} s" if isinstance(v, list) else f"{v:g} s"
 
 
 def _with_units(s: dict[str, Any]) -> dict[str, Any]:

@@ -39,7 +39,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..regions import METHODS, RegionMap
+from ..regions import CONTINUOUS, METHODS, RegionMap
 from ._common import (
     CLASS_COLORS,
     GAIN_LABELS,
@@ -74,6 +74,7 @@ _METHOD_TITLES = {
     "exact": "exact certificate",
     "taylor": "Taylor Prop. 1 (derived Ψ) types",
     "printed": "Taylor Prop. 1 (printed Ψ) types",
+    CONTINUOUS: "continuous-time certificate",
 }
 _AGREE_STABLE = "#BFE1F5"  # light tint of sky blue
 _AGREE_UNSTABLE = "#E4E4E4"
@@ -87,6 +88,29 @@ _VERDICT_MARKERS = {
 
 
 # --------------------------------------------------------------------------- helpers
+def _method_title(rmap: RegionMap, method: str) -> str:
+    """The title of ``method``'s classes: ``exact`` names the loop it certifies."""
+    if method == "exact" and (rmap.sample_time is not None or rmap.is_box):
+        return f"certificate of the {rmap.loop} loop"
+    return _METHOD_TITLES[method]
+
+
+def _short(rmap: RegionMap, method: str) -> str:
+    """A method's name in a comparison legend (``exact`` is ``sampled`` on a sampled map)."""
+    if method == "exact" and rmap.sample_time is not None:
+        return "sampled"
+    if method == "exact" and rmap.is_box:
+        return "robust"
+    return method
+
+
+def _gain_symbol(rmap: RegionMap) -> tuple[str, str]:
+    """(text, LaTeX) of the supremum the sup-gain map shows."""
+    if rmap.sample_time is not None:
+        return "sup|H(e^{jθ})|", r"$\sup_\theta |H(e^{j\theta})|$"
+    return "sup|Γ(jω)|", r"$\sup_\omega |\Gamma(j\omega)|$"
+
+
 def _need_2d(rmap: RegionMap, what: str) -> None:
     if not isinstance(rmap, RegionMap):
         raise StringStabError(f"{what} needs a RegionMap; got {type(rmap).__name__}")
@@ -178,7 +202,7 @@ def plot_class_map(
     handles = [patch(c, f"{n} ({pct(k, rmap.size)})") for n, c, k in zip(names, colors, counts)]
     leg = legend_below(ax, handles, title=f"{rmap.size:,} grid points") if legend else None
     if title:
-        ax.set_title(f"{_METHOD_TITLES[method]}\n{rmap.title()}", fontsize="medium")
+        ax.set_title(f"{_method_title(rmap, method)}\n{rmap.title()}", fontsize="medium")
     return PlotResult.of({"ax": ax, "image": im, "legend": leg, "handles": handles})
 
 
@@ -187,7 +211,7 @@ def _comparison_codes(
     rmap: RegionMap, methods: Sequence[str]
 ) -> tuple[np.ndarray, list[str], list[str], list[bool]]:
     """Category per point, with labels, colours and whether each is a disagreement."""
-    short = {"exact": "exact", "taylor": "taylor", "printed": "printed"}
+    short = {m: _short(rmap, m) for m in methods}
     stable = [rmap.stable(m) for m in methods]
     inc = np.zeros(rmap.shape, dtype=bool)
     for m in methods:
@@ -263,7 +287,8 @@ def plot_comparison(
         If ``rmap`` is not 2-D or fewer than two evaluated methods are given.
     """
     _need_2d(rmap, "plot_comparison")
-    ms = [m for m in METHODS if m in rmap.methods] if methods is None else list(methods)
+    ms = ([m for m in (*METHODS, CONTINUOUS) if m in rmap.methods] if methods is None
+          else list(methods))
     if len(ms) < 2 or len(set(ms)) != len(ms):
         raise StringStabError(f"plot_comparison needs 2 or 3 distinct evaluated methods; got {ms}")
     for m in ms:
@@ -284,7 +309,8 @@ def plot_comparison(
     ]
     leg = legend_below(ax, handles, title=f"disagreements: {n_dis:,} of {rmap.size:,} points") if legend else None
     if title:
-        ax.set_title(f"{' vs '.join(ms)}: where the verdicts differ\n{rmap.title()}", fontsize="medium")
+        ax.set_title(f"{' vs '.join(_short(rmap, m) for m in ms)}: where the verdicts differ\n"
+                     f"{rmap.title()}", fontsize="medium")
     return PlotResult.of({"ax": ax, "image": im, "legend": leg, "counts": counts, "disagreements": n_dis})
 
 
@@ -338,24 +364,26 @@ def plot_sup_gain(
     if vmax is None:
         vmax = float(np.percentile(sup[finite], 99)) if finite.any() else 10.0
         vmax = max(vmax, 1.1)
+    text, tex = _gain_symbol(rmap)
     cm = mpl.colormaps[cmap].with_extremes(bad="#E4E4E4")
     im = _draw_field(ax, rmap, np.ma.masked_invalid(np.where(finite, sup, np.nan)),
                      cmap=cm, norm=LogNorm(vmin=1.0, vmax=vmax))
     cert = rmap.stable("exact").astype(float)
     contour = None
-    handles = [patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)")]
+    handles = [patch("#E4E4E4", f"not internally stable (‖{'H' if rmap.sample_time else 'Γ'}‖∞ = ∞)")]
     if 0 < cert.sum() < cert.size:
         x, y = rmap.axes.values()
         contour = ax.contour(x, y, cert.T, levels=[0.5], colors=[OKABE_ITO["vermillion"]], linewidths=1.6)
         handles.append(Line2D([], [], color=OKABE_ITO["vermillion"], lw=1.6,
-                              label=f"boundary of sup|Γ| ≤ 1 (certified, {pct(int(cert.sum()), cert.size)})"))
+                              label=f"boundary of {text} ≤ 1 (certified, {pct(int(cert.sum()), cert.size)})"))
     leg = legend_below(ax, handles, ncol=1)
     cb = None
     if colorbar:
-        cb = ax.figure.colorbar(im, ax=ax, extend="max", label=r"$\sup_\omega |\Gamma(j\omega)|$")
+        cb = ax.figure.colorbar(im, ax=ax, extend="max", label=tex)
     _label_axes(ax, rmap)
     if title:
-        ax.set_title(f"sup|Γ(jω)| (exact delay)\n{rmap.title()}", fontsize="medium")
+        at = " at the witness member" if rmap.is_box else ""
+        ax.set_title(f"{text}{at} (exact delay)\n{rmap.title()}", fontsize="medium")
     return PlotResult.of({"ax": ax, "image": im, "contour": contour, "colorbar": cb, "legend": leg})
 
 
@@ -423,7 +451,8 @@ def plot_slices(
     names = rmap.class_names(method)
     handles = [patch(CLASS_COLORS[c], c) for c in names]
     leg = fig.legend(handles=handles, loc="outside right upper", frameon=False, fontsize="small")
-    fig.suptitle(f"{_METHOD_TITLES[method]}, slices over {gain}\n{rmap.title()}", fontsize="medium")
+    fig.suptitle(f"{_method_title(rmap, method)}, slices over {gain}\n{rmap.title()}",
+                 fontsize="medium")
     return PlotResult.of({"fig": fig, "axes": used, "images": images, "values": coords[idx], "legend": leg})
 
 
@@ -538,15 +567,24 @@ def plot_region_3d(
 
 
 # --------------------------------------------------------------------------- several maps
+def _param_values(rmap: RegionMap) -> dict[str, str]:
+    """τ, δ, T* of a map as text: ``0.1`` or ``[0.1, 0.3]``."""
+    out = {}
+    for k, v in rmap.params.as_dict().items():
+        out[k] = f"[{v[0]:g}, {v[1]:g}]" if isinstance(v, list) and v[0] != v[1] else \
+            f"{v[0] if isinstance(v, list) else v:g}"
+    return out
+
+
 def _param_label(rmap: RegionMap, vary: Sequence[str]) -> str:
-    p = rmap.params.as_dict()
+    p = _param_values(rmap)
     sym = {"tau": "τ", "delta": "δ", "headway": "T*"}
-    return ", ".join(f"{sym[k]} = {p[k]:g} s" for k in vary)
+    return ", ".join(f"{sym[k]} = {p[k]} s" for k in vary)
 
 
 def _varying(maps: Sequence[RegionMap]) -> list[str]:
     keys = ["tau", "delta", "headway"]
-    vary = [k for k in keys if len({m.params.as_dict()[k] for m in maps}) > 1]
+    vary = [k for k in keys if len({_param_values(m)[k] for m in maps}) > 1]
     return vary or ["tau"]
 
 
@@ -631,17 +669,17 @@ def plot_facets(
     else:
         from matplotlib.lines import Line2D
 
-        fig.colorbar(images[-1], ax=axes, extend="max", shrink=0.9,
-                     label=r"$\sup_\omega |\Gamma(j\omega)|$")
-        leg = fig.legend(handles=[patch("#E4E4E4", "not internally stable (‖Γ‖∞ = ∞)"),
+        fig.colorbar(images[-1], ax=axes, extend="max", shrink=0.9, label=_gain_symbol(maps[0])[1])
+        sym = "H" if maps[0].sample_time else "Γ"
+        leg = fig.legend(handles=[patch("#E4E4E4", f"not internally stable (‖{sym}‖∞ = ∞)"),
                                   Line2D([], [], color=OKABE_ITO["vermillion"], lw=1.6,
-                                         label="boundary of sup|Γ| ≤ 1 (certified)")],
+                                         label=f"boundary of sup|{sym}| ≤ 1 (certified)")],
                          loc="outside lower center", ncol=2, frameon=False, fontsize="small")
     fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
-    p = maps[0].params.as_dict()
-    const = ", ".join(f"{s} = {p[k]:g} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
+    p = _param_values(maps[0])
+    const = ", ".join(f"{s} = {p[k]} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
                       if k not in vary)
-    what = _METHOD_TITLES[method] if kind == "class" else "sup|Γ(jω)|"
+    what = _method_title(maps[0], method) if kind == "class" else _gain_symbol(maps[0])[0]
     fig.suptitle(f"{what}; {fixed}; {const}", fontsize="medium")
     return PlotResult.of({"fig": fig, "axes": axes, "images": images, "legend": leg, "shares": shares})
 
@@ -698,8 +736,8 @@ def plot_boundaries(
     leg = legend_below(ax, handles, title=f"boundary of the {word} region", ncol=1)
     if title:
         fixed = "; ".join(f"{k} = {v:g}" for k, v in maps[0].fixed.items())
-        p = maps[0].params.as_dict()
-        const = ", ".join(f"{s} = {p[k]:g} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
+        p = _param_values(maps[0])
+        const = ", ".join(f"{s} = {p[k]} s" for k, s in (("tau", "τ"), ("delta", "δ"), ("headway", "T*"))
                           if k not in vary)
         sym = {"tau": "τ", "delta": "δ", "headway": "T*"}
         ax.set_title(f"boundary of the {word} region for several {', '.join(sym[v] for v in vary)}\n"
@@ -720,7 +758,10 @@ def _gain_rows(gains: Any) -> tuple[npt.NDArray[np.float64], Any]:
 
 
 def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
-    """The exact verdict of each triple of ``gains`` at the map's τ, δ, T* (compute step).
+    """The exact verdict of each triple of ``gains`` for the map's loop (compute step).
+
+    The certificate the map's ``exact`` method is: continuous or sampled (``sample_time``),
+    at the map's τ, δ, T* or over its box.
 
     Examples
     --------
@@ -735,7 +776,8 @@ def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
     K, _ = _gain_rows(gains)
     p = rmap.params
     return certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta,
-                         headway=p.headway).verdict.tolist()
+                         headway=p.headway, sample_time=rmap.sample_time,
+                         heterogeneous=rmap.heterogeneous).verdict.tolist()
 
 
 def plot_trajectory(

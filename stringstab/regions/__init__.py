@@ -27,6 +27,14 @@ all three, and returns a :class:`RegionMap` holding, per grid point,
 * ``sup_gain`` (‖Γ‖_{H∞} = sup_ω |Γ(jω)|, ``inf`` when Γ is not internally
   stable) and ``margin`` (min_ω g(ω) found) when ``exact`` is requested.
 
+With ``sample_time`` or an interval for τ, δ or T*, ``exact`` is the sampled-data
+(:mod:`stringstab.sampled`) or robust (:mod:`stringstab.robust`) certificate, ``hurwitz`` the
+stability of that loop (Schur; every member of the box), and the one other method is
+``continuous`` (sampled maps only): the continuous-time certificate at the same parameters,
+so that :func:`stringstab.plots.plot_comparison` draws the band of gains certified in
+continuous time but not when sampled.  The Taylor criteria are of the continuous loop at one
+τ, δ, T* and are not evaluated there (``type`` is None).
+
 Classes of the class maps (:meth:`RegionMap.classes`):
 
 * ``taylor`` / ``printed``: *not internally stable*, then the type of that
@@ -64,16 +72,19 @@ from __future__ import annotations
 from .grid import EXACT_BLOCK, TAYLOR_BLOCK, region_map
 from .grid import _blocks as _blocks  # for tests
 from .result import (
+    CONTINUOUS,
     EXACT_CLASSES,
     GAIN_NAMES,
     METHODS,
     TYPE_CLASSES,
     VERDICT_LABELS,
     RegionMap,
+    describe_params,
     load_npz,
 )
 
 __all__ = [
+    "CONTINUOUS",
     "EXACT_BLOCK",
     "EXACT_CLASSES",
     "GAIN_NAMES",
@@ -82,6 +93,7 @@ __all__ = [
     "TYPE_CLASSES",
     "VERDICT_LABELS",
     "RegionMap",
+    "describe_params",
     "load_npz",
     "region_map",
 ]

@@ -6,7 +6,9 @@ process or a pool of workers) and assembles a :class:`~stringstab.regions.Region
 block, the Taylor quantities are evaluated as polynomials in one gain with coefficients on
 the plane of the other two (Horner's rule, coefficients generated from the SymPy expressions,
 :func:`stringstab._generated.psi_polynomials`), the exact verdicts by
-:func:`stringstab.certificate.certify_batch`.
+:func:`stringstab.certificate.certify_batch` — of the continuous loop, of the sampled-data loop
+(``sample_time``) or over a box of parameters (intervals), with the continuous certificate
+beside a sampled one as the ``continuous`` method.
 """
 
 from __future__ import annotations
@@ -23,9 +25,10 @@ import numpy.typing as npt
 from .. import _generated as _gen
 from ..criteria import hurwitz, proposition1, stability_type
 from ..errors import StringStabError
-from ..params import Params
+from ..params import Box, Params, parameter_model
+from ..params import sample_time as _sample_time
 from .pool import cpu_count, in_daemon, run_blocks
-from .result import GAIN_NAMES, INCONCLUSIVE, METHODS, STABLE, UNSTABLE, RegionMap
+from .result import CONTINUOUS, GAIN_NAMES, INCONCLUSIVE, METHODS, STABLE, UNSTABLE, RegionMap
 
 __all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
 
@@ -38,6 +41,8 @@ TAYLOR_BLOCK = 1 << 19
 _PARALLEL_SECONDS = 0.5
 _EXACT_SECONDS_PER_POINT = 2e-5
 _TAYLOR_SECONDS_PER_POINT = 1.5e-7
+#: Cost of the other certificates relative to the continuous one (analysis/bench_certify.py).
+_COST = {(False, False): 1.0, (True, False): 4.0, (False, True): 3.0, (True, True): 400.0}
 
 
 # --------------------------------------------------------------------------- Taylor on a grid
@@ -73,8 +78,41 @@ class _Spec:
 
     names: tuple[str, str, str]  # gain on internal axis 0, 1, 2
     coords: tuple[Array, Array, Array]
-    params: Params
+    params: Params | Box
     methods: tuple[str, ...]
+    sample_time: float | None = None
+    heterogeneous: bool = True
+
+    @property
+    def continuous_point(self) -> bool:
+        """The continuous loop at one τ, δ, T* (the Taylor criteria apply)."""
+        return self.sample_time is None and isinstance(self.params, Params)
+
+
+def _codes(verdict: npt.NDArray[np.str_]) -> npt.NDArray[np.int8]:
+    code = np.full(verdict.shape, INCONCLUSIVE, dtype=np.int8)
+    code[verdict == "certified"] = STABLE
+    code[verdict == "not_certified"] = UNSTABLE
+    return code
+
+
+def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, int]) -> dict[str, Any]:
+    """A sampled or robust block: ``exact`` (and ``continuous``) with their stability."""
+    from ..certificate import certify_batch
+
+    p = spec.params
+    out: dict[str, Any] = {}
+    b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway,
+                      sample_time=spec.sample_time, heterogeneous=spec.heterogeneous)
+    out["hurwitz"] = np.asarray(b.stable).reshape(shape)
+    out["verdict_exact"] = _codes(b.verdict).reshape(shape)
+    out["sup_gain"] = b.sup_gain.reshape(shape)
+    out["margin"] = b.margin.reshape(shape)
+    if CONTINUOUS in spec.methods:
+        c = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
+        out["verdict_continuous"] = _codes(c.verdict).reshape(shape)
+        out["hurwitz_continuous"] = np.asarray(c.stable).reshape(shape)
+    return out
 
 
 def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, Any]:
@@ -89,6 +127,10 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
         spec.names[1]: x1.reshape(1, -1, 1),
         spec.names[2]: x2.reshape(1, 1, -1),
     }
+    if not spec.continuous_point:
+        full = [np.broadcast_to(gains[g], shape).ravel() for g in GAIN_NAMES]
+        return _eval_certificates(spec, full, shape)
+    assert isinstance(p, Params)
     out: dict[str, Any] = {}
     hz = np.broadcast_to(hurwitz(gains["k_x"], gains["k_v"], tau=p.tau, headway=p.headway), shape)
     out["hurwitz"] = hz
@@ -107,10 +149,7 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
 
         full = [np.broadcast_to(gains[g], shape).ravel() for g in GAIN_NAMES]
         b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
-        code = np.full(b.verdict.shape, INCONCLUSIVE, dtype=np.int8)
-        code[b.verdict == "certified"] = STABLE
-        code[b.verdict == "not_certified"] = UNSTABLE
-        out["verdict_exact"] = code.reshape(shape)
+        out["verdict_exact"] = _codes(b.verdict).reshape(shape)
         out["sup_gain"] = b.sup_gain.reshape(shape)
         out["margin"] = b.margin.reshape(shape)
     return out
@@ -132,7 +171,9 @@ def _warm(spec: _Spec) -> None:
     if "exact" in spec.methods:
         from ..certificate import certify_batch
 
-        certify_batch([1.0], [0.5], [0.2], tau=0.1, delta=0.2, headway=1.1)
+        p = spec.params
+        certify_batch([1.0], [0.5], [0.2], tau=p.tau, delta=p.delta, headway=p.headway,
+                      sample_time=spec.sample_time)
 
 
 # --------------------------------------------------------------------------- validation
@@ -183,15 +224,28 @@ def _check_axes(
     return out, {missing[0]: v}
 
 
-def _check_methods(methods: str | Sequence[str]) -> tuple[str, ...]:
+def _check_methods(methods: str | Sequence[str] | None, continuous_point: bool,
+                   sampled: bool) -> tuple[str, ...]:
+    """The methods, checked against the loop: the Taylor criteria need the continuous loop at
+    one τ, δ, T*; ``continuous`` (the comparison) needs a sampled map."""
+    if methods is None:
+        return METHODS if continuous_point else ("exact",)
     ms = tuple(m.strip() for m in methods.split(",")) if isinstance(methods, str) else tuple(methods)
+    allowed = METHODS if continuous_point else ("exact", CONTINUOUS) if sampled else ("exact",)
     if not ms:
-        raise StringStabError(f"expected at least one method of {list(METHODS)}; got none")
+        raise StringStabError(f"expected at least one method of {list(allowed)}; got none")
     for m in ms:
-        if m not in METHODS:
-            raise StringStabError(f"methods must be among {list(METHODS)}; got {m!r}")
+        if m not in allowed:
+            if m in (*METHODS, CONTINUOUS):
+                why = ("the Taylor criteria are for the continuous loop at one τ, δ, T*"
+                       if m in METHODS else "'continuous' compares a sampled map with the "
+                       "continuous loop (it needs sample_time)")
+                raise StringStabError(f"methods must be among {list(allowed)} here ({why}); got {m!r}")
+            raise StringStabError(f"methods must be among {list(allowed)}; got {m!r}")
     if len(set(ms)) != len(ms):
         raise StringStabError(f"each method may be given once; got {list(ms)}")
+    if "exact" not in ms and not continuous_point:
+        raise StringStabError(f"a sampled or robust map evaluates 'exact'; got methods {list(ms)}")
     return ms
 
 
@@ -201,13 +255,15 @@ def region_map(
     axes: Mapping[str, npt.ArrayLike],
     fixed: Mapping[str, float] | None = None,
     *,
-    tau: float,
-    delta: float,
-    headway: float,
-    methods: str | Sequence[str] = METHODS,
+    tau: Any,
+    delta: Any,
+    headway: Any,
+    sample_time: float | None = None,
+    methods: str | Sequence[str] | None = None,
     workers: int | None = None,
     block: int | None = None,
     progress: bool | None = None,
+    heterogeneous: bool = True,
 ) -> RegionMap:
     """Evaluate every method on a grid of gains (see the module docstring).
 
@@ -219,11 +275,17 @@ def region_map(
         ``{"k_x": np.linspace(-2, 2, 401), "k_v": np.linspace(-2, 2, 401)}``.
     fixed : mapping of str to float, optional
         For a 2-D map, the value of the third gain, e.g. ``{"k_a": 0.5}``.
-    tau, delta, headway : float
-        Actuator lag τ > 0, delay δ ≥ 0 and desired headway T* ≥ 0 (seconds).
-    methods : str or sequence of str
-        Subset of ``("exact", "taylor", "printed")`` (or ``"exact,taylor"``).
-        The derived types are always computed.
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0 and desired headway T* ≥ 0 (seconds); an interval
+        maps the gains certified for every member of the box (the robust certificate).
+    sample_time : float, optional
+        H > 0 (s): ``exact`` is the sampled-data certificate (zero-order hold).
+    methods : str or sequence of str, optional
+        For the continuous loop at one τ, δ, T*: a subset of ``("exact", "taylor",
+        "printed")`` (or ``"exact,taylor"``), default all three; the derived types are always
+        computed.  For a sampled or robust map: ``"exact"`` (the default) and, sampled,
+        ``"continuous"`` (the continuous certificate at the same parameters, for the band
+        of gains certified in continuous time but not when sampled).
     workers : int, optional
         Worker processes.  Default: all available cores, or 1 when the map is
         estimated to take under half a second.  ``1`` runs in this process.
@@ -233,6 +295,8 @@ def region_map(
     progress : bool, optional
         tqdm progress bar on standard error; default: on for maps estimated to
         take more than 5 s.
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently.
 
     Returns
     -------
@@ -260,9 +324,11 @@ def region_map(
     """
     from .. import __version__  # the package's one version (a constant, not a layer)
 
-    p = Params(tau, delta, headway)
+    p = parameter_model(tau, delta, headway)
+    H = None if sample_time is None else _sample_time(sample_time)
+    box = isinstance(p, Box)
     coords, fixed_ = _check_axes(axes, fixed)
-    ms = _check_methods(methods)
+    ms = _check_methods(methods, H is None and not box, H is not None)
     names = tuple(coords) + tuple(fixed_)
     internal = tuple(coords.values()) + tuple(np.array([v]) for v in fixed_.values())
     n0, n1, n2 = (a.size for a in internal)
@@ -272,7 +338,8 @@ def region_map(
     if target < 1:
         raise StringStabError(f"block must be >= 1 grid points; got {block!r}")
     blocks = _blocks(n0, n1, n2, target)
-    seconds = n * (_EXACT_SECONDS_PER_POINT if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
+    cost = _COST[H is not None, box] + (CONTINUOUS in ms)
+    seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:
         workers = 1 if seconds < _PARALLEL_SECONDS else cpu_count()
     if int(workers) < 1:
@@ -282,18 +349,19 @@ def region_map(
         workers = 1
     if progress is None:
         progress = seconds / workers > 5.0
-    spec = _Spec(names, internal, p, ms)  # type: ignore[arg-type]
+    spec = _Spec(names, internal, p, ms, H, bool(heterogeneous))  # type: ignore[arg-type]
 
     shape3 = (n0, n1, n2)
-    res: dict[str, np.ndarray] = {
-        "hurwitz": np.empty(shape3, dtype=bool),
-        "type": np.empty(shape3, dtype=np.int8),
-    }
+    res: dict[str, np.ndarray] = {"hurwitz": np.empty(shape3, dtype=bool)}
+    if spec.continuous_point:
+        res["type"] = np.empty(shape3, dtype=np.int8)
+    if CONTINUOUS in ms:
+        res["hurwitz_continuous"] = np.empty(shape3, dtype=bool)
     if "printed" in ms:
         res["type_printed"] = np.empty(shape3, dtype=np.int8)
     for m in ms:
         res[f"verdict_{m}"] = np.empty(shape3, dtype=np.int8)
-        if m != "exact":
+        if m in ("taylor", "printed"):
             res[f"prop1_{m}"] = np.empty(shape3, dtype=bool)
     if exact:
         res["sup_gain"] = np.empty(shape3)
@@ -323,8 +391,9 @@ def region_map(
         axes=coords, fixed=fixed_, params=p, methods=ms,
         hurwitz=get("hurwitz"), type=get("type"),
         verdict={m: get(f"verdict_{m}") for m in ms},
-        prop1={m: get(f"prop1_{m}") for m in ms if m != "exact"},
+        prop1={m: get(f"prop1_{m}") for m in ms if m in ("taylor", "printed")},
         type_printed=get("type_printed"), sup_gain=get("sup_gain"), margin=get("margin"),
-        version=__version__,
+        version=__version__, sample_time=H, heterogeneous=bool(heterogeneous),
+        hurwitz_continuous=get("hurwitz_continuous"),
     )
 

@@ -34,7 +34,7 @@ def render_report(rmap: RegionMap) -> str:
     vs = rmap.verdict_shares()
     for m, shares in rmap.class_shares().items():
         text = ", ".join(f"{k} {percent(v)}" for k, v in shares.items())
-        if m != "exact":
+        if m in ("taylor", "printed"):
             text += f" (stable {percent(vs[m]['stable'])})"
         lines.append(f"{m + ':':<{width + 1}} {text}")
     if len(rmap.methods) > 1:
@@ -42,4 +42,10 @@ def render_report(rmap: RegionMap) -> str:
         pairs = ", ".join(f"{k} {v:,}" for k, v in d.items() if " vs " in k)
         lines.append(f"disagreements: {pairs}; any {d['any']:,} of {rmap.size:,} points"
                      + (f"; exact inconclusive at {d['inconclusive']:,}" if "exact" in rmap.methods else ""))
+    if "continuous" in rmap.methods:
+        band = int((rmap.stable("continuous") & ~rmap.stable("exact")).sum())
+        back = int((rmap.stable("exact") & ~rmap.stable("continuous")).sum())
+        lines.append(f"certified in continuous time but not when sampled: {band:,} points "
+                     f"({percent(band / rmap.size)}); certified when sampled but not in "
+                     f"continuous time: {back:,}")
     return "\n".join(lines)

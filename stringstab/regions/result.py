@@ -21,10 +21,11 @@ import numpy.typing as npt
 from ..criteria import TYPE_NAMES
 from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
-from ..params import Params
+from ..params import Box, Params
 from .files import FORMAT, csv_text, read_npz, write_npz
 
 __all__ = [
+    "CONTINUOUS",
     "EXACT_CLASSES",
     "GAIN_NAMES",
     "INCONCLUSIVE",
@@ -34,6 +35,7 @@ __all__ = [
     "UNSTABLE",
     "VERDICT_LABELS",
     "RegionMap",
+    "describe_params",
     "load_npz",
 ]
 
@@ -41,14 +43,20 @@ Array = npt.NDArray[np.float64]
 
 #: The gains, in the order of K = [k_x, k_v, k_a] (IDL eq 4).
 GAIN_NAMES: tuple[str, str, str] = ("k_x", "k_v", "k_a")
-#: The methods a map can evaluate.
+#: The methods a map of the continuous loop at one τ, δ, T* can evaluate (the default set).
 METHODS: tuple[str, str, str] = ("exact", "taylor", "printed")
+#: The comparison method of a sampled-data map: the continuous-time certificate at the same
+#: parameters (or box), beside ``exact`` (the sampled certificate).
+CONTINUOUS = "continuous"
 #: Labels of the verdict codes 0, 1, 2 per method (code 0 means "says string stable").
 VERDICT_LABELS: dict[str, tuple[str, str, str]] = {
     "exact": ("certified", "not_certified", "inconclusive"),
     "taylor": ("stable", "unstable", "inconclusive"),
     "printed": ("stable", "unstable", "inconclusive"),
+    CONTINUOUS: ("certified", "not_certified", "inconclusive"),
 }
+#: Methods decided by a certificate (tri-state verdicts, the classes of :data:`EXACT_CLASSES`).
+_CERTIFICATES = ("exact", CONTINUOUS)
 #: Classes of the ``taylor`` and ``printed`` class maps, by code 0-4.
 TYPE_CLASSES: tuple[str, ...] = (
     "not internally stable", "type III", "type IV", "type I", "type II",
@@ -79,14 +87,17 @@ class RegionMap:
         each with its increasing grid coordinates.
     fixed : dict of str to float
         The gain held fixed on a 2-D slice (empty for a 3-D map).
-    params : Params
-        τ, δ, T*.
+    params : Params or Box
+        τ, δ, T*: a point, or a box of intervals (the robust certificate).
     methods : tuple of str
-        The methods evaluated, a subset of :data:`METHODS`.
+        The methods evaluated: a subset of :data:`METHODS` for the continuous loop at one
+        τ, δ, T*; ``exact`` and optionally :data:`CONTINUOUS` for a sampled or robust map.
     hurwitz : ndarray of bool
-        Γ internally stable.
-    type : ndarray of int8
-        Stability type 1-4 (I-IV) from the derived Ψ.
+        Internally stable: Γ Hurwitz; the sampled Δ(z) Schur (``sample_time``); every
+        member of the box (a :class:`~stringstab.params.Box`).
+    type : ndarray of int8 or None
+        Stability type 1-4 (I-IV) from the derived Ψ (None for a sampled or robust map:
+        the Taylor types are of the continuous loop at one τ, δ, T*).
     type_printed : ndarray of int8 or None
         Stability type from the printed Ψ (when ``printed`` is evaluated).
     verdict : dict of str to ndarray of int8
@@ -94,23 +105,46 @@ class RegionMap:
     prop1 : dict of str to ndarray of bool
         Proposition 1 alone (without Hurwitz) for ``taylor`` and ``printed``.
     sup_gain, margin : ndarray of float or None
-        ‖Γ‖_{H∞} and min_ω g(ω) from the exact certificate (when evaluated).
+        ‖Γ‖_{H∞} and min_ω g(ω) from the exact certificate (when evaluated); for a
+        sampled map sup_θ |H(e^{jθ})| and min g_H; for a box, the sup gain at the witness
+        member (a lower bound on the worst member's) and the smallest margin found.
     version : str
         ``stringstab.__version__`` of the tool that computed the map.
+    sample_time : float or None
+        H (s) of a sampled-data map (``exact`` is then the sampled certificate); None for
+        the continuous loop.
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranged over the τ box independently.
+    hurwitz_continuous : ndarray of bool or None
+        Internal stability of the continuous loop, when :data:`CONTINUOUS` is evaluated.
     """
 
     axes: dict[str, Array]
     fixed: dict[str, float]
-    params: Params
+    params: Params | Box
     methods: tuple[str, ...]
     hurwitz: npt.NDArray[np.bool_]
-    type: npt.NDArray[np.int8]
+    type: npt.NDArray[np.int8] | None
     verdict: dict[str, npt.NDArray[np.int8]]
     prop1: dict[str, npt.NDArray[np.bool_]] = field(default_factory=dict)
     type_printed: npt.NDArray[np.int8] | None = None
     sup_gain: Array | None = None
     margin: Array | None = None
     version: str = ""
+    sample_time: float | None = None
+    heterogeneous: bool = True
+    hurwitz_continuous: npt.NDArray[np.bool_] | None = None
+
+    @property
+    def is_box(self) -> bool:
+        """The parameters are a box of intervals (the robust certificate)."""
+        return isinstance(self.params, Box)
+
+    @property
+    def loop(self) -> str:
+        """Which loop ``exact`` certifies, in words (``continuous``, ``sampled Δt = 0.1 s``, ...)."""
+        what = "continuous" if self.sample_time is None else f"sampled Δt = {self.sample_time:g} s"
+        return f"{what}, robust over the box" if self.is_box else what
 
     # ---------------------------------------------------------------- shape and points
     @property
@@ -156,22 +190,24 @@ class RegionMap:
     def class_names(self, method: str) -> tuple[str, ...]:
         """Names of the class codes of :meth:`classes` for ``method``."""
         self._check_method(method)
-        return EXACT_CLASSES if method == "exact" else TYPE_CLASSES
+        return EXACT_CLASSES if method in _CERTIFICATES else TYPE_CLASSES
 
     def classes(self, method: str) -> npt.NDArray[np.int8]:
         """Class code of every point for the class map of ``method``.
 
-        ``exact``: 0 not internally stable, 1 not certified, 2 inconclusive,
-        3 certified (:data:`EXACT_CLASSES`).  ``taylor`` / ``printed``: 0 not
+        ``exact`` (and ``continuous``): 0 not internally stable, 1 not certified,
+        2 inconclusive, 3 certified (:data:`EXACT_CLASSES`).  ``taylor`` / ``printed``: 0 not
         internally stable, then 1 type III, 2 type IV, 3 type I, 4 type II of
         that method's Ψ (:data:`TYPE_CLASSES`).
         """
         self._check_method(method)
-        if method == "exact":
-            v = self.verdict["exact"]
+        if method in _CERTIFICATES:
+            v = self.verdict[method]
+            stable = self.hurwitz if method == "exact" else self.hurwitz_continuous
+            assert stable is not None
             c = np.full(self.shape, 3, dtype=np.int8)
             c[v == UNSTABLE] = 1
-            c[(v == UNSTABLE) & ~self.hurwitz] = 0
+            c[(v == UNSTABLE) & ~stable] = 0
             c[v == INCONCLUSIVE] = 2
             return c
         t = self.type if method == "taylor" else self.type_printed
@@ -202,7 +238,7 @@ class RegionMap:
         for m in self.methods:
             counts = np.bincount(self.verdict[m].ravel(), minlength=3)
             out[m] = {lab: float(c) / self.size for lab, c in zip(VERDICT_LABELS[m], counts)
-                      if m == "exact" or lab != "inconclusive"}
+                      if m in _CERTIFICATES or lab != "inconclusive"}
         return out
 
     def disagreements(self) -> dict[str, int]:
@@ -247,10 +283,11 @@ class RegionMap:
         return render_report(self)
 
     def title(self) -> str:
-        """A one-line description: the fixed gain and the parameters."""
+        """A one-line description: the fixed gain, the parameters (or the box), the sample time."""
         parts = [f"{k} = {v:g}" for k, v in self.fixed.items()]
-        p = self.params
-        parts.append(f"τ = {p.tau:g} s, δ = {p.delta:g} s, T* = {p.headway:g} s")
+        parts.append(describe_params(self.params))
+        if self.sample_time is not None:
+            parts.append(f"sampled Δt = {self.sample_time:g} s")
         return "; ".join(parts)
 
     # ---------------------------------------------------------------- slicing
@@ -279,7 +316,8 @@ class RegionMap:
             verdict={m: take(v) for m, v in self.verdict.items()},
             prop1={m: take(v) for m, v in self.prop1.items()},
             type_printed=take(self.type_printed), sup_gain=take(self.sup_gain),
-            margin=take(self.margin), version=self.version,
+            margin=take(self.margin), version=self.version, sample_time=self.sample_time,
+            heterogeneous=self.heterogeneous, hurwitz_continuous=take(self.hurwitz_continuous),
         )
 
     # ---------------------------------------------------------------- files
@@ -289,6 +327,9 @@ class RegionMap:
             "format": FORMAT,
             "stringstab_version": self.version,
             "params": self.params.as_dict(),
+            **({} if self.sample_time is None else {"sample_time": self.sample_time}),
+            **({"heterogeneous": self.heterogeneous}
+               if self.sample_time is not None and self.is_box else {}),
             "axes": {n: {"min": float(a[0]), "max": float(a[-1]), "n": int(a.size)}
                      for n, a in self.axes.items()},
             "fixed": dict(self.fixed),
@@ -299,7 +340,11 @@ class RegionMap:
 
     def fields(self) -> dict[str, npt.NDArray[Any]]:
         """The per-point arrays by name (``hurwitz``, ``type``, ``verdict_<method>``, ...)."""
-        f: dict[str, npt.NDArray[Any]] = {"hurwitz": self.hurwitz, "type": self.type}
+        f: dict[str, npt.NDArray[Any]] = {"hurwitz": self.hurwitz}
+        if self.type is not None:
+            f["type"] = self.type
+        if self.hurwitz_continuous is not None:
+            f["hurwitz_continuous"] = self.hurwitz_continuous
         if self.type_printed is not None:
             f["type_printed"] = self.type_printed
         for m, code in self.verdict.items():
@@ -361,7 +406,8 @@ class RegionMap:
                                          np.asarray([self.fixed[name]], dtype=float))
         names = np.array(["", *TYPE_NAMES.values()])
         cols["hurwitz"] = self.hurwitz.ravel()
-        cols["type"] = Categorical(self.type.ravel(), names)
+        if self.type is not None:
+            cols["type"] = Categorical(self.type.ravel(), names)
         if self.type_printed is not None:
             cols["type_printed"] = Categorical(self.type_printed.ravel(), names)
         for m in self.methods:
@@ -431,14 +477,33 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
     """
     meta, data = read_npz(path)
     methods = tuple(meta["methods"])
+    p = meta["params"]
+    params: Params | Box = (Box(*(tuple(p[k]) for k in ("tau", "delta", "headway")))
+                            if isinstance(p["tau"], list) else Params(**p))
     return RegionMap(
         axes={n: data[f"axis_{n}"] for n in meta["axes"]},
         fixed={k: float(v) for k, v in meta["fixed"].items()},
-        params=Params(**meta["params"]), methods=methods,
-        hurwitz=data["hurwitz"], type=data["type"],
+        params=params, methods=methods,
+        hurwitz=data["hurwitz"], type=data.get("type"),
         verdict={m: data[f"verdict_{m}"] for m in methods},
         prop1={m: data[f"prop1_{m}"] for m in methods if f"prop1_{m}" in data},
         type_printed=data.get("type_printed"), sup_gain=data.get("sup_gain"),
         margin=data.get("margin"), version=meta["stringstab_version"],
+        sample_time=meta.get("sample_time"), heterogeneous=bool(meta.get("heterogeneous", True)),
+        hurwitz_continuous=data.get("hurwitz_continuous"),
     )
+
+
+def describe_params(p: Params | Box) -> str:
+    """``τ = 0.1 s, δ = 0.2 s, T* = 1.1 s``, intervals as ``τ ∈ [0.1, 0.3] s``.
+
+    Examples
+    --------
+    >>> describe_params(Box((0.1, 0.3), (0.2, 0.2), (1.1, 1.1)))
+    'τ ∈ [0.1, 0.3] s, δ = 0.2 s, T* = 1.1 s'
+    """
+    parts = []
+    for sym, (lo, hi) in zip(("τ", "δ", "T*"), Box.of(p).as_dict().values()):
+        parts.append(f"{sym} = {lo:g} s" if lo == hi else f"{sym} ∈ [{lo:g}, {hi:g}] s")
+    return ", ".join(parts)
 

@@ -9,6 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
+from ..params import Box, parameter_model
 from .projection import project
 from .region_growing import region_growing
 from .result import TuneResult
@@ -23,12 +24,22 @@ def tune(
     K0: Sequence[float] | npt.NDArray[np.float64],
     method: str = "projection",
     *,
-    tau: float,
-    delta: float,
-    headway: float,
+    tau: Any,
+    delta: Any,
+    headway: Any,
+    sample_time: float | None = None,
     **options: Any,
 ) -> TuneResult:
     """Repair K0 with ``method`` (``"region-growing"`` or ``"projection"``).
+
+    The projection repairs for any loop (``sample_time``, intervals for τ, δ, T*); region
+    growing's candidate test is the Taylor Proposition 1 of the continuous loop at one
+    τ, δ, T*, so it takes neither.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown method, or region growing asked for a sampled or robust loop.
 
     Examples
     --------
@@ -36,8 +47,13 @@ def tune(
     True
     """
     if method == "region-growing":
+        if sample_time is not None or isinstance(parameter_model(tau, delta, headway), Box):
+            raise StringStabError(
+                "region growing tests candidates with the Taylor Proposition 1 of the continuous "
+                "loop at one τ, δ, T*; for a sample time or an interval use the projection")
         return region_growing(K0, tau=tau, delta=delta, headway=headway, **options)
     if method == "projection":
-        return project(K0, tau=tau, delta=delta, headway=headway, **options)
+        return project(K0, tau=tau, delta=delta, headway=headway, sample_time=sample_time,
+                       **options)
     raise StringStabError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
 

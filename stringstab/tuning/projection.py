@@ -8,6 +8,13 @@ predictor of :mod:`stringstab.tuning.predictor` answers without IPOPT when it ca
 constraints are the generated Hurwitz conditions (:func:`stringstab.criteria.hurwitz_conditions`)
 and g (:func:`stringstab.margin.casadi_g`).
 
+For the sampled-data loop (``sample_time``) and for a box of parameters (intervals: every
+member certified) the same exchange runs on the NLP of :func:`_quad_nlp`, whose constraints
+are quadratic forms in K taken at members and frequencies of that loop
+(:mod:`stringstab.tuning.constraints`: the sampled margin g_H(θ), the Schur conditions, g(ω)
+at a member of the box), the certificate of that loop deciding every output and supplying
+each new constraint (its witness member and frequency).
+
 References
 ----------
 R. Hettich, K. O. Kortanek, "Semi-infinite programming: theory, methods, and
@@ -30,7 +37,9 @@ from .. import margin as _margin
 from ..certificate import certify, certify_batch, check
 from ..criteria import hurwitz_conditions, hurwitz_ok
 from ..errors import StringStabError
-from ..params import Params, positive
+from ..params import Box, Params, parameter_model, positive
+from ..params import sample_time as _sample_time
+from .constraints import FORM_SIZE, Loop, Member, Slot, evaluate_forms
 from .inputs import as_bounds, as_k0, as_weights
 from .predictor import predict, predict_dips, violating_dips
 from .result import CERTIFIED, TuneResult, Verdict, make_result, wdist
@@ -48,6 +57,9 @@ _LADDER: tuple[float, ...] = tuple(float(v) for v in np.geomspace(0.2, 5.0, 16))
 _CLUSTER = 0.05
 #: Multipliers of the violating frequencies of K0 in the first solve.
 _K0_CLUSTER = (1.0, 0.95, 0.9)
+#: The largest ε the sampled and robust exchange widens the frequency constraints to when the
+#: certificate is inconclusive at its solution.
+_EPS_MAX = 1e-1
 #: Multipliers of the predicted dips of the solution (:func:`~stringstab.tuning.predictor.predict_dips`) in the first solve.
 _PRED_CLUSTER = (1.0, 0.98, 1.02)
 
@@ -80,19 +92,43 @@ def _nlp(n_slots: int) -> Any:
     gs = _margin.casadi_g([par[9 + j] for j in range(n_slots)], kx, kv, ka, tau, delta, T)
     f = ca.sum1(w * (x - K0) ** 2)
     g = ca.vertcat(*hurwitz_conditions(kx, kv, ka, tau=tau, headway=T), *gs)
-    opts = {
-        "print_time": False,
-        "error_on_fail": False,
-        "ipopt.print_level": 0,
-        "ipopt.sb": "yes",
-        "ipopt.tol": 1e-8,
-        "ipopt.constr_viol_tol": 1e-9,
-        "ipopt.max_iter": 100,
-        "ipopt.mu_strategy": "adaptive",
-        "ipopt.mu_oracle": "probing",
-    }
     return ca.nlpsol(f"stringstab_projection_{n_slots}", "ipopt",
-                     {"x": x, "p": par, "f": f, "g": g}, opts)
+                     {"x": x, "p": par, "f": f, "g": g}, _IPOPT)
+
+
+#: IPOPT's options for every projection NLP.
+_IPOPT = {
+    "print_time": False,
+    "error_on_fail": False,
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-8,
+    "ipopt.constr_viol_tol": 1e-9,
+    "ipopt.max_iter": 100,
+    "ipopt.mu_strategy": "adaptive",
+    "ipopt.mu_oracle": "probing",
+}
+
+
+@cache
+def _quad_nlp(n_slots: int) -> Any:
+    """The projection NLP with ``n_slots`` quadratic constraints, built once per process.
+
+    Decision K = (k_x, k_v, k_a); parameters p = (K0, w, then per slot the 10 numbers of a
+    quadratic form q_j(K) = c + bᵀK + KᵀAK, :func:`stringstab.tuning.constraints.quadratic_form`).
+    Constraints q_j(K) ≥ lower bound (a margin, ε, or −inf for an unused slot).
+    """
+    ca = _import_casadi()
+    x = ca.SX.sym("K", 3)
+    par = ca.SX.sym("p", 6 + FORM_SIZE * n_slots)
+    K0, w = par[0:3], par[3:6]
+    kx, kv, ka = x[0], x[1], x[2]
+    mono = ca.vertcat(1, kx, kv, ka, kx * kx, 2 * kx * kv, 2 * kx * ka, kv * kv, 2 * kv * ka,
+                      ka * ka)
+    gs = [ca.dot(par[6 + FORM_SIZE * j: 6 + FORM_SIZE * (j + 1)], mono) for j in range(n_slots)]
+    f = ca.sum1(w * (x - K0) ** 2)
+    return ca.nlpsol(f"stringstab_projection_quadratic_{n_slots}", "ipopt",
+                     {"x": x, "p": par, "f": f, "g": ca.vertcat(*gs)}, _IPOPT)
 
 
 
@@ -126,6 +162,24 @@ def _certified_map(tau: float, delta: float, headway: float, lo: float, hi: floa
 
 
 
+@lru_cache(maxsize=16)
+def _loop_map(box: Box, sample_time: float | None, heterogeneous: bool, lo: float, hi: float,
+              margin: float, n: int = 21) -> Array:
+    """Certified points of an n³ grid over the bounds for a sampled or robust loop, whose
+    stability conditions (at the box's corners) are ≥ ``margin`` (starting points, fallbacks)."""
+    loop = Loop(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0]),
+                sample_time, heterogeneous)
+    g = np.linspace(lo, hi, n)
+    K = np.stack([a.ravel() for a in np.meshgrid(g, g, g, indexing="ij")], axis=1)
+    keep = np.ones(len(K), dtype=bool)
+    for m in loop.corners():
+        forms = np.array([s.form for s in loop.stability_slots(m)])
+        keep &= np.all(evaluate_forms(forms, K) >= margin, axis=0)
+    pts = K[keep][loop.certified_points(K[keep])]
+    pts.setflags(write=False)
+    return pts
+
+
 class Projector:
     """Nearest certified gains, with a fast path for a control loop.
 
@@ -147,8 +201,13 @@ class Projector:
 
     Parameters
     ----------
-    tau, delta, headway : float
-        Model parameters (s).
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Model parameters (s); an interval asks for gains certified for every member of the
+        box (the robust certificate).
+    sample_time : float, optional
+        H (s): gains certified for the sampled-data loop (zero-order hold).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently.
     weights : sequence of 3 floats
         Weights w of the distance sqrt(Σ w_i (K_i − K0_i)²), > 0.
     bounds : (float, float)
@@ -178,9 +237,11 @@ class Projector:
     def __init__(
         self,
         *,
-        tau: float,
-        delta: float,
-        headway: float,
+        tau: Any,
+        delta: Any,
+        headway: Any,
+        sample_time: float | None = None,
+        heterogeneous: bool = True,
         weights: Sequence[float] = (1.0, 1.0, 1.0),
         bounds: tuple[float, float] = (-2.0, 2.0),
         hurwitz_margin: float = 1e-3,
@@ -191,7 +252,11 @@ class Projector:
         predictor: bool = True,
         warm_from_previous: bool = False,
     ) -> None:
-        self.params = Params(tau, delta, headway)
+        self.params: Params | Box = parameter_model(tau, delta, headway)
+        self.sample_time = None if sample_time is None else _sample_time(sample_time)
+        #: The sampled or robust loop (None: the continuous loop at one τ, δ, T*).
+        self.loop = (None if self.sample_time is None and isinstance(self.params, Params)
+                     else Loop(self.params, self.sample_time, heterogeneous))
         self.weights = as_weights(weights)
         self.bounds = as_bounds(bounds)
         self.hurwitz_margin = positive("hurwitz_margin", hurwitz_margin, allow_zero=True)
@@ -209,9 +274,21 @@ class Projector:
         self.stats = {"calls": 0, "cache_hits": 0, "warm_starts": 0, "fallbacks": 0,
                       "predicted": 0}
 
+    @property
+    def _point(self) -> Params:
+        """The parameters of the continuous loop at one τ, δ, T*."""
+        assert isinstance(self.params, Params)
+        return self.params
+
     # -- the certified map (starting points, fallbacks) -------------------------------
     def _map(self) -> Array:
-        p = self.params
+        if self.loop is not None:
+            # a sampled box's certificate is the slow one: an 11³ map (72 points at
+            # Δt = 0.1 s, τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25] s: 3.5 s) instead of 21³ (33.6 s)
+            n = 11 if self.loop.sampled and isinstance(self.params, Box) else 21
+            return _loop_map(self.loop.box, self.sample_time, self.loop.heterogeneous,
+                             *self.bounds, self.hurwitz_margin, n)
+        p = self._point
         return _certified_map(p.tau, p.delta, p.headway, *self.bounds, self.hurwitz_margin)
 
     def reset(self) -> None:
@@ -223,7 +300,7 @@ class Projector:
     def _solve(self, K0: Array, x0: Array, omegas: list[float]) -> tuple[Array, str, int]:
         n = next(s for s in _SLOTS if s >= len(omegas))
         solver = _nlp(n)
-        p = self.params
+        p = self._point
         om = np.zeros(n)
         om[: len(omegas)] = omegas
         lbg = np.full(n + 2, -np.inf)
@@ -242,7 +319,7 @@ class Projector:
         smallest g(ω) was found; |Γ(jω)| > 1 there when K is internally stable
         and not certified).
         """
-        p = self.params
+        p = self._point
         c = check(K[0], K[1], K[2], tau=p.tau, delta=p.delta, headway=p.headway)
         return str(c.verdict[0]), bool(c.hurwitz[0]), float(c.witness_omega[0])
 
@@ -251,7 +328,7 @@ class Projector:
         """Repair one triple K0 (see :func:`project` for the algorithm)."""
         t0 = time.perf_counter()
         k0 = as_k0(K0)
-        p, w = self.params, self.weights
+        w = self.weights
         self.stats["calls"] += 1
         method = "projection"
 
@@ -263,6 +340,9 @@ class Projector:
             status = "unchanged" if np.array_equal(kc, k0) else "repaired"
             return make_result(method, k0, kc if status == "repaired" else k0, vc, status, w, 0, t0,
                            "cache hit: gains certified on an earlier call", cache_hit=True)
+        if self.loop is not None:
+            return self._repair_loop(self.loop, k0, key, use_state, warm_start, t0)
+        p = self._point
 
         # Is K0 already certified?  Skip the certificate when a violation is found cheaply.
         bad, dips = _surely_uncertifiable(k0, p)
@@ -369,6 +449,117 @@ class Projector:
                        active=active, frequencies=omegas,
                        ipopt_iterations=ipopt_iters, ipopt_status=statuses)
 
+    # -- the sampled and robust loops: the same exchange on quadratic constraints ------
+    def _solve_quad(self, K0: Array, x0: Array, slots: list[Slot],
+                    eps: float) -> tuple[Array, str, int]:
+        n = next(s for s in _SLOTS if s >= len(slots))
+        solver = _quad_nlp(n)
+        forms = np.zeros((n, FORM_SIZE))
+        forms[: len(slots)] = [sl.form for sl in slots]
+        lbg = np.full(n, -np.inf)
+        lbg[: len(slots)] = [self.hurwitz_margin if sl.kind == "stability" else eps
+                             for sl in slots]
+        lo, hi = self.bounds
+        par = np.concatenate([K0, self.weights, forms.ravel()])
+        sol = solver(x0=np.clip(x0, lo, hi), p=par, lbx=lo, ubx=hi, lbg=lbg, ubg=np.inf)
+        st = solver.stats()
+        return np.asarray(sol["x"], dtype=float).ravel(), str(st["return_status"]), int(st["iter_count"])
+
+    def _first_slots(self, loop: Loop, k0: Array, witnesses: list[tuple[Member, float]]) -> list[Slot]:
+        """Stability at the box's corners, the margin at 0 at every corner and on a ladder of
+        frequencies at the centre, and at the certificate's witness for K0 (±5 %)."""
+        slots: list[Slot] = []
+        worst = loop.corners() if loop.sampled else [Member(loop.box.tau[1], loop.box.tau[1],
+                                                            loop.centre().delta,
+                                                            loop.box.headway[0])]
+        for m in worst:
+            slots += [s for s in loop.stability_slots(m) if not loop.sampled or s.index in (0, 1, 4)]
+        for m in loop.first_members():
+            slots.append(loop.margin_slot(m, 0.0))
+        c = loop.centre()
+        slots += [loop.margin_slot(c, f) for f in loop.ladder()[1:]]
+        for m, f in witnesses:
+            slots += [loop.margin_slot(m, f * r) for r in _K0_CLUSTER if f > 0]
+        return _dedupe_slots(slots)
+
+    def _repair_loop(self, loop: Loop, k0: Array, key: tuple[float, ...], use_state: bool,
+                     warm_start: Sequence[float] | None, t0: float) -> TuneResult:
+        """Repair for the sampled or robust loop: exchange on :func:`_quad_nlp`, every output
+        decided by that loop's certificate (:meth:`Loop.check`)."""
+        method, w = "projection", self.weights
+        verdict0, _, wit0 = loop.check(k0)
+        if verdict0 == "certified":
+            self._remember(key, k0, use_state)
+            return make_result(method, k0, k0, CERTIFIED, "unchanged", w, 0, t0,
+                               f"already certified for the {self._loop_name()} loop; returned unchanged")
+        slots = self._first_slots(loop, k0, wit0)
+        M = self._map()
+        dm = wdist(M, k0, w)
+        im = int(np.argmin(dm)) if len(M) else -1
+        if warm_start is not None:
+            x, start = as_k0(warm_start), "warm_start"
+        elif im >= 0:
+            x, start = M[im], "map"
+        else:
+            x, start = k0, "input"
+        best: Array | None = None
+        n_solves = ipopt_iters = 0
+        statuses: list[str] = []
+        eps = self.eps
+        for _ in range(self.max_exchange):
+            x, status, its = self._solve_quad(k0, x, _fit_forms(slots, x), eps)
+            n_solves += 1
+            ipopt_iters += its
+            statuses.append(status)
+            if not np.all(np.isfinite(x)):
+                break
+            verdict, stable, wits = loop.check(x)
+            if verdict == "certified":
+                best = x
+                break
+            new: list[Slot] = []
+            for m, f in wits:
+                if not stable:  # an unstable member: all its stability conditions
+                    new += loop.stability_slots(m)
+                    continue
+                new += [loop.margin_slot(m, f * r) for r in (1.0, 1.0 - _CLUSTER, 1.0 + _CLUSTER)]
+                new += [loop.margin_slot(m, d * r) for d in loop.dips(x, m, 0.0)
+                        for r in (1.0, 1.0 - _CLUSTER, 1.0 + _CLUSTER)]
+                # the worst member of a box is usually a corner: the frequency there too
+                new += [loop.margin_slot(c, f) for c in loop.extreme_members()]
+            grown = _dedupe_slots([*slots, *new])
+            if verdict == "inconclusive" and stable and eps < _EPS_MAX:
+                # a margin too thin for the certificate to decide (a near-tangency): widen it
+                eps = min(10.0 * eps, _EPS_MAX)
+            elif len(grown) == len(slots):
+                break
+            slots = grown
+        fallback = False
+        if im >= 0 and (best is None or float(wdist(best, k0, w)) > float(dm[im])):
+            best, fallback = M[im].copy(), True  # certified when the map was made
+            self.stats["fallbacks"] += 1
+        if best is None:
+            xf = x if np.all(np.isfinite(x)) else k0
+            return make_result(method, k0, xf, loop.certify(xf), "failed", w, n_solves, t0,
+                               f"no point certified for the {self._loop_name()} loop found after "
+                               f"{n_solves} solve(s) (IPOPT: {statuses[-1] if statuses else 'not run'})",
+                               start=start, ipopt_iterations=ipopt_iters, ipopt_status=statuses)
+        self._remember(key, best, use_state)
+        if use_state:
+            self._last = best
+        msg = (f"nearest certified point of the {len(M)}-point certified map of the "
+               f"{self._loop_name()} loop (the NLP solution was not nearer)" if fallback else
+               f"nearest point certified for the {self._loop_name()} loop: {n_solves} solve(s), "
+               f"{len(slots)} constraints")
+        return make_result(method, k0, best, CERTIFIED, "repaired", w, n_solves, t0, msg,
+                           start=start, fallback=fallback, constraints=len(slots),
+                           ipopt_iterations=ipopt_iters, ipopt_status=statuses)
+
+    def _loop_name(self) -> str:
+        H = self.sample_time
+        what = "continuous" if H is None else f"sampled (Δt = {H:g} s)"
+        return f"{what}, robust over the box," if isinstance(self.params, Box) else what
+
     def _remember(self, key: tuple[float, ...], k: Array, use_state: bool) -> None:
         """Cache gains that the exact certificate certified."""
         if not (use_state and self.cache_size):
@@ -382,11 +573,39 @@ class Projector:
         cap = _SLOTS[-1]
         if len(omegas) <= cap:
             return omegas
-        p = self.params
+        p = self._point
         om = np.asarray(omegas[1:])
         gv = _margin.g(om, x[0], x[1], x[2], tau=p.tau, delta=p.delta, headway=p.headway)
         keep = np.sort(np.argsort(gv)[: cap - 1])
         return [omegas[0], *om[keep].tolist()]
+
+def _dedupe_slots(slots: list[Slot], rtol: float = 1e-6) -> list[Slot]:
+    """The slots in order, dropping one at the same member and (nearly) the same frequency."""
+    out: list[Slot] = []
+    seen: list[tuple[str, Member, int, float]] = []
+    for s in slots:
+        if s.kind == "margin" and not (math.isfinite(s.freq) and s.freq >= 0):
+            continue
+        dup = any(k == s.kind and m == s.member and i == s.index
+                  and (s.kind == "stability" or abs(f - s.freq) <= rtol * max(1.0, f))
+                  for k, m, i, f in seen)
+        if not dup:
+            out.append(s)
+            seen.append((s.kind, s.member, s.index, s.freq))
+    return out
+
+
+def _fit_forms(slots: list[Slot], x: Array) -> list[Slot]:
+    """At most the largest slot capacity: drop the slackest margin slots at x (never stability)."""
+    cap = _SLOTS[-1]
+    if len(slots) <= cap:
+        return slots
+    stab = [s for s in slots if s.kind == "stability"]
+    marg = [s for s in slots if s.kind != "stability"]
+    vals = evaluate_forms(np.array([s.form for s in marg]), x)
+    keep = np.sort(np.argsort(vals)[: cap - len(stab)])
+    return stab + [marg[i] for i in keep]
+
 
 def _dedupe(omegas: list[float], rtol: float = 1e-6) -> list[float]:
     """ω = 0 first, then the others in order, dropping near-duplicates."""
@@ -400,20 +619,24 @@ def _dedupe(omegas: list[float], rtol: float = 1e-6) -> list[float]:
 
 
 @lru_cache(maxsize=64)
-def _default_projector(tau: float, delta: float, headway: float, weights: tuple[float, ...],
+def _default_projector(params: Params | Box, weights: tuple[float, ...],
                        bounds: tuple[float, float], hurwitz_margin: float, eps: float,
-                       max_exchange: int, predictor: bool = True) -> Projector:
-    return Projector(tau=tau, delta=delta, headway=headway, weights=weights, bounds=bounds,
-                     hurwitz_margin=hurwitz_margin, eps=eps, max_exchange=max_exchange,
-                     cache_size=0, predictor=predictor)
+                       max_exchange: int, predictor: bool = True,
+                       sample_time: float | None = None, heterogeneous: bool = True) -> Projector:
+    return Projector(tau=params.tau, delta=params.delta, headway=params.headway,
+                     sample_time=sample_time, heterogeneous=heterogeneous, weights=weights,
+                     bounds=bounds, hurwitz_margin=hurwitz_margin, eps=eps,
+                     max_exchange=max_exchange, cache_size=0, predictor=predictor)
 
 
 def project(
     K0: Sequence[float] | Array,
     *,
-    tau: float,
-    delta: float,
-    headway: float,
+    tau: Any,
+    delta: Any,
+    headway: Any,
+    sample_time: float | None = None,
+    heterogeneous: bool = True,
     weights: Sequence[float] = (1.0, 1.0, 1.0),
     bounds: tuple[float, float] = (-2.0, 2.0),
     hurwitz_margin: float = 1e-3,
@@ -474,14 +697,21 @@ def project(
     ----------
     K0 : sequence of 3 floats
         The gains to repair.
-    tau, delta, headway : float
-        Model parameters (s).
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Model parameters (s); an interval asks for gains certified for every member of the
+        box (the robust certificate, :mod:`stringstab.robust`).
+    sample_time : float, optional
+        H (s): gains certified for the sampled-data loop (:mod:`stringstab.sampled`).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently.
     weights : sequence of 3 floats
         Weights of the squared distance, > 0.
     bounds : (float, float)
         Bounds on every gain (IDL Table 2: [-2, 2]).
     hurwitz_margin : float
-        m in k_x ≥ m and k_v + (T* − τ)k_x ≥ m (internal stability with a margin).
+        m in k_x ≥ m and k_v + (T* − τ)k_x ≥ m (internal stability with a margin); sampled,
+        m in each Schur condition normalised to these as H → 0
+        (:func:`stringstab.sampled.schur_margins`).
     eps : float
         ε > 0 of the frequency constraints.
     warm_start : sequence of 3 floats, optional
@@ -491,10 +721,18 @@ def project(
     predictor : bool
         Try the Newton predictor before IPOPT (default); False: IPOPT only.
 
+    For the sampled-data loop and for a parameter box there is no predictor; the exchange
+    runs on an NLP whose constraints are quadratic forms in K
+    (:mod:`stringstab.tuning.constraints`): the Schur (or worst-corner Hurwitz) conditions,
+    the margin at 0 at the box's corners and on the ladder at its centre, and then, after
+    each solve, the margin at the certificate's witness member and frequency (θ when
+    sampled) and at the dips of that member's margin; the certificate of that loop decides
+    every output, and the fallback is the nearest point of that loop's certified map.
+
     Returns
     -------
     TuneResult
-        ``certified`` is the exact certificate's verdict on the output.
+        ``certified`` is the exact certificate's verdict on the output (of the loop asked for).
 
     Raises
     ------
@@ -512,12 +750,15 @@ def project(
     ('repaired', True, 0.033)
     >>> project([1.3, 0.0, 0.6], tau=0.1, delta=0.2, headway=1.1).status
     'unchanged'
+    >>> r = project([0.9, -0.5, 1.1], tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    >>> r.status, r.certified
+    ('repaired', True)
     """
-    p = Params(tau, delta, headway)
     proj = _default_projector(
-        p.tau, p.delta, p.headway, tuple(float(v) for v in as_weights(weights)),
+        parameter_model(tau, delta, headway), tuple(float(v) for v in as_weights(weights)),
         as_bounds(bounds), positive("hurwitz_margin", hurwitz_margin, allow_zero=True),
         positive("eps", eps), max_exchange, bool(predictor),
+        None if sample_time is None else _sample_time(sample_time), bool(heterogeneous),
     )
     return proj(K0, warm_start=warm_start, use_state=False)
 

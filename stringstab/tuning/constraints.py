@@ -1,0 +1,319 @@
+"""The projection's constraints for any loop: quadratic forms in K from the one home of each margin.
+
+The gain repair (:mod:`stringstab.tuning.projection`) asks for gains certified for the loop a
+controller runs: the continuous loop at one τ, δ, T* (its own NLP, built on
+:func:`stringstab.margin.casadi_g`), the sampled-data loop (``sample_time``) or every member of
+a box of τ, δ, T* (the robust certificate), sampled or not.  For the last three, every
+constraint of the NLP is a *quadratic form in the gains*:
+
+* the continuous margin g(ω; K) (:func:`stringstab.margin.g`) at one member (τ, δ, T*) and one
+  frequency ω is a polynomial of degree 2 in K = (k_x, k_v, k_a): t2 does not depend on K,
+  a is affine, b, c_x, c_v are quadratic;
+* the sampled margin g_H(θ; K) (:func:`stringstab.sampled.sampled_margin`) is one too: every
+  w-coefficient of Δ(w) and n(w) is affine in K, and g_H is a sum of products of two of them;
+* so are the internal-stability conditions: the Hurwitz conditions (linear,
+  :func:`stringstab.criteria.hurwitz_conditions`) and the normalised Schur conditions of the
+  sampled loop (:func:`stringstab.sampled.schur_margins`).
+
+A quadratic q(K) = c + bᵀK + KᵀAK is recovered *exactly* (up to round-off) from ten evaluations
+by polarisation (:func:`quadratic_form`), so each constraint is evaluated by the same code as
+the certificate it serves, and the NLP sees only the numbers (c, b, A) of each slot: one NLP for
+every loop.  :class:`Loop` says which member and frequency each constraint is taken at: a few
+fixed ones to start, then the certificate's witnesses (the exchange method), and decides every
+output with the certificate of that loop (:func:`stringstab.certificate.check`).
+
+References
+----------
+R. Hettich, K. O. Kortanek, "Semi-infinite programming: theory, methods, and applications",
+SIAM Review 35 (1993) 380-429 (the exchange method).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from itertools import product
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import margin as _margin
+from ..criteria import hurwitz_conditions
+from ..params import Box, Params
+
+__all__ = ["FORM_SIZE", "Loop", "Member", "Slot", "quadratic_form"]
+
+Array = npt.NDArray[np.float64]
+
+#: Numbers per quadratic form: c, b (3), the upper triangle of A (xx, xv, xa, vv, va, aa).
+FORM_SIZE = 10
+#: The evaluation points of :func:`quadratic_form`: 0, ±e_i, e_i + e_j.
+_E = np.eye(3)
+_POINTS = np.array([np.zeros(3), *_E, *(-_E), _E[0] + _E[1], _E[0] + _E[2], _E[1] + _E[2]])
+
+
+def quadratic_form(f: Callable[[Array, Array, Array], Array]) -> Array:
+    """(c, b, A) of a polynomial q(K) of degree ≤ 2 in K = (k_x, k_v, k_a), from 10 values.
+
+    ``f(k_x, k_v, k_a)`` evaluates q on arrays.  With q(0) = c, q(±e_i) = c ± b_i + A_ii and
+    q(e_i + e_j) = c + b_i + b_j + A_ii + A_jj + 2A_ij, the identities are exact for a quadratic.
+
+    Returns
+    -------
+    ndarray, shape (10,)
+        c, b_x, b_v, b_a, A_xx, A_xv, A_xa, A_vv, A_va, A_aa (q = c + bᵀK + KᵀAK).
+
+    Examples
+    --------
+    >>> q = quadratic_form(lambda x, v, a: 1 + 2 * x - v + 3 * x * a + a * a)
+    >>> q.round(12).tolist()
+    [1.0, 2.0, -1.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.0, 1.0]
+    """
+    v = np.asarray(f(*_POINTS.T), dtype=float)
+    c = v[0]
+    plus, minus = v[1:4], v[4:7]
+    b = 0.5 * (plus - minus)
+    diag = 0.5 * (plus + minus) - c
+    off = []
+    for k, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
+        off.append(0.5 * (v[7 + k] - plus[i] - plus[j] + c))
+    return np.array([c, *b, diag[0], off[0], off[1], diag[1], off[2], diag[2]])
+
+
+def evaluate_forms(forms: Array, K: Array) -> Array:
+    """q(K) for each row of ``forms`` (shape (n, 10)) at K (shape (3,), or (m, 3): (n, m)).
+
+    Examples
+    --------
+    >>> f = quadratic_form(lambda x, v, a: 1 + x * v)
+    >>> evaluate_forms(f[None, :], np.array([2.0, 3.0, 0.0])).tolist()
+    [7.0]
+    """
+    x, v, a = np.asarray(K, dtype=float).T
+    mono = np.stack([np.ones_like(x), x, v, a, x * x, 2 * x * v, 2 * x * a, v * v, 2 * v * a, a * a])
+    return np.asarray(forms @ mono)
+
+
+@dataclass(frozen=True)
+class Member:
+    """One member of the parameter box: τ, the predecessor's lag τ_p, δ, T* (s)."""
+
+    tau: float
+    tau_prev: float
+    delta: float
+    headway: float
+
+
+@dataclass(frozen=True)
+class Slot:
+    """One constraint: its kind, the member and frequency it is taken at, and its form.
+
+    ``kind`` is ``"margin"`` (g ≥ ε at ``freq``: ω in rad/s, or θ in rad/sample when
+    sampled) or ``"stability"`` (the ``index``-th internal-stability condition ≥ the margin).
+    """
+
+    kind: str
+    member: Member
+    freq: float
+    index: int
+    form: Array
+
+
+class Loop:
+    """The loop to repair gains for, its constraints and its certificate.
+
+    Parameters
+    ----------
+    params : Params or Box
+        τ, δ, T* (a point) or the box every member of which must be certified.
+    sample_time : float or None
+        H (s) for the sampled-data loop.
+    heterogeneous : bool
+        Sampled box: the predecessor's lag ranges over the τ box independently.
+    """
+
+    def __init__(self, params: Params | Box, sample_time: float | None,
+                 heterogeneous: bool = True) -> None:
+        self.params = params
+        self.sample_time = sample_time
+        self.heterogeneous = bool(heterogeneous)
+        self.box = Box.of(params)
+
+    @property
+    def sampled(self) -> bool:
+        """The sampled-data loop."""
+        return self.sample_time is not None
+
+    @property
+    def H(self) -> float:
+        """The sample time of a sampled loop."""
+        assert self.sample_time is not None
+        return self.sample_time
+
+    # ------------------------------------------------------------------ members
+    def centre(self) -> Member:
+        """The box's centre (the point itself for a point)."""
+        (t0, t1), (d0, d1), (h0, h1) = self.box.tau, self.box.delta, self.box.headway
+        t = 0.5 * (t0 + t1)
+        return Member(t, t, 0.5 * (d0 + d1), 0.5 * (h0 + h1))
+
+    def corners(self) -> list[Member]:
+        """The corners of the (τ, T*) box with δ at its centre (where stability is worst)."""
+        c = self.centre()
+        return [Member(t, t, c.delta, h) for t, h in product(sorted(set(self.box.tau)),
+                                                             sorted(set(self.box.headway)))]
+
+    def first_members(self) -> list[Member]:
+        """Members whose margins are constrained in the first solve: the corners of the box
+        (every τ, δ, T* end; τ_p = τ) and its centre (a point: the point)."""
+        out = {self.centre()}
+        for t, d, h in product(*(sorted(set(iv)) for iv in (self.box.tau, self.box.delta,
+                                                             self.box.headway))):
+            out.add(Member(t, t, d, h))
+        return sorted(out, key=lambda m: (m.tau, m.delta, m.headway))
+
+    def extreme_members(self) -> list[Member]:
+        """Every corner of the box, with the predecessor's lag at either end of the τ box too
+        when sampled and heterogeneous (where a box's worst member usually is)."""
+        ends = [sorted(set(iv)) for iv in (self.box.tau, self.box.delta, self.box.headway)]
+        tp_free = self.sampled and self.heterogeneous
+        out = []
+        for t, tp, d, h in product(ends[0], ends[0] if tp_free else [None], ends[1], ends[2]):
+            out.append(Member(t, t if tp is None else tp, d, h))
+        return out
+
+    # ------------------------------------------------------------------ the one homes
+    def margin(self, member: Member, freq: Array, K: Array) -> Array:
+        """g (or g_H) at ``member`` on frequencies ``freq`` for the gains K (3,): from the one
+        home of each margin (:func:`stringstab.margin.g`, :func:`stringstab.sampled.sampled_margin`)."""
+        if not self.sampled:
+            return _margin.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
+                             headway=member.headway)
+        from ..sampled import sampled_margin
+
+        return sampled_margin(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
+                              headway=member.headway, sample_time=self.H,
+                              tau_prev=member.tau_prev)
+
+    def margin_slot(self, member: Member, freq: float) -> Slot:
+        """The constraint g(freq; K) ≥ ε at ``member``, as a quadratic form in K."""
+        if not self.sampled:
+            form = quadratic_form(lambda x, v, a: _margin.g(
+                freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway))
+        else:
+            from ..sampled import sampled_margin
+
+            form = quadratic_form(lambda x, v, a: sampled_margin(
+                freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway,
+                sample_time=self.H, tau_prev=member.tau_prev))
+        return Slot("margin", member, float(freq), 0, form)
+
+    def stability_slots(self, member: Member) -> list[Slot]:
+        """Internal stability at ``member``: the Hurwitz conditions (continuous) or the
+        normalised Schur conditions (sampled), each a quadratic form in K."""
+        def conditions(x: Array, v: Array, a: Array) -> Array:
+            if not self.sampled:
+                return np.asarray(hurwitz_conditions(x, v, a, tau=member.tau,
+                                                     headway=member.headway))
+            from ..sampled import schur_margins
+
+            return schur_margins(x, v, tau=member.tau, headway=member.headway, sample_time=self.H)
+
+        n = 5 if self.sampled else 2
+
+        def one(i: int) -> Callable[[Array, Array, Array], Array]:
+            return lambda x, v, a: conditions(x, v, a)[i]
+
+        return [Slot("stability", member, math.nan, i, quadratic_form(one(i))) for i in range(n)]
+
+    # ------------------------------------------------------------------ frequencies
+    def ladder(self) -> list[float]:
+        """Fixed frequencies of the first solve: 0, 16 from 0.2 to 5 rad/s (geometric) and,
+        sampled, up to 10 rad/s and π rad/sample (θ = ωH)."""
+        w = np.geomspace(0.2, 5.0, 16)
+        if not self.sampled:
+            return [0.0, *w.tolist()]
+        th = np.concatenate([w, np.geomspace(6.0, 10.0, 3)]) * self.H
+        return [0.0, *sorted({float(min(t, math.pi)) for t in th} | {math.pi})]
+
+    def dips(self, K: Array, member: Member, threshold: float, n: int = 384) -> list[float]:
+        """Local minima of the margin at ``member`` below ``threshold`` (a scan, zoomed): a
+        heuristic to pick frequencies, never a proof."""
+        if not self.sampled:
+            return _margin.local_minima(K, tau=member.tau, delta=member.delta,
+                                        headway=member.headway, threshold=threshold)[1]
+        grid = np.linspace(0.0, math.pi, n)
+        g = self.margin(member, grid, K)
+        left = np.concatenate([[np.inf], g[:-1]])
+        right = np.concatenate([g[1:], [np.inf]])
+        idx = np.flatnonzero((g <= left) & (g <= right) & (g < threshold))[:12]
+        out = []
+        for i in idx:
+            lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, n - 1)]
+            for _ in range(5):
+                z = np.linspace(lo, hi, 9)
+                j = int(np.argmin(self.margin(member, z, K)))
+                h = (hi - lo) / 8.0
+                lo, hi = max(z[j] - h, 0.0), min(z[j] + h, math.pi)
+            out.append(float(0.5 * (lo + hi)))
+        return out
+
+    # ------------------------------------------------------------------ the certificate
+    def check(self, K: Array) -> tuple[str, bool, list[tuple[Member, float]]]:
+        """The certificate of this loop on K: (verdict, internally stable, witnesses).
+
+        A witness is a member and a frequency (ω, or θ when sampled) where the margin was
+        found smallest: |Γ| > 1 (|H| > 1) there when K is internally stable and not certified.
+        """
+        from ..certificate import check
+
+        b = self.box
+        c = check(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
+                  sample_time=self.sample_time, heterogeneous=self.heterogeneous)
+        verdict, stable = str(c.verdict[0]), bool(c.hurwitz[0])
+        freq = c.witness_theta if c.witness_theta is not None else c.witness_omega
+        f = float(np.asarray(freq)[0])
+        if c.witness_tau is not None:
+            t = float(c.witness_tau[0])
+            tp = float(np.asarray(c.witness_tau_prev)[0]) if c.witness_tau_prev is not None else t
+            member = Member(t, tp if math.isfinite(tp) else t,
+                            float(np.asarray(c.witness_delta)[0]),
+                            float(np.asarray(c.witness_headway)[0]))
+        else:
+            member = self.centre()
+        if not all(math.isfinite(x) for x in (member.tau, member.delta, member.headway)):
+            member = self.centre()
+        return verdict, stable, ([(member, f)] if math.isfinite(f) else [])
+
+    def certify(self, K: Array) -> Any:
+        """The full certificate of K (for a result that failed: its verdict and sup gain)."""
+        from ..certificate import certify
+
+        b = self.box
+        return certify(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
+                       sample_time=self.sample_time, heterogeneous=self.heterogeneous)
+
+    def certified_points(self, K: Array) -> npt.NDArray[np.bool_]:
+        """Which rows of K (n, 3) this loop's certificate certifies.
+
+        For a box, the point certificate at the box's centre screens first (a gain certified
+        for the box is certified at its centre), then the robust one decides.
+        """
+        from ..certificate import certify_batch
+
+        b, c = self.box, self.centre()
+        ok = np.zeros(len(K), dtype=bool)
+        if not len(K):
+            return ok
+        screen = certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=c.tau, delta=c.delta,
+                               headway=c.headway, sample_time=self.sample_time).certified
+        if isinstance(self.params, Params):
+            return np.asarray(screen)
+        idx = np.flatnonzero(screen)
+        r = certify_batch(K[idx, 0], K[idx, 1], K[idx, 2], tau=b.tau, delta=b.delta,
+                          headway=b.headway, sample_time=self.sample_time,
+                          heterogeneous=self.heterogeneous)
+        ok[idx] = r.certified
+        return ok
