@@ -201,3 +201,43 @@ def test_bad_followers_and_leaders():
         simulate(lead, LinearController(*CERTIFIED), 0)
     with pytest.raises(StringStabError, match="share dt and length"):
         simulate([lead, sinusoid(omega=1.0, duration=3.0)], LinearController(*CERTIFIED), 1)
+
+
+# --------------------------------------------------------------------------- exact fractional delay
+@pytest.mark.parametrize("tau", [0.1, np.array([0.1, 0.15, 0.12])])
+def test_exact_fractional_delay_is_the_certified_sampled_loop(tau):
+    """With fractional_delay="exact" the follower receives a_p(kΔt − δ) itself: the amplitude
+    ratios of followers 2/1 and 3/2 behind a sinusoidal leader equal |H(e^{jωΔt})| of the
+    independent expm construction (tests/_sampled_truth.py), also with a different lag per car
+    (the predecessor's lag τ_p enters the received sample).  The default interpolation differs."""
+    from _sampled_truth import pair_response
+
+    K, H, delta, w = (1.2, 0.5, 0.6), 0.1, 0.25, 3.0
+    lead = sinusoid(omega=w, amplitude=0.3, speed=20.0, duration=120.0, dt=H)
+    taus = np.broadcast_to(np.asarray(tau, dtype=float), (3,))
+    res = simulate(lead, LinearController(*K, headway=HEADWAY), 3, tau=tau, delta=delta,
+                   fractional_delay="exact")
+    sel = res.t > 60.0
+    amp = [_amplitude(res.t[sel], res.accel[i][sel], w) for i in range(4)]
+    for i in (2, 3):  # follower i behind follower i − 1 (a lag vehicle)
+        want = abs(pair_response(np.array([w * H]), *K, taus[i - 1], delta, HEADWAY, H,
+                                 tau_prev=taus[i - 2])[0])
+        assert_allclose(amp[i] / amp[i - 1], want, rtol=1e-6)
+    assert res.params["fractional_delay"] == "exact"
+    lin = simulate(lead, LinearController(*K, headway=HEADWAY), 3, tau=tau, delta=delta)
+    amp_lin = [_amplitude(lin.t[sel], lin.accel[i][sel], w) for i in range(3)]
+    assert abs(amp_lin[2] / amp_lin[1] - amp[2] / amp[1]) > 1e-3
+    assert "fractional_delay" not in lin.params
+
+
+def test_exact_fractional_delay_on_a_multiple_of_the_step_changes_nothing():
+    lead = sinusoid(omega=2.0, amplitude=0.3, speed=20.0, duration=20.0, dt=0.1)
+    a = simulate(lead, LinearController(1.2, 0.5, 0.6), 2, delta=0.2)
+    b = simulate(lead, LinearController(1.2, 0.5, 0.6), 2, delta=0.2, fractional_delay="exact")
+    assert np.array_equal(a.accel, b.accel)
+
+
+def test_fractional_delay_option_is_checked():
+    lead = sinusoid(omega=2.0, duration=2.0)
+    with pytest.raises(StringStabError, match="fractional_delay must be 'linear' or 'exact'"):
+        simulate(lead, LinearController(1.2, 0.5, 0.6), 2, fractional_delay="cubic")

@@ -243,7 +243,7 @@ def _comparison_codes(
                 n_unsafe += 1
             disagree.append(True)
     codes[inc] = len(labels)
-    labels.append("exact inconclusive")
+    labels.append("a certificate inconclusive" if CONTINUOUS in methods else "exact inconclusive")
     colors.append(CLASS_COLORS["inconclusive"])
     disagree.append(False)
     return codes, labels, colors, disagree

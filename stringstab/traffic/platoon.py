@@ -22,10 +22,16 @@ Discretisation (``model="lag"``, the default)
     sampler, which acts like an extra delay of about Δt/2.
 
 Communication delay δ
-    Every step stores all vehicles' accelerations in a ring buffer.  With δ/Δt = n + f
-    (n integer, 0 ≤ f < 1) the received value is the linear interpolation
-    (1 − f) a(t_{k−n}) + f a(t_{k−n−1}), i.e. a(t_k − δ) to second order; it is exact when δ
-    is a multiple of Δt (f = 0).  Before t = 0 the history is the initial acceleration.
+    Every step stores all vehicles' accelerations (and commands) in a ring buffer.  With
+    δ/Δt = n + f (n integer, 0 ≤ f < 1) the received value is, by default
+    (``fractional_delay="linear"``), the linear interpolation (1 − f) a(t_{k−n}) + f a(t_{k−n−1}),
+    i.e. a(t_k − δ) to second order; it is exact when δ is a multiple of Δt (f = 0).  With
+    ``fractional_delay="exact"`` it is the predecessor's acceleration at t_k − δ itself, as its
+    model evolves inside the step: u + (a − u) e^{−(1−f)Δt/τ_p} from the sample and the held
+    command of step k − n − 1 (``model="lag"``; the held command u itself with
+    ``model="kinematic"``), which is the sampled-data loop :mod:`stringstab.sampled` certifies.
+    The leader's acceleration between samples is not modelled, so its followers receive the
+    interpolation either way.  Before t = 0 the history is the initial acceleration.
 
 ``model="kinematic"``
     The paper's simpler update (eqs 1-2): no lag, a_k = u_k (limited), v_{k+1} = v_k + a_k Δt,
@@ -68,6 +74,7 @@ Array = npt.NDArray[np.float64]
 DEFAULT_LENGTH = 5.0
 
 Model = Literal["lag", "kinematic"]
+FractionalDelay = Literal["linear", "exact"]
 
 
 @dataclass(frozen=True)
@@ -188,6 +195,10 @@ class Platoon:
         Acceleration and speed bounds.
     length : float
         Vehicle length, m (gap = x_{i−1} − x_i − length).
+    fractional_delay : {"linear", "exact"}
+        How a delay that is not a multiple of Δt is received: interpolated linearly between
+        samples (default), or the predecessor's exact acceleration inside the step (the
+        module docstring).
 
     Attributes
     ----------
@@ -205,7 +216,7 @@ class Platoon:
 
     def __init__(self, n_platoons: int, n_followers: int, *, dt: float, tau: npt.ArrayLike = DEFAULT_TAU,
                  delta: float = DEFAULT_DELTA, model: Model = "lag", limits: Limits | None = None,
-                 length: float = DEFAULT_LENGTH) -> None:
+                 length: float = DEFAULT_LENGTH, fractional_delay: FractionalDelay = "linear") -> None:
         if int(n_platoons) < 1 or int(n_followers) < 1:
             raise StringStabError(
                 f"n_platoons and n_followers must be >= 1; got {show(n_platoons)} and {show(n_followers)}"
@@ -214,6 +225,9 @@ class Platoon:
             raise StringStabError(f"dt must be a finite number > 0 s; got {show(dt)}")
         if model not in ("lag", "kinematic"):
             raise StringStabError(f"model must be 'lag' or 'kinematic'; got {show(model)}")
+        if fractional_delay not in ("linear", "exact"):
+            raise StringStabError(
+                f"fractional_delay must be 'linear' or 'exact'; got {show(fractional_delay)}")
         tau_arr, d = _check_lag_delay(tau, delta)
         P, N = int(n_platoons), int(n_followers)
         self.P, self.N, self.dt, self.model, self.delta = P, N, float(dt), model, d
@@ -237,11 +251,20 @@ class Platoon:
         if f < 1e-9:
             f = 0.0
         self._n_delay, self._frac = n, f
+        self.fractional_delay = fractional_delay
+        # the exact fractional delay: a_p(t_j + (1 − f)Δt) = u_j + (a_j − u_j) C, C per receiver
+        # (its predecessor's lag; 0 for the kinematic model, whose a is the held u in a step)
+        self._exact_frac = fractional_delay == "exact" and f > 0.0
+        C = np.zeros((P, N))
+        if model == "lag":
+            C[:, 1:] = np.exp(-(1.0 - f) * self.dt / tau_b[:, :-1])
+        self._frac_c = C
         self._ring = n + 2
         self.position = np.zeros((P, N + 1))
         self.speed = np.zeros((P, N + 1))
         self.accel = np.zeros((P, N + 1))
         self._buf = np.zeros((self._ring, P, N + 1))
+        self._ubuf = np.zeros((self._ring, P, N + 1))  # held commands (the exact fractional delay)
         self.step = 0
         self.collided = np.zeros((P, N), dtype=bool)
         self.collision_events = np.zeros((P, N), dtype=np.int64)
@@ -283,6 +306,7 @@ class Platoon:
         self.speed[r] = V
         self.accel[r] = A
         self._buf[:, r] = A
+        self._ubuf[:, r] = A  # a constant history: a = u
         self.collided[r] = False
         self.collision_events[r] = 0
         self.first_collision_step[r] = -1
@@ -307,8 +331,15 @@ class Platoon:
         rel = V[:, :-1] - V[:, 1:]
         ad = self._buf[(k - self._n_delay) % self._ring][:, :-1]
         if self._frac:
-            ad = ad * (1.0 - self._frac)
-            ad += self._frac * self._buf[(k - self._n_delay - 1) % self._ring][:, :-1]
+            older = self._buf[(k - self._n_delay - 1) % self._ring][:, :-1]
+            lead = (1.0 - self._frac) * ad[:, 0] + self._frac * older[:, 0]
+            if self._exact_frac:
+                u_old = self._ubuf[(k - self._n_delay - 1) % self._ring][:, :-1]
+                ad = u_old + (older - u_old) * self._frac_c
+                ad[:, 0] = lead  # the leader's acceleration between samples is not modelled
+            else:
+                ad = ad * (1.0 - self._frac)
+                ad += self._frac * older
         coll = gap <= 0.0
         if self._any_in_collision or coll.any():
             new = coll & ~self._in_collision
@@ -361,6 +392,8 @@ class Platoon:
         xo[...] = xn
         vo[...] = vn
         ao[...] = an
+        if self._exact_frac:
+            self._ubuf[self.step % self._ring][:, 1:] = u
         self.step += 1
         return u
 
@@ -484,6 +517,7 @@ def simulate(
     initial_speed: npt.ArrayLike | None = None,
     record: bool = True,
     progress: bool | None = None,
+    fractional_delay: FractionalDelay = "linear",
 ) -> PlatoonResult:
     """Simulate platoons of ``n_followers`` behind prescribed leaders.
 
@@ -515,6 +549,10 @@ def simulate(
         summaries (collisions, minimum gaps, Σa² for m_p) are kept.
     progress : bool, optional
         Show a tqdm bar; by default only for long runs (over 10⁸ vehicle-steps).
+    fractional_delay : {"linear", "exact"}
+        A delay that is not a multiple of Δt: interpolated linearly between received samples
+        (default), or the predecessor's exact acceleration inside the step, the loop the
+        sampled-data certificate certifies (module docstring; recorded in ``params`` then).
 
     Returns
     -------
@@ -540,7 +578,8 @@ def simulate(
         )
     N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
-    plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length)
+    plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length,
+                   fractional_delay=fractional_delay)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
     LV = np.ascontiguousarray(np.stack([tr.speed for tr in leaders], axis=1))
     LA = np.ascontiguousarray(np.stack([tr.accel for tr in leaders], axis=1))
@@ -612,6 +651,8 @@ def simulate(
         "headway": controller.headway, **controller.describe(),
         "leaders": [tr.name for tr in leaders] if batched else leaders[0].name,
     }
+    if fractional_delay != "linear":
+        params["fractional_delay"] = fractional_delay
     sq = (lambda a: a) if batched else (lambda a: a[0])
     return PlatoonResult(
         dt=dt,
