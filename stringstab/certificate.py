@@ -63,6 +63,7 @@ from .margin import tail_bound
 from .params import Box, Params, as_gains, parameter_model
 from .params import sample_time as _sample_time
 from .verdicts import (
+    ROW_COLUMNS,
     VERDICTS,
     BatchResult,
     Check,
@@ -374,11 +375,7 @@ def _taylor_columns(tc: TaylorCriteria) -> dict[str, Any]:
 
 #: The columns of the human table of certificates (``stringstab certify``).
 TABLE_COLUMNS: list[TableColumn] = [
-    TableColumn("t", "t"),
-    TableColumn("vehicle", "vehicle"),
-    TableColumn("k_x", "k_x"),
-    TableColumn("k_v", "k_v"),
-    TableColumn("k_a", "k_a"),
+    *ROW_COLUMNS,
     TableColumn("hurwitz", "hurwitz"),
     TableColumn("verdict", "verdict"),
     TableColumn("type", "type"),

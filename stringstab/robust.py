@@ -82,7 +82,7 @@ from .sampled import (
     _spread,
     split_delay,
 )
-from .verdicts import BatchResult, Check, SingleResult, chunks, names, one_triple
+from .verdicts import ROW_COLUMNS, BatchResult, Check, SingleResult, chunks, names, one_triple
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -589,11 +589,7 @@ class RobustCertificate(SingleResult):
 #: The columns of the human table of robust certificates (``stringstab certify`` with an
 #: interval).
 TABLE_COLUMNS: list[TableColumn] = [
-    TableColumn("t", "t"),
-    TableColumn("vehicle", "vehicle"),
-    TableColumn("k_x", "k_x"),
-    TableColumn("k_v", "k_v"),
-    TableColumn("k_a", "k_a"),
+    *ROW_COLUMNS,
     TableColumn("stable", "stable"),
     TableColumn("verdict", "verdict"),
     TableColumn("sup gain at witness", "sup_gain", "%.6g", missing="inf"),

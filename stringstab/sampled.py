@@ -77,6 +77,7 @@ from .verdicts import CERTIFIED as CERTIFIED_CODE
 from .verdicts import (
     INCONCLUSIVE,
     NOT_CERTIFIED,
+    ROW_COLUMNS,
     VERDICTS,
     BatchResult,
     Check,
@@ -1051,11 +1052,7 @@ class SampledCertificate(SingleResult):
 
 #: The columns of the human table of sampled certificates (``stringstab certify --sample-time``).
 TABLE_COLUMNS: list[TableColumn] = [
-    TableColumn("t", "t"),
-    TableColumn("vehicle", "vehicle"),
-    TableColumn("k_x", "k_x"),
-    TableColumn("k_v", "k_v"),
-    TableColumn("k_a", "k_a"),
+    *ROW_COLUMNS,
     TableColumn("schur", "schur"),
     TableColumn("ρ(Δ)", "spectral_radius", "%.4g"),
     TableColumn("verdict", "verdict"),

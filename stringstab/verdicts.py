@@ -28,12 +28,13 @@ import numpy as np
 import numpy.typing as npt
 
 from .errors import StringStabError
-from .io.results import records_from_columns
+from .io.results import TableColumn, records_from_columns
 
 __all__ = [
     "CERTIFIED",
     "INCONCLUSIVE",
     "NOT_CERTIFIED",
+    "ROW_COLUMNS",
     "VERDICTS",
     "BatchResult",
     "Check",
@@ -50,6 +51,16 @@ Array = npt.NDArray[np.float64]
 #: The three possible verdicts, by code: 0 certified, 1 not certified, 2 inconclusive.
 VERDICTS: tuple[str, str, str] = ("certified", "not_certified", "inconclusive")
 CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE = 0, 1, 2
+
+#: The first columns of every certificate's human table: the input row's time and vehicle
+#: (when the input has them) and the gains.
+ROW_COLUMNS: tuple[TableColumn, ...] = (
+    TableColumn("t", "t"),
+    TableColumn("vehicle", "vehicle"),
+    TableColumn("k_x", "k_x"),
+    TableColumn("k_v", "k_v"),
+    TableColumn("k_a", "k_a"),
+)
 
 
 def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:

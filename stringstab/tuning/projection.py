@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import time
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import cache, lru_cache
 from typing import Any
 
@@ -395,28 +395,31 @@ class Projector:
                 x = best
                 n_solves = 1
                 self.stats["predicted"] += 1
-        for _ in range(0 if predicted else self.max_exchange):
+
+        def solve(x: Array) -> tuple[Array, str, int]:
+            nonlocal omegas
             omegas = self._fit_slots(omegas, x)
-            x, status, its = self._solve(k0, x, omegas)
-            n_solves += 1
-            ipopt_iters += its
-            statuses.append(status)
-            if not np.all(np.isfinite(x)):
-                break
+            return self._solve(k0, x, omegas)
+
+        def step(x: Array) -> str:
             # the exact certificate's verdict; when it does not certify, its witness
             # frequency (|Γ| > 1 there) and the violating dips of a cheap scan are added
+            nonlocal omegas
             verdict, hz, wit = self._check(x)
             if verdict == "certified":
-                best = x
-                break
+                return "certified"
             new = [wit] if hz and wit > 0 else []
             new += violating_dips(x, p, threshold=0.0)[1]
             # each new frequency comes with two neighbours ±_CLUSTER: the dip moves as K moves
             new = [o * f for o in new for f in (1.0, 1.0 - _CLUSTER, 1.0 + _CLUSTER)]
             grown = _dedupe([*omegas, *new])
             if len(grown) == len(omegas):  # nothing new to add: stop
-                break
+                return "stuck"
             omegas = grown
+            return "grown"
+
+        if not predicted:
+            best, x, n_solves, ipopt_iters, statuses = _exchange(x, self.max_exchange, solve, step)
 
         fallback = False
         if im >= 0 and (best is None or float(wdist(best, k0, w)) > float(dm[im])):
@@ -502,21 +505,16 @@ class Projector:
             x, start = M[im], "map"
         else:
             x, start = k0, "input"
-        best: Array | None = None
-        n_solves = ipopt_iters = 0
-        statuses: list[str] = []
         eps = self.eps
-        for _ in range(self.max_exchange):
-            x, status, its = self._solve_quad(k0, x, _fit_forms(slots, x), eps)
-            n_solves += 1
-            ipopt_iters += its
-            statuses.append(status)
-            if not np.all(np.isfinite(x)):
-                break
+
+        def solve(x: Array) -> tuple[Array, str, int]:
+            return self._solve_quad(k0, x, _fit_forms(slots, x), eps)
+
+        def step(x: Array) -> str:
+            nonlocal slots, eps
             verdict, stable, wits = loop.check(x)
             if verdict == "certified":
-                best = x
-                break
+                return "certified"
             new: list[Slot] = []
             for m, f in wits:
                 if not stable:  # an unstable member: all its stability conditions
@@ -532,8 +530,11 @@ class Projector:
                 # a margin too thin for the certificate to decide (a near-tangency): widen it
                 eps = min(10.0 * eps, _EPS_MAX)
             elif len(grown) == len(slots):
-                break
+                return "stuck"
             slots = grown
+            return "grown"
+
+        best, x, n_solves, ipopt_iters, statuses = _exchange(x, self.max_exchange, solve, step)
         fallback = False
         if im >= 0 and (best is None or float(wdist(best, k0, w)) > float(dm[im])):
             best, fallback = M[im].copy(), True  # certified when the map was made
@@ -578,6 +579,38 @@ class Projector:
         gv = _margin.g(om, x[0], x[1], x[2], tau=p.tau, delta=p.delta, headway=p.headway)
         keep = np.sort(np.argsort(gv)[: cap - 1])
         return [omegas[0], *om[keep].tolist()]
+
+def _exchange(
+    x: Array, max_solves: int, solve: Callable[[Array], tuple[Array, str, int]],
+    step: Callable[[Array], str],
+) -> tuple[Array | None, Array, int, int, list[str]]:
+    """The exchange method: solve from x, ask the certificate (``step``), repeat.
+
+    ``solve(x)`` solves the NLP with the current constraints from x; ``step(x)`` asks the
+    certificate and returns ``"certified"``, ``"grown"`` (it added constraints at its witness)
+    or ``"stuck"`` (nothing new to add).  Stops at a certified point, when stuck, at a
+    non-finite solution or after ``max_solves`` solves.
+
+    Returns
+    -------
+    (best or None, last x, solves, IPOPT iterations, IPOPT statuses)
+    """
+    statuses: list[str] = []
+    n_solves = iters = 0
+    for _ in range(max_solves):
+        x, status, its = solve(x)
+        n_solves += 1
+        iters += its
+        statuses.append(status)
+        if not np.all(np.isfinite(x)):
+            break
+        outcome = step(x)
+        if outcome == "certified":
+            return x, x, n_solves, iters, statuses
+        if outcome == "stuck":
+            break
+    return None, x, n_solves, iters, statuses
+
 
 def _dedupe_slots(slots: list[Slot], rtol: float = 1e-6) -> list[Slot]:
     """The slots in order, dropping one at the same member and (nearly) the same frequency."""
