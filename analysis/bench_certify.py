@@ -23,22 +23,34 @@ satisfies |m| ≤ 1e-6 (m → Ψ3/k_x² as ω → 0, where |Γ| → 1; the plain
 ``|peak − 1|`` cannot separate anything since every Hurwitz triple has
 |Γ(0)| = 1).  Otherwise the sweep decides: certified iff Hurwitz and m > 0.
 
-(a) is timed as the best of ``--repeat`` full runs (it takes well under a
-second, so one run is at the mercy of other load); (b) once, over all its
-triples.  Prints its figures; asserts nothing about time.  Example::
+(d) the other loops, in the same run, on the same triples, through the same entry points
+    (:func:`stringstab.certificate.certify_batch` and :func:`~stringstab.certificate.check`
+    with ``sample_time`` and intervals): the sampled-data certificate at Δt = 0.1 s (δ on a
+    multiple of Δt) and at Δt = 0.08 s (δ/Δt = 2.5), the robust certificate over
+    τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25], T* ∈ [1.0, 1.2] in continuous time and, on the first
+    ``--n-robust-sampled`` triples (it is the slow one), sampled at Δt = 0.1 s with
+    heterogeneous lags; each as ms per triple and as the ratio to (a), with the verdict counts.
+
+(a) and (d) are timed as the best of ``--repeat`` full runs (each takes about a second, so one
+run is at the mercy of other load); (b) once, over all its triples.  The machine load
+(``os.getloadavg()``) is printed before and after.  Prints its figures; asserts nothing about
+time.  Examples::
 
     python analysis/bench_certify.py --n 10000 --seed 0 --pade-subset 1000
+    python analysis/bench_certify.py --n 5000 --parts a,d        # the loops only, a minute
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import warnings
+from collections.abc import Callable
 
 import numpy as np
 
-from stringstab.certificate import certify_batch
+from stringstab.certificate import certify_batch, check
 from stringstab.frequency import gain
 from stringstab.params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 
@@ -100,6 +112,54 @@ def sweep(K, tau, delta, headway, points, chunk=50_000):
     return cert, border, peak, omax
 
 
+def best_of(f: Callable[[], object], repeat: int) -> float:
+    """The shortest of ``repeat`` timed runs of f (a warm-up run first, untimed)."""
+    f()
+    best = float("inf")
+    for _ in range(max(repeat, 1)):
+        t0 = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+#: The box of (d): τ, δ, T* intervals (s).
+BOX = {"tau": (0.1, 0.2), "delta": (0.15, 0.25), "headway": (1.0, 1.2)}
+
+
+def other_loops(K, prm, ta, repeat, n_robust_sampled):
+    """(d): per-triple cost of the sampled and robust certificates, as ratios to (a)."""
+    Ks = K[:n_robust_sampled]
+    cases = [
+        ("continuous check (verdicts only)", lambda: check(*K.T, **prm), len(K), {}),
+        ("sampled certify_batch, Δt = 0.1 s", None, len(K), {"sample_time": 0.1}),
+        ("sampled check, Δt = 0.1 s", "check", len(K), {"sample_time": 0.1}),
+        ("sampled certify_batch, Δt = 0.08 s (δ/Δt = 2.5)", None, len(K), {"sample_time": 0.08}),
+        ("robust continuous certify_batch, box τ/δ/T*", None, len(K), BOX),
+        ("robust sampled certify_batch, Δt = 0.1 s, box τ/δ/T*, heterogeneous", None, len(Ks),
+         {**BOX, "sample_time": 0.1}),
+    ]
+    print(f"\n(d) the other loops on the same triples ({os.getloadavg()[0]:.2f} load): "
+          f"ms per triple, best of {repeat}; ratio to (a)")
+    print("| certificate | ms per triple | ratio to (a) certify_batch | certified | not_certified | inconclusive |")
+    print("|---|---|---|---|---|---|")
+    print(f"| (a) continuous certify_batch (baseline) | {ta * 1e3:.4f} | 1.00 | | | |")
+    for name, f, n, kw in cases:
+        k = K[:n]
+        p = {**prm, **kw}
+        if f is None:
+            def f(k=k, p=p):
+                return certify_batch(*k.T, **p)
+        elif f == "check":
+            def f(k=k, p=p):
+                return check(*k.T, **p)
+        t = best_of(f, repeat) / n
+        v = f().verdict
+        counts = " | ".join(str(int(np.count_nonzero(v == x)))
+                            for x in ("certified", "not_certified", "inconclusive"))
+        print(f"| {name} ({n} triples) | {t * 1e3:.4f} | {t / ta:.2f} | {counts} |")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=10_000, help="number of random triples (default 10^4)")
@@ -115,13 +175,19 @@ def main(argv=None):
     ap.add_argument("--tau", type=float, default=DEFAULT_TAU)
     ap.add_argument("--delta", type=float, default=DEFAULT_DELTA)
     ap.add_argument("--headway", type=float, default=DEFAULT_HEADWAY)
+    ap.add_argument("--parts", default="a,b,c,d",
+                    help="which of (a), (b), (c), (d) to run, e.g. a,d (default: all; (a) always)")
+    ap.add_argument("--n-robust-sampled", type=int, default=500,
+                    help="triples for the robust sampled certificate in (d) (default 500)")
     args = ap.parse_args(argv)
+    parts = set(args.parts.split(",")) | {"a"}
     prm = {"tau": args.tau, "delta": args.delta, "headway": args.headway}
 
     rng = np.random.default_rng(args.seed)
     K = rng.uniform(-2.0, 2.0, size=(args.n, 3))
     print(f"# {args.n} triples K ~ U[-2, 2]^3, seed {args.seed}; "
-          f"tau={args.tau}, delta={args.delta}, headway={args.headway}")
+          f"tau={args.tau}, delta={args.delta}, headway={args.headway}; "
+          "load before %.2f %.2f %.2f" % os.getloadavg())
 
     # (a) exact batch, one run (a tiny warm-up call first so imports are not timed)
     certify_batch([1.0], [1.0], [0.0], **prm)
@@ -137,7 +203,17 @@ def main(argv=None):
           f"certified {s['certified']}, not_certified {s['not_certified']}, "
           f"inconclusive {s['inconclusive']}")
 
-    # (b) python-control (warm-up call first so the import of control is not timed)
+    if "d" in parts:
+        other_loops(K, prm, ta, args.repeat, args.n_robust_sampled)
+    if "b" in parts:
+        pade_part(K, b, ta, args, rng)
+    if "c" in parts:
+        sweep_part(K, b, args, rng)
+    print("\nload after %.2f %.2f %.2f" % os.getloadavg())  # noqa: UP031
+
+
+def pade_part(K, b, ta, args, rng):
+    """(b) python-control (a warm-up call first so the import of control is not timed)."""
     python_control_verdicts(K[:1], args.tau, args.delta, args.headway, args.pade_order)
     m = args.n if args.pade_subset <= 0 else min(args.pade_subset, args.n)
     idx = np.sort(rng.choice(args.n, size=m, replace=False)) if m < args.n else np.arange(args.n)
@@ -160,7 +236,9 @@ def main(argv=None):
               f"sup {b.sup_gain[i]:.9g}, hurwitz margin {b.hurwitz_margin[i]:.3g}; "
               f"(b) norm {pc_norm[j]:.9g}")
 
-    # (c) independent roots + dense sweep
+
+def sweep_part(K, b, args, rng):
+    """(c) independent roots + dense sweep."""
     m = args.n if args.sweep_subset <= 0 else min(args.sweep_subset, args.n)
     idx = np.sort(rng.choice(args.n, size=m, replace=False)) if m < args.n else np.arange(args.n)
     t0 = time.perf_counter()

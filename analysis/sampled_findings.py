@@ -6,10 +6,10 @@ Measured by the tool (issue 10, item 4); prints its tables, asserts nothing.
    each of k_x, k_v, k_a in [−2, 2]; default n = 41, step 0.1) at τ = 0.1 s, δ = 0.2 s,
    T* = 1.1 s: the share certified in continuous time, and the share of those that are
    *not* certified when every vehicle samples at Δt = 0.05, 0.1, 0.2 s with a
-   zero-order hold (:func:`stringstab.sampled.certify_sampled_batch`), with the largest
+   zero-order hold (:func:`stringstab.certificate.certify_batch` with ``sample_time``), with the largest
    sampled peak sup|H(e^{jθ})| among them and its gains.
 2. **Robustness.**  How the certified share shrinks as the τ and δ boxes widen
-   (:func:`stringstab.robust.certify_robust_batch`): continuous time on the same grid,
+   (:func:`stringstab.certificate.certify_batch` with intervals): continuous time on the same grid,
    and sampled at Δt = 0.1 s on a coarser grid (``--n-robust-sampled``, default 11³).
 3. **The paper's range and example gains.**  How much of the continuous-certified part
    of [−2, 2]³ survives at the paper's own step (Δt = 0.1 s: not printed, but its leaders
@@ -33,9 +33,7 @@ import time
 import numpy as np
 
 from stringstab import constants
-from stringstab.certificate import check
-from stringstab.robust import certify_robust_batch
-from stringstab.sampled import certify_sampled, certify_sampled_batch, check_sampled
+from stringstab.certificate import certify, certify_batch, check
 
 TAU, DELTA, HEADWAY = constants.TAU, constants.DELTA, constants.HEADWAY
 PERIODS = (0.05, constants.DT, 0.2)  # around the IDL paper's step; 0.2 s is HCFS's
@@ -66,15 +64,14 @@ def sampling(K: np.ndarray) -> np.ndarray:
     print("|---|---|---|---|---|---|")
     for H in PERIODS:
         t0 = time.perf_counter()
-        s = check_sampled(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H).verdict
+        s = check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H).verdict
         lost = cert & (s != "certified")
         n_not = np.count_nonzero(lost & (s == "not_certified"))
         n_inc = np.count_nonzero(lost & (s == "inconclusive"))
         gained = (s == "certified") & ~cert
         peak = "—"
         if lost.any():
-            b = certify_sampled_batch(*K[lost].T, tau=TAU, delta=DELTA, headway=HEADWAY,
-                                      sample_time=H)
+            b = certify_batch(*K[lost].T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H)
             i = int(np.nanargmax(np.where(np.isfinite(b.sup_gain), b.sup_gain, -np.inf)))
             peak = (f"{b.sup_gain[i]:.4f} at K = ({b.k_x[i]:.1f}, {b.k_v[i]:.1f}, "
                     f"{b.k_a[i]:.1f}), ω = {b.peak_omega[i]:.3f} rad/s")
@@ -95,7 +92,7 @@ def robust_tables(K: np.ndarray, Ks: np.ndarray) -> None:
     for t in taus:
         row = []
         for d in deltas:
-            v = certify_robust_batch(*K.T, tau=t, delta=d, headway=HEADWAY).verdict
+            v = certify_batch(*K.T, tau=t, delta=d, headway=HEADWAY).verdict
             row.append(share(v == "certified").strip())
         print(f"| [{t[0]}, {t[1]}] | " + " | ".join(row) + " |")
     print(f"({time.perf_counter() - t0:.1f} s)")
@@ -109,7 +106,7 @@ def robust_tables(K: np.ndarray, Ks: np.ndarray) -> None:
         row = []
         for d in sub_d:
             t0 = time.perf_counter()
-            v = certify_robust_batch(*Ks.T, tau=t, delta=d, headway=HEADWAY, sample_time=H).verdict
+            v = certify_batch(*Ks.T, tau=t, delta=d, headway=HEADWAY, sample_time=H).verdict
             row.append(f"{share(v == 'certified').strip()} / {share(v == 'inconclusive').strip()}"
                        f" ({time.perf_counter() - t0:.0f} s)")
         print(f"| [{t[0]}, {t[1]}] | " + " | ".join(row) + " |")
@@ -123,7 +120,7 @@ def examples() -> None:
         c = check(*([k] for k in K), tau=TAU, delta=DELTA, headway=h).verdict[0]
         cells = []
         for H in PERIODS:
-            r = certify_sampled(*K, tau=TAU, delta=DELTA, headway=h, sample_time=H)
+            r = certify(*K, tau=TAU, delta=DELTA, headway=h, sample_time=H)
             cells.append(r.verdict if r.certified else f"{r.verdict} (peak {r.sup_gain:.4f})")
         print(f"| {K} | {h} | {c} | " + " | ".join(cells) + " |")
 
@@ -139,7 +136,7 @@ def main() -> None:
           f"τ = {TAU} s, δ = {DELTA} s, T* = {HEADWAY} s; {load()}")
     cert = sampling(K)
     H = constants.DT
-    s = check_sampled(*K[cert].T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H).verdict
+    s = check(*K[cert].T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H).verdict
     print(f"\nthe paper's range at its own step (Δt = {H} s): {np.count_nonzero(s == 'certified')} of "
           f"the {np.count_nonzero(cert)} continuous-certified grid points survive "
           f"({100.0 * np.count_nonzero(s == 'certified') / max(1, np.count_nonzero(cert)):.1f} %)")
