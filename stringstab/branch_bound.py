@@ -88,12 +88,22 @@ class BranchAndBound:
     pending_hi: Array
 
 
+#: Empty hand-backs (read-only).
+_NO_ITEMS = np.zeros(0, dtype=np.intp)
+_NO_POINTS = np.zeros(0)
+_NO_ITEMS.setflags(write=False)
+_NO_POINTS.setflags(write=False)
+
+
 def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
     """Item outcomes as verdict codes (:data:`stringstab.verdicts.VERDICTS`): certified 0,
-    violated 1 (not certified), anything else 2 (inconclusive)."""
-    v = np.full(np.shape(status), 2, dtype=np.int8)
-    v[status == CERTIFIED] = 0
-    v[status == VIOLATED] = 1
+    violated 1 (not certified), anything else 2 (inconclusive).
+
+    The outcome codes are chosen so that CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict
+    codes 0, 1, 2; only PENDING is mapped (to inconclusive).
+    """
+    v = np.array(status, dtype=np.int8)
+    v[v == PENDING] = INCONCLUSIVE
     return v
 
 
@@ -138,12 +148,12 @@ def branch_and_bound(
     -------
     BranchAndBound
     """
-    minimum = np.full(n, np.inf)
-    argmin = np.zeros(n)
     n_evals = np.zeros(n, dtype=np.int64)
     violated = np.zeros(n, dtype=bool)
     inconclusive = np.zeros(n, dtype=bool)
     held: list[tuple[Index, Array, Array]] = []
+    if intervals is not None or n == 0:  # (else the first pass sets them)
+        minimum, argmin = np.full(n, np.inf), np.zeros(n)
     if intervals is None:
         if right is None:
             raise ValueError("branch_and_bound needs right or intervals")
@@ -157,25 +167,36 @@ def branch_and_bound(
     grid_x, grid_f = (X, G) if intervals is None else (np.zeros((n, 0)), np.zeros((n, 0)))
 
     new_points = X.shape[1]  # the first evaluation: every point; later the interior ones
+    first = intervals is None  # one row per item, in order: no scatter needed
+    evaluated: list[tuple[Index, int]] = []  # (items, new points each), counted at the end
     while True:
-        np.add.at(n_evals, idx, new_points)
+        if first:
+            n_evals += new_points
+        else:
+            evaluated.append((idx, new_points))
         if idx.size:
             j = np.argmin(G, axis=1)
             rows = np.arange(idx.size)
             gmin = G[rows, j]
-            np.minimum.at(minimum, idx, gmin)
-            better = gmin <= minimum[idx]
-            argmin[idx[better]] = X[rows, j][better]
+            if first:
+                minimum, argmin = gmin.copy(), X[rows, j]
+            else:
+                np.minimum.at(minimum, idx, gmin)
+                better = gmin <= minimum[idx]
+                argmin[idx[better]] = X[rows, j][better]
             viol = np.any(G < -E, axis=1)
             if viol.any():
                 violated[np.unique(idx[viol])] = True
         low, gap, curv = _lower(Glow, E, M, X)
-        und = (low < 0) & ~violated[idx][:, None]
+        und = low < 0
+        und &= ~violated[idx][:, None]
         if refine is not None:  # the first pass only: later passes hold refined items alone
-            skip = und & ~refine[idx][:, None]
-            if skip.any():  # undecided but not to be refined: never certified
-                inconclusive[np.unique(idx[np.nonzero(skip)[0]])] = True
-            und &= refine[idx][:, None]
+            off = ~refine[idx]
+            if off.any():
+                skip = und & off[:, None]
+                if skip.any():  # undecided but not to be refined: never certified
+                    inconclusive[np.unique(idx[np.nonzero(skip)[0]])] = True
+                und &= ~off[:, None]
             refine = None
         ii, kk = np.nonzero(und)
         it, L, R = idx[ii], X[ii, kk], X[ii, kk + 1]
@@ -210,25 +231,28 @@ def branch_and_bound(
             split //= 2
         v = np.linspace(0.0, 1.0, split + 1)
         new_points = split - 1
+        first = False
         idx = it
         X = L[:, None] + (R - L)[:, None] * v[None, :]
         G, Glow, E, M = evaluate(idx, X)
 
+    if evaluated:
+        n_evals += np.bincount(np.concatenate([i for i, _ in evaluated]),
+                               weights=np.concatenate([np.full(i.size, k) for i, k in evaluated]),
+                               minlength=n).astype(np.int64)
     status = np.full(n, CERTIFIED, dtype=np.int8)
-    pend = np.zeros(n, dtype=bool)
     if held:
         pi = np.concatenate([h[0] for h in held])
-        pend[pi] = True
+        status[pi] = PENDING
         pl = np.concatenate([h[1] for h in held])
         ph = np.concatenate([h[2] for h in held])
+        keep = ~violated[pi] & ~inconclusive[pi]
+        pi, pl, ph = pi[keep], pl[keep], ph[keep]
     else:
-        pi, pl, ph = np.zeros(0, dtype=np.intp), np.zeros(0), np.zeros(0)
-    status[pend] = PENDING
+        pi, pl, ph = _NO_ITEMS, _NO_POINTS, _NO_POINTS
     status[inconclusive] = INCONCLUSIVE
     status[violated] = VIOLATED
-    keep = ~violated[pi] & ~inconclusive[pi]
-    return BranchAndBound(status, minimum, argmin, n_evals, grid_x, grid_f,
-                          pi[keep], pl[keep], ph[keep])
+    return BranchAndBound(status, minimum, argmin, n_evals, grid_x, grid_f, pi, pl, ph)
 
 
 def zoom_max(
