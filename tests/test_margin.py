@@ -82,6 +82,19 @@ def test_margin_coefficients_and_their_scales():
         assert np.all(np.asarray(s_) >= np.abs(v) - 1e-15)
 
 
+def test_separable_form_reassembles_the_derived_margin():
+    """g = (τω² − c)² + h2 ω² + h0 + cx cos δω − cv ω sin δω: symbolically and numerically."""
+    c = codegen.margin_separable()
+    d, t = S.delta, S.tau
+    rebuilt = ((t * W**2 - c["c"]) ** 2 + c["h2"] * W**2 + c["h0"] + c["cx"] * sp.cos(d * W)
+               - c["cv"] * W * sp.sin(d * W))
+    assert sp.expand(rebuilt - G_EXPR) == 0
+    (cc, h2, h0, cx, cv), scales = margin.separable(KX, KV, KA, headway=HEADWAY)
+    close([cc, h2, h0, cx, cv], ref(list(c.values())))
+    for s_, v in zip(scales, (cc, h2, h0, cx, cv)):
+        assert np.all(np.asarray(s_) >= np.abs(v) - 1e-15)
+
+
 def test_margin_g_in_every_form():
     expect = ref([G_EXPR], W)
     close([gen.margin_g(OMEGA, *POINT)], expect)
