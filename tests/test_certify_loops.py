@@ -67,7 +67,7 @@ def test_sample_time_dispatches_to_the_sampled_certificate():
 
 @pytest.mark.parametrize("H", [None, 0.1])
 def test_intervals_dispatch_to_the_robust_certificate(H):
-    k = K[:60] if H else K
+    k = K[:30] if H else K
     box = dict(tau=(0.1, 0.2), delta="0.15:0.25", headway=1.1)
     b = certify_batch(*k.T, sample_time=H, **box)
     d = certify_robust_batch(*k.T, sample_time=H, **box)
@@ -94,7 +94,7 @@ def _truth(k, H, tau=0.1, delta=0.2, headway=1.1, tau_prev=None):
 
 @pytest.mark.parametrize("H, delta", [(0.1, 0.2), (0.08, 0.2), (0.2, 0.05)])
 def test_sampled_verdicts_through_certify_against_the_expm_truth(H, delta):
-    b = certify_batch(*K[:40].T, tau=0.1, delta=delta, headway=1.1, sample_time=H)
+    b = certify_batch(*K[:20].T, tau=0.1, delta=delta, headway=1.1, sample_time=H)
     for i in range(len(b)):
         peak, radius = _truth(K[i], H, delta=delta)
         if b.verdict[i] == "certified":
