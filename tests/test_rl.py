@@ -1,6 +1,8 @@
 """The policy trainer (stringstab.rl): tiny budgets, checkpoints, safety of loading, certified gains.
 
-Independent truths: executed gains are checked by numpy.roots (internal stability) and a fine
+Independent truths: executed gains are checked by the Routh-Hurwitz test in exact rational
+arithmetic (internal stability; numpy.roots cannot resolve a pole at -1e-43, which a certified
+k_x = 1e-43 has) and a fine
 frequency sweep of |Γ(jω)| written out here (not the toolkit's certificate); reward terms against
 hand-computed values of eqs 20, 21 and 24.
 """
@@ -47,11 +49,26 @@ def short_leaders():
 
 
 # --------------------------------------------------------------------------- independent truth
+def exactly_hurwitz(a3: float, a2: float, a1: float, a0: float) -> bool:
+    """Routh-Hurwitz for a3 s³ + a2 s² + a1 s + a0 (a3 > 0), in exact rational arithmetic."""
+    from fractions import Fraction
+
+    a3_, a2_, a1_, a0_ = (Fraction(v) for v in (a3, a2, a1, a0))
+    return a2_ > 0 and a1_ > 0 and a0_ > 0 and a2_ * a1_ > a3_ * a0_
+
+
+def test_exactly_hurwitz_agrees_with_numpy_roots_away_from_zero_poles():
+    rng = np.random.default_rng(0)
+    for a2, a1, a0 in rng.uniform(-3, 3, (500, 3)):
+        poles = np.roots([TAU, a2, a1, a0])
+        if np.abs(poles.real).min() > 1e-6:
+            assert exactly_hurwitz(TAU, a2, a1, a0) == bool((poles.real < 0).all())
+
+
 def independent_certified(K: np.ndarray) -> bool:
-    """Internally stable (numpy.roots) and max |Γ(jω)| ≤ 1 on a fine sweep (0, 60] rad/s."""
+    """Internally stable (exact Routh-Hurwitz) and max |Γ(jω)| ≤ 1 on a fine sweep (0, 60] rad/s."""
     kx, kv, ka = (float(v) for v in K)
-    poles = np.roots([TAU, 1.0, kv + HEADWAY * kx, kx])
-    if not (poles.real < 0).all():
+    if not exactly_hurwitz(TAU, 1.0, kv + HEADWAY * kx, kx):
         return False
     w = np.concatenate([np.linspace(1e-4, 10.0, 40_000), np.linspace(10.0, 60.0, 5_000)])
     s = 1j * w
