@@ -94,7 +94,7 @@ def main() -> None:
     fig = Figure(figsize=(11, 4.2), layout="constrained")
     a1, a2 = fig.subplots(1, 2)
     plot_learning(noisy, ax=a1, ylabel="mean reward per step (training, with noise)")
-    a1.set_title("training reward: mean over the last two episodes of every follower", fontsize=9)
+    a1.set_title("training reward: last two episodes of every follower", fontsize=9)
     vals = [v for c in (*curves_ddpg.values(), *curves_hcfs.values()) for _, v in c] + [stand_in]
     lo, hi = min(vals) - 3, max(vals) + 3
     refs = {"stand-in alone": stand_in, **({"CACC alone": cacc} if cacc >= lo else {})}
@@ -104,8 +104,8 @@ def main() -> None:
                 fontsize=8)
     plot_learning(curves_hcfs, ax=a2, ylabel="Σr over hcfs-case1..3", linestyle=":")
     a2.set_ylim(lo, hi)
-    a2.set_title("deterministic policy on the held-out cases at each checkpoint: DDPG alone "
-                 "(solid), HCFS (dotted)", fontsize=9)
+    a2.set_title("deterministic policy, held-out cases: DDPG alone (solid), HCFS (dotted)",
+                 fontsize=9)
     fig.savefig(args.figure, dpi=100)
     print(f"\nwrote {args.figure}")
     print("\nfinal policies, Σr summed over the cases (mean over seeds):")

@@ -2,6 +2,7 @@
 the DDPG bundled with the package, and bad input to `hcfs train`."""
 
 import json
+import shutil
 import sys
 
 import numpy as np
@@ -11,6 +12,8 @@ import stringstab
 from stringstab.cli import main
 from stringstab.errors import StringStabError
 from stringstab.hcfs import constants as C
+from stringstab.hcfs.compare import compare_controllers
+from stringstab.hcfs.leaders import paper_cases
 
 TINY = ["--steps", "480", "--seed", "3", "--platoons", "1", "--followers", "2",
         "--episode-seconds", "4", "--no-progress"]
@@ -85,6 +88,65 @@ def test_training_is_seeded_and_checkpoints_are_evaluated(tmp_path):
         train_hcfs_ddpg(total_steps=10, env=env(), on_checkpoint=lambda s, p: None)
 
 
+@pytest.mark.torch
+def test_bundled_policy_loads_and_learned():
+    """The shipped DDPG loads through the safe loader, says how it was trained, and beats CACC
+    alone on the held-out cases (Σr, the HCFS reward) — it learned."""
+    _torch()
+    from stringstab.hcfs.ddpg import bundled_policy_dir, load_bundled_ddpg
+
+    d = bundled_policy_dir()
+    pol = load_bundled_ddpg()
+    side = json.loads((d / "hcfs_policy.json").read_text())
+    readme = (d / "README.md").read_text()
+    tr = side["training"]
+    assert pol.label == side["label"] and pol.label.startswith("DDPG (stringstab.rl, HCFS reward")
+    cmd = (f"stringstab hcfs train --steps {tr['total_steps']} --seed {tr['seed']}")
+    assert cmd in readme and tr["leaders"] == ["udds/2 600-1369 s"] and tr["n_followers"] == 6
+    rows = compare_controllers(paper_cases(), pol)
+    total = {c: sum(r["sum_reward"] for r in rows if r["controller"] == c) for c in ("CACC", "DDPG", "HCFS")}
+    assert total["DDPG"] > total["CACC"] and total["HCFS"] > total["CACC"]
+    for r in (r for r in rows if r["controller"] == "HCFS"):
+        assert f"{r['sum_reward']:.2f}" in readme  # the README quotes what the policy earns
+
+
+@pytest.mark.torch
+def test_verify_uses_the_bundled_ddpg_by_default(tmp_path, capsys):
+    _torch()
+    from stringstab.hcfs.ddpg import load_bundled_ddpg
+
+    out = tmp_path / "rep"
+    assert main(["hcfs", "verify", "-J", "2.5", "-N", "4", "--leader", "hcfs-case3", "--no-figures",
+                 "--out", str(out)]) == 0
+    doc = json.loads((out / "report.json").read_text())
+    assert doc["setup"]["policy_label"] == load_bundled_ddpg().label
+    assert doc["setup"]["policy_is_stand_in"] is False and "--policy bundled" in doc["command"]
+    assert "a1 = DDPG (stringstab.rl" in capsys.readouterr().out
+    md = (out / "report.md").read_text()
+    assert "stand-in" not in md
+    out2 = tmp_path / "rep2"
+    assert main(["hcfs", "verify", "-J", "2.5", "-N", "4", "--leader", "hcfs-case3", "--policy",
+                 "stand-in", "--no-figures", "--out", str(out2)]) == 0
+    assert json.loads((out2 / "report.json").read_text())["setup"]["policy_is_stand_in"] is True
+    assert "is a **stand-in**, not a DDPG" in (out2 / "report.md").read_text()
+
+
+@pytest.mark.torch
+def test_a_tampered_policy_is_refused(tmp_path, capsys):
+    _torch()
+    from stringstab.hcfs.ddpg import bundled_policy_dir
+
+    d = tmp_path / "pol"
+    shutil.copytree(bundled_policy_dir(), d)
+    raw = bytearray((d / "policy.safetensors").read_bytes())
+    raw[-1] ^= 1
+    (d / "policy.safetensors").write_bytes(bytes(raw))
+    out = tmp_path / "rep"
+    assert main(["hcfs", "verify", "-J", "2", "--policy", str(d), "--no-figures", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "SHA-256" in err and not out.exists()
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [
@@ -127,3 +189,35 @@ def test_train_names_the_missing_trainer(tmp_path, monkeypatch, capsys):
     assert not out.exists()
 
 
+@pytest.mark.torch
+def test_demo_hcfs_step(tmp_path):
+    _torch()
+    from stringstab.demo import run_demo
+
+    lines = []
+    summary = run_demo(tmp_path / "demo", log=lines.append, only=["hcfs"])["hcfs"]
+    assert summary["ok"] is True and summary["policy"].startswith("DDPG (stringstab.rl")
+    d = tmp_path / "demo" / "hcfs"
+    assert (d / "report.md").is_file() and len(list(d.glob("*.png"))) == 3
+    paper = summary["results"]["paper J=2.5"]
+    doc = json.loads((d / "report.json").read_text())
+    tot = next(x["totals"] for x in doc["results"] if x["mode"] == "paper" and x["jerk_limit"] == 2.5)
+    assert paper["max_jerk"] == tot["max_jerk"] and summary["results"]["safe J=2.5"]["conclusion_fails"] == 0
+    assert any("no frame falsifies" in ln for ln in lines)
+
+
+@pytest.mark.torch
+def test_scaled_policy_runs_torch_on_one_thread_and_restores_the_pool():
+    torch = pytest.importorskip("torch")
+    from stringstab.hcfs.policy import ScaledPolicy
+
+    seen = []
+    net = ScaledPolicy(lambda z: seen.append(torch.get_num_threads()) or z[:, :1], torch_threads=1)
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        out = net(np.ones((3, 6)) * np.asarray(C.ACCEL_MAX))
+        assert seen == [1] and torch.get_num_threads() == 2
+        np.testing.assert_allclose(out, C.ACCEL_MAX / 10.0, rtol=0, atol=0)  # scaled by STATE_SCALES[0]
+    finally:
+        torch.set_num_threads(before)

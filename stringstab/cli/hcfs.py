@@ -59,10 +59,10 @@ def add_parser(sub: Any) -> None:
                    help="keep only the first S seconds of each leader")
     v.add_argument("--beta", default=str(BETA), metavar="B",
                    help=f"soft-switch coefficient at a switch, in [0, 1] (eq 14: {BETA:g})")
-    v.add_argument("--policy", default="stand-in", metavar="bundled|stand-in|DIR",
-                   help="the learned candidate: 'stand-in' (default: a hand-written, deliberately "
-                        "imperfect law, labelled as such), 'bundled' (the DDPG shipped with the "
-                        "package) or a folder written by "
+    v.add_argument("--policy", default="bundled", metavar="bundled|stand-in|DIR",
+                   help="the learned candidate: 'bundled' (default: the DDPG shipped with the "
+                        "package, trained by 'stringstab hcfs train'), 'stand-in' (a hand-written, "
+                        "deliberately imperfect law, labelled as such) or a folder written by "
                         "'stringstab hcfs train' or stringstab.hcfs.save_ddpg; needs the rl extra "
                         "(torch) unless 'stand-in'")
     v.add_argument("--no-figures", action="store_true", help="skip the figures")
@@ -84,8 +84,8 @@ def add_parser(sub: Any) -> None:
         ),
     )
     t.add_argument("--steps", default="400000", metavar="N",
-                   help="environment steps, summed over the followers (default 400000, a few "
-                        "minutes on 2 cores)")
+                   help="environment steps, summed over the followers (default 400000, about a "
+                        "minute on 2 cores)")
     t.add_argument("--seed", default="0", metavar="S", help="seed (default 0)")
     t.add_argument("--out", required=True, metavar="DIR", help="run folder (new or empty)")
     t.add_argument("--leader", nargs="+", default=["hcfs-train"], metavar="SPEC",
@@ -101,24 +101,10 @@ def add_parser(sub: Any) -> None:
     t.set_defaults(func=run)
 
 
-def _policy(spec: str) -> Any:
-    from ..hcfs.ddpg import load_bundled_ddpg, load_ddpg
-    from ..hcfs.policy import LeaderSpeedMatcher
-
-    if spec == "stand-in":
-        return LeaderSpeedMatcher()
-    if spec == "bundled":
-        return load_bundled_ddpg()
-    p = Path(spec)
-    if not p.is_dir():
-        raise StringStabError(f"--policy must be 'stand-in' or a directory written by 'stringstab "
-                              f"hcfs train' (or 'bundled'); got {spec!r}")
-    return load_ddpg(p)
-
-
 def run_verify(args: argparse.Namespace) -> int:
     """Run ``hcfs verify``: validate everything, simulate, check, write the report."""
     from ..hcfs.constants import DT
+    from ..hcfs.ddpg import candidate
     from ..hcfs.leaders import hcfs_leader
     from ..hcfs.report import write_report
     from ..hcfs.switching import check_beta
@@ -134,7 +120,7 @@ def run_verify(args: argparse.Namespace) -> int:
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
-    policy = _policy(args.policy)
+    policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
         "--followers", str(args.followers), "--leader", *args.leader,

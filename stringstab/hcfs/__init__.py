@@ -52,6 +52,7 @@ from .constants import (
 from .ddpg import (
     HCFSTraining,
     bundled_policy_dir,
+    candidate,
     load_bundled_ddpg,
     load_ddpg,
     save_ddpg,
@@ -132,6 +133,7 @@ __all__ = [
     "bundled_policy_dir",
     "cacc_acceleration",
     "cacc_printed",
+    "candidate",
     "case_leader",
     "check_beta",
     "check_jerk_limit",

@@ -31,10 +31,10 @@ from .. import __version__
 from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
 from .env import HCFSVectorEnv
-from .policy import ScaledPolicy
+from .policy import AccelerationPolicy, LeaderSpeedMatcher, ScaledPolicy
 
-__all__ = ["BUNDLED_POLICY", "HCFSTraining", "bundled_policy_dir", "load_bundled_ddpg", "load_ddpg",
-           "save_ddpg", "train_ddpg", "train_hcfs_ddpg"]
+__all__ = ["BUNDLED_POLICY", "HCFSTraining", "bundled_policy_dir", "candidate", "load_bundled_ddpg",
+           "load_ddpg", "save_ddpg", "train_ddpg", "train_hcfs_ddpg"]
 
 _SIDECAR = "hcfs_policy.json"
 #: Folder of the bundled DDPG inside the package.
@@ -159,12 +159,13 @@ def train_hcfs_ddpg(*, total_steps: int = 100_000, seed: int = 0, env: HCFSVecto
             step = int(name.removeprefix("ckpt-"))
             if seen and seen[-1][0] == step:  # the final checkpoint can repeat the last one
                 return
-            seen.append((step, on_checkpoint(step, ScaledPolicy(rl.load_policy(folder), scales))))
+            pol = ScaledPolicy(rl.load_policy(folder), scales, torch_threads=1)
+            seen.append((step, on_checkpoint(step, pol)))
 
         kwargs["log"] = log
     result = rl.train(cfg, env=env, **kwargs)
     label = f"DDPG (stringstab.rl, HCFS reward, {int(total_steps)} steps, seed {int(seed)})"
-    policy = ScaledPolicy(result.policy, env.scales, label=label)
+    policy = ScaledPolicy(result.policy, env.scales, label=label, torch_threads=1)
     training = _describe(env, cfg, total_steps, seed)
     if out is not None:
         _write_sidecar(Path(out), policy, training)
@@ -227,7 +228,7 @@ def load_ddpg(directory: str | Path) -> ScaledPolicy:
             f"'label' (written by save_ddpg); {e}"
         ) from e
     rl = _rl()
-    return ScaledPolicy(rl.load_policy(d), scales, label=label)
+    return ScaledPolicy(rl.load_policy(d), scales, label=label, torch_threads=1)
 
 
 def bundled_policy_dir() -> Path:
@@ -244,3 +245,30 @@ def load_bundled_ddpg() -> ScaledPolicy:
         If torch (the ``rl`` extra) is missing or the files were altered.
     """
     return load_ddpg(bundled_policy_dir())
+
+
+def candidate(spec: str, *, what: str = "--policy") -> AccelerationPolicy:
+    """The learned candidate a1 named by ``spec``: ``"bundled"`` (:func:`load_bundled_ddpg`),
+    ``"stand-in"`` (:class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`) or a folder written by
+    ``stringstab hcfs train`` / :func:`save_ddpg`.
+
+    Raises
+    ------
+    StringStabError
+        For anything else, a folder that is not an HCFS policy, altered files, or a missing
+        torch (except for ``"stand-in"``).
+
+    Examples
+    --------
+    >>> candidate("stand-in").label.startswith("stand-in")
+    True
+    """
+    if spec == "stand-in":
+        return LeaderSpeedMatcher()
+    if spec == "bundled":
+        return load_bundled_ddpg()
+    p = Path(spec)
+    if not p.is_dir():
+        raise StringStabError(f"{what} must be 'stand-in' or a directory written by 'stringstab hcfs "
+                              f"train' (or 'bundled', the DDPG shipped with the package); got {spec!r}")
+    return load_ddpg(p)
