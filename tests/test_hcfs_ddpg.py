@@ -221,3 +221,23 @@ def test_scaled_policy_runs_torch_on_one_thread_and_restores_the_pool():
         np.testing.assert_allclose(out, C.ACCEL_MAX / 10.0, rtol=0, atol=0)  # scaled by STATE_SCALES[0]
     finally:
         torch.set_num_threads(before)
+
+
+def test_verify_names_missing_torch(tmp_path, monkeypatch, capsys):
+    """Without torch the default (bundled DDPG) is refused in one line; the stand-in still runs."""
+    monkeypatch.setitem(sys.modules, "torch", None)
+    out = tmp_path / "rep"
+    assert main(["hcfs", "verify", "-J", "2", "-N", "2", "--leader", "hcfs-case3", "--no-figures",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "needs torch, which is not installed" in err and err.count("\n") == 1 and not out.exists()
+    assert main(["hcfs", "verify", "-J", "2", "-N", "2", "--leader", "hcfs-case3", "--policy",
+                 "stand-in", "--no-figures", "--out", str(out)]) == 0
+
+
+def test_train_names_missing_torch(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "torch", None)
+    out = tmp_path / "out"
+    assert main(["hcfs", "train", "--steps", "10", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "needs torch, which is not installed" in err and err.count("\n") == 1 and not out.exists()

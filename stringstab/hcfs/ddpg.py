@@ -56,6 +56,13 @@ def _rl() -> Any:
     return rl
 
 
+def _torch_missing(e: ImportError) -> StringStabError:
+    """The error for a missing torch, which stringstab.rl imports only where a network runs."""
+    return StringStabError(f"training or loading the HCFS DDPG needs torch, which is not installed "
+                           f"({e}); install the rl extra: pip install -e '.[rl]' (or use --policy "
+                           "stand-in)")
+
+
 @dataclass
 class HCFSTraining:
     """What :func:`train_hcfs_ddpg` returns.
@@ -163,7 +170,12 @@ def train_hcfs_ddpg(*, total_steps: int = 100_000, seed: int = 0, env: HCFSVecto
             seen.append((step, on_checkpoint(step, pol)))
 
         kwargs["log"] = log
-    result = rl.train(cfg, env=env, **kwargs)
+    try:
+        result = rl.train(cfg, env=env, **kwargs)
+    except ModuleNotFoundError as e:
+        if e.name != "torch":
+            raise
+        raise _torch_missing(e) from e
     label = f"DDPG (stringstab.rl, HCFS reward, {int(total_steps)} steps, seed {int(seed)})"
     policy = ScaledPolicy(result.policy, env.scales, label=label, torch_threads=1)
     training = _describe(env, cfg, total_steps, seed)
@@ -228,7 +240,13 @@ def load_ddpg(directory: str | Path) -> ScaledPolicy:
             f"'label' (written by save_ddpg); {e}"
         ) from e
     rl = _rl()
-    return ScaledPolicy(rl.load_policy(d), scales, label=label, torch_threads=1)
+    try:
+        net = rl.load_policy(d)
+    except ModuleNotFoundError as e:
+        if e.name != "torch":
+            raise
+        raise _torch_missing(e) from e
+    return ScaledPolicy(net, scales, label=label, torch_threads=1)
 
 
 def bundled_policy_dir() -> Path:
