@@ -196,6 +196,35 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": summary}
 
 
+def _step_hcfs(out: Path, log: Log) -> dict[str, Any]:
+    """``hcfs verify`` with the bundled DDPG behind the paper's case 1 (its analogue on UDDS at
+    half speed, 20 s, 8 followers): the jerk theorem at every frame for J = 2.5 m/s³."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .hcfs import case_leader, load_bundled_ddpg, verify, write_report
+
+    leader, n = case_leader("hcfs-case1")
+    ver = verify([leader], load_bundled_ddpg(), jerk_limits=[2.5], n_followers=n)
+    files = write_report(ver, out, command=f"stringstab hcfs verify --jerk-limit 2.5 --followers {n} "
+                                           "--leader hcfs-case1 --out hcfs")
+    log(f"a1 = {ver.runs[0].params['policy_label']}; leader {leader.name}, {n} followers")
+    rows = {}
+    for x in ver.results:
+        t = x["totals"]
+        rows[f"{x['mode']} J={x['jerk_limit']:g}"] = {k: t[k] for k in (
+            "max_jerk", "conclusion_fails", "counterexamples", "violations", "bound_violations",
+            "sum_abs_speed_error", "sum_abs_jerk", "sum_reward", "collisions")}
+        if x["mode"] in ("paper", "safe"):
+            log(f"  J = {x['jerk_limit']:<4g} {x['mode']:5s}: max jerk {t['max_jerk']:.3g} m/s^3, "
+                f"conclusion fails {t['conclusion_fails']}, P3 fails {t['P3_fails']}/{t['frames']}, "
+                f"theorem violations {t['violations']}, bound violations {t['bound_violations']}")
+    log("no frame falsifies the theorem, the bound or the jerk-safe variant" if ver.ok
+        else f"{len(ver.violations)} frame(s) falsify a guarantee")
+    return {"files": sorted(files.values()), "policy": ver.runs[0].params["policy_label"],
+            "ok": ver.ok, "results": rows}
+
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
@@ -203,6 +232,7 @@ STEPS: list[tuple[str, Step]] = [
     ("simulate", _step_simulate),
     ("region", _step_region),
     ("tune", _step_tune),
+    ("hcfs", _step_hcfs),
 ]
 
 

@@ -1,5 +1,6 @@
 """``stringstab hcfs verify`` end to end: exit 0 on a tiny run, 1 when a guarantee breaks, 2 on bad input."""
 
+import importlib.util
 import json
 
 import numpy as np
@@ -7,7 +8,13 @@ import pytest
 
 from stringstab.cli import main
 
+#: runs that reach the simulation use the bundled DDPG (the default --policy), which needs torch
+needs_torch = pytest.mark.skipif(importlib.util.find_spec("torch") is None,
+                                 reason="the bundled DDPG needs torch (the rl extra)")
 
+
+@pytest.mark.torch
+@needs_torch
 def test_verify_tiny_run(tmp_path, capsys):
     out = tmp_path / "rep"
     rc = main(["hcfs", "verify", "--jerk-limit", "2.5", "5", "--followers", "4", "--leader", "us06",
@@ -26,6 +33,8 @@ def test_verify_tiny_run(tmp_path, capsys):
     assert "smallest counterexample" in text and "no frame falsifies" in text
 
 
+@pytest.mark.torch
+@needs_torch
 def test_verify_beta_and_csv_leader(tmp_path, capsys):
     lead = tmp_path / "lead.csv"
     lead.write_text("t,v\n0,10\n5,10\n10,15\n20,15\n")
@@ -38,6 +47,8 @@ def test_verify_beta_and_csv_leader(tmp_path, capsys):
     assert "wrote report.md, report.json to" in capsys.readouterr().out
 
 
+@pytest.mark.torch
+@needs_torch
 def test_verify_exit_1_when_a_guarantee_breaks(tmp_path, monkeypatch):
     """A broken jerk-safe variant (no clipping) is caught: frames listed, exit 1."""
     import stringstab.hcfs.simulate as sim
@@ -97,6 +108,8 @@ def test_verify_out_is_a_file(tmp_path, capsys):
     assert f.read_text() == "x"
 
 
+@pytest.mark.torch
+@needs_torch
 def test_verify_refuses_another_commands_folder_and_replaces_its_own(tmp_path, capsys):
     from stringstab.io import OutputDir
 

@@ -1,11 +1,13 @@
 """docs/hcfs.md shows what `stringstab hcfs verify` prints and what the library computes."""
 
 import contextlib
+import importlib.util
 import io
 import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from stringstab.cli import main
 from stringstab.hcfs import closed_loop_matrix, reward_weights_from_table_iv
@@ -13,6 +15,8 @@ from stringstab.hcfs import closed_loop_matrix, reward_weights_from_table_iv
 DOC = (Path(__file__).resolve().parents[1] / "docs" / "hcfs.md").read_text()
 
 
+@pytest.mark.torch
+@pytest.mark.skipif(importlib.util.find_spec("torch") is None, reason="the bundled DDPG needs torch")
 def test_console_example_is_what_the_tool_prints(tmp_path):
     block = re.search(r"```console\n\$ (stringstab hcfs verify [^\n]*)\n(.*?)```", DOC, re.S)
     assert block is not None

@@ -38,6 +38,7 @@ __all__ = [
     "check_horizon",
     "check_output",
     "gains_from_args",
+    "integer",
     "loop_params",
     "shown_params",
 ]
@@ -46,6 +47,27 @@ __all__ = [
 #: starts like a negative number (or -inf/-nan, rejected later with a clear
 #: message) is a value.  Installed on every sub-parser by ``stringstab.cli``.
 NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+
+
+def integer(name: str, text: Any, minimum: int) -> int:
+    """A command-line integer >= ``minimum`` (a step budget, a seed, a count).
+
+    Examples
+    --------
+    >>> integer("--steps", "200", 1)
+    200
+    >>> integer("--seed", "-1", 0)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: --seed must be an integer >= 0; got -1
+    """
+    try:
+        v = int(str(text))
+    except ValueError as e:
+        raise StringStabError(f"{name} must be an integer >= {minimum}; got {text!r}") from e
+    if v < minimum:
+        raise StringStabError(f"{name} must be an integer >= {minimum}; got {v}")
+    return v
 
 
 def add_model_arguments(p: argparse.ArgumentParser) -> None:

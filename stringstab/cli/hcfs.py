@@ -1,4 +1,5 @@
-"""``stringstab hcfs verify``: check the HCFS jerk theorem in closed loop and write a report."""
+"""``stringstab hcfs verify`` (check the HCFS jerk theorem in closed loop, write a report) and
+``stringstab hcfs train`` (train the HCFS DDPG into a folder that ``verify --policy`` reads)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from typing import Any
 
 from ..errors import StringStabError
 
-__all__ = ["add_parser", "run", "run_verify"]
+__all__ = ["add_parser", "run", "run_train", "run_verify"]
 
 
 def add_parser(sub: Any) -> None:
@@ -51,40 +52,65 @@ def add_parser(sub: Any) -> None:
     v.add_argument("--followers", "-N", type=int, default=8, metavar="N",
                    help="followers per platoon (the paper uses 4, 6, 8; default 8)")
     v.add_argument("--leader", nargs="+", default=["udds"], metavar="SPEC",
-                   help="one or more leaders (default: udds)")
+                   help="one or more leaders (default: udds); also hcfs-train, hcfs-case1, "
+                        "hcfs-case2, hcfs-case3 (the paper's leaders as far as the bundled data "
+                        "allows: UDDS at half speed, see docs/hcfs.md)")
     v.add_argument("--duration", type=float, default=None, metavar="S",
                    help="keep only the first S seconds of each leader")
     v.add_argument("--beta", default=str(BETA), metavar="B",
                    help=f"soft-switch coefficient at a switch, in [0, 1] (eq 14: {BETA:g})")
-    v.add_argument("--policy", default="stand-in", metavar="stand-in|DIR",
-                   help="the learned candidate: 'stand-in' (a hand-written, deliberately imperfect "
-                        "law, labelled as such) or a DDPG saved by stringstab.hcfs.save_ddpg")
+    v.add_argument("--policy", default="bundled", metavar="bundled|stand-in|DIR",
+                   help="the learned candidate: 'bundled' (default: the DDPG shipped with the "
+                        "package, trained by 'stringstab hcfs train'), 'stand-in' (a hand-written, "
+                        "deliberately imperfect law, labelled as such) or a folder written by "
+                        "'stringstab hcfs train' or stringstab.hcfs.save_ddpg; needs the rl extra "
+                        "(torch) unless 'stand-in'")
     v.add_argument("--no-figures", action="store_true", help="skip the figures")
     v.add_argument("--out", required=True, metavar="DIR", help="output directory")
     v.set_defaults(func=run)
 
-
-def _policy(spec: str) -> Any:
-    from ..hcfs.ddpg import load_ddpg
-    from ..hcfs.policy import LeaderSpeedMatcher
-
-    if spec == "stand-in":
-        return LeaderSpeedMatcher()
-    p = Path(spec)
-    if not p.is_dir():
-        raise StringStabError(f"--policy must be 'stand-in' or a directory saved by save_ddpg; got {spec!r}")
-    return load_ddpg(p)
+    t = hs.add_parser(
+        "train",
+        help="train the HCFS DDPG (HCFS reward, eqs 4-6) into a folder that 'hcfs verify --policy' reads",
+        description=(
+            "Train the HCFS paper's DDPG with its reward (eqs 4-6: speed error to the leader and "
+            "jerk) through stringstab.rl, in platoons of --followers followers (section IV: 6) "
+            "behind --leader (default hcfs-train: UDDS at half speed from 600 s to the end, the "
+            "paper's training leader as far as the bundled data allows), T = 0.2 s, 5 ms V2V "
+            "delay.  Writes the trainer's run folder (policy.safetensors + policy.json, "
+            "checkpoint, train_log.csv, rolling_reward.png, summary.json) and hcfs_policy.json "
+            "into --out, then compares the DDPG with CACC and the stand-in on the three held-out "
+            "test cases (evaluation.json).  Exit 0 on success, 2 on bad input."
+        ),
+    )
+    t.add_argument("--steps", default="400000", metavar="N",
+                   help="environment steps, summed over the followers (default 400000, about a "
+                        "minute on 2 cores)")
+    t.add_argument("--seed", default="0", metavar="S", help="seed (default 0)")
+    t.add_argument("--out", required=True, metavar="DIR", help="run folder (new or empty)")
+    t.add_argument("--leader", nargs="+", default=["hcfs-train"], metavar="SPEC",
+                   help="training leaders (default hcfs-train); cycles, synthetic profiles, CSV "
+                        "files as for verify")
+    t.add_argument("--platoons", default="4", metavar="P",
+                   help="platoons stepped together (default 4)")
+    t.add_argument("--followers", "-N", default="6", metavar="N",
+                   help="followers per training platoon (section IV: 6)")
+    t.add_argument("--episode-seconds", default="60", metavar="S",
+                   help="length of a training episode, s (default 60)")
+    t.add_argument("--no-progress", action="store_true", help="no progress bar")
+    t.set_defaults(func=run)
 
 
 def run_verify(args: argparse.Namespace) -> int:
     """Run ``hcfs verify``: validate everything, simulate, check, write the report."""
     from ..hcfs.constants import DT
+    from ..hcfs.ddpg import candidate
+    from ..hcfs.leaders import hcfs_leader
     from ..hcfs.report import write_report
     from ..hcfs.switching import check_beta
     from ..hcfs.verify import verify
     from ..io import OutputDir
     from ..params import positive
-    from ..traffic.leaders import leader_by_name
 
     Js = [positive("--jerk-limit J", s, unit=" m/s^3") for s in args.jerk_limit]
     beta = check_beta(args.beta)
@@ -93,8 +119,8 @@ def run_verify(args: argparse.Namespace) -> int:
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
-    leaders = [leader_by_name(s, dt=DT, duration=args.duration) for s in args.leader]
-    policy = _policy(args.policy)
+    leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
+    policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
         "--followers", str(args.followers), "--leader", *args.leader,
@@ -126,6 +152,65 @@ def run_verify(args: argparse.Namespace) -> int:
     return 0 if ver.ok else 1
 
 
+def run_train(args: argparse.Namespace) -> int:
+    """Run ``hcfs train``: validate everything, train, write the run folder, compare."""
+    from ..hcfs.constants import DT
+    from ..hcfs.leaders import hcfs_leader
+    from ..params import positive
+    from ._common import integer as _int
+
+    steps = _int("--steps", args.steps, 1)
+    seed = _int("--seed", args.seed, 0)
+    platoons = _int("--platoons", args.platoons, 1)
+    followers = _int("--followers", args.followers, 1)
+    seconds = positive("--episode-seconds", args.episode_seconds, unit=" s")
+    out = Path(args.out)
+    _check_new_folder(out)
+    leaders = [hcfs_leader(s, dt=DT) for s in args.leader]
+    from ..hcfs.ddpg import train_hcfs_ddpg
+    from ..hcfs.env import HCFSVectorEnv
+
+    env = HCFSVectorEnv(platoons, leaders, n_followers=followers, episode_seconds=seconds)
+    run = train_hcfs_ddpg(total_steps=steps, seed=seed, env=env, out=out,
+                          progress=False if args.no_progress else None, stop_episodes=0)
+    res = run.result
+    n = len(res.episodes)
+    if n:
+        tenth = max(1, n // 10)
+        first, last = (sum(e["mean_reward"] for e in part) / len(part)
+                       for part in (res.episodes[:tenth], res.episodes[-tenth:]))
+        curve = (f"mean reward per step (with exploration noise) {first:.4f} in the first tenth "
+                 f"of the episodes, {last:.4f} in the last")
+    else:
+        curve = f"no episode ended yet (one lasts {env.window - 1} steps per follower)"
+    print(f"trained the HCFS DDPG: {res.steps} steps, {n} episodes behind "
+          f"{', '.join(tr.name for tr in leaders)}, {res.timing['steps_per_second']:.0f} steps/s; "
+          f"{curve}")
+    from ..hcfs.compare import compare_controllers, comparison_markdown
+    from ..hcfs.leaders import paper_cases
+    from ..hcfs.policy import LeaderSpeedMatcher
+    from ..io import atomic_write_text, dumps_json
+
+    rows = compare_controllers(paper_cases(), run.policy, others={"stand-in": LeaderSpeedMatcher()})
+    atomic_write_text(out / "evaluation.json", dumps_json({
+        "what": "held-out test cases (hcfs-case1..3), every controller limited only by the "
+                "acceleration bounds (J = 2 a_max / T)", "rows": rows}))
+    print("held-out test cases, sums over followers and frames (HCFS Tables IV-VI):")
+    print(comparison_markdown(rows), end="")
+    print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png, summary.json, "
+          f"hcfs_policy.json and evaluation.json to {args.out.rstrip('/')}/; use it with "
+          f"'stringstab hcfs verify --policy {args.out}'")
+    return 0
+
+
+def _check_new_folder(out: Path) -> None:
+    from ..io import check_output_dir
+
+    check_output_dir(out, what="--out")
+    if out.exists() and any(not p.name.startswith(".") for p in out.iterdir()):
+        raise StringStabError(f"--out: expected a new or empty folder; {str(out)!r} is not empty")
+
+
 def run(args: argparse.Namespace) -> int:
     """Dispatch ``hcfs`` sub-commands."""
-    return run_verify(args)
+    return run_train(args) if args.hcfs_command == "train" else run_verify(args)

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
+from ._common import integer as _int
 
 __all__ = ["add_parser", "run"]
 
@@ -43,16 +44,6 @@ def add_parser(sub: Any) -> None:
                    help="stop after N collision-free episode ends (default 700; 0: only --steps)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
-
-
-def _int(name: str, text: Any, minimum: int) -> int:
-    try:
-        v = int(str(text))
-    except ValueError as e:
-        raise StringStabError(f"{name} must be an integer >= {minimum}; got {text!r}") from e
-    if v < minimum:
-        raise StringStabError(f"{name} must be an integer >= {minimum}; got {v}")
-    return v
 
 
 def run(args: argparse.Namespace) -> int:

@@ -18,8 +18,12 @@ checks the bound that holds without the last premise, and verifies both in close
 * :mod:`~stringstab.hcfs.simulate` — the closed loop of §IV;
 * :mod:`~stringstab.hcfs.verify` — the closed-loop verification;
 * :mod:`~stringstab.hcfs.report`, :mod:`~stringstab.hcfs.plots` — the report and Figs 4-6;
-* :mod:`~stringstab.hcfs.env`, :mod:`~stringstab.hcfs.ddpg` — the training environment and
-  the DDPG trained through :mod:`stringstab.rl`.
+* :mod:`~stringstab.hcfs.leaders` — the paper's training leader and test cases, as far as the
+  bundled data allows (UDDS at half speed);
+* :mod:`~stringstab.hcfs.env`, :mod:`~stringstab.hcfs.ddpg` — the training environment, the
+  DDPG trained through :mod:`stringstab.rl`, and the one bundled with the package;
+* :mod:`~stringstab.hcfs.compare` — CACC alone, the DDPG alone and HCFS side by side (the
+  paper's Tables IV-VI).
 
 See ``docs/hcfs.md``.
 """
@@ -27,6 +31,7 @@ See ``docs/hcfs.md``.
 from __future__ import annotations
 
 from .cacc import CACC, cacc_acceleration, cacc_printed, closed_loop_matrix
+from .compare import compare_controllers, comparison_markdown
 from .constants import (
     ACCEL_MAX,
     ACCEL_MIN,
@@ -44,10 +49,20 @@ from .constants import (
     V2V_DELAY,
     reward_weights_from_table_iv,
 )
-from .ddpg import load_ddpg, save_ddpg, train_ddpg
+from .ddpg import (
+    HCFSTraining,
+    bundled_policy_dir,
+    candidate,
+    load_bundled_ddpg,
+    load_ddpg,
+    save_ddpg,
+    train_ddpg,
+    train_hcfs_ddpg,
+)
 from .env import HCFSVectorEnv, default_training_leaders
+from .leaders import CASES, case_leader, half_speed, hcfs_leader, paper_cases, training_leader
 from .mdp import STATE_NAMES, STATE_SCALES, received, reward, state
-from .plots import plot_figure, plot_jerk, plot_speed, plot_switching
+from .plots import plot_figure, plot_jerk, plot_learning, plot_speed, plot_switching
 from .policy import (
     AccelerationPolicy,
     LeaderSpeedMatcher,
@@ -87,6 +102,7 @@ __all__ = [
     "BETA",
     "CACC",
     "CACC_GAINS",
+    "CASES",
     "DEFAULT_TOL",
     "DT",
     "LENGTH",
@@ -105,6 +121,7 @@ __all__ = [
     "AccelerationPolicy",
     "Frame",
     "HCFSRun",
+    "HCFSTraining",
     "HCFSVectorEnv",
     "LatticeSearch",
     "LeaderSpeedMatcher",
@@ -113,20 +130,30 @@ __all__ = [
     "TheoremCheck",
     "Verification",
     "accelerations",
+    "bundled_policy_dir",
     "cacc_acceleration",
     "cacc_printed",
+    "candidate",
+    "case_leader",
     "check_beta",
     "check_jerk_limit",
     "check_theorem",
     "choose",
     "closed_loop_matrix",
+    "compare_controllers",
+    "comparison_markdown",
     "default_training_leaders",
+    "half_speed",
+    "hcfs_leader",
     "jerk_bound",
     "lattice_search",
     "limit_step",
+    "load_bundled_ddpg",
     "load_ddpg",
+    "paper_cases",
     "plot_figure",
     "plot_jerk",
+    "plot_learning",
     "plot_speed",
     "plot_switching",
     "policy_label",
@@ -145,6 +172,8 @@ __all__ = [
     "switch_weights",
     "tight_example",
     "train_ddpg",
+    "train_hcfs_ddpg",
+    "training_leader",
     "verify",
     "weight_change",
     "write_report",

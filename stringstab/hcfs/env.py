@@ -39,7 +39,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..errors import StringStabError
 from ..params import positive
-from ..traffic.leaders import Trajectory, cycle
+from ..traffic.leaders import Trajectory
 from ..traffic.platoon import Limits, Platoon
 from .constants import (
     ACCEL_MAX,
@@ -53,6 +53,7 @@ from .constants import (
     TRAINING_FOLLOWERS,
     V2V_DELAY,
 )
+from .leaders import training_leader
 from .mdp import STATE_SCALES, reward, state
 from .policy import rate_limit
 
@@ -63,8 +64,9 @@ Obs = npt.NDArray[np.float32]
 
 
 def default_training_leaders(*, dt: float = DT) -> list[Trajectory]:
-    """The four bundled driving cycles (UDDS, HWFET, US06, WLTC 3b) at step ``dt``."""
-    return [cycle(name, dt=dt) for name in ("udds", "hwfet", "us06", "wltc3b")]
+    """The paper's training leader as far as the bundled data allows: UDDS at half speed from
+    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``."""
+    return [training_leader(dt=dt)]
 
 
 class HCFSVectorEnv(VectorEnv[Obs, Obs, npt.NDArray[Any]]):
@@ -124,6 +126,7 @@ class HCFSVectorEnv(VectorEnv[Obs, Obs, npt.NDArray[Any]]):
         if len(dts) != 1:
             raise StringStabError(f"all leaders must share one step T; got {sorted(dts)}")
         self.dt = dts.pop()
+        self.leader_names = tuple(tr.name for tr in trs)
         self.P, self.N = P, N
         self.num_envs = P * N
         self.window = max(2, round(positive("episode_seconds", episode_seconds, unit=" s") / self.dt) + 1)

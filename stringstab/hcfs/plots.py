@@ -6,6 +6,7 @@ coloured by their position in the platoon (:func:`stringstab.traffic.plots.plot_
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -13,7 +14,7 @@ import numpy as np
 from ..traffic.plots import plot_vehicles
 from .simulate import HCFSRun
 
-__all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_speed", "plot_switching"]
+__all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_learning", "plot_speed", "plot_switching"]
 
 #: Panel titles of the modes; the policy's label says whether it is a DDPG or a stand-in.
 MODE_TITLES = {
@@ -112,6 +113,51 @@ def plot_switching(run: HCFSRun, i: int, *, ax: Any = None) -> Any:
     ax.set_ylabel("follower")
     ax.set_title(f"{_title(run, i)}: weight of the policy (0 = CACC, 1 = policy)", fontsize=9)
     return img
+
+
+def plot_learning(curves: Mapping[str, Sequence[tuple[float, float]]], *,
+                  references: Mapping[str, float] | None = None, ax: Any = None,
+                  ylabel: str = "value", linestyle: str = "-") -> dict[str, Any]:
+    """Learning curves (a value against training steps), with constant references drawn flat.
+
+    Parameters
+    ----------
+    curves : mapping of label to [(step, value), …]
+        E.g. the deterministic policy's Σr on held-out cases at every checkpoint, per seed.
+    references : mapping of label to float, optional
+        E.g. the same Σr of CACC alone and of the stand-in (dashed horizontal lines).
+    ax : matplotlib Axes, optional
+    ylabel : str
+    linestyle : str
+        Of the curves, which take the colours C0, C1, … in order (so that two calls with the
+        same keys' order, e.g. two controllers per seed, match colours).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``lines`` (one per curve) and ``references`` (one per reference).
+
+    Examples
+    --------
+    >>> d = plot_learning({"seed 0": [(0, -3.0), (10, -1.0)]}, references={"CACC": -2.0})
+    >>> len(d["lines"]), list(d["references"][0].get_ydata())
+    (1, [-2.0, -2.0])
+    >>> import matplotlib.pyplot as plt; plt.close("all")
+    """
+    ax = _ax(ax)
+    lines = []
+    for i, (label, pts) in enumerate(curves.items()):
+        xy = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        (ln,) = ax.plot(xy[:, 0], xy[:, 1], marker="o", ms=3, lw=1.2, ls=linestyle, color=f"C{i}",
+                        label=label)
+        lines.append(ln)
+    refs = [ax.axhline(v, ls=(0, (4, 2 + 2 * i)), lw=1.2, color=("k", "0.45", "0.7")[i % 3], label=label)
+            for i, (label, v) in enumerate((references or {}).items())]
+    ax.set_xlabel("training steps (all followers)")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return {"ax": ax, "lines": lines, "references": refs}
 
 
 def plot_figure(run: HCFSRun, jerk_limit: float, kind: str, *, fig: Any = None) -> tuple[Any, Any]:

@@ -152,6 +152,10 @@ class ScaledPolicy:
         Divisors of the state components (default :data:`~stringstab.hcfs.mdp.STATE_SCALES`).
     label : str
         Name in reports.
+    torch_threads : int, optional
+        Run each call of a torch network with this many torch threads (restored afterwards).
+        The batches are one row per follower: with the default thread pool on a busy 2-core
+        machine a call took 9.4 ms, with one thread 0.67 ms (load 5.8).
 
     Examples
     --------
@@ -161,11 +165,26 @@ class ScaledPolicy:
     """
 
     def __init__(self, policy: AccelerationPolicy, scales: npt.ArrayLike = STATE_SCALES, *,
-                 label: str = "DDPG") -> None:
+                 label: str = "DDPG", torch_threads: int | None = None) -> None:
         sc = np.asarray(scales, dtype=np.float64)
         if sc.shape != (6,) or not (np.isfinite(sc).all() and (sc > 0).all()):
             raise StringStabError(f"scales must be 6 finite numbers > 0; got {scales!r}")
         self.policy, self.scales, self.label = policy, sc, label
+        self.torch_threads = torch_threads
 
     def __call__(self, state: Array) -> Any:
-        return self.policy(np.asarray(state, dtype=np.float64) / self.scales)
+        z = np.asarray(state, dtype=np.float64) / self.scales
+        if self.torch_threads is None:
+            return self.policy(z)
+        try:
+            import torch
+        except ImportError:  # not a torch network after all
+            return self.policy(z)
+        before = torch.get_num_threads()
+        if before == self.torch_threads:
+            return self.policy(z)
+        torch.set_num_threads(self.torch_threads)
+        try:
+            return self.policy(z)
+        finally:
+            torch.set_num_threads(before)
