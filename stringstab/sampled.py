@@ -357,8 +357,12 @@ def _primitives_iv(
     """The model quantities over a cell by interval arithmetic (a point when lo is hi)."""
     T = _iv(*tau)
     Tp = _iv(*tau_p)
-    f1, p2, p3 = _phi_iv(H / tau[1], H / tau[0])
-    xp_lo, xp_hi = H / tau_p[1], H / tau_p[0]
+    # a point parameter gives one array for both ends, so that _phi_iv returns points and the
+    # whole build takes the point path of _Iv (two arrays of equal values would be an interval)
+    x_lo = H / tau[1]
+    f1, p2, p3 = _phi_iv(x_lo, x_lo if tau[0] is tau[1] else H / tau[0])
+    xp_lo = H / tau_p[1]
+    xp_hi = xp_lo if tau_p[0] is tau_p[1] else H / tau_p[0]
     f1p, p2p, p3p = _phi_iv(xp_lo, xp_hi)
     point = tau_p[0] is tau_p[1] and eps[0] is eps[1]
     y_lo = (1.0 - eps[1]) * xp_lo
