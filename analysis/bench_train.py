@@ -1,8 +1,13 @@
 """Training throughput (environment steps per second) and the repair's share of training time.
 
-Same run, same machine load, three arms of the IDL trainer for ``--steps`` environment steps:
-the default repair (certified lookup projection), no repair (the ablation, the baseline of the
-ratio), and the exact projection (:class:`stringstab.tuning.Projector`) for a shorter stretch.
+Same run, same machine load, arms of the IDL trainer for ``--steps`` environment steps: no
+repair (the ablation, the baseline of the ratio); the default repair (certified lookup
+projection, continuous and sampled-data certificates); the same with the sampled-data check as
+it was before commit fe1711a ("before": the lag primitives of ``check_sampled`` built as
+zero-width intervals, reproduced here by forcing the interval path of the first two
+``_phi_iv`` calls of each build); the continuous certificate alone (``repair_sampled=False``);
+and the exact projection (:class:`stringstab.tuning.Projector`) for a shorter stretch.  Also
+``check_sampled`` per call on 8 triples (one control step of 8 environments), before and after.
 Also the repair's per-triple latency against :func:`stringstab.tuning.project` on the same
 uncertified proposals, and how much farther from the proposal the lookup lands than the exact
 projection.  Ratios are what count: the 2 cores are shared.
@@ -13,11 +18,15 @@ projection.  Ratios are what count: the 2 cores are shared.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import time
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
+from stringstab import sampled
 from stringstab.rl import config_for, train
 from stringstab.rl.repair import GainRepair
 from stringstab.tuning import project
@@ -34,13 +43,59 @@ def arm(name: str, steps: int, **kw: object) -> dict[str, float]:
     return t
 
 
+@contextlib.contextmanager
+def sampled_before() -> Iterator[None]:
+    """``check_sampled`` as before fe1711a: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
+    prim, phi = sampled._primitives_iv, sampled._phi_iv
+    left = [0]
+
+    def phi_before(lo: Any, hi: Any) -> Any:
+        if left[0] > 0 and hi is lo:
+            left[0] -= 1
+            hi = np.array(hi, copy=True)  # equal values, another array: the interval path
+        return phi(lo, hi)
+
+    def prim_before(*a: Any, **k: Any) -> Any:
+        left[0] = 2
+        return prim(*a, **k)
+
+    sampled._primitives_iv, sampled._phi_iv = prim_before, phi_before  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        sampled._primitives_iv, sampled._phi_iv = prim, phi  # type: ignore[assignment]
+
+
+def per_call(n_calls: int = 200) -> float:
+    """Seconds per ``check_sampled`` call on 8 triples near the certified set."""
+    rng = np.random.default_rng(0)
+    K = np.array([1.14, 1.03, 0.02]) + rng.normal(0.0, 0.05, (8, 3))
+    sampled.check_sampled(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    t0 = time.perf_counter()
+    for _ in range(n_calls):
+        sampled.check_sampled(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    return (time.perf_counter() - t0) / n_calls
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=20_000)
     ap.add_argument("--triples", type=int, default=200)
     args = ap.parse_args()
+    with sampled_before():
+        before_call = per_call()
+    after_call = per_call()
+    print(f"check_sampled, 8 triples: before {1e3 * before_call:.2f} ms, after "
+          f"{1e3 * after_call:.2f} ms per call, ratio {before_call / after_call:.1f}x "
+          f"(load {os.getloadavg()[0]:.2f})")
     base = arm("repair off", args.steps, repair="off")
     look = arm("projection (lookup)", args.steps)
+    with sampled_before():
+        old = arm("lookup, before", args.steps)
+    cont = arm("lookup, continuous", args.steps, repair_sampled=False)
+    print(f"repair share: default {100 * look['repair_share']:.1f}% (before fe1711a "
+          f"{100 * old['repair_share']:.1f}%, continuous only {100 * cont['repair_share']:.1f}%); "
+          f"steps/s ratio default/before = {look['steps_per_second'] / old['steps_per_second']:.2f}")
     # shorter (it is slow), but past learning_starts so that its updates are counted too
     exact = arm("projection-exact", max(args.steps // 4, 4000), repair="projection-exact")
     print(f"steps/s ratio lookup/off = {look['steps_per_second'] / base['steps_per_second']:.2f}, "

@@ -446,3 +446,102 @@ def test_contract_with_the_hcfs_environment(tmp_path):
     a = back.policy(obs)
     assert a.shape == (3, 1) and (np.abs(a) <= 3.0).all()
     np.testing.assert_array_equal(a, pol.policy(obs))
+
+
+# --------------------------------------------------------------------------- phase-2 options
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 6), min_size=1, max_size=5),
+       st.floats(0.001, 0.5))
+def test_limit_rate_clips_to_the_previous_gains(rows, rate):
+    from stringstab.traffic.env import limit_rate
+
+    A = np.array(rows)
+    K, P = A[:, :3], A[:, 3:]
+    out = limit_rate(K, P, rate)
+    assert (np.abs(out - P) <= rate + 1e-12).all()
+    near = np.abs(K - P) <= rate
+    np.testing.assert_array_equal(out[near], K[near])  # within the limit: unchanged
+    np.testing.assert_array_equal(limit_rate(K, P, rate, fresh=np.ones(len(K), bool)), K)
+
+
+def test_options_change_the_state_and_bound_the_gain_steps():
+    """Repair off: the executed gains move at most gain_rate per step (after an episode's first)."""
+    lead = [sinusoid(omega=0.8, amplitude=3.0, speed=15.0, duration=6.0)]
+    env = BatchedCarFollowingEnv(2, lead, gain_rate=0.03, observe=("accel", "gains"))
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (2, 7)
+    np.testing.assert_array_equal(obs[:, 3:], 0.0)  # no previous gains yet
+    rng = np.random.default_rng(0)
+    prev = None
+    for _ in range(40):
+        obs, _, _, _, info = env.step(rng.uniform(-2, 2, (2, 3)))
+        K = info["gains"]
+        np.testing.assert_allclose(obs[:, 4:], K / 2.0, rtol=0, atol=1e-6)
+        np.testing.assert_allclose(obs[:, 3], info["accel"] / 4.5, rtol=0, atol=1e-6)
+        if prev is not None:
+            assert np.abs(K - prev).max() <= 0.03 + 1e-12
+        prev = K
+
+
+def test_start_spread_moves_the_start_and_keeps_its_bounds():
+    lead = [sinusoid(omega=0.5, amplitude=0.0, speed=20.0, duration=3.0)]
+    eq = BatchedCarFollowingEnv(64, lead)
+    sp = BatchedCarFollowingEnv(64, lead, start_spread=(0.3, 2.0))
+    eq.reset(seed=1)
+    sp.reset(seed=1)
+    g0 = eq._core.obs.gap[:, 0]
+    g, v = sp._core.obs.gap[:, 0], sp._core.obs.speed[:, 0]
+    np.testing.assert_allclose(g0, 2.0 + 1.1 * 20.0, rtol=1e-12)
+    assert (np.abs(g / g0 - 1.0) <= 0.3 + 1e-12).all() and np.std(g) > 1.0
+    assert (np.abs(v - 20.0) <= 2.0 + 1e-12).all() and np.std(v) > 0.3
+
+
+@pytest.mark.parametrize("bad", [dict(observe=("speed",)), dict(observe=("gains", "gains")),
+                                 dict(start_spread=(0.1,)), dict(start_spread=(-0.1, 1.0)),
+                                 dict(gain_rate=-0.1), dict(gain_rate=float("nan"))])
+def test_option_fields_are_checked(bad):
+    with pytest.raises(StringStabError, match="config field"):
+        config_for("idl", **bad)
+    with pytest.raises(StringStabError, match="gain_rate needs action 'gains'"):
+        config_for("td3", gain_rate=0.1)
+
+
+def test_rate_limited_policy_runs_in_evaluation_as_in_training():
+    """The executed gains of the evaluation (simulator + Policy.step_gains) equal those of the
+    training environment stepped with the deterministic policy, and each is certified by the
+    independent sweep."""
+    from stringstab.rl.evaluate import evaluate
+
+    cfg = tiny("idl", gain_rate=0.05, observe=("accel", "gains"), start_spread=(0.2, 1.0),
+               total_steps=200, learning_starts=64)
+    pol = train(cfg, leaders=short_leaders(), progress=False).policy
+    assert pol.info["obs_dim"] == 7 and pol.gain_rate == 0.05
+    lead = sinusoid(omega=1.0, amplitude=3.0, speed=15.0, duration=4.0)
+    ev = evaluate(pol, [lead], tau=TAU, delta=DELTA, headway=HEADWAY)
+    from stringstab.rl.train import make_env
+
+    env = make_env(cfg.replace(num_envs=1, start_spread=(0.0, 0.0)), leaders=[lead])
+    env._core.terminate_on_collision = False
+    obs, _ = env.reset(seed=0)
+    rows = []
+    for _ in range(lead.n_steps - 1):
+        obs, _, _, trunc, info = env.step(pol(obs))
+        rows.append(info["gains"][0])
+        if trunc[0]:
+            break
+    np.testing.assert_allclose(ev.gains[: len(rows), 2:], np.array(rows), rtol=0, atol=1e-9)
+    uniq = np.unique(np.round(ev.gains[:, 2:], 12), axis=0)
+    for K in uniq[:: max(1, len(uniq) // 12)]:
+        assert independent_certified(K), K
+
+
+def test_resume_is_bit_for_bit_with_the_phase2_options(tmp_path):
+    cfg = tiny("idl", total_steps=160, checkpoint_every=80, gain_rate=0.05,
+               observe=("accel", "gains"), start_spread=(0.3, 2.0))
+    full = train(cfg, leaders=short_leaders(), out=tmp_path / "full", progress=False)
+    train(cfg.replace(total_steps=80), leaders=short_leaders(), out=tmp_path / "half", progress=False)
+    resumed = train(cfg, leaders=short_leaders(), out=tmp_path / "half", resume=True, progress=False)
+    for (k, a), (_, b) in zip(full.policy.actor.state_dict().items(),
+                              resumed.policy.actor.state_dict().items()):
+        assert torch.equal(a, b), k
+    assert full.episodes == resumed.episodes

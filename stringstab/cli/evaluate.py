@@ -49,6 +49,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``evaluate``."""
     from ..io import OutputDir
     from ..rl.evaluate import evaluate, platoon_test
+    from ..rl.report import verdict as report_verdict
     from ..rl.report import write_evaluation
     from ..rl.runs import open_run, test_leaders
 
@@ -62,16 +63,7 @@ def run(args: argparse.Namespace) -> int:
     platoons = [platoon_test(policy, n, tau=p["tau"], delta=p["delta"], headway=p["headway"],
                              dt=p["dt"]) for n in sizes]
     s = ev.summary
-    gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
-        q["M_fss"] == 100.0 for q in platoons)
-    no_coll = s["collisions"] == 0 and all(q["collisions"] == 0 for q in platoons)
-    if policy.action != "gains":
-        verdict = "not certified: an acceleration policy executes no gains to certify"
-    elif gains_ok and no_coll:
-        verdict = "every executed gain certified, no collision"
-    else:
-        verdict = ("NOT every executed gain certified" if not gains_ok else "certified gains")
-        verdict += "" if no_coll else ", COLLISIONS"
+    verdict, passed = report_verdict(ev, platoons, policy.action)
     run_doc = {**info, "leaders": desc, "tau": p["tau"], "delta": p["delta"],
                "headway": p["headway"], "dt": p["dt"], "repair": p.get("repair")}
     with out:
@@ -88,4 +80,4 @@ def run(args: argparse.Namespace) -> int:
               f"M_fss {q['M_fss'] if q['M_fss'] is not None else 'n/a'}")
     print(f"verdict: {verdict}")
     print(f"wrote {', '.join(files)} to {out.root}/")
-    return 0 if (policy.action == "gains" and gains_ok and no_coll) else 1
+    return 0 if passed else 1

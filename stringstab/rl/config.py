@@ -120,6 +120,22 @@ class TD3Config:
     #: environment and Q is flat along the directions the projection collapses, so without it
     #: the actor drifts to the corners of the gain box; 0 disables it (it acts only with a repair).
     proposal_penalty: float = 1.0
+    #: Largest change of each executed gain per control step, gain units (not in the paper; 0:
+    #: off).  The proposal is clipped to within ``gain_rate`` of the previous executed gains,
+    #: then repaired.  Phase 1 found that most of the IDL policy's jerk (M_CI) comes from its
+    #: gains changing every step (u = K·Y jumps when K does): frozen at their median, the same
+    #: policy's gains give a third of its M_CI.  Use with ``observe`` containing "gains" (the
+    #: limit makes the previous gains part of the state).
+    gain_rate: float = 0.0
+    #: Extras appended to the eq-16 state (not in the paper): "accel" (the follower's own
+    #: acceleration, which the comfort reward of eq 21 penalises changes of and eq 16 omits)
+    #: and "gains" (the gains executed at the previous step).
+    observe: tuple[str, ...] = ()
+    #: Random start of training episodes off equilibrium (not in the paper): initial gap scaled by
+    #: 1 + s_g·U(−1, 1) and speed offset by s_v·U(−1, 1), (s_g, s_v) in (fraction, m/s); NGSIM
+    #: pairs start as recorded.  (0, 0): every episode starts in equilibrium; phase 1's
+    #: policies then met no collision in training and learnt nothing about avoiding one.
+    start_spread: tuple[float, float] = (0.0, 0.0)
     #: Actuator lag τ, s (not printed by the paper; 0.1 s as in its reference Zhou et al. 2020).
     tau: float = constants.TAU
     #: Communication delay δ, s (Table 2).
@@ -147,6 +163,8 @@ class TD3Config:
         d = dataclasses.asdict(self)
         d["hidden"] = list(self.hidden)
         d["weights"] = list(self.weights)
+        d["observe"] = list(self.observe)
+        d["start_spread"] = list(self.start_spread)
         return {"class": type(self).__name__, **d}
 
     def replace(self, **changes: Any) -> TD3Config:
@@ -213,7 +231,7 @@ _MIN_INT = {"total_steps": 1, "seed": 0, "buffer_size": 1, "batch_size": 1, "pol
             "repair_refine": 0, "checkpoint_every": 1, "torch_threads": 1}
 _POSITIVE = ("learning_rate_actor", "learning_rate_critic", "soft_update", "repair_resolution",
              "tau", "dt", "episode_seconds")
-_NONNEG = ("proposal_penalty", "exploration_noise", "target_policy_noise", "noise_clip", "delta", "headway")
+_NONNEG = ("gain_rate", "proposal_penalty", "exploration_noise", "target_policy_noise", "noise_clip", "delta", "headway")
 
 
 def _check(c: TD3Config) -> None:
@@ -259,6 +277,21 @@ def _check(c: TD3Config) -> None:
     if len(w) != 3 or not all(math.isfinite(x) and x >= 0 for x in w):
         raise StringStabError(f"config field weights must be 3 numbers >= 0; got {show(c.weights)}")
     object.__setattr__(c, "weights", w)
+    obs = tuple(c.observe) if isinstance(c.observe, (list, tuple)) else None
+    if obs is None or not set(obs) <= {"accel", "gains"} or len(set(obs)) != len(obs):
+        raise StringStabError(
+            f"config field observe must list distinct names from ['accel', 'gains']; got {show(c.observe)}")
+    object.__setattr__(c, "observe", tuple(x for x in ("accel", "gains") if x in obs))
+    try:
+        sp = tuple(float(x) for x in c.start_spread)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(
+            f"config field start_spread must be 2 numbers >= 0; got {show(c.start_spread)}") from e
+    if len(sp) != 2 or not all(math.isfinite(x) and x >= 0 for x in sp):
+        raise StringStabError(f"config field start_spread must be 2 numbers >= 0; got {show(c.start_spread)}")
+    object.__setattr__(c, "start_spread", sp)
+    if c.gain_rate > 0 and c.action != "gains":
+        raise StringStabError(f"config field gain_rate needs action 'gains'; got action {c.action!r}")
     if c.batch_size > c.buffer_size:
         raise StringStabError(
             f"config field batch_size ({c.batch_size}) must not exceed buffer_size ({c.buffer_size})")
@@ -312,8 +345,9 @@ def config_from_dict(doc: Any, *, source: str = "config") -> TD3Config:
         raise StringStabError(f"{source}: unknown config fields {unknown}")
     if "hidden" in d and isinstance(d["hidden"], list):
         d["hidden"] = tuple(d["hidden"])
-    if "weights" in d and isinstance(d["weights"], list):
-        d["weights"] = tuple(d["weights"])
+    for key in ("weights", "observe", "start_spread"):
+        if key in d and isinstance(d[key], list):
+            d[key] = tuple(d[key])
     try:
         return cls(**d)
     except TypeError as e:

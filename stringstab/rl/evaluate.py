@@ -108,9 +108,17 @@ def controller_for(strategy: Policy | str, *, headway: float,
         return state_vector(obs, headway=headway, standstill=standstill)
 
     if pol.action == "gains":
+        memory: dict[str, Any] = {}  # the previous step's executed gains, per vehicle
+
         def schedule(obs: Any) -> Array:
             s = state(obs)
-            return pol.gains(s.reshape(-1, s.shape[-1])).reshape(*s.shape[:-1], 3)
+            prev = memory.get("K")
+            if obs.step == 0 or prev is None or prev.shape != s.shape:
+                prev = None  # a new run: no previous gains
+            K = pol.step_gains(s.reshape(-1, 3), accel=np.asarray(obs.accel).reshape(-1),
+                               prev_gains=prev).reshape(s.shape)
+            memory["K"] = K
+            return K
 
         return TimeVaryingLinearController(schedule, headway=headway, standstill=standstill)
 

@@ -83,8 +83,45 @@ class Policy:
             a = self.actor(torch.as_tensor(x2)).numpy().astype(np.float64)
         return a[0] if one else a
 
+    @property
+    def observe(self) -> tuple[str, ...]:
+        """Extras of the state beyond eq 16 (``TD3Config.observe``; empty for phase-1 policies)."""
+        return tuple(self.info.get("observe") or ())
+
+    @property
+    def gain_rate(self) -> float:
+        """Per-step limit on each gain's change (``TD3Config.gain_rate``; 0: none)."""
+        return float(self.info.get("gain_rate") or 0.0)
+
+    def step_gains(self, state: npt.ArrayLike, *, accel: npt.ArrayLike | None = None,
+                   prev_gains: npt.ArrayLike | None = None) -> Array:
+        """One control step of an IDL policy, as in training: the executed gains ``(n, 3)``.
+
+        ``state`` is the eq-16 state ``(n, 3)``; the policy's ``observe`` extras are appended
+        (own acceleration ``accel`` (n,), the previous executed gains ``prev_gains`` (n, 3);
+        None at an episode's first step: zeros, and no rate limit), the proposal is rate
+        limited (``gain_rate``) and repaired, so each returned triple is certified (unless the
+        repair is off).
+        """
+        from ..traffic.env import extend_state, limit_rate
+
+        s = np.asarray(state, dtype=np.float64).reshape(-1, 3)
+        fresh = prev_gains is None
+        prev = np.zeros((s.shape[0], 3)) if fresh else np.asarray(prev_gains, np.float64).reshape(-1, 3)
+        a = np.zeros(s.shape[0]) if accel is None else np.asarray(accel, np.float64).reshape(-1)
+        x = extend_state(s, observe=self.observe, accel=a, prev_gains=prev)
+        K = np.clip(self(x), self.info["low"][0], self.info["high"][0])
+        if self.gain_rate > 0 and not fresh:
+            K = limit_rate(K, prev, self.gain_rate)
+        assert self.repair is not None
+        return self.repair(K)
+
     def gains(self, obs: npt.ArrayLike) -> Array:
-        """The executed gains of an IDL policy: μ(s) repaired (each certified unless repair off)."""
+        """The executed gains of an IDL policy: μ(s) repaired (each certified unless repair off).
+
+        Stateless: for a policy trained with a ``gain_rate`` or ``observe`` extras, use
+        :meth:`step_gains`, which is how it runs in training and evaluation.
+        """
         if self.action != "gains":
             raise StringStabError(f"policy of {self.algo!r} outputs accelerations, not gains")
         K = self(obs)

@@ -15,7 +15,7 @@ from ..io import OutputDir
 from .compare import table_csv, table_markdown, table_rows
 from .evaluate import PAPER_MP_10, PAPER_MP_100_MAX, Evaluation
 
-__all__ = ["evaluation_markdown", "platoon_markdown", "write_comparison", "write_evaluation"]
+__all__ = ["evaluation_markdown", "platoon_markdown", "verdict", "write_comparison", "write_evaluation"]
 
 
 def _fmt(v: Any) -> str:
@@ -73,6 +73,21 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                  f"dt = {run.get('dt')} s, which the simulator runs.\n\n")
     lines.append("## Platoon test\n\n" + platoon_markdown(platoons))
     return "".join(lines)
+
+
+def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) -> tuple[str, bool]:
+    """The one-line verdict of an evaluation and whether it passes (``stringstab evaluate``'s
+    exit 0): every executed gain certified and no collision, on the episodes and platoons."""
+    s = ev.summary
+    gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
+        q["M_fss"] == 100.0 for q in platoons)
+    no_coll = s["collisions"] == 0 and all(q["collisions"] == 0 for q in platoons)
+    if action != "gains":
+        return "not certified: an acceleration policy executes no gains to certify", False
+    if gains_ok and no_coll:
+        return "every executed gain certified, no collision", True
+    text = "NOT every executed gain certified" if not gains_ok else "certified gains"
+    return text + ("" if no_coll else ", COLLISIONS"), False
 
 
 def write_evaluation(out: OutputDir, ev: Evaluation, platoons: Sequence[Mapping[str, Any]],

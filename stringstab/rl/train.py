@@ -105,7 +105,9 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> Any:
     env = BatchedCarFollowingEnv(config.num_envs, leaders, action=config.action, tau=config.tau,
                                  delta=config.delta, headway=config.headway,
                                  gain_bounds=config.gain_bounds, weights=config.weights,
-                                 terminate_on_collision=True, gain_filter=repair)
+                                 terminate_on_collision=True, gain_filter=repair,
+                                 gain_rate=config.gain_rate, observe=config.observe,
+                                 start_spread=config.start_spread)
     env.repair = repair  # type: ignore[attr-defined]
     return env
 
@@ -122,6 +124,7 @@ def _policy_info(config: TD3Config, obs_dim: int, act_dim: int, low: Any, high: 
             "act_dim": int(act_dim), "low": [float(v) for v in low],
             "high": [float(v) for v in high], "hidden": list(config.hidden),
             "tau": config.tau, "delta": config.delta, "headway": config.headway, "dt": config.dt,
+            "observe": list(config.observe), "gain_rate": config.gain_rate,
             "repair": repair.describe() if repair is not None else None}
 
 

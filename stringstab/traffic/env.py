@@ -15,7 +15,18 @@ Two action modes:
     the action is the desired acceleration u ∈ [−7.6, 3] m/s².
 
 State (eq 16): s = [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc] with Δp = gap − (T* v + l_0),
-α_p = 25, α_v = 2.5, α_acc = 4.5 (Table 2).
+α_p = 25, α_v = 2.5, α_acc = 4.5 (Table 2).  Optionally (``observe``, not in the paper) the
+follower's own acceleration a_i/α_acc and the gains it executed at the previous step
+(K_{t−1}/2, zero at an episode's first step) are appended (:func:`extend_state`): the eq-16
+state does not say what the vehicle is doing now, which the comfort reward (eq 21) penalises
+changes of, nor which gains it runs, which a ``gain_rate`` limit makes part of the dynamics.
+
+Gain actions may be rate limited (``gain_rate`` r > 0, not in the paper): each proposed gain is
+first clipped to within r of the gain executed at the previous step
+(:func:`limit_rate`), then the ``gain_filter`` (the repair) acts, so every
+executed gain is still certified.  Training episodes may start off equilibrium
+(``start_spread``, not in the paper): the initial gap scaled by 1 + s_g·U(−1, 1) and the speed
+offset by s_v·U(−1, 1) m/s, so that closing situations are met in training.
 
 An episode runs over one leader (a :class:`~stringstab.traffic.leaders.Trajectory`, started in
 equilibrium, or a :class:`~stringstab.traffic.leaders.FollowingPair`, started where the recorded
@@ -51,11 +62,16 @@ from .platoon import DEFAULT_LENGTH, Limits, Model, Platoon
 from .reward import reward
 from .trajectory import Trajectory
 
-__all__ = ["SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "state_vector"]
+__all__ = ["OBSERVE", "SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "extend_state",
+           "limit_rate", "state_vector"]
 
 #: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).
 _PLATOON_STATE = ("position", "speed", "accel", "_buf", "collided", "collision_events",
                   "first_collision_step", "_in_collision")
+#: What may be appended to the eq-16 state (``observe``): own acceleration, previous gains.
+OBSERVE = ("accel", "gains")
+#: Scale of the previous gains in the state (the half-range of Table 2's [−2, 2]).
+GAIN_SCALE = 2.0
 
 Array = npt.NDArray[np.float64]
 ActionMode = Literal["gains", "accel"]
@@ -77,6 +93,56 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
                      obs.pred_accel_delayed / scales[2]], axis=-1)
 
 
+def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
+                 accel: npt.ArrayLike | None = None, prev_gains: npt.ArrayLike | None = None,
+                 scales: tuple[float, float, float] = SCALES) -> Array:
+    """The eq-16 ``state`` (..., 3) with the ``observe`` extras appended (not in the paper).
+
+    ``"accel"`` appends the follower's own acceleration a_i/α_acc (``accel``, shape ``(...)``),
+    ``"gains"`` the gains executed at the previous step K_{t−1}/2 (``prev_gains``, (..., 3)).
+
+    Examples
+    --------
+    >>> extend_state([[0.1, 0.2, 0.3]], observe=("accel", "gains"), accel=[0.9],
+    ...              prev_gains=[[1.0, 0.5, -0.4]]).round(2).tolist()
+    [[0.1, 0.2, 0.3, 0.2, 0.5, 0.25, -0.2]]
+    """
+    s = np.asarray(state, dtype=np.float64)
+    unknown = sorted(set(observe) - set(OBSERVE))
+    if unknown:
+        raise StringStabError(f"observe must name some of {list(OBSERVE)}; got {unknown}")
+    parts = [s]
+    if "accel" in observe:
+        if accel is None:
+            raise StringStabError("observe 'accel' needs the follower's acceleration")
+        parts.append(np.asarray(accel, dtype=np.float64)[..., None] / scales[2])
+    if "gains" in observe:
+        if prev_gains is None:
+            raise StringStabError("observe 'gains' needs the previous gains")
+        parts.append(np.asarray(prev_gains, dtype=np.float64) / GAIN_SCALE)
+    return np.concatenate(parts, axis=-1) if len(parts) > 1 else s
+
+
+def limit_rate(gains: npt.ArrayLike, prev_gains: npt.ArrayLike, rate: float, *,
+               fresh: npt.ArrayLike | bool = False) -> Array:
+    """Clip each gain to within ``rate`` of the previous step's (a gain rate limit; not in the paper).
+
+    Rows where ``fresh`` is true (an episode's first step: no previous gains) are left as
+    they are.  The result still needs the repair: the rate limit keeps the gains near a
+    certified triple, it does not certify them.
+
+    Examples
+    --------
+    >>> limit_rate([[1.5, 0.0, 0.3]], [[1.0, 0.1, 0.3]], 0.2).tolist()
+    [[1.2, 0.0, 0.3]]
+    """
+    K = np.asarray(gains, dtype=np.float64)
+    P = np.asarray(prev_gains, dtype=np.float64)
+    out = np.clip(K, P - rate, P + rate)
+    f = np.asarray(fresh, dtype=bool)
+    return np.asarray(np.where(f[..., None] if f.ndim else f, K, out))
+
+
 def _is_pair(x: Any) -> TypeGuard[FollowingPair]:
     # duck typing (see stringstab.traffic.platoon._is_trajectory)
     return hasattr(x, "leader") and hasattr(x, "follower") and hasattr(x, "gap")
@@ -90,7 +156,9 @@ class _Core:
                  limits: Limits | None, length: float, gain_bounds: tuple[float, float],
                  weights: tuple[float, float, float], ttc_star: float,
                  scales: tuple[float, float, float], terminate_on_collision: bool,
-                 gain_filter: Callable[[Array], npt.ArrayLike] | None) -> None:
+                 gain_filter: Callable[[Array], npt.ArrayLike] | None, gain_rate: float = 0.0,
+                 observe: Sequence[str] = (), start_spread: tuple[float, float] = (0.0, 0.0)
+                 ) -> None:
         items = list(leaders)
         if not items:
             raise StringStabError("the environment needs at least one leader trajectory or pair")
@@ -115,6 +183,14 @@ class _Core:
         self.headway, self.standstill = float(headway), float(standstill)
         self.weights, self.ttc_star, self.scales = weights, float(ttc_star), scales
         self.terminate_on_collision, self.gain_filter = terminate_on_collision, gain_filter
+        if not (np.isfinite(gain_rate) and gain_rate >= 0):
+            raise StringStabError(f"gain_rate must be a number >= 0; got {show(gain_rate)}")
+        spread = tuple(float(x) for x in start_spread)
+        if len(spread) != 2 or not all(np.isfinite(x) and x >= 0 for x in spread):
+            raise StringStabError(f"start_spread must be (gap fraction, speed m/s) >= 0; got {show(start_spread)}")
+        extend_state(np.zeros((1, 3)), observe=observe, accel=np.zeros(1),
+                     prev_gains=np.zeros((1, 3)))  # checks the names
+        self.gain_rate, self.extras, self.start_spread = float(gain_rate), tuple(observe), spread
         self.lengths = np.array([tr.n_steps for tr in trs])
         T = int(self.lengths.max())
         pad = [(tr.position, tr.speed, tr.accel) for tr in trs]
@@ -138,6 +214,8 @@ class _Core:
                                limits=limits, length=length)
         self.which = np.zeros(self.n, dtype=np.int64)
         self.k = np.zeros(self.n, dtype=np.int64)
+        #: Gains executed at the previous step (zero, and not rate limited, at an episode start).
+        self.prev_gains = np.zeros((self.n, 3))
         self.obs: Observation | None = None
         self.ret = np.zeros(self.n)
 
@@ -145,13 +223,20 @@ class _Core:
         kk = np.minimum(self.k, self.lengths[self.which] - 1)
         return self.LX[self.which, kk], self.LV[self.which, kk], self.LA[self.which, kk]
 
-    def reset_rows(self, rows: npt.NDArray[np.int64], which: npt.NDArray[np.int64]) -> None:
+    def reset_rows(self, rows: npt.NDArray[np.int64], which: npt.NDArray[np.int64],
+                   rng: np.random.Generator | None = None) -> None:
         self.which[rows] = which
         self.k[rows] = 0
         self.ret[rows] = 0.0
+        self.prev_gains[rows] = 0.0
+        gap, speed = self.init_gap[which], self.init_speed[which]
+        if rng is not None and any(self.start_spread):
+            u = rng.uniform(-1.0, 1.0, size=(2, len(rows)))
+            free = np.array([not _is_pair(self.items[j]) for j in which])  # NGSIM: as recorded
+            gap = np.where(free, gap * (1.0 + self.start_spread[0] * u[0]), gap)
+            speed = np.where(free, np.maximum(speed + self.start_spread[1] * u[1], 0.0), speed)
         self.platoon.reset(self.LX[which, 0], self.LV[which, 0], self.LA[which, 0],
-                           gap=self.init_gap[which][:, None], speed=self.init_speed[which][:, None],
-                           accel=0.0, rows=rows)
+                           gap=gap[:, None], speed=speed[:, None], accel=0.0, rows=rows)
 
     def observe(self) -> Observation:
         self.obs = self.platoon.observe(*self.leader_now())
@@ -159,8 +244,12 @@ class _Core:
 
     def state(self) -> npt.NDArray[np.float32]:
         assert self.obs is not None
-        return state_vector(self.obs, headway=self.headway, standstill=self.standstill,
-                            scales=self.scales)[:, 0, :].astype(np.float32)
+        s = state_vector(self.obs, headway=self.headway, standstill=self.standstill,
+                         scales=self.scales)[:, 0, :]
+        if self.extras:
+            s = extend_state(s, observe=self.extras, accel=self.obs.accel[:, 0],
+                             prev_gains=self.prev_gains, scales=self.scales)
+        return s.astype(np.float32)
 
     def command(self, actions: npt.ArrayLike) -> tuple[Array, Array | None]:
         assert self.obs is not None
@@ -172,8 +261,11 @@ class _Core:
         if a.shape[1] != 3:
             raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
         K = np.clip(a, *self.gain_bounds)
+        if self.gain_rate > 0:
+            K = limit_rate(K, self.prev_gains, self.gain_rate, fresh=self.k == 0)
         if self.gain_filter is not None:
             K = np.asarray(self.gain_filter(K), dtype=np.float64).reshape(self.n, 3)
+        self.prev_gains = K.copy()
         o = self.obs
         u = (K[:, :1] * (o.gap - self.headway * o.speed - self.standstill)
              + K[:, 1:2] * o.rel_speed + K[:, 2:3] * o.pred_accel_delayed)
@@ -204,8 +296,9 @@ class _Core:
 
 
 def _spaces(action: ActionMode, gain_bounds: tuple[float, float],
-            limits: Limits | None) -> tuple[spaces.Box, spaces.Box]:
-    obs_space = spaces.Box(-np.inf, np.inf, shape=(3,), dtype=np.float32)
+            limits: Limits | None, observe: Sequence[str] = ()) -> tuple[spaces.Box, spaces.Box]:
+    dim = 3 + ("accel" in observe) + 3 * ("gains" in observe)
+    obs_space = spaces.Box(-np.inf, np.inf, shape=(dim,), dtype=np.float32)
     if action == "gains":
         act_space = spaces.Box(float(gain_bounds[0]), float(gain_bounds[1]), shape=(3,), dtype=np.float32)
     else:
@@ -323,7 +416,11 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
     """``num_envs`` independent car-following episodes stepped together (NumPy, no subprocesses).
 
     The same model and parameters as :class:`CarFollowingEnv` (see it for the parameters);
-    episodes draw their leader at random from ``leaders`` (seeded by :meth:`reset`).
+    episodes draw their leader at random from ``leaders`` (seeded by :meth:`reset`).  Three
+    training options, none in the paper (module docstring): ``gain_rate`` (a per-step limit
+    on each gain's change, before ``gain_filter``), ``observe`` (extras appended to the eq-16
+    state: ``"accel"``, ``"gains"``) and ``start_spread`` (random initial gap fraction and
+    speed offset, m/s, for trajectory leaders).
 
     API (a Gymnasium ``VectorEnv`` with *same-step* autoreset):
 
@@ -358,7 +455,9 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True,
-                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None) -> None:
+                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None,
+                 gain_rate: float = 0.0, observe: Sequence[str] = (),
+                 start_spread: tuple[float, float] = (0.0, 0.0)) -> None:
         if int(num_envs) < 1:
             raise StringStabError(f"num_envs must be >= 1; got {show(num_envs)}")
         self.num_envs = int(num_envs)
@@ -367,8 +466,10 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                            standstill=standstill, model=model, limits=limits, length=length,
                            gain_bounds=gain_bounds, weights=weights, ttc_star=ttc_star,
                            scales=scales, terminate_on_collision=terminate_on_collision,
-                           gain_filter=gain_filter)
-        self.single_observation_space, self.single_action_space = _spaces(action, gain_bounds, limits)
+                           gain_filter=gain_filter, gain_rate=gain_rate, observe=observe,
+                           start_spread=start_spread)
+        self.single_observation_space, self.single_action_space = _spaces(action, gain_bounds,
+                                                                          limits, observe)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
 
@@ -380,7 +481,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``."""
         super().reset(seed=seed)
         rows = np.arange(self.num_envs)
-        self._core.reset_rows(rows, self._draw(self.num_envs))
+        self._core.reset_rows(rows, self._draw(self.num_envs), self.np_random)
         self._core.observe()
         return self._core.state(), {"leader_index": self._core.which.copy()}
 
@@ -394,7 +495,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         if self._core.obs is None:
             raise StringStabError("call reset() before state_dict()")
         c, p = self._core, self._core.platoon
-        arrays = {"which": c.which, "k": c.k, "ret": c.ret}
+        arrays = {"which": c.which, "k": c.k, "ret": c.ret, "prev_gains": c.prev_gains}
         arrays.update({f"platoon.{a}": getattr(p, a) for a in _PLATOON_STATE})
         meta = {"num_envs": self.num_envs, "n_leaders": len(c.items), "step": int(p.step),
                 "any_in_collision": bool(p._any_in_collision),
@@ -411,6 +512,8 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         try:
             for name in ("which", "k", "ret"):
                 self._restore(getattr(c, name), arrays[name], name)
+            if "prev_gains" in arrays:  # absent from checkpoints of phase 1 (always zero there)
+                self._restore(c.prev_gains, arrays["prev_gains"], "prev_gains")
             for a in _PLATOON_STATE:
                 self._restore(getattr(p, a), arrays[f"platoon.{a}"], f"platoon.{a}")
         except KeyError as e:
@@ -435,12 +538,13 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
             raise StringStabError("call reset() before step()")
         r, term, trunc, info = self._core.step(actions)
         done = term | trunc
-        info["final_obs"] = np.full((self.num_envs, 3), np.nan, dtype=np.float32)
+        dim = self.single_observation_space.shape[0]  # type: ignore[index]
+        info["final_obs"] = np.full((self.num_envs, dim), np.nan, dtype=np.float32)
         info["_final_obs"] = done.copy()
         info["episode_return"] = np.where(done, self._core.ret, np.nan)
         if done.any():
             rows = np.flatnonzero(done)
             info["final_obs"][rows] = self._core.state()[rows]
-            self._core.reset_rows(rows, self._draw(rows.size))
+            self._core.reset_rows(rows, self._draw(rows.size), self.np_random)
             self._core.observe()
         return self._core.state(), r, term, trunc, info
