@@ -25,7 +25,7 @@ from stringstab.rl.episodes import default_leaders
 from stringstab.rl.evaluate import evaluate, platoon_test
 from stringstab.traffic import train_test_split
 
-#: The variants compared (each a set of TD3Config overrides; "paper" is phase 1's default).
+#: The variants compared (TD3Config overrides of phase 1's defaults, config_for("idl", paper=True)).
 VARIANTS: dict[str, dict[str, Any]] = {
     "paper": {},
     "rate0.05": {"gain_rate": 0.05, "observe": ("accel", "gains")},
@@ -33,6 +33,8 @@ VARIANTS: dict[str, dict[str, Any]] = {
                         "start_spread": (0.3, 3.0)},
     "rate0.02+spread": {"gain_rate": 0.02, "observe": ("accel", "gains"),
                         "start_spread": (0.3, 3.0)},
+    "rate0.05+spread+ttc4": {"gain_rate": 0.05, "observe": ("accel", "gains"),
+                             "start_spread": (0.3, 3.0), "reward_ttc_star": 4.0},
 }
 KEYS = ("TIT", "M_CI", "M_lss", "M_fss", "M_fss_sampled", "collisions", "min_gap",
         "median_headway")
@@ -50,9 +52,11 @@ def main() -> None:
     print(f"{len(fit)} fitting and {len(val)} validation episodes (of the training split)")
     root = Path(args.out)
     root.mkdir(parents=True, exist_ok=True)
-    rows = {}
+    store = root / "validation.json"
+    rows = json.loads(store.read_text()) if store.is_file() else {}  # earlier variants kept
     for name in args.variants.split(","):
-        cfg = config_for("idl", total_steps=args.steps, seed=args.seed, **VARIANTS[name])
+        cfg = config_for("idl", paper=True, total_steps=args.steps, seed=args.seed,
+                         **VARIANTS[name])
         load0 = os.getloadavg()[0]
         t0 = time.perf_counter()
         res = train(cfg, leaders=fit, progress=False)
@@ -67,7 +71,7 @@ def main() -> None:
             row["platoon100_max_m_p"] = pt["max_m_p"]
         rows[name] = row
         print(f"{name}: {json.dumps(row)}", flush=True)
-        (root / "validation.json").write_text(json.dumps(rows, indent=1))
+        store.write_text(json.dumps(rows, indent=1))
 
 
 if __name__ == "__main__":

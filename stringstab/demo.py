@@ -238,6 +238,11 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS) -> dict[str, A
     docs/training.md's), but every executed gain is certified whatever the budget: the repair
     guarantees it and the evaluation re-checks each one (M_fss, continuous and sampled).
     """
+    import importlib.util
+
+    if importlib.util.find_spec("torch") is None or importlib.util.find_spec("safetensors") is None:
+        log("skipped: training needs the rl extra (pip install 'stringstab[rl]')")
+        return {"skipped": "torch or safetensors not installed (the rl extra)", "files": []}
     import matplotlib
 
     matplotlib.use("Agg")

@@ -42,6 +42,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--num-envs", default=None, metavar="N", help="parallel environments (default 8)")
     p.add_argument("--stop-episodes", default=None, metavar="N",
                    help="stop after N collision-free episode ends (default 700; 0: only --steps)")
+    p.add_argument("--paper", action="store_true",
+                   help="IDL as printed: the eq-16 state, no gain rate limit, episodes started in "
+                        "equilibrium (without the trainer's phase-2 options; docs/training.md)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -61,7 +64,9 @@ def run(args: argparse.Namespace) -> int:
         if args.algo != "idl":
             raise StringStabError(f"--repair applies to --algo idl; got --algo {args.algo}")
         kw["repair"] = args.repair
-    config = config_for(args.algo, **kw)
+    if args.paper and args.algo != "idl":
+        raise StringStabError(f"--paper applies to --algo idl; got --algo {args.algo}")
+    config = config_for(args.algo, paper=args.paper, **kw)
     out = Path(args.out)
     check_run_folder(out, resume=args.resume, config=config)
     leaders = None

@@ -31,6 +31,7 @@ from ..errors import StringStabError, show
 
 __all__ = [
     "ALGOS",
+    "IDL_OPTIONS",
     "REPAIRS",
     "DDPGConfig",
     "TD3Config",
@@ -136,6 +137,10 @@ class TD3Config:
     #: pairs start as recorded.  (0, 0): every episode starts in equilibrium; phase 1's
     #: policies then met no collision in training and learnt nothing about avoiding one.
     start_spread: tuple[float, float] = (0.0, 0.0)
+    #: TTC* of the safety reward (eq 20), s.  Table 2's 3 s is also the threshold of the TIT
+    #: metric (eq 31); a larger value in the reward (not in the paper) is a safety margin: the
+    #: agent is penalised before the metric counts, so it learns to keep TTC above 3 s.
+    reward_ttc_star: float = constants.TTC_STAR
     #: Actuator lag τ, s (not printed by the paper; 0.1 s as in its reference Zhou et al. 2020).
     tau: float = constants.TAU
     #: Communication delay δ, s (Table 2).
@@ -230,7 +235,7 @@ _MIN_INT = {"total_steps": 1, "seed": 0, "buffer_size": 1, "batch_size": 1, "pol
             "learning_starts": 0, "updates_per_step": 1, "num_envs": 1, "stop_episodes": 0,
             "repair_refine": 0, "checkpoint_every": 1, "torch_threads": 1}
 _POSITIVE = ("learning_rate_actor", "learning_rate_critic", "soft_update", "repair_resolution",
-             "tau", "dt", "episode_seconds")
+             "tau", "dt", "episode_seconds", "reward_ttc_star")
 _NONNEG = ("gain_rate", "proposal_penalty", "exploration_noise", "target_policy_noise", "noise_clip", "delta", "headway")
 
 
@@ -297,10 +302,20 @@ def _check(c: TD3Config) -> None:
             f"config field batch_size ({c.batch_size}) must not exceed buffer_size ({c.buffer_size})")
 
 
-def config_for(algo: str, **overrides: Any) -> TD3Config:
+#: The options ``config_for("idl")`` adds to :class:`TD3Config` (phase 2 of the trainer, none in
+#: the paper; chosen on a validation split of the training episodes by
+#: ``analysis/train_validate.py``, see docs/training.md).  ``config_for("idl", paper=True)``
+#: leaves them out.
+IDL_OPTIONS: dict[str, Any] = {"gain_rate": 0.02, "observe": ("accel", "gains"),
+                               "start_spread": (0.3, 3.0)}
+
+
+def config_for(algo: str, *, paper: bool = False, **overrides: Any) -> TD3Config:
     """The config of agent ``algo`` ("idl", "td3" or "ddpg") with ``overrides``.
 
-    ``idl`` is :class:`TD3Config` with gain actions and the projection repair; ``td3`` is
+    ``idl`` is :class:`TD3Config` with gain actions, the projection repair and
+    :data:`IDL_OPTIONS` (without them when ``paper`` is true: the eq-16 state, no gain rate
+    limit, episodes started in equilibrium, phase 1's defaults); ``td3`` is
     :class:`TD3Config` with acceleration actions and exploration noise 0.25 (the best for pure
     TD3 in the paper's §5.1(2)); ``ddpg`` is :class:`DDPGConfig`.
 
@@ -308,13 +323,16 @@ def config_for(algo: str, **overrides: Any) -> TD3Config:
     --------
     >>> config_for("td3").action, config_for("td3").exploration_noise
     ('accel', 0.25)
+    >>> config_for("idl").gain_rate > 0, config_for("idl", paper=True).gain_rate
+    (True, 0.0)
     >>> config_for("ppo")
     Traceback (most recent call last):
     ...
     stringstab.errors.StringStabError: --algo must be one of idl, td3, ddpg; got 'ppo'
     """
     if algo == "idl":
-        return TD3Config(**{"algo": "idl", "action": "gains", **overrides})
+        return TD3Config(**{"algo": "idl", "action": "gains", **({} if paper else IDL_OPTIONS),
+                            **overrides})
     if algo == "td3":
         return TD3Config(**{"algo": "td3", "action": "accel", "exploration_noise": 0.25,
                             "repair": "off", **overrides})

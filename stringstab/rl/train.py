@@ -106,6 +106,7 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> Any:
                                  delta=config.delta, headway=config.headway,
                                  gain_bounds=config.gain_bounds, weights=config.weights,
                                  terminate_on_collision=True, gain_filter=repair,
+                                 ttc_star=config.reward_ttc_star,
                                  gain_rate=config.gain_rate, observe=config.observe,
                                  start_spread=config.start_spread)
     env.repair = repair  # type: ignore[attr-defined]
