@@ -82,9 +82,10 @@ def main() -> None:
                 G = np.asarray(res.gains).reshape(-1, 3)  # type: ignore[attr-defined]
                 Km = np.median(G, axis=0)
                 dK = np.abs(np.diff(np.asarray(res.gains), axis=-2)).sum(-1)  # type: ignore[attr-defined]
-                v = [check(*Km, tau=TAU, delta=DELTA, headway=HEADWAY).verdict,
-                     check_sampled(*Km, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=0.1).verdict]
-                print(f"  median executed K = {np.round(Km, 3).tolist()} ({v[0]}, sampled {v[1][0]}); "
+                v = [np.ravel(check(*Km, tau=TAU, delta=DELTA, headway=HEADWAY).verdict)[0],
+                     np.ravel(check_sampled(*Km, tau=TAU, delta=DELTA, headway=HEADWAY,
+                                            sample_time=0.1).verdict)[0]]
+                print(f"  median executed K = {np.round(Km, 3).tolist()} ({v[0]}, sampled {v[1]}); "
                       f"mean Σ|ΔK| per step {dK.mean():.4f}")
             t0 = time.perf_counter()
             print(line(f"frozen median K, {lname}", run(LinearController(*Km, headway=HEADWAY),

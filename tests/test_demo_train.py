@@ -20,7 +20,7 @@ def test_demo_train_step(tmp_path):
     lines: list[str] = []
     out = tmp_path / "train"
     out.mkdir()
-    s = demo._step_train(out, lines.append, steps=400)
+    s = demo._step_train(out, lines.append, steps=400, episodes=6, platoon=0)
     assert s["steps"] == 400
     assert s["idl"]["M_fss"] == 100.0 and s["idl"]["M_fss_sampled"] == 100.0
     assert s["passed"] == (s["idl"]["collisions"] == 0)
@@ -29,7 +29,7 @@ def test_demo_train_step(tmp_path):
         assert (out / f).is_file(), f
     with (out / "evaluation" / "gains.csv").open() as fh:
         rows = list(csv.DictReader(fh))
-    assert len(rows) == s["idl"]["n_gains"]
+    assert len(rows) == s["idl"]["n_gains"] == 6 * 301  # 6 episodes of 30 s at 0.1 s, ends included
     K = np.unique(np.array([[float(r[k]) for k in ("k_x", "k_v", "k_a")] for r in rows]), axis=0)
     # an independent look at the written gains: the exact certificate on every distinct triple
     assert (check(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1).verdict
