@@ -546,3 +546,24 @@ def test_resume_is_bit_for_bit_with_the_phase2_options(tmp_path):
                               resumed.policy.actor.state_dict().items()):
         assert torch.equal(a, b), k
     assert full.episodes == resumed.episodes
+
+
+def test_policy_json_options_are_checked(tmp_path):
+    pol = train(tiny("idl", gain_rate=0.05, observe=("accel", "gains")), leaders=short_leaders(),
+                progress=False).policy
+    pol.save(tmp_path / "p")
+    assert load_policy(tmp_path / "p").observe == ("accel", "gains")
+    doc = json.loads((tmp_path / "p" / "policy.json").read_text())
+    for key, bad, msg in (("observe", ["speed"], "observe must list"),
+                          ("observe", ["accel"], "obs_dim must be 4"),
+                          ("gain_rate", -1, "gain_rate must be a number")):
+        (tmp_path / "p" / "policy.json").write_text(json.dumps({**doc, key: bad}))
+        with pytest.raises(StringStabError, match=msg):
+            load_policy(tmp_path / "p")
+
+
+def test_cli_train_paper_flag_is_for_idl_only(tmp_path, capsys):
+    assert main(["train", "--algo", "td3", "--paper", "--steps", "10",
+                 "--out", str(tmp_path / "r")]) == 2
+    assert "--paper applies to --algo idl" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()

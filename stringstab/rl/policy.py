@@ -180,6 +180,18 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
         _need(info, key, (int, float), where)
     if len(low) != act_dim or len(high) != act_dim:
         raise StringStabError(f"{where}: low/high must have act_dim={act_dim} entries")
+    observe = info.get("observe") or []  # absent from phase-1 policies: the eq-16 state
+    if (not isinstance(observe, list) or not set(observe) <= {"accel", "gains"}
+            or len(set(observe)) != len(observe)):
+        raise StringStabError(f"{where}: observe must list names from ['accel', 'gains']; "
+                              f"found {observe!r}")
+    want_dim = 3 + ("accel" in observe) + 3 * ("gains" in observe)
+    if observe and obs_dim != want_dim:  # (without extras a custom environment's states may be any size)
+        raise StringStabError(f"{where}: obs_dim must be {want_dim} for observe {observe}; "
+                              f"found {obs_dim}")
+    rate = info.get("gain_rate") or 0.0
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 <= rate < float("inf"):
+        raise StringStabError(f"{where}: gain_rate must be a number >= 0; found {rate!r}")
     arrays = read_tensors(d / "policy.safetensors", expected_sha256=_need(info, "sha256", str, where),
                           what="policy")
     try:
