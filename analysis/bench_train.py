@@ -3,7 +3,7 @@
 Same run, same machine load, arms of the IDL trainer for ``--steps`` environment steps: no
 repair (the ablation, the baseline of the ratio); the default repair (certified lookup
 projection, continuous and sampled-data certificates); the same with the sampled-data check as
-it was before commit fe1711a ("before": the lag primitives of ``check_sampled`` built as
+it was before the point-path fix of issue 11 phase 2 ("before": the lag primitives of ``check_sampled`` built as
 zero-width intervals, reproduced here by forcing the interval path of the first two
 ``_phi_iv`` calls of each build); the continuous certificate alone (``repair_sampled=False``);
 and the exact projection (:class:`stringstab.tuning.Projector`) for a shorter stretch.  Also
@@ -45,7 +45,7 @@ def arm(name: str, steps: int, **kw: object) -> dict[str, float]:
 
 @contextlib.contextmanager
 def sampled_before() -> Iterator[None]:
-    """``check_sampled`` as before fe1711a: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
+    """``check_sampled`` as before the point-path fix: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
     prim, phi = sampled._primitives_iv, sampled._phi_iv
     left = [0]
 
@@ -105,7 +105,7 @@ def main() -> None:
     with sampled_before():
         old = arm("lookup, before", args.steps)
     cont = arm("lookup, continuous", args.steps, repair_sampled=False)
-    print(f"repair share: default {100 * look['repair_share']:.1f}% (before fe1711a "
+    print(f"repair share: default {100 * look['repair_share']:.1f}% (before the point-path fix "
           f"{100 * old['repair_share']:.1f}%, continuous only {100 * cont['repair_share']:.1f}%); "
           f"steps/s ratio default/before = {look['steps_per_second'] / old['steps_per_second']:.2f}")
     # shorter (it is slow), but past learning_starts so that its updates are counted too
