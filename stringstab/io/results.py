@@ -395,7 +395,8 @@ def _csv_quote(x: str) -> str:
 
 def _join_rows(rows: Any, sep: str) -> str:
     """The rows joined by ``sep``: each row gets ``sep`` appended in C, and the text is the
-    array's character buffer read once (no list of rows, no second join)."""
+    array's character buffer read once, without the last ``sep`` (no list of rows, no second
+    join, no copy to cut the end)."""
     pa, pc = _pa()
     if len(rows) == 0:
         return ""
@@ -405,8 +406,8 @@ def _join_rows(rows: Any, sep: str) -> str:
     offsets = np.frombuffer(ended.buffers()[1], dtype=np.int64, count=len(ended) + 1,
                             offset=8 * ended.offset)
     data = ended.buffers()[2]
-    text = data[int(offsets[0]):int(offsets[-1])].to_pybytes().decode("utf-8")
-    return text[: len(text) - len(sep)]
+    end = int(offsets[-1]) - len(sep.encode("utf-8"))
+    return data[int(offsets[0]):end].to_pybytes().decode("utf-8")
 
 
 def _params_flat(params: Mapping[str, Any] | None) -> dict[str, Any]:
@@ -486,16 +487,17 @@ def _json_rows(cols: Mapping[str, _Leaf | dict[str, _Leaf]]) -> str:
 def _json(cols: Mapping[str, _Leaf | dict[str, _Leaf]], params: Mapping[str, Any] | None,
           summary: Mapping[str, Any] | None) -> str:
     dump = json.JSONEncoder(ensure_ascii=False, allow_nan=False).encode
-    parts: list[str] = []
+    parts: list[str] = ["{\n"]  # joined once at the end: the rows' text is copied once
     if params is not None:
-        parts.append(f' "params": {dump(to_plain(params))}')
+        parts.append(f' "params": {dump(to_plain(params))},\n')
     if _n_rows(cols):
-        parts.append(' "results": [\n  ' + _json_rows(cols) + "\n ]")
+        parts += [' "results": [\n  ', _json_rows(cols), "\n ]"]
     else:
         parts.append(' "results": []')
     if summary is not None:
-        parts.append(f' "summary": {dump(to_plain(summary))}')
-    return "{\n" + ",\n".join(parts) + "\n}\n"
+        parts.append(f',\n "summary": {dump(to_plain(summary))}')
+    parts.append("\n}\n")
+    return "".join(parts)
 
 
 # --------------------------------------------------------------------------- the human table
