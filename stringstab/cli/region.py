@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ..regions import CONTINUOUS, GAIN_NAMES
@@ -23,7 +24,7 @@ from ._common import add_model_arguments, loop_params
 
 __all__ = ["add_parser", "run"]
 
-DEFAULT_RANGE = (-2.0, 2.0)
+DEFAULT_RANGE = GAIN_BOUNDS
 DEFAULT_N_2D = 201
 DEFAULT_N_3D = 61
 

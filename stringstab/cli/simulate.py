@@ -14,7 +14,7 @@ import math
 import sys
 from typing import Any
 
-from ..constants import DT, STANDSTILL, TTC_STAR
+from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, STANDSTILL, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
 
@@ -34,7 +34,8 @@ def add_parser(sub: Any) -> None:
         help="simulate a platoon behind a leader; write trajectories, metrics JSON and figures",
         description=(
             "Simulate N followers (IDL third-order model, eqs 5-7, actuator lag tau, predecessor "
-            "acceleration received delta late, limits [-7.6, 3] m/s^2 and [0, 33.3] m/s) behind a "
+            f"acceleration received delta late, limits [{ACCEL_MIN:g}, {ACCEL_MAX:g}] m/s^2 and "
+            f"[0, {SPEED_MAX:g}] m/s) behind a "
             "leader, and write trajectories, the IDL metrics (m_p, M_lss, TIT, M_CI, M_effi, "
             "M_fss, collisions) and figures like the paper's Figs 7-8. Refused: a leader above "
             "the speed limit, --dt longer than tau or delta, an output folder that cannot be "

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ._common import PlotResult, pyplot
 
@@ -18,7 +19,7 @@ __all__ = ["moves_region", "plot_moves"]
 
 
 def moves_region(results: Sequence[TuneResult], *, tau: float, delta: float, headway: float,
-                 k_a: float | None = None, bounds: tuple[float, float] = (-2.0, 2.0),
+                 k_a: float | None = None, bounds: tuple[float, float] = GAIN_BOUNDS,
                  n: int = 121) -> RegionMap:
     """The exact region map behind :func:`plot_moves`: a k_x–k_v slice at ``k_a`` (compute step).
 
@@ -44,7 +45,7 @@ def plot_moves(
     delta: float | None = None,
     headway: float | None = None,
     k_a: float | None = None,
-    bounds: tuple[float, float] = (-2.0, 2.0),
+    bounds: tuple[float, float] = GAIN_BOUNDS,
     n: int = 121,
     ax: Any = None,
 ) -> PlotResult:

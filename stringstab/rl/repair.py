@@ -52,6 +52,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certificate import check
+from ..constants import GAIN_BOUNDS
 from ..criteria import hurwitz
 from ..errors import StringStabError
 from ..frequency import margin_g
@@ -166,7 +167,7 @@ class GainRepair:
     """
 
     def __init__(self, method: str = "projection", *, tau: float, delta: float, headway: float,
-                 bounds: tuple[float, float] = (-2.0, 2.0), resolution: float = 0.05,
+                 bounds: tuple[float, float] = GAIN_BOUNDS, resolution: float = 0.05,
                  refine: int = 4, sample_time: float | None = None) -> None:
         if method not in REPAIRS:
             raise StringStabError(f"repair method must be one of {list(REPAIRS)}; got {method!r}")

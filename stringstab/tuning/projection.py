@@ -35,6 +35,7 @@ import numpy.typing as npt
 
 from .. import margin as _margin
 from ..certificate import certify, certify_batch, check
+from ..constants import GAIN_BOUNDS
 from ..criteria import hurwitz_conditions, hurwitz_ok
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model, positive
@@ -243,7 +244,7 @@ class Projector:
         sample_time: float | None = None,
         heterogeneous: bool = True,
         weights: Sequence[float] = (1.0, 1.0, 1.0),
-        bounds: tuple[float, float] = (-2.0, 2.0),
+        bounds: tuple[float, float] = GAIN_BOUNDS,
         hurwitz_margin: float = 1e-3,
         eps: float = 1e-4,
         max_exchange: int = 25,
@@ -671,7 +672,7 @@ def project(
     sample_time: float | None = None,
     heterogeneous: bool = True,
     weights: Sequence[float] = (1.0, 1.0, 1.0),
-    bounds: tuple[float, float] = (-2.0, 2.0),
+    bounds: tuple[float, float] = GAIN_BOUNDS,
     hurwitz_margin: float = 1e-3,
     eps: float = 1e-4,
     warm_start: Sequence[float] | None = None,

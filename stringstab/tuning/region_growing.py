@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certificate import certify
+from ..constants import GAIN_BOUNDS
 from ..criteria import TYPE_NAMES, hurwitz, taylor_criteria
 from ..errors import StringStabError
 from ..params import Params, positive
@@ -69,7 +70,7 @@ def region_growing(
     headway: float,
     r0: float = 0.1,
     grid: int = 2,
-    bounds: tuple[float, float] = (-2.0, 2.0),
+    bounds: tuple[float, float] = GAIN_BOUNDS,
     max_iter: int | None = None,
     criterion: str = "derived",
     weights: Sequence[float] = (1.0, 1.0, 1.0),
