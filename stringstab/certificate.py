@@ -63,6 +63,10 @@ from .margin import tail_bound
 from .params import Box, Params, as_gains, parameter_model
 from .params import sample_time as _sample_time
 from .verdicts import (
+    CERTIFIED,
+    INCONCLUSIVE,
+    NOT_CERTIFIED,
+    ROUNDOFF_SLACK,
     ROW_COLUMNS,
     VERDICTS,
     BatchResult,
@@ -94,8 +98,8 @@ __all__ = [
 
 Array = npt.NDArray[np.float64]
 
-_CERT, _NOT, _INC = 0, 1, 2
-_SLACK = 1e-13  # relative round-off slack on g
+_CERT, _NOT, _INC = CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE
+_SLACK = ROUNDOFF_SLACK
 
 
 # ---------------------------------------------------------------------------

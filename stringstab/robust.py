@@ -82,7 +82,19 @@ from .sampled import (
     _spread,
     split_delay,
 )
-from .verdicts import ROW_COLUMNS, BatchResult, Check, SingleResult, chunks, names, one_triple
+from .verdicts import CERTIFIED as CERTIFIED_CODE
+from .verdicts import (
+    INCONCLUSIVE,
+    NOT_CERTIFIED,
+    ROUNDOFF_SLACK,
+    ROW_COLUMNS,
+    BatchResult,
+    Check,
+    SingleResult,
+    chunks,
+    names,
+    one_triple,
+)
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -100,8 +112,8 @@ __all__ = [
 ]
 
 Array = npt.NDArray[np.float64]
-_CERT, _NOT, _INC = 0, 1, 2
-_SLACK = 1e-13
+_CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
+_SLACK = ROUNDOFF_SLACK
 _SCHUR_RTOL = 1e-12
 
 

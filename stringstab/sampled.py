@@ -77,6 +77,7 @@ from .verdicts import CERTIFIED as CERTIFIED_CODE
 from .verdicts import (
     INCONCLUSIVE,
     NOT_CERTIFIED,
+    ROUNDOFF_SLACK,
     ROW_COLUMNS,
     VERDICTS,
     BatchResult,
@@ -108,7 +109,7 @@ Array = npt.NDArray[np.float64]
 
 _CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
 
-_SLACK = 1e-13  # relative round-off slack on g_H (per unit of the magnitude companion)
+_SLACK = ROUNDOFF_SLACK  # on g_H, per unit of the magnitude companion
 _SCHUR_RTOL = 1e-12  # relative band around the Schur boundary left inconclusive
 
 

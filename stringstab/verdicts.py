@@ -34,6 +34,7 @@ __all__ = [
     "CERTIFIED",
     "INCONCLUSIVE",
     "NOT_CERTIFIED",
+    "ROUNDOFF_SLACK",
     "ROW_COLUMNS",
     "VERDICTS",
     "BatchResult",
@@ -51,6 +52,10 @@ Array = npt.NDArray[np.float64]
 #: The three possible verdicts, by code: 0 certified, 1 not certified, 2 inconclusive.
 VERDICTS: tuple[str, str, str] = ("certified", "not_certified", "inconclusive")
 CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE = 0, 1, 2
+
+#: Relative round-off slack of every certificate's comparisons: each bound on a margin is
+#: widened by this factor times the sum of the absolute values of its terms (hundreds of ulps).
+ROUNDOFF_SLACK = 1e-13
 
 #: The first columns of every certificate's human table: the input row's time and vehicle
 #: (when the input has them) and the gains.
