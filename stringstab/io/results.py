@@ -431,8 +431,14 @@ def _csv(cols: Mapping[str, _Leaf | dict[str, _Leaf]], params: Mapping[str, Any]
     if n == 0:
         return header + "\n"
     pieces = [_filled(_cells(leaf, "csv"), "") for leaf in flat.values()]
-    pieces += [pa.repeat(pa.scalar(_csv_cell(v), pa.string()), n) for v in extra.values()]
-    if not any(pc.any(pc.starts_with(p, '"')).as_py() for p in pieces):
+    extra_cells = [_csv_cell(v) for v in extra.values()]
+    pieces += [pa.repeat(pa.scalar(c, pa.string()), n) for c in extra_cells]
+    # only text can carry quotes (numbers and booleans never do); a categorical's labels suffice
+    quoted = any(c.startswith('"') for c in extra_cells) or any(
+        any(_csv_quote(str(x)) != str(x) for x in leaf.base.tolist()) if leaf.codes is not None
+        else pc.any(pc.starts_with(cells, '"')).as_py()
+        for leaf, cells in zip(flat.values(), pieces) if leaf.kind not in "bif")
+    if not quoted:
         # Arrow's CSV writer lays the (already formatted) cells out in C++, 3x faster than
         # joining them here; "none" because every cell is final text needing no quotes.
         import pyarrow.csv as pa_csv
