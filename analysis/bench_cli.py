@@ -11,7 +11,8 @@
    (which python-control's ``norm`` uses when present) is installed is printed.
 3. **Region map through the CLI.**  ``stringstab region`` on an ``--region-n``² (801²) exact
    map over (k_x, k_v) at k_a = 0.5 with ``--format png`` and the CSV data, against
-   :func:`stringstab.regions.region_map` alone (in this process) on the same grid; target ≤ 1.5.
+   :func:`stringstab.regions.region_map` alone (in this process) on the same grid, the two
+   alternated ``--region-repeat`` times and the medians compared; target ≤ 1.5.
 
 Every figure is printed with the machine load (``os.getloadavg()``) beside it; nothing is
 asserted.  Run from the repository root::
@@ -68,8 +69,8 @@ def bench_start(repeat: int) -> None:
         lib.append(_wall(lib_cmd))
         target.append(_wall(cmd))
     mb, ml, mt = statistics.median(base), statistics.median(lib), statistics.median(target)
-    print("1. fast start: the CLI layer (lazy sub-commands, light io: helper B) adds the last "
-          "line minus the middle one; the library's import chain (helper A) is the middle one")
+    print("1. fast start: the command-line layer (lazy sub-commands, light io) adds the last "
+          "line minus the middle one; the library's import chain is the middle one")
     for label, m, xs in (("baseline  python -c 'import numpy, scipy.linalg'", mb, base),
                          ("library   python -c 'import stringstab.certificate'", ml, lib),
                          ("target    stringstab certify 1,0.5,0.5           ", mt, target)):
@@ -136,37 +137,42 @@ def bench_outputs(n: int, pade_n: int, formats: list[str], seed: int, repeat: in
         shutil.rmtree(work, ignore_errors=True)
 
 
-def bench_region(n: int, workers: int | None) -> None:
+def bench_region(n: int, workers: int | None, repeat: int) -> None:
     from stringstab.regions import region_map
 
     g = np.linspace(-2.0, 2.0, n)
     kw = {} if workers is None else {"workers": workers}
-    t0 = time.perf_counter()
-    region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
-               methods="exact", progress=False, **kw)  # type: ignore[arg-type]
-    alone = time.perf_counter() - t0
-    load_alone = _load()
     work = Path(tempfile.mkdtemp(prefix="bench_cli_region_"))
+    cmd = [*_cli(), "region", "--x", "k_x", "--y", "k_v", "--fix", "k_a=0.5",
+           "--range", "-2,2", "--n", str(n), "--method", "exact", "--format", "png",
+           "--no-progress", "--out", str(work / "maps")]
+    if workers is not None:
+        cmd += ["--workers", str(workers)]
+    alone: list[float] = []
+    cli: list[float] = []
+    print(f"3. region map {n}x{n} exact (k_x, k_v at k_a = 0.5), PNG and data; "
+          f"region_map alone (in process) and the command (a fresh process) alternated {repeat} times")
     try:
-        cmd = [*_cli(), "region", "--x", "k_x", "--y", "k_v", "--fix", "k_a=0.5",
-               "--range", "-2,2", "--n", str(n), "--method", "exact", "--format", "png",
-               "--no-progress", "--out", str(work / "maps")]
-        if workers is not None:
-            cmd += ["--workers", str(workers)]
-        t0 = time.perf_counter()
-        r = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        cli = time.perf_counter() - t0
-        if r.returncode != 0:
-            raise SystemExit(f"stringstab region failed: {r.stderr.strip()}")
+        for i in range(repeat):
+            t0 = time.perf_counter()
+            region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
+                       methods="exact", progress=False, **kw)  # type: ignore[arg-type]
+            alone.append(time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            r = subprocess.run(cmd, capture_output=True, text=True, check=False)
+            cli.append(time.perf_counter() - t0)
+            if r.returncode != 0:
+                raise SystemExit(f"stringstab region failed: {r.stderr.strip()}")
+            print(f"   run {i + 1}: region_map alone {alone[-1]:6.2f} s, stringstab region {cli[-1]:6.2f} s, "
+                  f"ratio {cli[-1] / alone[-1]:.2f}   [{_load()}]")
         files = sorted(p.name for p in (work / "maps").iterdir() if not p.name.startswith("."))
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    print(f"3. region map {n}x{n} exact (k_x, k_v at k_a = 0.5), PNG and data "
-          "(CLI layer and writer: helper B; map internals: helper A)")
-    print(f"   baseline  region_map alone, in process: {alone:7.2f} s   [{load_alone}]")
-    print(f"   target    stringstab region (fresh process, writes {', '.join(files)}): "
-          f"{cli:7.2f} s")
-    print(f"   ratio {cli / alone:.2f} (target <= 1.5)   [{_load()}]")
+    a, c = statistics.median(alone), statistics.median(cli)
+    print(f"   baseline  region_map alone, in process: median {a:7.2f} s")
+    print(f"   target    stringstab region (fresh process, writes {', '.join(files)}): median {c:7.2f} s")
+    print(f"   ratio of medians {c / a:.2f} (target <= 1.5; per run {min(x / y for x, y in zip(cli, alone)):.2f}"
+          f"-{max(x / y for x, y in zip(cli, alone)):.2f})   [{_load()}]")
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -181,6 +187,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--output-repeat", type=int, default=3, help="CLI runs per format (median; default 3)")
     ap.add_argument("--region-n", type=int, default=801, help="grid points per axis of target 3 (default 801)")
     ap.add_argument("--workers", type=int, default=None, help="worker processes for target 3 (both sides)")
+    ap.add_argument("--region-repeat", type=int, default=5,
+                    help="alternated runs of each side of target 3 (median; default 5)")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
     only = set(args.only or ("start", "outputs", "region"))
@@ -190,7 +198,7 @@ def main(argv: list[str] | None = None) -> None:
     if "outputs" in only:
         bench_outputs(args.n, args.pade_n, args.formats.split(","), args.seed, args.output_repeat)
     if "region" in only:
-        bench_region(args.region_n, args.workers)
+        bench_region(args.region_n, args.workers, args.region_repeat)
 
 
 if __name__ == "__main__":
