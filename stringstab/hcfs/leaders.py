@@ -162,9 +162,4 @@ def hcfs_leader(spec: str, *, dt: float = DT, duration: float | None = None) -> 
     if key not in LEADER_NAMES:
         return leader_by_name(spec, dt=dt, duration=duration)
     tr = training_leader(dt=dt) if key == "hcfs-train" else case_leader(key, dt=dt)[0]
-    if duration is not None:
-        if not (math.isfinite(float(duration)) and duration > 0):
-            raise StringStabError(f"duration must be > 0 s; got {show(duration)}")
-        n = min(tr.n_steps, math.floor(duration / tr.dt + 1e-9) + 1)
-        tr = tr.window(0, max(n, 2))
-    return tr
+    return tr if duration is None else tr.head(duration)

@@ -11,7 +11,6 @@ cycle (:mod:`~stringstab.traffic.cycles`), a synthetic profile with parameters
 from __future__ import annotations
 
 import inspect
-import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -128,9 +127,4 @@ def leader_by_name(spec: str, *, dt: float = DT, duration: float | None = None) 
             f"unknown leader {show(spec)}; expected a cycle {sorted(CYCLES)}, a synthetic profile "
             f"{sorted(SYNTHETIC)} (NAME:key=value,...) or the path of a 't, v[, a]' CSV file"
         )
-    if duration is not None:
-        if not duration > 0:
-            raise StringStabError(f"duration must be > 0 s; got {show(duration)}")
-        n = min(tr.n_steps, math.floor(duration / tr.dt + 1e-9) + 1)
-        tr = tr.window(0, max(n, 2))
-    return tr
+    return tr if duration is None else tr.head(duration)

@@ -117,6 +117,25 @@ class Trajectory:
         return Trajectory(self.dt, self.position[sl], self.speed[sl], self.accel[sl], self.name,
                           dict(self.meta))
 
+    def head(self, duration: float) -> Trajectory:
+        """The first ``duration`` seconds (at least two samples, at most the whole trajectory).
+
+        Raises
+        ------
+        StringStabError
+            If ``duration`` is not a finite number > 0.
+
+        Examples
+        --------
+        >>> from stringstab.traffic.leaders import cycle
+        >>> cycle("udds").head(10.0).duration
+        10.0
+        """
+        if not (math.isfinite(float(duration)) and duration > 0):
+            raise StringStabError(f"duration must be > 0 s; got {show(duration)}")
+        n = min(self.n_steps, math.floor(duration / self.dt + 1e-9) + 1)
+        return self.window(0, max(n, 2))
+
 
 def _grid(t0: float, t1: float, dt: float) -> Array:
     n = math.floor((t1 - t0) / dt + 1e-9) + 1
