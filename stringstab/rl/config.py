@@ -282,11 +282,13 @@ def _check(c: TD3Config) -> None:
     if len(w) != 3 or not all(math.isfinite(x) and x >= 0 for x in w):
         raise StringStabError(f"config field weights must be 3 numbers >= 0; got {show(c.weights)}")
     object.__setattr__(c, "weights", w)
+    from ..traffic.env import OBSERVE
+
     obs = tuple(c.observe) if isinstance(c.observe, (list, tuple)) else None
-    if obs is None or not set(obs) <= {"accel", "gains"} or len(set(obs)) != len(obs):
+    if obs is None or not set(obs) <= set(OBSERVE) or len(set(obs)) != len(obs):
         raise StringStabError(
-            f"config field observe must list distinct names from ['accel', 'gains']; got {show(c.observe)}")
-    object.__setattr__(c, "observe", tuple(x for x in ("accel", "gains") if x in obs))
+            f"config field observe must list distinct names from {list(OBSERVE)}; got {show(c.observe)}")
+    object.__setattr__(c, "observe", tuple(x for x in OBSERVE if x in obs))
     try:
         sp = tuple(float(x) for x in c.start_spread)
     except (TypeError, ValueError) as e:

@@ -180,12 +180,14 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
         _need(info, key, (int, float), where)
     if len(low) != act_dim or len(high) != act_dim:
         raise StringStabError(f"{where}: low/high must have act_dim={act_dim} entries")
+    from ..traffic.env import OBSERVE, state_dim
+
     observe = info.get("observe") or []  # absent from phase-1 policies: the eq-16 state
-    if (not isinstance(observe, list) or not set(observe) <= {"accel", "gains"}
+    if (not isinstance(observe, list) or not set(observe) <= set(OBSERVE)
             or len(set(observe)) != len(observe)):
-        raise StringStabError(f"{where}: observe must list names from ['accel', 'gains']; "
+        raise StringStabError(f"{where}: observe must list names from {list(OBSERVE)}; "
                               f"found {observe!r}")
-    want_dim = 3 + ("accel" in observe) + 3 * ("gains" in observe)
+    want_dim = state_dim(observe)
     if observe and obs_dim != want_dim:  # (without extras a custom environment's states may be any size)
         raise StringStabError(f"{where}: obs_dim must be {want_dim} for observe {observe}; "
                               f"found {obs_dim}")

@@ -63,7 +63,7 @@ from .reward import reward
 from .trajectory import Trajectory
 
 __all__ = ["OBSERVE", "SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "extend_state",
-           "limit_rate", "state_vector"]
+           "limit_rate", "state_dim", "state_vector"]
 
 #: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).
 _PLATOON_STATE = ("position", "speed", "accel", "_buf", "collided", "collision_events",
@@ -93,6 +93,21 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
                      obs.pred_accel_delayed / scales[2]], axis=-1)
 
 
+def state_dim(observe: Sequence[str] = ()) -> int:
+    """Length of the state with the ``observe`` extras: 3 (eq 16), 1 more for ``"accel"``, 3
+    more for ``"gains"`` (:func:`extend_state`).
+
+    Examples
+    --------
+    >>> state_dim(), state_dim(("accel", "gains"))
+    (3, 7)
+    """
+    unknown = sorted(set(observe) - set(OBSERVE))
+    if unknown:
+        raise StringStabError(f"observe must name some of {list(OBSERVE)}; got {unknown}")
+    return 3 + ("accel" in observe) + 3 * ("gains" in observe)
+
+
 def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
                  accel: npt.ArrayLike | None = None, prev_gains: npt.ArrayLike | None = None,
                  scales: tuple[float, float, float] = SCALES) -> Array:
@@ -108,9 +123,7 @@ def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
     [[0.1, 0.2, 0.3, 0.2, 0.5, 0.25, -0.2]]
     """
     s = np.asarray(state, dtype=np.float64)
-    unknown = sorted(set(observe) - set(OBSERVE))
-    if unknown:
-        raise StringStabError(f"observe must name some of {list(OBSERVE)}; got {unknown}")
+    state_dim(observe)  # checks the names
     parts = [s]
     if "accel" in observe:
         if accel is None:
@@ -188,8 +201,7 @@ class _Core:
         spread = tuple(float(x) for x in start_spread)
         if len(spread) != 2 or not all(np.isfinite(x) and x >= 0 for x in spread):
             raise StringStabError(f"start_spread must be (gap fraction, speed m/s) >= 0; got {show(start_spread)}")
-        extend_state(np.zeros((1, 3)), observe=observe, accel=np.zeros(1),
-                     prev_gains=np.zeros((1, 3)))  # checks the names
+        state_dim(observe)  # checks the names
         self.gain_rate, self.extras, self.start_spread = float(gain_rate), tuple(observe), spread
         self.lengths = np.array([tr.n_steps for tr in trs])
         T = int(self.lengths.max())
@@ -297,8 +309,7 @@ class _Core:
 
 def _spaces(action: ActionMode, gain_bounds: tuple[float, float],
             limits: Limits | None, observe: Sequence[str] = ()) -> tuple[spaces.Box, spaces.Box]:
-    dim = 3 + ("accel" in observe) + 3 * ("gains" in observe)
-    obs_space = spaces.Box(-np.inf, np.inf, shape=(dim,), dtype=np.float32)
+    obs_space = spaces.Box(-np.inf, np.inf, shape=(state_dim(observe),), dtype=np.float32)
     if action == "gains":
         act_space = spaces.Box(float(gain_bounds[0]), float(gain_bounds[1]), shape=(3,), dtype=np.float32)
     else:
