@@ -819,15 +819,26 @@ def spectral_radius(
     return _spectral_radius([d.lo for d in delta]).reshape(shape)
 
 
-def _spectral_radius(delta: list[Array]) -> Array:
+def _poles(delta: list[Array]) -> npt.NDArray[np.complex128]:
+    """The roots of Δ(z), one row of three per triple (companion-matrix eigenvalues)."""
     a2, a1, a0 = _z_coeffs(delta)
     n = a2.size
+    if not n:
+        return np.zeros((0, 3), dtype=complex)
     C = np.zeros((n, 3, 3))
     C[:, 0, :] = -np.stack([a2, a1, a0], axis=1)
     C[:, 1, 0] = 1.0
     C[:, 2, 1] = 1.0
-    ev = np.linalg.eigvals(C) if n else np.zeros((0, 3))
-    return np.asarray(np.abs(ev).max(axis=1) if n else np.zeros(0))
+    return np.asarray(np.linalg.eigvals(C), dtype=complex)
+
+
+def _spectral_radius(delta: list[Array]) -> Array:
+    return np.asarray(np.abs(_poles(delta)).max(axis=1) if delta[0].size else np.zeros(0))
+
+
+def _pole_angles(delta: list[Array]) -> Array:
+    """|arg z| ∈ [0, π] of the roots of Δ(z): where a lightly damped pole makes |H| peak."""
+    return np.abs(np.angle(_poles(delta)))
 
 
 # ---------------------------------------------------------------------------
@@ -1001,9 +1012,18 @@ def _peak(co: _Coeffs, m: int, ka: Array, W: Array, worst: Array) -> tuple[Array
 
     A = absH(Wall)
     A[:, 0] = np.where(co.delta[0].lo != 0, 1.0, A[:, 0])  # H(1) = 1 exactly
+    half = np.full(n, np.pi / (W.shape[1] - 1))
     j = np.argmax(A, axis=1)
-    return zoom_max(absH, Wall[rows, j], A[rows, j], np.full(n, np.pi / (W.shape[1] - 1)),
-                    hi=np.pi)
+    best, where = zoom_max(absH, Wall[rows, j], A[rows, j], half, hi=np.pi)
+    # A lightly damped pole of the loop (radius near 1) makes a resonance narrower than the
+    # grid, which can sit between two grid points below another local maximum: zoom also
+    # from the angles of the poles of Δ(z), and keep the larger peak.
+    P = _pole_angles([d.lo for d in co.delta])
+    Ap = absH(P)
+    k = np.argmax(Ap, axis=1)
+    pb, pw = zoom_max(absH, P[rows, k], Ap[rows, k], half, hi=np.pi)
+    take = pb > best
+    return np.where(take, pb, best), np.where(take, pw, where)
 
 
 @dataclass(frozen=True)
