@@ -41,7 +41,7 @@ from .progress import Progress
 from .runtime import SumoSession
 from .scenario import LEADER_ID, follower_ids, straight_road
 
-__all__ = ["DEFAULT_LENGTH", "SumoPlatoon", "cosimulate", "vehicle_state"]
+__all__ = ["DEFAULT_LENGTH", "SumoPlatoon", "ballistic_leader", "cosimulate", "vehicle_state"]
 
 Array = npt.NDArray[np.float64]
 #: Vehicle length, m (as the toolkit's simulator).
@@ -69,6 +69,34 @@ def vehicle_state(session: SumoSession, ids: list[str], t: float) -> tuple[Array
         x[j] = r[c.VAR_LANEPOSITION]
         v[j] = r[c.VAR_SPEED]
     return x, v
+
+
+def ballistic_leader(leader: Trajectory) -> tuple[Trajectory, float]:
+    """The leader as SUMO moves it: its speed samples, positions by the trapezoid rule.
+
+    SUMO is told the leader's speed every step and moves it by Δt (v_k + v_{k+1})/2 (the
+    ballistic update); a trajectory whose positions are another integral of its speeds (the
+    synthetic profiles' closed-form positions) is driven in SUMO as this one.  Accelerations are
+    kept (they are what the followers receive over the delayed link).
+
+    Returns
+    -------
+    (Trajectory, float)
+        The leader with trapezoidal positions, and the largest |position change| this made, m.
+
+    Examples
+    --------
+    >>> from stringstab.traffic import from_speed
+    >>> tr, moved = ballistic_leader(from_speed([0, 1, 2], [10.0, 11.0, 11.0], dt=1.0))
+    >>> tr.position.tolist(), moved
+    ([0.0, 10.5, 21.5], 0.0)
+    """
+    x = np.empty_like(leader.position)
+    x[0] = leader.position[0]
+    np.cumsum((leader.speed[1:] + leader.speed[:-1]) * (0.5 * leader.dt), out=x[1:])
+    x[1:] += x[0]
+    moved = float(np.max(np.abs(x - leader.position)))
+    return Trajectory(leader.dt, x, leader.speed.copy(), leader.accel.copy(), leader.name), moved
 
 
 class SumoPlatoon:

@@ -167,11 +167,17 @@ def _check_peer(proc: subprocess.Popen[bytes], conn: Any) -> None:
     """Linux: SUMO's only TCP socket must be its connection to this process on 127.0.0.1."""
     if not Path(f"/proc/{proc.pid}/fd").exists():
         return
+    conn.getVersion()  # a round trip: SUMO has accepted its client
     mine = conn._socket.getsockname()  # the client side of the one connection
     local = f"0100007F:{mine[1]:04X}"
-    theirs = _socket_inodes(proc.pid)
-    rows = [r for r in _tcp_rows() if r[9] in theirs]
-    ok = len(rows) == 1 and rows[0][2] == local and rows[0][3] == "01"
+    end = time.monotonic() + 5.0
+    while True:
+        theirs = _socket_inodes(proc.pid)
+        rows = [r for r in _tcp_rows() if r[9] in theirs]
+        ok = len(rows) == 1 and rows[0][2] == local and rows[0][3] == "01"
+        if ok or time.monotonic() > end:
+            break
+        time.sleep(0.01)  # the listening socket is closed just after the accept
     if not ok:
         raise StringStabError(
             "SUMO's TraCI server did not end up connected to this process alone on 127.0.0.1 "

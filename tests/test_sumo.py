@@ -1,0 +1,107 @@
+"""stringstab.sumo: SUMO runs the toolkit's controllers exactly (skipped without the extra)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("libsumo", reason="needs the optional extra 'sumo' (pip install 'stringstab[sumo]')")
+pytest.importorskip("traci", reason="needs the optional extra 'sumo' (pip install 'stringstab[sumo]')")
+
+from stringstab.cli import main
+from stringstab.errors import StringStabError
+from stringstab.sumo import cosimulate
+from stringstab.sumo.agreement import agreement
+from stringstab.traffic import LinearController, leader_by_name, simulate, sinusoid
+
+
+def test_toolkit_and_sumo_agree_on_a_udds_leader_with_stops():
+    lead = leader_by_name("udds", dt=0.1, duration=60.0)  # starts and ends stopped
+    assert lead.speed.min() == 0.0
+    res = agreement(lead, LinearController(1.2, 0.5, 0.6), 3)
+    assert res["passed"]
+    for k, v in res["differences"].items():
+        assert v < 1e-9, k  # round-off: the same equations on both sides
+    # the toolkit's default exact positions are measurably different (the option matters)
+    assert res["differences_exact_positions"]["accel"] > 1e-5
+    assert res["sumo_speed_override"] == 0.0
+
+
+def test_traci_equals_libsumo():
+    lead = sinusoid(omega=0.5, amplitude=1.0, duration=15.0)
+    c = LinearController(1.2, 0.5, 0.6)
+    a = cosimulate(lead, c, 3, api="libsumo")
+    b = cosimulate(lead, c, 3, api="traci")
+    assert a.params["sumo_api"] == "libsumo" and b.params["sumo_api"] == "traci"
+    np.testing.assert_array_equal(a.position, b.position)
+    np.testing.assert_array_equal(a.speed, b.speed)
+    np.testing.assert_array_equal(a.accel, b.accel)
+
+
+def test_speed_mode_semantics():
+    # a controller that drives into its leader (u = +3 m/s² throughout)
+    from stringstab.traffic import FunctionController
+
+    lead = sinusoid(omega=0.5, amplitude=0.1, duration=12.0)
+    c = FunctionController(lambda obs: 3.0)
+    # speed mode 0: SUMO executes the commanded speed exactly, into a collision the toolkit counts
+    exact = cosimulate(lead, c, 2, speed_mode=0)
+    assert exact.params["sumo_speed_override"] == 0.0
+    assert exact.collided.any()
+    # SUMO's default speed mode (31): its safe-speed rule silently overrides the controller
+    safe = cosimulate(lead, c, 2, speed_mode=31)
+    assert safe.params["sumo_speed_override"] > 0.1
+    assert not safe.collided.any()
+
+
+def test_check_command_passes_on_a_sine(capsys, tmp_path):
+    out = tmp_path / "check.json"
+    rc = main(["sumo", "check", "--leader", "sinusoid:omega=0.5,amplitude=1", "--duration", "20",
+               "--followers", "3", "--json", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 0, text
+    assert "passed" in text and "accel" in text
+    doc = json.loads(out.read_text())
+    assert doc["passed"] and max(doc["differences"].values()) < 1e-3
+
+
+def test_check_fails_above_the_tolerance(capsys):
+    # a tolerance below round-off: the check must be able to fail (exit 1)
+    rc = main(["sumo", "check", "--leader", "sinusoid:omega=0.5", "--duration", "10",
+               "--followers", "2",
+               "--tolerance", "1e-300"])
+    assert rc == 1
+    assert "FAILED" in capsys.readouterr().out
+
+
+def test_cosimulate_matches_simulate_metrics():
+    lead = leader_by_name("udds", dt=0.1, duration=30.0)
+    c = LinearController(1.2, 0.5, 0.6)
+    co = cosimulate(lead, c, 2)
+    tk = simulate(lead, c, 2, position_update="trapezoid")
+    m1, m2 = co.metrics(), tk.metrics()
+    assert m1["m_fss"] == m2["m_fss"] == 1.0
+    assert m1["max_m_p"] == pytest.approx(m2["max_m_p"], abs=1e-9)
+    assert m1["TIT"] == pytest.approx(m2["TIT"], abs=1e-6)
+
+
+def test_step_mismatch_is_refused():
+    from stringstab.sumo import SumoSession
+
+    lead = leader_by_name("udds", dt=0.1, duration=5.0)
+    with pytest.raises(StringStabError, match="step"):
+        # a leader sampled at 0.05 s against a SUMO running 0.1 s
+        import tempfile
+
+        from stringstab.sumo.scenario import straight_road
+        with tempfile.TemporaryDirectory() as d:
+            road = straight_road(d, distance=100.0, gaps=[2.0], speeds=[0.0], leader_speed=0.0,
+                                 length=5.0)
+            with SumoSession(road.sumo_args(), dt=0.1) as s:
+                s.step()
+                from stringstab.sumo import SumoPlatoon
+
+                SumoPlatoon(s, leader_by_name("udds", dt=0.05, duration=5.0), ["F1"])
+    assert lead.dt == 0.1
