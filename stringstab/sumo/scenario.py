@@ -68,7 +68,8 @@ class StraightRoad:
 
 
 def straight_road(directory: str | Path, *, distance: float, gaps: npt.ArrayLike,
-                  speeds: npt.ArrayLike, leader_speed: float, length: float) -> StraightRoad:
+                  speeds: npt.ArrayLike, leader_speed: float, length: float,
+                  vtype: str | None = None, type_id: str = "platoon") -> StraightRoad:
     """Write a straight one-lane road with a leader and its followers into ``directory``.
 
     Parameters
@@ -83,6 +84,9 @@ def straight_road(directory: str | Path, *, distance: float, gaps: npt.ArrayLike
         The leader's initial speed, m/s.
     length : float
         Vehicle length, m.
+    vtype, type_id : str, optional
+        The XML of another vType for every vehicle (e.g. SUMO's CACC) and its id; default a
+        Krauss vType driven through speed commands (the module docstring).
 
     Returns
     -------
@@ -116,18 +120,20 @@ def straight_road(directory: str | Path, *, distance: float, gaps: npt.ArrayLike
         msg = " ".join((proc.stderr or proc.stdout).split())[:300]
         raise StringStabError(f"netconvert could not build the straight road: {msg}")
     x = start - np.cumsum(g + length)
+    if vtype is None:
+        vtype = (f'<vType id="{type_id}" length="{length!r}" minGap="0" accel="10" decel="10" '
+                 'emergencyDecel="20" sigma="0" maxSpeed="60" speedFactor="1" speedDev="0" '
+                 'carFollowModel="Krauss" tau="1"/>')
     lines = [
         "<routes>",
-        f'  <vType id="platoon" length="{length!r}" minGap="0" accel="10" decel="10" '
-        'emergencyDecel="20" sigma="0" maxSpeed="60" speedFactor="1" speedDev="0" '
-        'carFollowModel="Krauss" tau="1"/>',
+        f"  {vtype}",
         f'  <route id="r" edges="{EDGE}"/>',
-        f'  <vehicle id="{LEADER_ID}" type="platoon" route="r" depart="0" departLane="0" '
+        f'  <vehicle id="{LEADER_ID}" type="{type_id}" route="r" depart="0" departLane="0" '
         f'departPos="{start!r}" departSpeed="{float(leader_speed)!r}" insertionChecks="none"/>',
     ]
     for vid, xi, vi in zip(follower_ids(g.size), x, v):
         lines.append(
-            f'  <vehicle id="{vid}" type="platoon" route="r" depart="0" departLane="0" '
+            f'  <vehicle id="{vid}" type="{type_id}" route="r" depart="0" departLane="0" '
             f'departPos="{float(xi)!r}" departSpeed="{float(vi)!r}" insertionChecks="none"/>')
     lines.append("</routes>")
     routes = d / "platoon.rou.xml"
