@@ -363,8 +363,8 @@ def measure_platoon(vt: CACCType, leader: Trajectory, n_followers: int, *,
     acc[1:] = np.diff(V, axis=0) / dt
     mp = damping_ratios_from_energy((acc * acc).sum(axis=0))
     records = {k: np.concatenate(v) if v else np.array([]) for k, v in rec.items()}
-    modes = records["mode"]
-    share = {m: float(np.mean(modes == m)) for m in sorted(set(modes.tolist()))}
+    mode_arr: Any = records["mode"]
+    share = {m: float(np.mean(mode_arr == m)) for m in sorted(set(mode_arr.tolist()))}
     gap = X[:, :-1] - X[:, 1:] - L
     rms = np.sqrt((acc * acc).mean(axis=0))
     return {"followers": N, "leader": leader.name, "seconds": leader.duration, "dt": dt,
