@@ -196,6 +196,9 @@ class SumoSession:
         The step, s (``--step-length``).
     api : {"libsumo", "traci"}
         In-process libsumo (default; one per process) or the TraCI protocol to a subprocess.
+    scenario : bool
+        A user's scenario: only the step, the ballistic update and quiet logs are imposed (the
+        generated road also turns SUMO's collision handling and teleports off).
 
     Attributes
     ----------
@@ -205,7 +208,8 @@ class SumoSession:
         The SUMO subprocess (TraCI only).
     """
 
-    def __init__(self, args: list[str], *, dt: float, api: str = "libsumo") -> None:
+    def __init__(self, args: list[str], *, dt: float, api: str = "libsumo",
+                 scenario: bool = False) -> None:
         self.api = api
         self.dt = float(dt)
         self.proc: subprocess.Popen[bytes] | None = None
@@ -213,9 +217,10 @@ class SumoSession:
         self._mod = import_api(api)
         cmd = [binary("sumo"), *args, "--step-length", repr(self.dt), "--step-method.ballistic",
                "true", "--no-step-log", "true", "--no-warnings", "true",
-               "--duration-log.disable", "true", "--collision.action", "none",
-               "--collision.check-junctions", "false", "--time-to-teleport", "-1",
-               "--seed", "0"]
+               "--duration-log.disable", "true"]
+        if not scenario:  # the generated road: collisions are the toolkit's to count
+            cmd += ["--collision.action", "none", "--collision.check-junctions", "false",
+                    "--time-to-teleport", "-1", "--seed", "0"]
         self.cmd = cmd
         if api == "libsumo":
             if _ACTIVE_LIBSUMO:
