@@ -177,7 +177,7 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
                 gone |= seen & ~present
                 seen |= present
                 idx = np.flatnonzero(present)
-                lead_info = []
+                lead_info: list[Any] = []
                 for j in idx:
                     vid = ids[j]
                     if vid not in min_gap:
@@ -201,8 +201,9 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
                 active &= present
                 drive = idx[led]
                 if drive.size:
-                    lids = [li[0] for li, has in zip(lead_info, led) if has]
-                    gaps = np.array([li[1] for li, has in zip(lead_info, led) if has])
+                    found = [li for li in lead_info if li is not None]
+                    lids = [str(li[0]) for li in found]
+                    gaps = np.array([float(li[1]) for li in found])
                     gaps = gaps + np.array([min_gap[ids[j]] for j in drive])
                     v = np.array([res[ids[j]][c.VAR_SPEED] for j in drive])
                     a = lag.accel[drive, 1].copy()
