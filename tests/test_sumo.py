@@ -11,7 +11,6 @@ pytest.importorskip("libsumo", reason="needs the optional extra 'sumo' (pip inst
 pytest.importorskip("traci", reason="needs the optional extra 'sumo' (pip install 'stringstab[sumo]')")
 
 from stringstab.cli import main
-from stringstab.errors import StringStabError
 from stringstab.sumo import cosimulate
 from stringstab.sumo.agreement import agreement
 from stringstab.traffic import LinearController, leader_by_name, simulate, sinusoid
@@ -85,23 +84,3 @@ def test_cosimulate_matches_simulate_metrics():
     assert m1["m_fss"] == m2["m_fss"] == 1.0
     assert m1["max_m_p"] == pytest.approx(m2["max_m_p"], abs=1e-9)
     assert m1["TIT"] == pytest.approx(m2["TIT"], abs=1e-6)
-
-
-def test_step_mismatch_is_refused():
-    from stringstab.sumo import SumoSession
-
-    lead = leader_by_name("udds", dt=0.1, duration=5.0)
-    with pytest.raises(StringStabError, match="step"):
-        # a leader sampled at 0.05 s against a SUMO running 0.1 s
-        import tempfile
-
-        from stringstab.sumo.scenario import straight_road
-        with tempfile.TemporaryDirectory() as d:
-            road = straight_road(d, distance=100.0, gaps=[2.0], speeds=[0.0], leader_speed=0.0,
-                                 length=5.0)
-            with SumoSession(road.sumo_args(), dt=0.1) as s:
-                s.step()
-                from stringstab.sumo import SumoPlatoon
-
-                SumoPlatoon(s, leader_by_name("udds", dt=0.05, duration=5.0), ["F1"])
-    assert lead.dt == 0.1

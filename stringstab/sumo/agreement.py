@@ -32,16 +32,21 @@ def differences(a: PlatoonResult, b: PlatoonResult) -> dict[str, float]:
     Returns
     -------
     dict
-        ``accel`` (m/s²), ``speed`` (m/s), ``gap`` (m) and ``m_p`` (eq 29, per follower).
+        ``accel`` (m/s²), ``speed`` (m/s), ``gap`` (m) and ``m_p`` (eq 29, per follower; over
+        the followers where it is defined in both runs, ``inf`` if it is defined in only one).
     """
     assert a.accel is not None and b.accel is not None and a.speed is not None and b.speed is not None
     mp_a, mp_b = a.damping_ratios, b.damping_ratios
     ok = np.isfinite(mp_a) & np.isfinite(mp_b)
+    if (np.isfinite(mp_a) != np.isfinite(mp_b)).any():
+        mp = float("inf")  # defined in one run and not in the other
+    else:  # m_p is undefined (0/0) where a predecessor never accelerates, in both runs alike
+        mp = float(np.max(np.abs(mp_a[ok] - mp_b[ok]))) if ok.any() else 0.0
     return {
         "accel": float(np.max(np.abs(a.accel[1:] - b.accel[1:]))),
         "speed": float(np.max(np.abs(a.speed[1:] - b.speed[1:]))),
         "gap": float(np.max(np.abs(a.gap - b.gap))),
-        "m_p": float(np.max(np.abs(mp_a[ok] - mp_b[ok]))) if ok.any() else float("nan"),
+        "m_p": mp,
     }
 
 
