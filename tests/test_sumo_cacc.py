@@ -76,7 +76,7 @@ def test_discrete_sweep_against_time_domain_iteration():
 
 
 def test_bad_vtypes(tmp_path):
-    with pytest.raises(StringStabError, match="FILE.rou.xml:TYPE"):
+    with pytest.raises(StringStabError, match=r"FILE\.rou\.xml:TYPE"):
         read_vtype(DATA)
     with pytest.raises(StringStabError, match="does not exist"):
         read_vtype(f"{tmp_path / 'x.rou.xml'}:cacc")

@@ -103,7 +103,7 @@ def test_step_mismatch_and_euler_are_refused(capsys, tmp_path):
                          length=5.0)
     with SumoSession(road.sumo_args(), dt=0.1) as s:
         s.step()
-        with pytest.raises(StringStabError, match="leader's step is 0.05 s but SUMO runs with 0.1 s"):
+        with pytest.raises(StringStabError, match=r"leader's step is 0\.05 s but SUMO runs with 0\.1 s"):
             SumoPlatoon(s, leader_by_name("udds", dt=0.05, duration=5.0), ["F1"])
 
 
