@@ -32,7 +32,7 @@ def test_mode_laws_of_the_default_type():
 
 
 def test_certificates_match_the_no_lag_closed_form():
-    for tid in ("cacc", "cacc_t15"):
+    for tid in ("cacc", "cacc_t14"):
         for row in certify_modes(read_vtype(f"{DATA}:{tid}"), 0.1):
             closed = row["no_lag_closed_form"]["string_stable"]
             assert (row["continuous"]["verdict"] == "certified") == closed, (tid, row["mode"])
@@ -62,7 +62,7 @@ def _iterate(law, dt=0.1, steps=3000):
 
 def test_discrete_sweep_against_time_domain_iteration():
     unstable = 0
-    for tid in ("cacc", "cacc_t15"):
+    for tid in ("cacc", "cacc_t14"):
         for law in mode_laws(read_vtype(f"{DATA}:{tid}"), 0.1):
             sw = discrete_sweep(law, 0.1)
             errs = _iterate(law)
@@ -72,7 +72,7 @@ def test_discrete_sweep_against_time_domain_iteration():
                 unstable += 1
                 growth = (errs[-1] / errs[-201]) ** (1 / 200)
                 assert growth == pytest.approx(sw["spectral_radius"], rel=1e-2)
-    assert unstable == 1  # collision avoidance at T = 1.5 s: the own-acceleration term at 0.1 s
+    assert unstable == 1  # collision avoidance at T = 1.4 s: the own-acceleration term at 0.1 s
 
 
 def test_bad_vtypes(tmp_path):
