@@ -17,8 +17,8 @@ from stringstab.traffic import LinearController, leader_by_name, simulate, sinus
 
 
 def test_toolkit_and_sumo_agree_on_a_udds_leader_with_stops():
-    lead = leader_by_name("udds", dt=0.1, duration=60.0)  # starts and ends stopped
-    assert lead.speed.min() == 0.0
+    lead = leader_by_name("udds", dt=0.1, duration=140.0)  # moves at 20.1 s, stops at 124.9 s
+    assert lead.speed[1300:].min() == 0.0 and lead.speed[300:1200].min() > 0.0
     res = agreement(lead, LinearController(1.2, 0.5, 0.6), 3)
     assert res["passed"]
     for k, v in res["differences"].items():
@@ -26,6 +26,8 @@ def test_toolkit_and_sumo_agree_on_a_udds_leader_with_stops():
     # the toolkit's default exact positions are measurably different (the option matters)
     assert res["differences_exact_positions"]["accel"] > 1e-5
     assert res["sumo_speed_override"] == 0.0
+    co = cosimulate(lead, LinearController(1.2, 0.5, 0.6), 3)
+    assert co.speed[1, -50:].max() == 0.0  # the first follower stopped too (clipped at 0)
 
 
 def test_traci_equals_libsumo():
