@@ -276,8 +276,14 @@ def run_platoon(args: argparse.Namespace) -> int:
     leader, controller = case["leader"], case["controller"]
     result = cosimulate(leader, controller, args.followers, tau=case["tau"], delta=case["delta"],
                         api=args.api, length=args.length, progress=True)
+    warnings = list(case["warnings"])
+    over = float(result.params["sumo_speed_override"])
+    if over > 1e-9:
+        warnings.append(f"SUMO did not execute the commanded speeds exactly (largest difference "
+                        f"{over:.3g} m/s): the run is SUMO's, not the controller's alone")
+        print(f"stringstab sumo run: warning: {warnings[-1]}", file=sys.stderr)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
-                       warnings=case["warnings"])
+                       warnings=warnings)
     if result.gains is not None and result.gains.shape[-2] == result.t.size:
         from ..rl.evaluate import fss
 
