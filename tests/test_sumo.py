@@ -86,3 +86,34 @@ def test_cosimulate_matches_simulate_metrics():
     assert m1["m_fss"] == m2["m_fss"] == 1.0
     assert m1["max_m_p"] == pytest.approx(m2["max_m_p"], abs=1e-9)
     assert m1["TIT"] == pytest.approx(m2["TIT"], abs=1e-6)
+
+
+def test_run_writes_what_simulate_writes(tmp_path, capsys):
+    sim, sumo = tmp_path / "sim", tmp_path / "sumo"
+    args = ["--leader", "udds", "--duration", "40", "--followers", "2"]
+    assert main(["simulate", *args, "--out", str(sim)]) == 0
+    assert main(["sumo", "run", *args, "--out", str(sumo)]) == 0
+    capsys.readouterr()
+    names = {p.name for p in sim.iterdir() if not p.name.startswith(".")}
+    assert names == {p.name for p in sumo.iterdir() if not p.name.startswith(".")}
+    a = json.loads((sim / "metrics.json").read_text())
+    b = json.loads((sumo / "metrics.json").read_text())
+    assert b["run"]["simulator"] == "sumo" and b["certificate"] == a["certificate"]
+    # same controller and leader; the position rule differs (simulate's default is exact)
+    assert b["max_m_p"] == pytest.approx(a["max_m_p"], abs=1e-3)
+    assert b["m_fss"] == a["m_fss"] == 1.0
+
+
+def test_run_with_a_gain_file(tmp_path, capsys):
+    from pathlib import Path
+
+    import stringstab
+
+    f = Path(stringstab.__file__).parent / "data" / "examples" / "gain_rollout.csv"
+    out = tmp_path / "run"
+    rc = main(["sumo", "run", "--leader", "udds", "--duration", "30", "--followers", "2",
+               "--gains-file", str(f), "--no-figures", "--out", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 0, text
+    doc = json.loads((out / "metrics.json").read_text())
+    assert doc["executed_gains"]["n"] == 2 * 301
