@@ -117,3 +117,17 @@ def test_run_with_a_gain_file(tmp_path, capsys):
     assert rc == 0, text
     doc = json.loads((out / "metrics.json").read_text())
     assert doc["executed_gains"]["n"] == 2 * 301
+
+
+@pytest.mark.parametrize("kind", ["cacc", "idm", "mixed"])
+def test_other_controllers_run_unchanged(kind):
+    from stringstab.sumo.platoon import ballistic_leader
+    from stringstab.traffic import CACCController, IDMController, MixedController
+
+    ctrl = {"cacc": CACCController(), "idm": IDMController(),
+            "mixed": MixedController([LinearController(1.2, 0.5, 0.6), IDMController()], [0, 1, 0])}[kind]
+    lead = sinusoid(omega=0.5, amplitude=1.0, duration=15.0)
+    co = cosimulate(lead, ctrl, 3)
+    tk = simulate(ballistic_leader(lead)[0], ctrl, 3, position_update="trapezoid")
+    assert np.abs(co.accel - tk.accel).max() < 1e-9
+    assert np.abs(co.gap - tk.gap).max() < 1e-9
