@@ -16,17 +16,24 @@ naming the extra.
 
 from __future__ import annotations
 
-from .platoon import SumoPlatoon, cosimulate
+from .agreement import TOLERANCE, agreement
+from .inscenario import ScenarioRun, run_scenario
+from .platoon import SumoPlatoon, ballistic_leader, cosimulate
 from .runtime import EXTRA, SUMO_SERIES, SumoSession, check_config, import_api
 from .scenario import straight_road
 
 __all__ = [
     "EXTRA",
     "SUMO_SERIES",
+    "TOLERANCE",
+    "ScenarioRun",
     "SumoPlatoon",
     "SumoSession",
+    "agreement",
+    "ballistic_leader",
     "check_config",
     "cosimulate",
     "import_api",
+    "run_scenario",
     "straight_road",
 ]
