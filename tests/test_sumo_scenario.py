@@ -58,3 +58,12 @@ def test_scenario_cli_writes_its_files(tmp_path, capsys):
     with open(out / "scenario.csv") as f:
         rows = list(csv.DictReader(f))
     assert rows and {r["vehicle"] for r in rows} == {"c1"} and rows[0]["leader"] == "exiting"
+
+
+def test_scenario_traci_equals_libsumo():
+    c = LinearController(1.2, 0.5, 0.6)
+    a = run_scenario(SCENARIO, ["c1", "c2"], c, dt=0.1, steps=300, api="libsumo")
+    b = run_scenario(SCENARIO, ["c1", "c2"], c, dt=0.1, steps=300, api="traci")
+    for key in ("t", "gap", "speed", "accel", "command"):
+        np.testing.assert_array_equal(a.columns[key], b.columns[key])
+    assert list(a.columns["leader"]) == list(b.columns["leader"])
