@@ -112,11 +112,16 @@ def test_run_with_a_gain_file(tmp_path, capsys):
     f = Path(stringstab.__file__).parent / "data" / "examples" / "gain_rollout.csv"
     out = tmp_path / "run"
     rc = main(["sumo", "run", "--leader", "udds", "--duration", "30", "--followers", "2",
-               "--gains-file", str(f), "--no-figures", "--out", str(out)])
+               "--gains-file", str(f), "--no-figures", "--format", "parquet", "--out", str(out)])
     text = capsys.readouterr().out
     assert rc == 0, text
+    assert "pyarrow" not in text  # libsumo's import-time version warning is kept out
     doc = json.loads((out / "metrics.json").read_text())
     assert doc["executed_gains"]["n"] == 2 * 301
+    # pyarrow writes and reads Parquet in the process that loaded libsumo (its own libarrow)
+    import pyarrow.parquet as pq
+
+    assert pq.read_table(out / "trajectories.parquet").num_rows == 3 * 301
 
 
 @pytest.mark.parametrize("kind", ["cacc", "idm", "mixed"])
