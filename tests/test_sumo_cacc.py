@@ -90,13 +90,14 @@ def test_bad_vtypes(tmp_path):
         read_vtype(f"{f}:b")
 
 
-def test_derived_law_reproduces_sumo_and_cli(tmp_path, capsys):
+@pytest.mark.parametrize("dt", ["0.1", "0.05", "0.2"])  # SUMO scales the gains by max(dt, 0.1 s)
+def test_derived_law_reproduces_sumo_and_cli(tmp_path, capsys, dt):
     pytest.importorskip("libsumo", reason="needs the optional extra 'sumo' (pip install 'stringstab[sumo]')")
     from stringstab.cli import main
 
     out = tmp_path / "cacc.json"
     rc = main(["sumo", "cacc", "--vtype", f"{DATA}:cacc", "--followers", "4", "--duration", "40",
-               "--json", str(out)])
+               "--dt", dt, "--json", str(out)])
     text = capsys.readouterr().out
     assert rc == 0, text
     assert "does not certify the switched law" in text
