@@ -33,6 +33,14 @@ Communication delay δ
     The leader's acceleration between samples is not modelled, so its followers receive the
     interpolation either way.  Before t = 0 the history is the initial acceleration.
 
+``position_update="trapezoid"``
+    With ``model="lag"``, positions advance by the trapezoid rule on the step's speeds,
+    x_{k+1} = x_k + Δt (v_k + v_{k+1})/2, instead of the exact integral above (speeds and
+    accelerations are unchanged).  This is Eclipse SUMO's ballistic position update
+    (``--step-method.ballistic``), so a run with it is the one :mod:`stringstab.sumo` co-simulates;
+    the difference from the exact integral is ā (τ(Δt − τ(1 − e)) − τ(1 − e)Δt/2) per step, of
+    order ā Δt³/(12 τ).
+
 ``model="kinematic"``
     The paper's simpler update (eqs 1-2): no lag, a_k = u_k (limited), v_{k+1} = v_k + a_k Δt,
     and positions by the trapezoid rule, which is exactly the spacing update of eq 2.
@@ -75,6 +83,7 @@ DEFAULT_LENGTH = 5.0
 
 Model = Literal["lag", "kinematic"]
 FractionalDelay = Literal["linear", "exact"]
+PositionUpdate = Literal["exact", "trapezoid"]
 
 
 @dataclass(frozen=True)
@@ -199,6 +208,9 @@ class Platoon:
         How a delay that is not a multiple of Δt is received: interpolated linearly between
         samples (default), or the predecessor's exact acceleration inside the step (the
         module docstring).
+    position_update : {"exact", "trapezoid"}
+        With ``model="lag"``: the exact integral of the speed over the step (default) or the
+        trapezoid rule, SUMO's ballistic update (the module docstring).
 
     Attributes
     ----------
@@ -216,7 +228,8 @@ class Platoon:
 
     def __init__(self, n_platoons: int, n_followers: int, *, dt: float, tau: npt.ArrayLike = DEFAULT_TAU,
                  delta: float = DEFAULT_DELTA, model: Model = "lag", limits: Limits | None = None,
-                 length: float = DEFAULT_LENGTH, fractional_delay: FractionalDelay = "linear") -> None:
+                 length: float = DEFAULT_LENGTH, fractional_delay: FractionalDelay = "linear",
+                 position_update: PositionUpdate = "exact") -> None:
         if int(n_platoons) < 1 or int(n_followers) < 1:
             raise StringStabError(
                 f"n_platoons and n_followers must be >= 1; got {show(n_platoons)} and {show(n_followers)}"
@@ -228,7 +241,11 @@ class Platoon:
         if fractional_delay not in ("linear", "exact"):
             raise StringStabError(
                 f"fractional_delay must be 'linear' or 'exact'; got {show(fractional_delay)}")
+        if position_update not in ("exact", "trapezoid"):
+            raise StringStabError(
+                f"position_update must be 'exact' or 'trapezoid'; got {show(position_update)}")
         tau_arr, d = _check_lag_delay(tau, delta)
+        self.position_update = position_update
         P, N = int(n_platoons), int(n_followers)
         self.P, self.N, self.dt, self.model, self.delta = P, N, float(dt), model, d
         self.limits = limits or Limits()
@@ -372,6 +389,10 @@ class Platoon:
             vn += du * self._c1
             an = du * self._e
             an += u
+            if self.position_update == "trapezoid":
+                xn = vo + vn
+                xn *= 0.5 * dt
+                xn += xo
         else:
             an = u
             vn = u * dt
@@ -518,6 +539,7 @@ def simulate(
     record: bool = True,
     progress: bool | None = None,
     fractional_delay: FractionalDelay = "linear",
+    position_update: PositionUpdate = "exact",
 ) -> PlatoonResult:
     """Simulate platoons of ``n_followers`` behind prescribed leaders.
 
@@ -553,6 +575,9 @@ def simulate(
         A delay that is not a multiple of Δt: interpolated linearly between received samples
         (default), or the predecessor's exact acceleration inside the step, the loop the
         sampled-data certificate certifies (module docstring; recorded in ``params`` then).
+    position_update : {"exact", "trapezoid"}
+        Positions by the exact integral of the lag model (default) or by the trapezoid rule,
+        Eclipse SUMO's ballistic update (module docstring; recorded in ``params`` then).
 
     Returns
     -------
@@ -579,7 +604,7 @@ def simulate(
     N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length,
-                   fractional_delay=fractional_delay)
+                   fractional_delay=fractional_delay, position_update=position_update)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
     LV = np.ascontiguousarray(np.stack([tr.speed for tr in leaders], axis=1))
     LA = np.ascontiguousarray(np.stack([tr.accel for tr in leaders], axis=1))
@@ -653,6 +678,8 @@ def simulate(
     }
     if fractional_delay != "linear":
         params["fractional_delay"] = fractional_delay
+    if position_update != "exact":
+        params["position_update"] = position_update
     sq = (lambda a: a) if batched else (lambda a: a[0])
     return PlatoonResult(
         dt=dt,
