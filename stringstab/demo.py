@@ -259,6 +259,8 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
     cfg = config_for("idl", total_steps=steps, seed=0, learning_starts=min(2_000, steps // 4),
                      checkpoint_every=max(steps, 1))
     res = train(cfg, out=out / "run", progress=False)
+    if res.stopped_by == "interrupted":  # Ctrl-C: the demo's folder is discarded as a whole
+        raise KeyboardInterrupt
     t = res.timing
     log(f"trained IDL for {res.steps} steps ({len(res.episodes)} episodes) in {t['total_seconds']:.1f} s: "
         f"{t['steps_per_second']:.0f} steps/s, repair {100 * t['repair_share']:.0f}% of the time")

@@ -28,6 +28,7 @@ from ..params import (
     parameter_model,
     positive,
 )
+from ..ranges import check_magnitude, sensible_warning
 
 __all__ = [
     "NEGATIVE_NUMBER",
@@ -41,6 +42,7 @@ __all__ = [
     "integer",
     "loop_params",
     "shown_params",
+    "warn_beyond_sensible",
 ]
 
 #: argparse (< 3.13) reads "-0.5,1,1" or "-2,2" as an unknown option; anything that
@@ -94,7 +96,33 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
         model = Params(*check_params(*values))
     H = None if args.sample_time is None else positive(
         "--sample-time (sampling period H)", args.sample_time, unit=" s")
+    if H is not None:
+        check_magnitude("sample_time", H, name="--sample-time")
+    box = Box.of(model)
+    warn_beyond_sensible(args, [("tau", box.tau[1], "--tau"), ("delta", box.delta[1], "--delta"),
+                                ("headway", box.headway[1], "--headway"),
+                                ("sample_time", H, "--sample-time")])
     return model, H
+
+
+def warn_beyond_sensible(args: Any, values: list[tuple[str, float | None, str]]) -> None:
+    """One warning line on stderr per value beyond its sensible range (:mod:`stringstab.ranges`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's arguments (``args.command`` names it in the warning).
+    values : list of (kind, value, option)
+        The kind of :data:`stringstab.ranges.RANGES`, the value (None: skipped) and the option.
+    """
+    import sys
+
+    for kind, value, option in values:
+        if value is None:
+            continue
+        w = sensible_warning(kind, value, name=option)
+        if w is not None:
+            print(f"stringstab {getattr(args, 'command', '')}: warning: {w}", file=sys.stderr)
 
 
 def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
@@ -171,10 +199,24 @@ def gains_from_args(args: Any) -> GainTable:
             f"and --file {args.file}"
         )
     if args.file:
-        return read_gains(args.file)
+        table = read_gains(args.file)
+        _warn_gains(args, table)
+        return table
     if not args.triples:
         raise StringStabError(
             "expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none"
         )
     triples = [parse_triple(t, where=f"triple {i + 1} {show(t)}") for i, t in enumerate(args.triples)]
-    return GainTable.from_triples(triples, source="<command line>")
+    table = GainTable.from_triples(triples, source="<command line>")
+    _warn_gains(args, table)
+    return table
+
+
+def _warn_gains(args: Any, table: GainTable) -> None:
+    """One warning when some gain is beyond the sensible range (the largest one named)."""
+    K = np.abs(np.stack([table.k_x, table.k_v, table.k_a]))
+    if K.size and float(K.max()) > 0:
+        j, i = np.unravel_index(int(np.argmax(K)), K.shape)
+        name = ("k_x", "k_v", "k_a")[int(j)]
+        warn_beyond_sensible(args, [("gain", float(getattr(table, name)[int(i)]),
+                                     f"{name} (row {int(i) + 1})")])

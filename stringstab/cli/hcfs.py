@@ -118,8 +118,16 @@ def run_verify(args: argparse.Namespace) -> int:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
+    if args.duration is not None:
+        from ..ranges import check_magnitude
+
+        check_magnitude("duration", args.duration, name="--duration")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
+    from ._budget import refuse_platoon
+
+    refuse_platoon(args.followers * max(len(leaders), 1), max(len(ld.speed) for ld in leaders),
+                   f"--followers {args.followers}")
     policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],

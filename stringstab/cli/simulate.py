@@ -165,8 +165,16 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
     _check_step(args.dt, tau, delta)
+    from ..ranges import check_magnitude
+
+    for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
+        if v is not None and math.isfinite(v):
+            check_magnitude("duration", v, name=opt)
     out = OutputDir(args.out, command="simulate", owns=RUN_FILES, what="--out")
     leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
+    from ._budget import refuse_platoon
+
+    refuse_platoon(args.followers, len(leader.speed), f"--followers {args.followers}")
     warnings = check_leader(leader)
     controller = _controller(args, headway)
     n_series = getattr(controller, "followers", None)

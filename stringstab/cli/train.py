@@ -77,6 +77,15 @@ def run(args: argparse.Namespace) -> int:
                                      dt=config.dt)
     res = train(config, out=out, resume=args.resume, progress=not args.no_progress,
                 leaders=leaders, log=print)
+    if res.stopped_by == "interrupted":
+        import shlex
+        import sys
+
+        again = ["stringstab", "train", *_argv_of(args), "--resume"]
+        print(f"stringstab train: interrupted at step {res.steps} of {config.total_steps}; {out}/ "
+              f"holds its checkpoint, policy, train_log.csv and summary.json; continue with: "
+              f"{shlex.join(again)}", file=sys.stderr)
+        return 130
     n = len(res.episodes)
     coll = sum(e["collision"] for e in res.episodes)
     t = res.timing
@@ -85,3 +94,18 @@ def run(args: argparse.Namespace) -> int:
           f"repair {100 * t['repair_share']:.1f}% of the time")
     print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png and summary.json to {out}/")
     return 0
+
+
+def _argv_of(args: argparse.Namespace) -> list[str]:
+    """The options of this run that a resume must repeat (the configuration is checked)."""
+    out = ["--algo", args.algo, "--steps", str(args.steps), "--seed", str(args.seed),
+           "--out", str(args.out)]
+    for flag, name in (("--num-envs", "num_envs"), ("--stop-episodes", "stop_episodes"),
+                       ("--repair", "repair")):
+        if getattr(args, name, None) is not None:
+            out += [flag, str(getattr(args, name))]
+    if getattr(args, "paper", False):
+        out.append("--paper")
+    if getattr(args, "leaders", None):
+        out += ["--leaders", *map(str, args.leaders)]
+    return out

@@ -41,6 +41,7 @@ __all__ = [
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
+    "deferred_interrupt",
 ]
 
 #: Name of the file in which an :class:`OutputDir` lists what it wrote.
@@ -205,6 +206,35 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "o
     return atomic_write_bytes(path, text.encode("utf-8"), what=what)
 
 
+@contextlib.contextmanager
+def deferred_interrupt() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) until the block is done, then raise KeyboardInterrupt.
+
+    For the few milliseconds that move finished files into place: an interrupt there would
+    leave a mix of two runs.  Outside the main thread (where signals cannot be handled) the
+    block runs unprotected.
+
+    Examples
+    --------
+    >>> with deferred_interrupt():
+    ...     x = 1
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+    if caught:
+        raise KeyboardInterrupt
+
+
 class OutputDir:
     """An output folder written all-or-nothing, replacing only its own earlier run.
 
@@ -251,6 +281,7 @@ class OutputDir:
         self._staging: Path | None = None
         self._written: list[str] = []
         self._folders: list[str] = []
+        self._committed = False
         old = self._read_manifest()
         if old is not None and old.get("command") != command:
             raise StringStabError(
@@ -273,6 +304,7 @@ class OutputDir:
     # -- context ------------------------------------------------------------------------------
     def __enter__(self) -> OutputDir:
         try:
+            self._created = [q for q in (self.root, *self.root.parents) if not q.exists()]
             self.root.mkdir(parents=True, exist_ok=True)
             self._staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.root))
         except OSError as e:
@@ -345,9 +377,22 @@ class OutputDir:
         if self._staging is not None:
             shutil.rmtree(self._staging, ignore_errors=True)
             self._staging = None
+            if not self._committed:  # the folders this run created go too (emptied, not absent)
+                for q in getattr(self, "_created", []):
+                    with contextlib.suppress(OSError):
+                        q.rmdir()
 
     def commit(self) -> None:
-        """Move the staged files in, remove this command's stale files, update the manifest."""
+        """Move the staged files in, remove this command's stale files, update the manifest.
+
+        Ctrl-C during the moves is held until they are done (:func:`deferred_interrupt`), so
+        the folder holds the whole new run or, interrupted before, the whole old one.
+        """
+        self._committed = True  # from here, the folder is kept (it receives the run)
+        with deferred_interrupt():
+            self._commit()
+
+    def _commit(self) -> None:
         staging = self.staging
         old = self._read_manifest() or {}
         new = [n for n in self._written if (staging / n).is_file()]

@@ -199,6 +199,8 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     Returns
     -------
     TrainResult
+        ``stopped_by`` is ``"interrupted"`` when Ctrl-C stopped it (with ``out``: at a step
+        boundary, the run folder written as at the end of a budget, so resume continues it).
 
     Raises
     ------
@@ -213,6 +215,17 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     >>> res.steps, res.policy(np.zeros((2, 3))).shape
     (64, (2, 1))
     """
+    interrupt = _StepInterrupt(active=out is not None)
+    try:
+        return _train(config, env=env, out=out, resume=resume, progress=progress,
+                      leaders=leaders, log=log, interrupt=interrupt)
+    finally:
+        interrupt.restore()
+
+
+def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, resume: bool,
+           progress: bool | None, leaders: list[Any] | None, log: Any,
+           interrupt: _StepInterrupt) -> TrainResult:
     import torch
 
     from .agent import Agent
@@ -293,6 +306,8 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
             log(f"checkpoint at step {step}: {len(episodes)} episodes, rolling return "
                 f"{_rolling(returns):.3f}")
 
+    # Ctrl-C stops the loop at the next step boundary (interrupt.caught): the checkpoint,
+    # policy, log and summary are written as at the end of a budget, so resume continues there
     if out_path is not None and not resume:
         out_path.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out_path / "run.json", dumps_json(
@@ -314,6 +329,9 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     while step < config.total_steps:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
+            break
+        if interrupt.caught:
+            stopped_by = "interrupted"
             break
         if step < config.learning_starts:
             actions = rng.uniform(low, high, size=(n_env, act_dim))
@@ -377,6 +395,32 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
         checkpoint()
         _write_outputs(result)
     return result
+
+
+class _StepInterrupt:
+    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only."""
+
+    def __init__(self, active: bool = True) -> None:
+        import signal
+        import threading
+
+        self.caught = False
+        self._old: Any = None
+        if active and threading.current_thread() is threading.main_thread():
+            self._old = signal.signal(signal.SIGINT, self._handle)
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        import signal
+
+        self.caught = True
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    def restore(self) -> None:
+        import signal
+
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._old)
+            self._old = None
 
 
 def _write_outputs(result: TrainResult) -> None:

@@ -202,7 +202,16 @@ def region_growing(
     h = r0 / G
     evaluated = 0
     k = 0
-    for k in range(1, int(max_iter) + 1):
+    # the shells R_k with k r0 short of the bounds hold no point inside them: start at the first
+    # that can (a K0 far outside the bounds would otherwise walk through millions of empty shells)
+    outside = max(max(lo - k0[i], k0[i] - hi, 0.0) for i in grow)
+    if outside > hi - lo:  # its shells would grow by O(outside / r0)² points each before any fits
+        raise StringStabError(
+            f"region growing searches the gain bounds [{lo:g}, {hi:g}] outward from K0; expected "
+            f"K0 within [{2 * lo - hi:g}, {2 * hi - lo:g}] (the bounds widened by their width); got "
+            f"K0 = ({k0[0]:g}, {k0[1]:g}, {k0[2]:g}); the projection method takes any K0")
+    k_first = max(1, math.floor((outside - 1e-12) / r0))
+    for k in range(k_first, int(max_iter) + 1):
         off = _shell(k, G, grow_ka)
         if k == 1 and type0 == 3:  # Step 2: the type-III exclusion (into R_N)
             excl = (off[:, 0] == 0) & (off[:, 1] <= 0) & (off[:, 2] <= 0)
