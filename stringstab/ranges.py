@@ -26,7 +26,13 @@ from typing import Any
 
 from .errors import StringStabError
 
-__all__ = ["RANGES", "check_magnitude", "sensible_warning"]
+__all__ = ["LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "RANGES", "check_magnitude",
+           "sensible_warning"]
+
+#: A leader (or a speed limit) faster than this, m/s (252 km/h), is no road vehicle: refused.
+LEADER_SPEED_ABSURD = 70.0
+#: A leader (or an acceleration limit) beyond ±this, m/s² (1.5 g), is no road vehicle: refused.
+LEADER_ACCEL_ABSURD = 15.0
 
 #: name -> (sensible upper bound, refused above, unit, what it is)
 RANGES: dict[str, tuple[float, float, str, str]] = {

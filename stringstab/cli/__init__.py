@@ -113,8 +113,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = _chosen(argv)
     parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)
+    from ..io.outputs import invocation
+    from ._provenance import provenance
+
     try:
-        return int(args.func(args) or 0)
+        with invocation(lambda: provenance(args, argv)):
+            return int(args.func(args) or 0)
     except StringStabError as e:
         msg = str(e).replace("\n", " ")
         print(f"stringstab {args.command}: error: {msg}", file=sys.stderr)

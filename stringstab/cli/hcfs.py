@@ -67,6 +67,13 @@ def add_parser(sub: Any) -> None:
                         "(torch) unless 'stand-in'")
     v.add_argument("--no-figures", action="store_true", help="skip the figures")
     v.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    v.add_argument("--no-progress", action="store_true", help="no progress bar or lines (stderr)")
+    from ..hcfs.constants import ACCEL_MAX as HCFS_ACCEL_MAX
+    from ..hcfs.constants import ACCEL_MIN as HCFS_ACCEL_MIN
+    from ._common import add_limit_arguments
+
+    add_limit_arguments(v, accel_min=HCFS_ACCEL_MIN, accel_max=HCFS_ACCEL_MAX,
+                        source="HCFS section IV, v_max IDL Table 2")
     v.set_defaults(func=run)
 
     t = hs.add_parser(
@@ -128,6 +135,10 @@ def run_verify(args: argparse.Namespace) -> int:
 
     refuse_platoon(args.followers * max(len(leaders), 1), max(len(ld.speed) for ld in leaders),
                    f"--followers {args.followers}")
+    from ._common import checked_leaders, limits_from_args
+
+    limits = limits_from_args(args)
+    checked_leaders(args, leaders, limits)
     policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
@@ -135,8 +146,16 @@ def run_verify(args: argparse.Namespace) -> int:
         *(["--duration", f"{args.duration:g}"] if args.duration is not None else []),
         "--beta", f"{beta:g}", "--policy", args.policy,
         *(["--no-figures"] if args.no_figures else []), "--out", args.out,
+        "--v-max", f"{limits.speed_max:g}", "--a-min", f"{limits.accel_min:g}",
+        "--a-max", f"{limits.accel_max:g}",
     ])
-    ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta)
+    from ..progress import Progress
+
+    with Progress(len(leaders), "stringstab hcfs verify", unit="leaders",
+                  enabled=not args.no_progress) as bar:
+        ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta,
+                     progress=bar.update, accel_min=limits.accel_min,
+                     accel_max=limits.accel_max, speed_max=limits.speed_max)
     with out:
         files = write_report(ver, out, figures=not args.no_figures, command=command)
     print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")

@@ -93,7 +93,27 @@ def run(args: argparse.Namespace) -> int:
           f"ends), stopped by {res.stopped_by}; {t['steps_per_second']:.0f} steps/s this call, "
           f"repair {100 * t['repair_share']:.1f}% of the time")
     print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png and summary.json to {out}/")
+    _note_stale_evaluation(out)
     return 0
+
+
+def _note_stale_evaluation(out: Path) -> None:
+    """Say so when ``out/evaluation/`` evaluated another policy than the one just written."""
+    import json
+    import sys
+
+    from ..io import MANIFEST
+    from ._provenance import policy_identity
+
+    try:
+        prev = json.loads((out / "evaluation" / MANIFEST).read_text(encoding="utf-8")).get("policy")
+    except (OSError, ValueError, AttributeError):
+        return
+    now = policy_identity(out) or {}
+    if isinstance(prev, dict) and prev.get("policy_sha256") != now.get("policy_sha256"):
+        print(f"stringstab train: note: {out}/evaluation/ evaluated the policy at step "
+              f"{prev.get('steps')}, not this one (step {now.get('steps')}); it is stale: run "
+              f"'stringstab evaluate {out}' to replace it", file=sys.stderr)
 
 
 def _argv_of(args: argparse.Namespace) -> list[str]:

@@ -100,7 +100,8 @@ def add_parser(sub: Any) -> None:
                    help="margin m in k_x >= m, k_v + (T* - tau) k_x >= m (default: 1e-3)")
     q.add_argument("--eps", default="1e-4", metavar="E",
                    help="margin of the frequency constraints g(omega_j) >= E (default: 1e-4)")
-    p.add_argument("--format", choices=_FORMATS, default="table", help="output format (default: table)")
+    p.add_argument("--format", choices=_FORMATS, default=None,
+                   help="output format (default: the --out file's extension .json/.csv, else table)")
     p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
     p.set_defaults(func=run)
 
@@ -163,6 +164,9 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(
             f"--hurwitz-margin must be >= 0 and --eps > 0; got {args.hurwitz_margin!r}, {args.eps!r}"
         )
+    from ._common import resolve_format
+
+    args.format = resolve_format(args.format, args.out, _FORMATS)
     out = check_output_file(args.out, what="--out") if args.out else None
     table = gains_from_args(args)
     check_horizon(H, table)

@@ -190,7 +190,9 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     resume : bool
         Continue the newest checkpoint in ``out`` up to ``config.total_steps``.
     progress : bool, optional
-        tqdm bar (steps/s, rolling episode reward); default: when stderr is a terminal.
+        None or True: a tqdm bar (steps/s, rolling episode reward) when stderr is a terminal,
+        else one line every 10 s with the time left (:class:`stringstab.progress.Progress`);
+        False: silent.
     leaders : list, optional
         Training leaders of the default environment.
     log : callable, optional
@@ -314,13 +316,12 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
             {"format": RUN_FORMAT, "algo": config.algo, "action": config.action}))
         atomic_write_text(out_path / "config.json", dumps_json(config.as_dict()))
 
-    show = progress if progress is not None else os.isatty(2)
-    bar: Any = None
-    if show:
-        from tqdm.auto import tqdm
+    # a bar on a terminal, one line every 10 s with the time left otherwise (False: silent)
+    from ..progress import Progress
 
-        bar = tqdm(total=config.total_steps, initial=step, unit="step", desc=f"train {config.algo}",
-                   mininterval=0.5)
+    meter = Progress(config.total_steps, f"train {config.algo}", unit="steps",
+                     enabled=progress is not False, initial=step)
+    bar: Any = meter.bar
     t_env = t_upd = 0.0
     steps_here = 0
     rep0 = float(repair.stats["seconds"]) if repair is not None else 0.0
@@ -370,8 +371,8 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
             for _ in range(config.updates_per_step):
                 agent.update(buffer.sample(config.batch_size))
             t_upd += time.perf_counter() - t0
+        meter.update(n_env)
         if bar is not None:
-            bar.update(n_env)
             el = max(bar.format_dict.get("elapsed", 0.0), 1e-9)
             bar.set_postfix({"steps/s": f"{steps_here / el:.0f}", "episodes": len(episodes),
                              "rolling": f"{_rolling(returns):.2f}"}, refresh=False)
@@ -381,8 +382,7 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
     else:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
-    if bar is not None:
-        bar.close()
+    meter.close()
     seconds = time.perf_counter() - t_start
     rep_s = (float(repair.stats["seconds"]) - rep0) if repair is not None else 0.0
     timing = {"env_seconds": t_env, "repair_seconds": rep_s, "update_seconds": t_upd,
