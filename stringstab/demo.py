@@ -261,7 +261,7 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
     cfg = config_for("idl", total_steps=steps, seed=0, learning_starts=min(2_000, steps // 4),
                      checkpoint_every=max(steps, 1))
     res = train(cfg, out=out / "run", progress=None)  # a bar on a terminal, else lines
-    if res.stopped_by == "interrupted":  # Ctrl-C: the demo's folder is discarded as a whole
+    if getattr(res, "stopped_by", None) == "interrupted":  # Ctrl-C: the demo's folder is discarded as a whole
         raise KeyboardInterrupt
     t = res.timing
     log(f"trained IDL for {res.steps} steps ({len(res.episodes)} episodes) in {t['total_seconds']:.1f} s: "

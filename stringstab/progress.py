@@ -47,8 +47,8 @@ class Progress:
         False: silent (``--no-progress``).
     stream : file, optional
         Where to report (default: stderr).
-    every : float
-        Seconds between two lines when not on a terminal.
+    every : float, optional
+        Seconds between two lines when not on a terminal (default :attr:`EVERY`).
     tty : bool, optional
         Force the bar (True) or the lines (False); default: ``stream.isatty()``.
     initial : int
@@ -65,8 +65,11 @@ class Progress:
     demo: 2/4 step (50%)
     """
 
+    #: Default seconds between two progress lines.
+    EVERY: float = 10.0
+
     def __init__(self, total: int, desc: str, *, unit: str = "it", enabled: bool = True,
-                 stream: TextIO | None = None, every: float = 10.0, tty: bool | None = None,
+                 stream: TextIO | None = None, every: float | None = None, tty: bool | None = None,
                  initial: int = 0) -> None:
         self.total = max(int(total), 0)
         self.initial = int(initial)
@@ -74,7 +77,7 @@ class Progress:
         self.unit = unit
         self.enabled = enabled
         self.stream = stream if stream is not None else sys.stderr
-        self.every = every
+        self.every = Progress.EVERY if every is None else every
         self.done = self.initial
         self._t0 = time.perf_counter()
         self._last = self._t0
@@ -113,11 +116,13 @@ class Progress:
               f"{duration(el)} elapsed{eta}", file=self.stream, flush=True)
 
     def close(self) -> None:
-        """Close the bar, or print the last line (the time it took) when lines were printed."""
+        """Close the bar, or print the last line (the time it took) when lines were printed or
+        the work took longer than ``every``."""
         if self._bar is not None:
             self._bar.close()
             self._bar = None
-        elif self.enabled and self._last > self._t0:
+        elif self.enabled and (self._last > self._t0
+                               or time.perf_counter() - self._t0 >= self.every):
             print(f"{self.desc}: {self.done}/{self.total} {self.unit} done in "
                   f"{duration(time.perf_counter() - self._t0)}", file=self.stream, flush=True)
             self._last = self._t0

@@ -110,6 +110,11 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stringstab`` console script; returns the exit code."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    for stream in (sys.stdout, sys.stderr):  # a file name of undecodable bytes prints, escaped
+        try:
+            stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
+        except (AttributeError, ValueError, OSError):
+            pass
     command = _chosen(argv)
     parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)

@@ -268,7 +268,16 @@ def gains_from_args(args: Any) -> GainTable:
 
 
 def _warn_gains(args: Any, table: GainTable) -> None:
-    """One warning when some gain is beyond the sensible range (the largest one named)."""
+    """Refuse a gain beyond the physical bound (:mod:`stringstab.ranges`: the certificate's
+    coefficients would overflow), naming its row; warn once beyond the sensible range."""
+    from ..ranges import RANGES
+
+    for name in ("k_x", "k_v", "k_a"):
+        a = np.asarray(getattr(table, name), dtype=float)
+        big = np.flatnonzero(np.abs(a) > RANGES["gain"][1])
+        if big.size:
+            check_magnitude("gain", float(a[big[0]]),
+                            name=f"{table.source}, row {int(big[0]) + 1}, {name}")
     K = np.abs(np.stack([table.k_x, table.k_v, table.k_a]))
     if K.size and float(K.max()) > 0:
         j, i = np.unravel_index(int(np.argmax(K)), K.shape)

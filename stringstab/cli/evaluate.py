@@ -126,7 +126,7 @@ def _policy_of(run: Path, out: Any) -> dict[str, Any]:
             raise StringStabError(
                 f"--out {out.root} holds the evaluation of another run ({prev.get('run')}); "
                 f"expected an empty folder or an evaluation of {run}; choose another --out")
-        if prev.get("policy_sha256") != doc["policy_sha256"]:
+        if (prev.get("policy_sha256"), prev.get("steps")) != (doc["policy_sha256"], doc["steps"]):
             print(f"stringstab evaluate: note: {out.root}/ held the evaluation of an older policy "
                   f"of this run (step {prev.get('steps')}); it is replaced by this one's "
                   f"(step {doc['steps']})", file=sys.stderr)

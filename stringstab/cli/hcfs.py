@@ -198,8 +198,13 @@ def run_train(args: argparse.Namespace) -> int:
     from ..hcfs.env import HCFSVectorEnv
 
     env = HCFSVectorEnv(platoons, leaders, n_followers=followers, episode_seconds=seconds)
-    run = train_hcfs_ddpg(total_steps=steps, seed=seed, env=env, out=out,
-                          progress=False if args.no_progress else None, stop_episodes=0)
+    existed = out.exists()
+    try:
+        run = train_hcfs_ddpg(total_steps=steps, seed=seed, env=env, out=out,
+                              progress=False if args.no_progress else None, stop_episodes=0)
+    except KeyboardInterrupt:  # the folder was new or empty: leave it so (outputs absent)
+        _empty(out, remove=not existed)
+        raise
     res = run.result
     n = len(res.episodes)
     if n:
@@ -228,6 +233,19 @@ def run_train(args: argparse.Namespace) -> int:
           f"hcfs_policy.json and evaluation.json to {args.out.rstrip('/')}/; use it with "
           f"'stringstab hcfs verify --policy {args.out}'")
     return 0
+
+
+def _empty(out: Path, *, remove: bool) -> None:
+    """Delete what an interrupted ``hcfs train`` wrote into its new (or empty) folder."""
+    import shutil
+
+    if not out.is_dir():
+        return
+    for p in out.iterdir():
+        if not p.name.startswith("."):
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+    if remove:
+        shutil.rmtree(out, ignore_errors=True)
 
 
 def _check_new_folder(out: Path) -> None:

@@ -110,7 +110,8 @@ def _note_stale_evaluation(out: Path) -> None:
     except (OSError, ValueError, AttributeError):
         return
     now = policy_identity(out) or {}
-    if isinstance(prev, dict) and prev.get("policy_sha256") != now.get("policy_sha256"):
+    if isinstance(prev, dict) and ((prev.get("policy_sha256"), prev.get("steps"))
+                                   != (now.get("policy_sha256"), now.get("steps"))):
         print(f"stringstab train: note: {out}/evaluation/ evaluated the policy at step "
               f"{prev.get('steps')}, not this one (step {now.get('steps')}); it is stale: run "
               f"'stringstab evaluate {out}' to replace it", file=sys.stderr)

@@ -110,14 +110,6 @@ class GainTable:
                     f"{self.source}: {name} must have one entry per gain triple ({n}); "
                     f"found {len(a)}"
                 )
-        from ..ranges import RANGES, check_magnitude
-
-        for name in GAIN_COLUMNS:  # beyond the refusal bound the certificate's coefficients overflow
-            a = np.asarray(getattr(self, name), dtype=float)
-            big = np.flatnonzero(np.abs(a) > RANGES["gain"][1])
-            if big.size:
-                check_magnitude("gain", float(a[big[0]]),
-                                name=f"{self.source}, row {int(big[0]) + 1}, {name}")
 
     @classmethod
     def from_triples(
