@@ -166,3 +166,35 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     monkeypatch.setattr(rl_train, "make_env", real)
     assert main([*argv, "--resume"]) == 0
     assert "trained ddpg: 64 steps" in capsys.readouterr().out
+
+
+def test_a_batch_file_too_big_for_memory_is_refused(capsys, tmp_path, monkeypatch):
+    """The estimate (4.5 kB per row) against the memory available, before certifying."""
+    import numpy as np
+
+    import stringstab.cli._budget as budget
+
+    monkeypatch.setattr(budget, "available_bytes", lambda: 200_000_000)  # a small machine
+    f = tmp_path / "big.npz"
+    np.savez(f, K=np.tile([1.2, 0.5, 0.6], (20_000, 1)))
+    out = tmp_path / "v.npz"
+    _one_line(capsys, ["certify", "--file", str(f), "--out", str(out)], 2,
+              f"stringstab certify: error: {f} (20000 rows) needs about 228.9 MiB of memory; "
+              "190.7 MiB is available; expected at most about 11111 rows")
+    assert not out.exists()
+
+
+def test_the_example_rollout_that_collides_says_so_and_exits_1(capsys, tmp_path):
+    from pathlib import Path
+
+    import stringstab
+
+    rollout = Path(stringstab.__file__).parent / "data" / "examples" / "gain_rollout.csv"
+    out = tmp_path / "rollout"
+    rc = main(["simulate", "--gains-file", str(rollout), "--followers", "2", "--no-figures",
+               "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1
+    assert err[-1].startswith("stringstab simulate: warning: 2 collision(s): follower 1 first "
+                              "reached its predecessor at t = 81.8 s (m_fss = 0.037)")
+    assert (out / "metrics.json").is_file()  # the outputs are written: they show the collision

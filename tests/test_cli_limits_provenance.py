@@ -121,6 +121,11 @@ def test_evaluate_records_the_policy_refuses_mixing_and_names_a_stale_evaluation
     assert len(man["policy"]["policy_sha256"]) == 64 and man["inputs"][str(lead)]["sha256"]
     doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
     assert doc["run"]["steps"] == 64 and doc["run"]["limits"]["speed_max"] == 33.3
+    # a leader no road vehicle could drive is refused, as by simulate and hcfs verify
+    fast = _leader(tmp_path, 100.0, "fast.csv")
+    assert main(["evaluate", str(run), "--leaders", str(fast), "--platoon", "none"]) == 2
+    err = _err_lines(capsys)
+    assert len(err) == 1 and "reaches 100 m/s" in err[0] and "no road vehicle" in err[0]
     # the run goes on: the old evaluation is named stale, then replaced with a note
     assert main([*train, "--steps", "96", "--resume"]) == 0
     assert "evaluation/ evaluated the policy at step 64, not this one (step 96)" in \
@@ -137,6 +142,17 @@ def test_evaluate_records_the_policy_refuses_mixing_and_names_a_stale_evaluation
                  "--out", str(run / "evaluation")]) == 2
     assert "holds the evaluation of another run" in capsys.readouterr().err
     assert (run / "evaluation" / "evaluation.json").read_bytes() == before
+
+
+def test_hcfs_verify_and_compare_report_progress_off_a_terminal(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr(Progress, "EVERY", 0.0)
+    out = tmp_path / "h"
+    assert main(["hcfs", "verify", "-J", "2.5", "--followers", "2", "--policy", "stand-in",
+                 "--leader", "stop-and-go", "braking", "--duration", "10", "--no-figures",
+                 "--out", str(out)]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "stringstab hcfs verify: 1/2 leaders (50%), " in err and "left" in err
+    assert "stringstab hcfs verify: 2/2 leaders done in " in err
 
 
 def test_demo_takes_the_limits(capsys, tmp_path):
