@@ -13,6 +13,7 @@ folder) — a training run interrupted leaves its resumable folder with its log 
 import os
 import signal
 import string
+import time
 from pathlib import Path
 
 import pytest
@@ -119,7 +120,9 @@ class _Alarm:
 
     def __enter__(self):
         self.old = signal.signal(signal.SIGALRM, lambda *_: os.kill(os.getpid(), signal.SIGINT))
-        signal.setitimer(signal.ITIMER_REAL, self.seconds)
+        # again every `seconds` (a user pressing Ctrl-C again): a swallowed first one cannot
+        # hang the test, and the time it took says that it was swallowed
+        signal.setitimer(signal.ITIMER_REAL, self.seconds, self.seconds)
         return self
 
     def __exit__(self, *exc):
@@ -151,19 +154,23 @@ def test_random_command_lines_fail_as_one_sentence(argv, payload, tmp_path_facto
              "@out/x.json": str(out / "x.json"), "@out/x.csv": str(out / "x.csv")}
     args = [subst.get(a, a) for a in argv]
     code = None
-    with _Alarm(ALARM_S):
-        try:
-            code = main(args)
-        except SystemExit as e:  # argparse: --help/--version (0) or a usage error (2)
-            code = e.code if isinstance(e.code, int) else 2
-        except KeyboardInterrupt:  # the alarm fired between main's return and the timer's end
-            code = 130
+    t0 = time.monotonic()
+    try:
+        with _Alarm(ALARM_S):
+            try:
+                code = main(args)
+            except SystemExit as e:  # argparse: --help/--version (0) or a usage error (2)
+                code = e.code if isinstance(e.code, int) else 2
+    except KeyboardInterrupt:  # the alarm fired outside main (before it, or after its return)
+        code = 130 if code is None else code
+    took = time.monotonic() - t0
     captured = capsys.readouterr()
     if os.environ.get("STRINGSTAB_FUZZ_LOG"):  # what was tried, for a human to look at
         with open(os.environ["STRINGSTAB_FUZZ_LOG"], "a", encoding="utf-8",
                   errors="backslashreplace") as f:
             f.write(f"{code}\t{args!r}\t{captured.err.strip().splitlines()[-1:]!r}\n")
     assert code in (0, 1, 2, 130), (args, code, captured.err[-2000:])
+    assert took < 15 * ALARM_S, (args, f"Ctrl-C was not obeyed for {took:.0f} s")
     assert "Traceback" not in captured.err, (args, captured.err[-3000:])
     assert not _staging_left(root), args
     if code in (2, 130):

@@ -23,6 +23,7 @@ would.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import os
 import time
@@ -219,10 +220,15 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     """
     interrupt = _StepInterrupt(active=out is not None)
     try:
-        return _train(config, env=env, out=out, resume=resume, progress=progress,
-                      leaders=leaders, log=log, interrupt=interrupt)
+        result = _train(config, env=env, out=out, resume=resume, progress=progress,
+                        leaders=leaders, log=log, interrupt=interrupt)
     finally:
         interrupt.restore()
+    if interrupt.caught and result.stopped_by != "interrupted":
+        # Ctrl-C after the last step (while the outputs were written): the run is complete,
+        # and the caller still learns that the user asked to stop
+        result = dataclasses.replace(result, stopped_by="interrupted")
+    return result
 
 
 def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, resume: bool,
