@@ -121,6 +121,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     from ..io.outputs import invocation
     from ._provenance import provenance
 
+    hook = sys.unraisablehook
+
+    def quiet_interrupt(u: Any) -> None:  # Ctrl-C landing in a finaliser: not a traceback
+        if u.exc_type is not KeyboardInterrupt:
+            hook(u)
+
+    sys.unraisablehook = quiet_interrupt
     try:
         with invocation(lambda: provenance(args, argv)):
             return int(args.func(args) or 0)
@@ -141,6 +148,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     except BrokenPipeError:  # pragma: no cover - e.g. piped into head
         return 0
+    finally:
+        sys.unraisablehook = hook
 
 
 if __name__ == "__main__":  # pragma: no cover
