@@ -31,6 +31,10 @@ def _one_line(capsys, argv, code, starts, match=""):
     (["certify", "1,1,1", "--sample-time", "1e6"], "--sample-time = 1e+06 s is far outside"),
     (["certify", "1,1,1", "--delta", "1e5"], "communication delay delta = 100000 s"),
     (["tune", "7,1,1", "--method", "both"], "expected K0 within [-6, 6]"),
+    (["tune", "0.9,-0.5,1.1", "--bounds", "-1e308,1e308"], "--bounds = -1e+308 is far outside"),
+    (["region", "--fix", "k_a=0.5", "--range", "-1e308,1e308", "--out", "unused"],
+     "--range = -1e+308 is far outside"),
+    (["region", "--fix", "k_a=1e300", "--out", "unused"], "--fix k_a = 1e+300 is far outside"),
 ])
 def test_absurd_magnitudes_are_refused_before_any_solver(capsys, argv, match):
     out, _ = _one_line(capsys, argv, 2, f"stringstab {argv[0]}: error: ", match)
@@ -198,3 +202,14 @@ def test_the_example_rollout_that_collides_says_so_and_exits_1(capsys, tmp_path)
     assert err[-1].startswith("stringstab simulate: warning: 2 collision(s): follower 1 first "
                               "reached its predecessor at t = 81.8 s (m_fss = 0.037)")
     assert (out / "metrics.json").is_file()  # the outputs are written: they show the collision
+
+
+def test_region_growing_with_a_tiny_r0_stops_with_a_sentence(capsys, monkeypatch):
+    """A tiny r0 would build ever larger grids for hours: the search stops at MAX_POINTS."""
+    import importlib
+
+    rg = importlib.import_module("stringstab.tuning.region_growing")  # the package exports the function
+    monkeypatch.setattr(rg, "MAX_POINTS", 1e5)  # the same rule, reached sooner
+    _one_line(capsys, ["tune", "0.9,-0.5,1.1", "--method", "region-growing", "--r0", "1e-300"], 2,
+              "stringstab tune: error: region growing reached region R_", "without a solution; "
+              "expected at most 1e+05 points: a larger r0 (got 1e-300)")

@@ -126,6 +126,10 @@ def _pair(text: str, what: str) -> tuple[float, float]:
     if len(parts) != 2:
         raise StringStabError(f"{what} must be LO,HI (two numbers); got {text!r}")
     lo, hi = (_number(s.strip(), what) for s in parts)
+    from ..ranges import check_magnitude
+
+    for v in (lo, hi):  # gains: refused far beyond physical sense (the maps would overflow)
+        check_magnitude("gain", v, name=what)
     if not lo < hi:
         raise StringStabError(f"{what} must have LO < HI; got {text!r}")
     return lo, hi
@@ -198,6 +202,9 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
         if g != third:
             raise StringStabError(f"--fix must fix {third} (the gain not on --x/--y); got {g}")
         fixed = {g: _number(v.strip(), f"--fix {g}")}
+        from ..ranges import check_magnitude
+
+        check_magnitude("gain", fixed[g], name=f"--fix {g}")
         names = [x, y]
     ranges = _ranges(args.range, names)
     sizes = _sizes(args.n, len(names), DEFAULT_N_3D if args.three_d else DEFAULT_N_2D)

@@ -148,6 +148,10 @@ def run(args: argparse.Namespace) -> int:
             f"at one tau, delta, headway; expected --method projection with "
             f"{'--sample-time' if H is not None else 'an interval'}, got --method {args.method}")
     lo, hi = _numbers(args.bounds, 2, "--bounds")
+    from ..ranges import check_magnitude
+
+    for v in (lo, hi):
+        check_magnitude("gain", v, name="--bounds")
     if not lo < hi:
         raise StringStabError(f"--bounds expects LO,HI with LO < HI; got {args.bounds!r}")
     weights = _numbers(args.weights, 3, "--weights")
