@@ -35,6 +35,10 @@ def _one_line(capsys, argv, code, starts, match=""):
     (["region", "--fix", "k_a=0.5", "--range", "-1e308,1e308", "--out", "unused"],
      "--range = -1e+308 is far outside"),
     (["region", "--fix", "k_a=1e300", "--out", "unused"], "--fix k_a = 1e+300 is far outside"),
+    (["train", "--algo", "idl", "--steps", "99999999999999999999999", "--out", "unused"],
+     "is far beyond any training run"),
+    (["train", "--algo", "idl", "--steps", "100", "--num-envs", "1000000000000", "--out", "unused"],
+     "--num-envs 1000000000000 needs about "),
 ])
 def test_absurd_magnitudes_are_refused_before_any_solver(capsys, argv, match):
     out, _ = _one_line(capsys, argv, 2, f"stringstab {argv[0]}: error: ", match)
