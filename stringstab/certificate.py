@@ -204,6 +204,90 @@ def _peak(
     return np.sqrt(best), best_w
 
 
+def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, ka: npt.ArrayLike,
+                   tau: float, delta: float, headway: float) -> Array:
+    """|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
+
+    g (:mod:`stringstab.margin`) is evaluated from its coefficients, so an excess of 1e-20,
+    which |Γ|² computed directly rounds to exactly 1, keeps its sign and its digits.  Near
+    ω = 0, g(ω) = Ψ3 + g₂ω² + O(ω⁴) with g₂ = a − c_x δ²/2 − c_v δ and |D(0)|² = k_x², so
+
+    .. math:: |Γ(jω)|^2 = 1 − \\frac{Ψ_3}{k_x^2} ω^2 − \\frac{g_2 k_x^2 − Ψ_3 d_1}{k_x^4} ω^4 + …
+
+    (d₁ the ω² coefficient of |D|²): Ψ3 < 0 makes |Γ| > 1 on a neighbourhood of 0.
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequencies in rad/s (broadcast against the gains).
+    kx, kv, ka : array_like
+        The gains.
+    tau, delta, headway : float
+        τ, δ, T* in s.
+
+    Returns
+    -------
+    ndarray
+        |Γ(jω)|² − 1 (``inf`` where D(jω) = 0).
+
+    Examples
+    --------
+    >>> float(excess_squared(0.0, 1.0, 0.5, 0.2, 0.1, 0.2, 1.1))
+    0.0
+    >>> bool(np.isclose(excess_squared(2.0, 0.9, -0.5, 1.1, 0.1, 0.2, 1.1),
+    ...                 gain_squared(2.0, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1) - 1))
+    True
+    """
+    w = np.asarray(omega, dtype=float)
+    kx, kv, ka = (np.asarray(k, dtype=float) for k in (kx, kv, ka))
+    co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
+    gv = _margin.g_from_coefficients(w, co, delta)
+    re_d = kx - w * w
+    im_d = w * (kv + headway * kx - tau * w * w)
+    d2 = re_d * re_d + im_d * im_d
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        out = -(w * w) * gv / d2
+    return np.asarray(np.where(d2 > 0, out, np.inf))
+
+
+def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float,
+                    Om: Array, cand: Array) -> tuple[Array, Array]:
+    """max over ω of |Γ(jω)|² − 1 (:func:`excess_squared`) and where, for not-certified rows.
+
+    Searched on a logarithmic grid from 10⁻¹² Ω to Ω (a violation from Ψ3 < 0 sits near
+    ω = √(−Ψ3/(2g₂)), which can be 10⁻⁷ rad/s), at the candidates ``cand`` (the peak of
+    :func:`_peak` and the branch and bound's witness, where g < 0 was proven) and at that
+    small-ω estimate, then refined on a log scale.  Reporting only: the verdict is the
+    branch and bound's.
+    """
+    n = kx.size
+    rows = np.arange(n)
+    Om = np.maximum(Om, 1.0)
+    co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
+    _t2, a, b, cx, cv = (np.broadcast_to(np.asarray(c, float), (n,)) for c in co)
+    psi3, g2 = b + cx, a - cx * delta * delta / 2.0 - cv * delta
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w_small = np.where((psi3 < 0) & (g2 > 0), np.sqrt(-psi3 / (2.0 * g2)), 0.0)
+    u = np.linspace(-12.0, 0.0, 241)
+    W = np.concatenate([col(Om) * 10.0 ** u[None, :], cand, col(w_small)], axis=1)
+    E = excess_squared(W, col(kx), col(kv), col(ka), tau, delta, headway)
+    E = np.where(np.isnan(E) | (W <= 0), -np.inf, E)
+    j = np.argmax(E, axis=1)
+    best_w, best = W[rows, j], E[rows, j]
+    step = np.full(n, 0.05)  # in log10(ω)
+    v = np.linspace(-1.0, 1.0, 9)
+    for _ in range(12):
+        Wl = (best_w[:, None] * 10.0 ** (step[:, None] * v[None, :]))
+        El = excess_squared(Wl, col(kx), col(kv), col(ka), tau, delta, headway)
+        El = np.where(np.isnan(El), -np.inf, El)
+        k = np.argmax(El, axis=1)
+        better = El[rows, k] > best
+        best = np.where(better, El[rows, k], best)
+        best_w = np.where(better, Wl[rows, k], best_w)
+        step = step / 3.0
+    return best, best_w
+
+
 # ---------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------
@@ -228,6 +312,10 @@ class Certificate(SingleResult):
     sup_gain : float
         ‖Γ‖_{H∞}: sup_ω |Γ(jω)| for a stable Γ, ``inf`` otherwise (largest value
         found: exact to ~1e-12 at the reported peak frequency).
+    sup_gain_excess : float
+        sup|Γ| − 1 at the reported peak, computed without cancellation (−ω²g/|D|²): 0 when
+        certified, > 0 when not certified and stable (also when ``sup_gain`` rounds to 1.0,
+        e.g. Ψ3 just below 0: the violation sits near ω = 0 and is tiny), ``inf`` unstable.
     linf_gain : float
         sup_ω |Γ(jω)| regardless of stability (the L∞ norm).
     peak_omega : float
@@ -266,6 +354,7 @@ class Certificate(SingleResult):
     omega_max: float = float("nan")
     n_evals: int = 0
     pade: dict[str, Any] | None = None
+    sup_gain_excess: float = float("nan")
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON row of ``stringstab certify`` (non-finite numbers become None)."""
@@ -278,6 +367,7 @@ class Certificate(SingleResult):
             "verdict": self.verdict,
             "type": self.type,
             "sup_gain": num(self.sup_gain),
+            "sup_gain_excess": num(self.sup_gain_excess),
             "linf_gain": num(self.linf_gain),
             "peak_omega": num(self.peak_omega),
             "margin": num(self.margin),
@@ -313,6 +403,7 @@ class CertificateBatch(BatchResult):
     taylor_printed: TaylorCriteria
     method: str = "exact"
     pade: list[dict[str, Any]] | None = field(default=None)
+    sup_gain_excess: Array | None = field(default=None)
 
     @property
     def stable(self) -> npt.NDArray[np.bool_]:  # type: ignore[override]
@@ -330,7 +421,13 @@ class CertificateBatch(BatchResult):
             taylor_printed=self.taylor_printed.row(i), method=self.method,
             omega_max=float(self.omega_max[i]), n_evals=int(self.n_evals[i]),
             pade=None if self.pade is None else self.pade[i],
+            sup_gain_excess=float(self._excess()[i]),
         )
+
+    def _excess(self) -> Array:
+        if self.sup_gain_excess is not None:
+            return self.sup_gain_excess
+        return np.where(np.asarray(self.verdict) == "certified", 0.0, self.sup_gain - 1.0)
 
     # -- result rendering: the rows, columns and totals every output format is written from --
     def columns(self) -> dict[str, Any]:
@@ -350,8 +447,8 @@ class CertificateBatch(BatchResult):
         cols: dict[str, Any] = {
             "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "hurwitz": self.hurwitz,
             "hurwitz_margin": self.hurwitz_margin, "verdict": self.verdict, "type": self.type,
-            "sup_gain": self.sup_gain, "linf_gain": self.linf_gain,
-            "peak_omega": self.peak_omega, "margin": self.margin, "omega_max": self.omega_max,
+            "sup_gain": self.sup_gain, "sup_gain_excess": self._excess(),
+            "linf_gain": self.linf_gain, "peak_omega": self.peak_omega, "margin": self.margin, "omega_max": self.omega_max,
             "taylor_derived": _taylor_columns(self.taylor_derived),
             "taylor_printed": _taylor_columns(self.taylor_printed),
             "method": np.full(n, self.method),
@@ -384,6 +481,7 @@ TABLE_COLUMNS: list[TableColumn] = [
     TableColumn("verdict", "verdict"),
     TableColumn("type", "type"),
     TableColumn("sup|Γ|", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("sup|Γ|-1", "sup_gain_excess", "%.3g", missing="inf"),
     TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
     TableColumn("margin", "margin", "%.3g"),
     TableColumn("taylor(derived)", "taylor_derived.verdict"),
@@ -611,6 +709,7 @@ def _continuous_batch(
     n_evals = np.empty(n, dtype=np.int64)
     sup = np.empty(n)
     peak_w = np.empty(n)
+    worst_w = np.empty(n)
 
     # internal stability, with an inconclusive band around the boundary
     hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
@@ -621,6 +720,7 @@ def _continuous_batch(
                           n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals,
                           refine=~hz_fail[sl])
         verdict[sl], margin[sl], omega_max[sl], n_evals[sl] = ex.verdict, ex.margin, ex.omega_max, ex.n_evals
+        worst_w[sl] = ex.worst_omega
         # certified ⇒ sup |Γ| = 1 at ω = 0: only the others need a peak search
         need = ex.verdict != _CERT
         sup[sl], peak_w[sl] = 1.0, 0.0
@@ -635,6 +735,19 @@ def _continuous_batch(
     # certified ⇒ sup |Γ| = 1 exactly, at ω = 0 (Γ(0) = 1 for k_x ≠ 0)
     cert = verdict == _CERT
     sup[cert] = np.maximum(sup[cert], 1.0)
+    # not certified and stable ⇒ |Γ| > 1 somewhere: sup|Γ| − 1 without cancellation, so a
+    # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0
+    excess = np.where(cert, 0.0, sup - 1.0)
+    viol = np.flatnonzero((verdict == _NOT) & hz_sure)
+    if viol.size:
+        e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
+                                  omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
+        e1 = e2 / (1.0 + np.sqrt(1.0 + np.maximum(e2, 0.0)))  # sup|Γ| − 1
+        take = e1 >= excess[viol]
+        excess[viol] = np.where(take, e1, excess[viol])
+        peak_w[viol] = np.where(take, w_e, peak_w[viol])
+        sup[viol] = np.maximum(sup[viol], 1.0 + excess[viol])
+    excess = np.where(hz_sure, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")
     tp = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="printed")
@@ -666,6 +779,7 @@ def _continuous_batch(
         hurwitz_margin=hz_margin, verdict=vnames, type=np.array([TYPE_NAMES[int(t)] for t in td.type]) if n else np.array([], dtype=str),
         sup_gain=hinf, linf_gain=sup, peak_omega=peak_w, margin=margin, omega_max=omega_max,
         n_evals=n_evals, taylor_derived=td, taylor_printed=tp, method=method, pade=pade_rows,
+        sup_gain_excess=excess,
     )
 
 

@@ -21,7 +21,7 @@ from .constants import DELTA, HEADWAY, TAU
 __all__ = ["DEMO_TRIPLES", "STEPS", "TRAIN_STEPS", "TUNE_TRIPLES", "run_demo"]
 
 Log = Callable[[str], None]
-Step = Callable[[Path, Log], dict[str, Any]]
+Step = Callable[..., dict[str, Any]]  # (out, log) plus limits= for LIMITED_STEPS
 
 PARAMS = {"tau": TAU, "delta": DELTA, "headway": HEADWAY}
 ROLLOUT = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
@@ -94,7 +94,7 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     }
 
 
-def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
+def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
     """A 10-vehicle platoon behind the §5.1-style leader: certified gains vs the CACC baseline."""
     from .traffic.controllers import CACCController, LinearController
     from .traffic.leaders import leader_by_name
@@ -102,12 +102,14 @@ def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
     from .traffic.platoon import check_leader, simulate
 
     leader = leader_by_name("mix")
-    warnings = check_leader(leader)
+    warnings = check_leader(leader, limits)
+    for w in warnings:
+        log(f"   warning: {w}")
     runs = {"certified": LinearController(1.2, 0.5, 0.6, headway=HEADWAY),
             "cacc": CACCController(t_system=HEADWAY)}
     summary: dict[str, Any] = {}
     for name, controller in runs.items():
-        result = simulate(leader, controller, 10, tau=TAU, delta=DELTA)
+        result = simulate(leader, controller, 10, tau=TAU, delta=DELTA, limits=limits)
         doc = run_document(result, leader=leader, controller=controller, spec="mix",
                            warnings=warnings)
         files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {name}")
@@ -258,7 +260,9 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
 
     cfg = config_for("idl", total_steps=steps, seed=0, learning_starts=min(2_000, steps // 4),
                      checkpoint_every=max(steps, 1))
-    res = train(cfg, out=out / "run", progress=False)
+    res = train(cfg, out=out / "run", progress=None)  # a bar on a terminal, else lines
+    if getattr(res, "stopped_by", None) == "interrupted":  # Ctrl-C: the demo's folder is discarded as a whole
+        raise KeyboardInterrupt
     t = res.timing
     log(f"trained IDL for {res.steps} steps ({len(res.episodes)} episodes) in {t['total_seconds']:.1f} s: "
         f"{t['steps_per_second']:.0f} steps/s, repair {100 * t['repair_share']:.0f}% of the time")
@@ -292,6 +296,9 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
             "files": ["run/", "evaluation/", "comparison/"]}
 
 
+#: The steps that take the followers' limits (``run_demo(limits=...)``).
+LIMITED_STEPS = ("simulate",)
+
 #: The demo's steps, in order: (name, function).  Later capabilities append here.
 STEPS: list[tuple[str, Step]] = [
     ("derive", _step_derive),
@@ -304,7 +311,8 @@ STEPS: list[tuple[str, Step]] = [
 ]
 
 
-def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None) -> dict[str, Any]:
+def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None,
+             limits: Any = None) -> dict[str, Any]:
     """Run every demo step, writing outputs under ``out``.
 
     Parameters
@@ -317,6 +325,8 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
         Receives one line of progress at a time.
     only : list of str, optional
         Run only the named steps.
+    limits : Limits, optional
+        The followers' limits of the simulate step (default: IDL Table 2).
 
     Returns
     -------
@@ -336,13 +346,20 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
         if o not in names:
             raise StringStabError(f"unknown demo step {o!r}; expected one of {names}")
     summary: dict[str, Any] = {}
+    from .progress import duration
+
+    todo = sum(1 for n in names if not only or n in only)
+    done, start = 0, time.perf_counter()
     with OutputDir(out, command="demo", what="demo output folder") as d:
         for name, step in STEPS:
             if only and name not in only:
                 continue
             t0 = time.perf_counter()
-            log(f"== {name} ==")
-            result = step(d.folder(name), log)
+            done += 1
+            log(f"== {name} == (step {done} of {todo}, {duration(time.perf_counter() - start)} "
+                "elapsed)")
+            kw = {"limits": limits} if name in LIMITED_STEPS else {}
+            result = step(d.folder(name), log, **kw)
             result["seconds"] = round(time.perf_counter() - t0, 2)
             summary[name] = result
             log(f"   ({result['seconds']} s, outputs in {d.final(name)})")

@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from . import constants
 from .errors import StringStabError, show
+from .ranges import RANGES, check_magnitude
 
 __all__ = [
     "DEFAULT_DELTA",
@@ -166,6 +167,8 @@ def check_params(tau: Any, delta: Any, headway: Any) -> tuple[float, float, floa
     h = _finite("headway (desired time headway T*)", headway)
     if h < 0:
         raise StringStabError(f"headway (desired time headway T*) must be >= 0 s; got {show(headway)}")
+    for kind, x in (("tau", t), ("delta", d), ("headway", h)):
+        check_magnitude(kind, x)
     return t, d, h
 
 
@@ -193,6 +196,11 @@ def as_gains(
             idx = np.argwhere(bad)[0]
             where = f" at index {tuple(int(i) for i in idx)}" if a.ndim else ""
             raise StringStabError(f"{name} must be finite{where}; got {show(float(a[tuple(idx)]))}")
+        big = np.abs(a) > RANGES["gain"][1]
+        if big.any():  # the certificate's coefficients (products of gains) would overflow
+            idx = np.argwhere(big)[0]
+            where = f" (index {tuple(int(i) for i in idx)})" if a.ndim else ""
+            check_magnitude("gain", float(a[tuple(idx)]), name=f"{name}{where}")
     return arrs[0], arrs[1], arrs[2]
 
 
@@ -213,7 +221,7 @@ def sample_time(value: Any) -> float:
     ...
     stringstab.errors.StringStabError: sample_time (sampling period H) must be a finite number > 0 s; got 0
     """
-    return positive("sample_time (sampling period H)", value, unit=" s")
+    return check_magnitude("sample_time", positive("sample_time (sampling period H)", value, unit=" s"))
 
 
 # ---------------------------------------------------------------------------
@@ -331,6 +339,8 @@ class Box:
             raise StringStabError(
                 f"headway (desired time headway T*) interval must be >= 0 s; "
                 f"got [{self.headway[0]}, {self.headway[1]}]")
+        for kind, (_, hi) in (("tau", self.tau), ("delta", self.delta), ("headway", self.headway)):
+            check_magnitude(kind, hi)
 
     @property
     def is_point(self) -> bool:

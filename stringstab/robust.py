@@ -300,10 +300,10 @@ class _Cells:
 
 def _delay_pieces(d_lo: float, d_hi: float, H: float) -> list[tuple[int, float, float]]:
     """(m, ε_lo, ε_hi) pieces covering δ ∈ [d_lo, d_hi] (ends widened by a few ulps)."""
-    m_lo, e_lo = split_delay(d_lo, H)
+    m_lo, e_lo = split_delay(d_lo, H, whole=False)  # the box's ends exactly: it covers them
     if d_hi == d_lo:
         return [(m_lo, e_lo, e_lo)]
-    m_hi, e_hi = split_delay(d_hi, H)
+    m_hi, e_hi = split_delay(d_hi, H, whole=False)
     tol = 8.0 * np.finfo(float).eps * (m_hi + 1.0)
     out = []
     for mm in range(m_lo, m_hi + 1):

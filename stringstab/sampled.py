@@ -512,16 +512,27 @@ def _spread(theta: Array, co: _Coeffs, m: Array, hw: Array) -> Array:
     return out
 
 
-def split_delay(delta: float, sample_time: float) -> tuple[int, float]:
+#: A delay this close to a whole number of samples (relative to H) is that whole number.
+WHOLE_SAMPLE_RTOL = 1e-9
+
+
+def split_delay(delta: float, sample_time: float, *, whole: bool = True) -> tuple[int, float]:
     """δ = (m + ε) H with m an integer ≥ 0 and 0 ≤ ε < 1.
 
-    Uses the exact ``math.fmod`` so that a δ on a multiple of H gives ε = 0 when the
-    float division would not.
+    A δ within :data:`WHOLE_SAMPLE_RTOL` of a sample of a whole number of samples is that
+    whole number (ε = 0): ``0.3`` is not a multiple of ``0.1`` in binary floating point
+    (``math.fmod(0.3, 0.1)`` is 0.0999...), but the delay meant, and the loop certified, is
+    three samples, not two samples and 0.9999999999999998 of a third.  Otherwise the exact
+    ``math.fmod`` gives m and ε.
 
     Parameters
     ----------
     delta, sample_time : float
         δ ≥ 0 and H > 0, s (not validated here).
+    whole : bool
+        Round a δ within :data:`WHOLE_SAMPLE_RTOL` H of a whole number of samples to it
+        (default).  False: the exact split of the float δ (the robust certificate's box ends,
+        which must cover every δ in the box).
 
     Returns
     -------
@@ -532,7 +543,12 @@ def split_delay(delta: float, sample_time: float) -> tuple[int, float]:
     --------
     >>> split_delay(0.2, 0.1), split_delay(0.25, 0.1)[0], split_delay(0.0, 0.05)
     ((2, 0.0), 2, (0, 0.0))
+    >>> split_delay(0.3, 0.1), split_delay(0.7, 0.1)
+    ((3, 0.0), (7, 0.0))
     """
+    n = round(delta / sample_time)
+    if whole and abs(delta - n * sample_time) <= WHOLE_SAMPLE_RTOL * sample_time:
+        return int(n), 0.0
     r = math.fmod(delta, sample_time)
     m = round((delta - r) / sample_time)
     return m, r / sample_time

@@ -25,13 +25,19 @@ def _refused(capsys, tmp_path, *argv, match):
     return err
 
 
-def test_leader_above_the_speed_limit_is_refused(capsys, tmp_path):
+def test_absurd_leader_is_refused_and_one_above_v_max_warns(capsys, tmp_path):
+    """Issue 21: one leader check; beyond the followers' limits a warning, beyond 70 m/s refused."""
     lead = tmp_path / "fast.csv"
     lead.write_text("t,v\n0,100\n10,100\n20,100\n")
     _refused(capsys, tmp_path, "--leader", str(lead), *SHORT,
-             match="reaches 100 m/s at t = 0 s, above the followers' speed limit v_max = 33.3 m/s")
-    _refused(capsys, tmp_path, "--leader", "sinusoid:omega=0.5,speed=40", *SHORT,
-             match="above the followers' speed limit")
+             match="reaches 100 m/s at t = 0 s: no road vehicle; expected a leader within [0, 70] m/s")
+    out = tmp_path / "out40"
+    assert main(["simulate", "--leader", "sinusoid:omega=0.5,speed=40", "--followers", "2", *SHORT,
+                 "--out", str(out)]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "warning: the leader reaches" in err and "above the followers' speed limit v_max = " \
+        "33.3 m/s (IDL Table 2; --v-max raises it): they saturate there and the gap opens" in err
+    assert "v_max" in json.loads((out / "metrics.json").read_text())["warnings"][0]
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -101,11 +107,12 @@ def test_output_folder_checked_before_work(capsys, tmp_path, monkeypatch):
 def test_a_second_run_replaces_the_first(capsys, tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", "--duration", "10", "--followers", "2", "--out", str(out)]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["damping.png", "metrics.json", "platoon.png",
-                                                     "trajectories.npz"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "damping.png", "metrics.json",
+                                                     "platoon.png", "trajectories.npz"]
     (out / "notes.txt").write_text("mine")
     assert main(["simulate", *SHORT, "--followers", "2", "--format", "csv", "--out", str(out)]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt", "trajectories.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "metrics.json", "notes.txt",
+                                                     "trajectories.csv"]
 
 
 def test_parquet_trajectories(tmp_path, capsys):

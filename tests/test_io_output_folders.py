@@ -32,11 +32,11 @@ def test_owned_names_replace_an_earlier_run_without_a_manifest(tmp_path: Path) -
     (run / "mine.txt").write_text("kept")
     with OutputDir(run, command="simulate", owns=owns) as out:
         out.write_text("a.csv", "2")
-    assert sorted(p.name for p in run.iterdir()) == ["a.csv", "mine.txt"]
+    assert sorted(p.name for p in run.iterdir()) == [MANIFEST, "a.csv", "mine.txt"]
     with pytest.raises(RuntimeError), OutputDir(run, command="simulate", owns=owns) as out:
         out.write_text("a.npz", "3")
         raise RuntimeError("failed run")
-    assert sorted(p.name for p in run.iterdir()) == ["a.csv", "mine.txt"]
+    assert sorted(p.name for p in run.iterdir()) == [MANIFEST, "a.csv", "mine.txt"]
     (run / MANIFEST).write_text('{"command": "region", "files": []}')
     with pytest.raises(StringStabError, match="holds the outputs of 'stringstab region'"):
         OutputDir(run, command="simulate", owns=owns)

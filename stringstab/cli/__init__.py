@@ -3,7 +3,9 @@
 Each sub-command lives in its own module of this package and exposes
 ``add_parser(subparsers)`` (which registers it and sets ``func``) and a
 ``run(args) -> int``.  Bad input (:class:`~stringstab.errors.StringStabError`)
-becomes a one-line message on stderr and exit code 2; no verdict is printed.
+becomes a one-line message on stderr and exit code 2; no verdict is printed.  The
+entry point is the one place that also turns Ctrl-C (``KeyboardInterrupt``: one line,
+exit 130) and ``MemoryError`` (one line, exit 2) into a sentence.
 
 Sub-commands are registered lazily: ``stringstab --help`` lists them from
 :data:`HELP` and ``stringstab NAME ...`` imports only ``stringstab.cli.NAME``,
@@ -110,17 +112,46 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stringstab`` console script; returns the exit code."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    for stream in (sys.stdout, sys.stderr):  # a file name of undecodable bytes prints, escaped
+        try:
+            stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
+        except (AttributeError, ValueError, OSError):
+            pass
     command = _chosen(argv)
     parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)
+    from ..io.outputs import invocation
+    from ._provenance import provenance
+
+    hook = sys.unraisablehook
+
+    def quiet_interrupt(u: Any) -> None:  # Ctrl-C landing in a finaliser: not a traceback
+        if u.exc_type is not KeyboardInterrupt:
+            hook(u)
+
+    sys.unraisablehook = quiet_interrupt
     try:
-        return int(args.func(args) or 0)
+        with invocation(lambda: provenance(args, argv)):
+            return int(args.func(args) or 0)
     except StringStabError as e:
         msg = str(e).replace("\n", " ")
         print(f"stringstab {args.command}: error: {msg}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        # output folders (OutputDir) and single files (atomic writes) are complete or absent;
+        # an interrupted training run stops at a step boundary itself and says how to resume
+        print(f"stringstab {args.command}: interrupted; nothing partial was written "
+              "(outputs are complete or absent)", file=sys.stderr)
+        return 130
+    except MemoryError as e:
+        detail = f" ({e})" if str(e) else ""
+        print(f"stringstab {args.command}: error: out of memory{detail}; expected a smaller "
+              "request (fewer grid points, followers or rows)", file=sys.stderr)
+        return 2
     except BrokenPipeError:  # pragma: no cover - e.g. piped into head
         return 0
+    finally:
+        sys.unraisablehook = hook
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -28,19 +28,25 @@ from ..params import (
     parameter_model,
     positive,
 )
+from ..ranges import check_magnitude, sensible_warning
 
 __all__ = [
     "NEGATIVE_NUMBER",
     "RESULT_FORMATS",
     "add_gain_arguments",
+    "add_limit_arguments",
     "add_model_arguments",
     "add_output_arguments",
     "check_horizon",
     "check_output",
+    "checked_leaders",
     "gains_from_args",
     "integer",
+    "limits_from_args",
     "loop_params",
+    "resolve_format",
     "shown_params",
+    "warn_beyond_sensible",
 ]
 
 #: argparse (< 3.13) reads "-0.5,1,1" or "-2,2" as an unknown option; anything that
@@ -94,7 +100,33 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
         model = Params(*check_params(*values))
     H = None if args.sample_time is None else positive(
         "--sample-time (sampling period H)", args.sample_time, unit=" s")
+    if H is not None:
+        check_magnitude("sample_time", H, name="--sample-time")
+    box = Box.of(model)
+    warn_beyond_sensible(args, [("tau", box.tau[1], "--tau"), ("delta", box.delta[1], "--delta"),
+                                ("headway", box.headway[1], "--headway"),
+                                ("sample_time", H, "--sample-time")])
     return model, H
+
+
+def warn_beyond_sensible(args: Any, values: list[tuple[str, float | None, str]]) -> None:
+    """One warning line on stderr per value beyond its sensible range (:mod:`stringstab.ranges`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's arguments (``args.command`` names it in the warning).
+    values : list of (kind, value, option)
+        The kind of :data:`stringstab.ranges.RANGES`, the value (None: skipped) and the option.
+    """
+    import sys
+
+    for kind, value, option in values:
+        if value is None:
+            continue
+        w = sensible_warning(kind, value, name=option)
+        if w is not None:
+            print(f"stringstab {getattr(args, 'command', '')}: warning: {w}", file=sys.stderr)
 
 
 def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
@@ -144,8 +176,9 @@ def add_gain_arguments(p: argparse.ArgumentParser) -> None:
 def add_output_arguments(p: argparse.ArgumentParser,
                          formats: tuple[str, ...] = RESULT_FORMATS) -> None:
     """``--format`` (default ``table``) and ``--out FILE`` of a command that writes results."""
-    p.add_argument("--format", choices=formats, default="table",
-                   help="output format (default: table); parquet and npz need --out")
+    p.add_argument("--format", choices=formats, default=None,
+                   help="output format (default: the --out file's extension, .json .csv "
+                        ".parquet .npz, else table); parquet and npz need --out")
     p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
 
 
@@ -153,7 +186,9 @@ def check_output(args: Any) -> Path | None:
     """``--out`` checked before any work (see :func:`stringstab.io.check_output_file`).
 
     Returns the path, or None for standard output; a binary ``--format`` needs ``--out``.
+    Resolves ``args.format`` (:func:`resolve_format`) first.
     """
+    args.format = resolve_format(args.format, args.out, RESULT_FORMATS)
     if args.out is None:
         if args.format in BINARY_FORMATS:
             raise StringStabError(
@@ -161,6 +196,54 @@ def check_output(args: Any) -> Path | None:
             )
         return None
     return check_output_file(args.out, what="--out (expected a file path in an existing directory)")
+
+
+#: The format a known ``--out`` extension names.
+FORMAT_BY_EXTENSION: dict[str, str] = {
+    ".json": "json", ".csv": "csv", ".parquet": "parquet", ".npz": "npz", ".txt": "table",
+    ".tex": "latex",
+}
+
+
+def resolve_format(given: str | None, out: str | None, formats: tuple[str, ...],
+                   default: str = "table") -> str:
+    """The output format: ``--format`` if given, else the one ``--out``'s extension names.
+
+    Parameters
+    ----------
+    given : str or None
+        ``--format`` as given (None: not given).
+    out : str or None
+        ``--out``.
+    formats : tuple of str
+        The command's formats.
+    default : str
+        Without either.
+
+    Raises
+    ------
+    StringStabError
+        When ``--format`` and a known extension of ``--out`` name different formats.
+
+    Examples
+    --------
+    >>> resolve_format(None, "v.json", ("table", "json")), resolve_format("csv", "v.dat", ("csv",))
+    ('json', 'csv')
+    >>> resolve_format("csv", "y.json", ("csv", "json"))
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: --format csv conflicts with --out y.json (a .json file is json); expected --format json, or an --out ending in the format's extension
+    """
+    ext = Path(out).suffix.lower() if out else ""
+    by_ext = FORMAT_BY_EXTENSION.get(ext)
+    by_ext = by_ext if by_ext in formats else None
+    if given is None:
+        return by_ext or default
+    if by_ext is not None and by_ext != given:
+        raise StringStabError(
+            f"--format {given} conflicts with --out {out} (a {ext} file is {by_ext}); expected "
+            f"--format {by_ext}, or an --out ending in the format's extension")
+    return given
 
 
 def gains_from_args(args: Any) -> GainTable:
@@ -171,10 +254,130 @@ def gains_from_args(args: Any) -> GainTable:
             f"and --file {args.file}"
         )
     if args.file:
-        return read_gains(args.file)
+        table = read_gains(args.file)
+        _warn_gains(args, table)
+        return table
     if not args.triples:
         raise StringStabError(
             "expected gain triples K_X,K_V,K_A (e.g. 0.9,-0.5,1.1) or --file F; got none"
         )
     triples = [parse_triple(t, where=f"triple {i + 1} {show(t)}") for i, t in enumerate(args.triples)]
-    return GainTable.from_triples(triples, source="<command line>")
+    table = GainTable.from_triples(triples, source="<command line>")
+    _warn_gains(args, table)
+    return table
+
+
+def _warn_gains(args: Any, table: GainTable) -> None:
+    """Refuse a gain beyond the physical bound (:mod:`stringstab.ranges`: the certificate's
+    coefficients would overflow), naming its row; warn once beyond the sensible range."""
+    from ..ranges import RANGES
+
+    for name in ("k_x", "k_v", "k_a"):
+        a = np.asarray(getattr(table, name), dtype=float)
+        big = np.flatnonzero(np.abs(a) > RANGES["gain"][1])
+        if big.size:
+            check_magnitude("gain", float(a[big[0]]),
+                            name=f"{table.source}, row {int(big[0]) + 1}, {name}")
+    K = np.abs(np.stack([table.k_x, table.k_v, table.k_a]))
+    if K.size and float(K.max()) > 0:
+        j, i = np.unravel_index(int(np.argmax(K)), K.shape)
+        name = ("k_x", "k_v", "k_a")[int(j)]
+        warn_beyond_sensible(args, [("gain", float(getattr(table, name)[int(i)]),
+                                     f"{name} (row {int(i) + 1})")])
+
+
+def add_limit_arguments(p: argparse.ArgumentParser, *, speed_max: float | None = None,
+                        accel_min: float | None = None, accel_max: float | None = None,
+                        source: str = "IDL Table 2") -> None:
+    """``--v-max --a-min --a-max``: the followers' limits (default: IDL Table 2).
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The command's parser.
+    speed_max, accel_min, accel_max : float, optional
+        Other defaults (the HCFS paper's ±3 m/s²), named by ``source`` in the help.
+    source : str
+        Where the defaults come from.
+    """
+    from .. import constants as c
+
+    v = c.SPEED_MAX if speed_max is None else speed_max
+    lo = c.ACCEL_MIN if accel_min is None else accel_min
+    hi = c.ACCEL_MAX if accel_max is None else accel_max
+    g = p.add_argument_group(f"followers' limits (defaults: {source})")
+    g.add_argument("--v-max", default=str(v), metavar="M/S",
+                   help=f"followers' speed limit v_max in m/s (default {v:g}); a faster leader "
+                        "runs with a warning, one above 70 m/s is refused")
+    g.add_argument("--a-min", default=str(lo), metavar="M/S2",
+                   help=f"followers' braking limit acc_min in m/s², < 0 (default {lo:g})")
+    g.add_argument("--a-max", default=str(hi), metavar="M/S2",
+                   help=f"followers' acceleration limit acc_max in m/s², > 0 (default {hi:g})")
+
+
+def limits_from_args(args: Any) -> Any:
+    """The :class:`~stringstab.traffic.Limits` of ``--v-max --a-min --a-max``, checked.
+
+    Raises
+    ------
+    StringStabError
+        A limit that is not a finite number, acc_min ≥ 0, acc_max ≤ 0, v_max ≤ 0, or a limit
+        beyond any road vehicle (v_max > 70 m/s, |acc| > 15 m/s²).
+    """
+    from ..traffic.platoon import Limits
+
+    def number(option: str, text: Any) -> float:
+        try:
+            x = float(str(text))
+        except ValueError as e:
+            raise StringStabError(f"{option} must be a number; got {show(text)}") from e
+        if not np.isfinite(x):
+            raise StringStabError(f"{option} must be a finite number; got {show(text)}")
+        return x
+
+    v_max = number("--v-max", args.v_max)
+    a_min, a_max = number("--a-min", args.a_min), number("--a-max", args.a_max)
+    if not v_max > 0:
+        raise StringStabError(f"--v-max must be > 0 m/s; got {v_max:g}")
+    if not a_min < 0 < a_max:
+        raise StringStabError(f"expected --a-min < 0 < --a-max; got --a-min {a_min:g}, --a-max {a_max:g}")
+    return Limits(accel_min=a_min, accel_max=a_max, speed_max=v_max)
+
+
+def checked_leaders(args: Any, leaders: Any, limits: Any) -> list[str]:
+    """:func:`stringstab.traffic.check_leader` on every leader, its warnings printed (stderr).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's arguments (``args.command`` names it in the warnings).
+    leaders : sequence of Trajectory
+        The leaders the command will run.
+    limits : Limits
+        The followers' limits.
+
+    Returns
+    -------
+    list of str
+        The warnings (also for the run's metrics), each once.
+
+    Raises
+    ------
+    StringStabError
+        A physically absurd leader (above 70 m/s or beyond ±15 m/s²).
+    """
+    import sys
+
+    from ..traffic.platoon import check_leader
+
+    out: list[str] = []
+    for leader in leaders:
+        for w in check_leader(leader, limits):
+            text = w if len(leaders) == 1 else f"{leader.name}: {w}"
+            if text not in out:
+                out.append(text)
+    command = getattr(args, "command", "")
+    sub = getattr(args, "hcfs_command", None)
+    for w in out:
+        print(f"stringstab {command}{' ' + sub if sub else ''}: warning: {w}", file=sys.stderr)
+    return out

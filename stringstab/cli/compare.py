@@ -6,6 +6,8 @@ import argparse
 from typing import Any
 
 from ..errors import StringStabError
+from ..progress import Progress
+from ._common import add_limit_arguments, checked_leaders, limits_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -30,6 +32,8 @@ def add_parser(sub: Any) -> None:
                    help="strategy whose improvements are listed (default idl when present)")
     p.add_argument("--platoon", action="store_true", help="also run the 10-vehicle platoon test")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar or lines (stderr)")
+    add_limit_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -51,23 +55,33 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"runs must share tau, delta, headway and dt; found {sorted(params)}")
     tau, delta, headway, dt = params.pop()
     leaders, desc = test_leaders(args.leaders, dt=dt)
+    limits = limits_from_args(args)
     out = OutputDir(args.out, command="compare")
+    from ..traffic.leaders import paper_mix
+
+    checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits)
     groups: dict[str, list[Any]] = {}
     platoons: dict[str, Any] = {}
-    for info, pol in opened:
-        ev = evaluate(pol, leaders, tau=tau, delta=delta, headway=headway, name=pol.algo)
-        groups.setdefault(pol.algo, []).append(ev)
-        print(f"{info['folder']} ({pol.algo}): TIT {ev.summary['TIT']:.3f}, "
-              f"M_CI {ev.summary['M_CI']:.3f}, collisions {ev.summary['collisions']}, "
-              f"M_fss {ev.summary['M_fss'] if ev.summary['M_fss'] is not None else 'n/a'}")
-        if args.platoon and pol.algo not in platoons:
-            platoons[pol.algo] = {"run": info["folder"], "tests": [platoon_test(
-                pol, 10, tau=tau, delta=delta, headway=headway, dt=dt)]}
-    for b in base:
-        groups[b] = [evaluate(b, leaders, tau=tau, delta=delta, headway=headway, name=b)]
-        if args.platoon:
-            platoons[b] = {"run": None, "tests": [platoon_test(b, 10, tau=tau, delta=delta,
-                                                               headway=headway, dt=dt)]}
+    kw: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "limits": limits}
+    per = len(leaders) + (10 if args.platoon else 0)
+    with Progress(per * (len(opened) + len(base)), "stringstab compare", unit="vehicle-runs",
+                  enabled=not args.no_progress) as bar:
+        for info, pol in opened:
+            ev = evaluate(pol, leaders, name=pol.algo, progress=bar.update, **kw)
+            groups.setdefault(pol.algo, []).append(ev)
+            print(f"{info['folder']} ({pol.algo}): TIT {ev.summary['TIT']:.3f}, "
+                  f"M_CI {ev.summary['M_CI']:.3f}, collisions {ev.summary['collisions']}, "
+                  f"M_fss {ev.summary['M_fss'] if ev.summary['M_fss'] is not None else 'n/a'}")
+            if args.platoon and pol.algo not in platoons:
+                platoons[pol.algo] = {"run": info["folder"], "tests": [platoon_test(
+                    pol, 10, dt=dt, **kw)]}
+            if args.platoon:
+                bar.update(10)
+        for b in base:
+            groups[b] = [evaluate(b, leaders, name=b, progress=bar.update, **kw)]
+            if args.platoon:
+                platoons[b] = {"run": None, "tests": [platoon_test(b, 10, dt=dt, **kw)]}
+                bar.update(10)
     ref = args.reference or ("idl" if "idl" in groups else None)
     if ref is not None and ref not in groups:
         raise StringStabError(f"--reference {ref!r} is not among the strategies {sorted(groups)}")

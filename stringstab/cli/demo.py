@@ -21,6 +21,9 @@ def add_parser(sub: Any) -> None:
                    help="output directory (default: demo-out); an earlier demo's files in it are "
                         "replaced, and it is left untouched if the demo fails")
     p.add_argument("--only", action="append", metavar="STEP", help="run only this step (repeatable)")
+    from ._common import add_limit_arguments
+
+    add_limit_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -33,6 +36,8 @@ def run(args: argparse.Namespace) -> int:
     for o in args.only or []:
         if o not in names:
             raise StringStabError(f"--only: unknown step {show(o)}; expected one of {names}")
-    run_demo(args.out, only=args.only)
+    from ._common import limits_from_args
+
+    run_demo(args.out, only=args.only, limits=limits_from_args(args))
     print(f"demo done: outputs in {args.out}/ (summary.json)")
     return 0

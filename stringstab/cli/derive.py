@@ -31,7 +31,9 @@ def add_parser(sub: Any) -> None:
             "delay), its characteristic polynomial Δ(z) and the Schur conditions."
         ),
     )
-    p.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    p.add_argument("--format", choices=("text", "latex", "json"), default=None,
+                   help="text, latex or json (default: the --out file's extension .json/.tex, "
+                        "else text)")
     p.add_argument(
         "--errata",
         action="store_true",
@@ -80,6 +82,9 @@ def run(args: argparse.Namespace) -> int:
             raise StringStabError(
                 "--errata and --delay-order are about the continuous loop's Ψ (IDL eqs 12-15); "
                 f"expected neither with --sample-time; got {'--errata' if args.errata else '--delay-order ' + args.delay_order}")
+    from ._common import resolve_format
+
+    args.format = resolve_format(args.format, args.out, ("text", "latex", "json"), default="text")
     out = check_output_file(args.out, what="--out") if args.out else None
     d = (sampled_derivation(H, args.substitute) if H is not None
          else derivation(delay_order, args.substitute, args.errata))

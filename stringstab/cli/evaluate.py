@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
+from ..progress import Progress
+from ._budget import refuse_platoon
+from ._common import add_limit_arguments, checked_leaders, limits_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -30,6 +34,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--platoon", default="10,100", metavar="N,N",
                    help="platoon sizes of the §5.1 test (default 10,100; 'none' to skip)")
     p.add_argument("--out", metavar="DIR", help="output folder (default RUN/evaluation)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar or progress lines (stderr)")
+    add_limit_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -54,18 +61,34 @@ def run(args: argparse.Namespace) -> int:
     from ..rl.runs import open_run, test_leaders
 
     sizes = _sizes(args.platoon)
+    limits = limits_from_args(args)
     info, policy = open_run(args.run)
     p = policy.info
     leaders, desc = test_leaders(args.leaders, dt=p["dt"])
     out = OutputDir(Path(args.out) if args.out else Path(args.run) / "evaluation",
                     command="evaluate")
-    ev = evaluate(policy, leaders, tau=p["tau"], delta=p["delta"], headway=p["headway"])
-    platoons = [platoon_test(policy, n, tau=p["tau"], delta=p["delta"], headway=p["headway"],
-                             dt=p["dt"]) for n in sizes]
+    policy_doc = _policy_of(Path(args.run), out)
+    from ..traffic.leaders import paper_mix
+
+    warnings = checked_leaders(args, [*leaders, *([paper_mix(dt=p["dt"])] if sizes else [])],
+                               limits)
+    for n in sizes:
+        refuse_platoon(n, int(paper_mix(dt=p["dt"]).n_steps + 100.0 / p["dt"]), f"--platoon {n}")
+    with Progress(len(leaders) + sum(sizes), "stringstab evaluate", unit="vehicle-runs",
+                  enabled=not args.no_progress) as bar:
+        ev = evaluate(policy, leaders, tau=p["tau"], delta=p["delta"], headway=p["headway"],
+                      limits=limits, progress=bar.update)
+        platoons = []
+        for n in sizes:
+            platoons.append(platoon_test(policy, n, tau=p["tau"], delta=p["delta"],
+                                         headway=p["headway"], dt=p["dt"], limits=limits))
+            bar.update(n)
     s = ev.summary
     verdict, passed = report_verdict(ev, platoons, policy.action)
     run_doc = {**info, "leaders": desc, "tau": p["tau"], "delta": p["delta"],
-               "headway": p["headway"], "dt": p["dt"], "repair": p.get("repair")}
+               "headway": p["headway"], "dt": p["dt"], "repair": p.get("repair"),
+               "limits": dataclasses.asdict(limits), "warnings": warnings,
+               "policy_sha256": policy_doc["policy_sha256"], "steps": policy_doc["steps"]}
     with out:
         files = write_evaluation(out, ev, platoons, run_doc, verdict)
     print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
@@ -81,3 +104,31 @@ def run(args: argparse.Namespace) -> int:
     print(f"verdict: {verdict}")
     print(f"wrote {', '.join(files)} to {out.root}/")
     return 0 if passed else 1
+
+
+def _policy_of(run: Path, out: Any) -> dict[str, Any]:
+    """The evaluated policy's identity, recorded in the manifest; a stale evaluation is named.
+
+    An output folder holding the evaluation of *another* run folder is refused (two policies'
+    results are never mixed, nor one silently replaced by another's); one holding an evaluation
+    of an older policy of this run (before ``train --resume``) is replaced, and the command
+    says so.
+    """
+    import sys
+
+    from ._provenance import policy_identity
+
+    ident = policy_identity(run) or {"policy_sha256": None, "steps": None}
+    doc = {"run": str(run.resolve()), **ident}
+    prev = (out.previous() or {}).get("policy")
+    if isinstance(prev, dict):
+        if prev.get("run") not in (None, doc["run"]):
+            raise StringStabError(
+                f"--out {out.root} holds the evaluation of another run ({prev.get('run')}); "
+                f"expected an empty folder or an evaluation of {run}; choose another --out")
+        if (prev.get("policy_sha256"), prev.get("steps")) != (doc["policy_sha256"], doc["steps"]):
+            print(f"stringstab evaluate: note: {out.root}/ held the evaluation of an older policy "
+                  f"of this run (step {prev.get('steps')}); it is replaced by this one's "
+                  f"(step {doc['steps']})", file=sys.stderr)
+    out.record(policy=doc)
+    return doc

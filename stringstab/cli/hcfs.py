@@ -67,6 +67,13 @@ def add_parser(sub: Any) -> None:
                         "(torch) unless 'stand-in'")
     v.add_argument("--no-figures", action="store_true", help="skip the figures")
     v.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    v.add_argument("--no-progress", action="store_true", help="no progress bar or lines (stderr)")
+    from ..hcfs.constants import ACCEL_MAX as HCFS_ACCEL_MAX
+    from ..hcfs.constants import ACCEL_MIN as HCFS_ACCEL_MIN
+    from ._common import add_limit_arguments
+
+    add_limit_arguments(v, accel_min=HCFS_ACCEL_MIN, accel_max=HCFS_ACCEL_MAX,
+                        source="HCFS section IV, v_max IDL Table 2")
     v.set_defaults(func=run)
 
     t = hs.add_parser(
@@ -118,8 +125,20 @@ def run_verify(args: argparse.Namespace) -> int:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
+    if args.duration is not None:
+        from ..ranges import check_magnitude
+
+        check_magnitude("duration", args.duration, name="--duration")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
+    from ._budget import refuse_platoon
+
+    refuse_platoon(args.followers * max(len(leaders), 1), max(len(ld.speed) for ld in leaders),
+                   f"--followers {args.followers}")
+    from ._common import checked_leaders, limits_from_args
+
+    limits = limits_from_args(args)
+    checked_leaders(args, leaders, limits)
     policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
@@ -127,8 +146,16 @@ def run_verify(args: argparse.Namespace) -> int:
         *(["--duration", f"{args.duration:g}"] if args.duration is not None else []),
         "--beta", f"{beta:g}", "--policy", args.policy,
         *(["--no-figures"] if args.no_figures else []), "--out", args.out,
+        "--v-max", f"{limits.speed_max:g}", "--a-min", f"{limits.accel_min:g}",
+        "--a-max", f"{limits.accel_max:g}",
     ])
-    ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta)
+    from ..progress import Progress
+
+    with Progress(len(leaders), "stringstab hcfs verify", unit="leaders",
+                  enabled=not args.no_progress) as bar:
+        ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta,
+                     progress=bar.update, accel_min=limits.accel_min,
+                     accel_max=limits.accel_max, speed_max=limits.speed_max)
     with out:
         files = write_report(ver, out, figures=not args.no_figures, command=command)
     print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")
@@ -171,8 +198,13 @@ def run_train(args: argparse.Namespace) -> int:
     from ..hcfs.env import HCFSVectorEnv
 
     env = HCFSVectorEnv(platoons, leaders, n_followers=followers, episode_seconds=seconds)
-    run = train_hcfs_ddpg(total_steps=steps, seed=seed, env=env, out=out,
-                          progress=False if args.no_progress else None, stop_episodes=0)
+    existed = out.exists()
+    try:
+        run = train_hcfs_ddpg(total_steps=steps, seed=seed, env=env, out=out,
+                              progress=False if args.no_progress else None, stop_episodes=0)
+    except KeyboardInterrupt:  # the folder was new or empty: leave it so (outputs absent)
+        _empty(out, remove=not existed)
+        raise
     res = run.result
     n = len(res.episodes)
     if n:
@@ -201,6 +233,19 @@ def run_train(args: argparse.Namespace) -> int:
           f"hcfs_policy.json and evaluation.json to {args.out.rstrip('/')}/; use it with "
           f"'stringstab hcfs verify --policy {args.out}'")
     return 0
+
+
+def _empty(out: Path, *, remove: bool) -> None:
+    """Delete what an interrupted ``hcfs train`` wrote into its new (or empty) folder."""
+    import shutil
+
+    if not out.is_dir():
+        return
+    for p in out.iterdir():
+        if not p.name.startswith("."):
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+    if remove:
+        shutil.rmtree(out, ignore_errors=True)
 
 
 def _check_new_folder(out: Path) -> None:

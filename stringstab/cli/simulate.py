@@ -1,10 +1,12 @@
 """``stringstab simulate``: drive a platoon with a leader and write trajectories, metrics, figures.
 
 Refused before anything is simulated or written (exit 2, one line): an output folder that
-cannot be written or holds another command's outputs, a leader faster than the followers'
-speed limit, and a step ``--dt`` longer than τ or δ (the run would be a sampled-data system
-whose behaviour the continuous-time certificate and M_fss do not describe).  A leader that
-accelerates beyond the followers' limits is simulated with a warning.
+cannot be written or holds another command's outputs, a physically absurd leader (above 70 m/s
+or beyond ±15 m/s²), a platoon that cannot fit in memory, and a step ``--dt`` longer than τ or
+δ (the run would be a sampled-data system whose behaviour the continuous-time certificate and
+M_fss do not describe).  A leader beyond the followers' limits (``--v-max``, ``--a-min``,
+``--a-max``; IDL Table 2 by default) is simulated with a warning.  Exit status 0; 1 when a
+follower collided (outputs written, a warning says who and when); 2 on bad input.
 """
 
 from __future__ import annotations
@@ -14,9 +16,12 @@ import math
 import sys
 from typing import Any
 
+import numpy as np
+
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, STANDSTILL, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
+from ._common import add_limit_arguments, checked_leaders, limits_from_args
 
 __all__ = ["DEFAULT_GAINS", "add_parser", "parse_gains", "run"]
 
@@ -34,12 +39,13 @@ def add_parser(sub: Any) -> None:
         help="simulate a platoon behind a leader; write trajectories, metrics JSON and figures",
         description=(
             "Simulate N followers (IDL third-order model, eqs 5-7, actuator lag tau, predecessor "
-            f"acceleration received delta late, limits [{ACCEL_MIN:g}, {ACCEL_MAX:g}] m/s^2 and "
+            f"acceleration received delta late, limits (default, IDL Table 2) [{ACCEL_MIN:g}, {ACCEL_MAX:g}] m/s^2 and "
             f"[0, {SPEED_MAX:g}] m/s) behind a "
             "leader, and write trajectories, the IDL metrics (m_p, M_lss, TIT, M_CI, M_effi, "
-            "M_fss, collisions) and figures like the paper's Figs 7-8. Refused: a leader above "
-            "the speed limit, --dt longer than tau or delta, an output folder that cannot be "
-            "written."
+            "M_fss, collisions) and figures like the paper's Figs 7-8. A leader beyond the "
+            "followers' limits (--v-max, --a-min, --a-max) runs with a warning; refused: a leader "
+            "above 70 m/s or beyond ±15 m/s², --dt longer than tau or delta, an output folder "
+            "that cannot be written."
         ),
         epilog=(
             f"Leaders: cycles {', '.join(sorted(CYCLES))}; synthetic {', '.join(SYNTHETIC)} "
@@ -80,6 +86,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (an earlier run's files in it are replaced)")
+    add_limit_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -151,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io import OutputDir
     from ..traffic.leaders import leader_by_name
     from ..traffic.output import RUN_FILES, run_document, write_run
-    from ..traffic.platoon import check_leader, simulate
+    from ..traffic.platoon import simulate
 
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
     if args.followers < 1:
@@ -165,9 +172,17 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
     _check_step(args.dt, tau, delta)
+    from ..ranges import check_magnitude
+
+    for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
+        if v is not None and math.isfinite(v):
+            check_magnitude("duration", v, name=opt)
     out = OutputDir(args.out, command="simulate", owns=RUN_FILES, what="--out")
     leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
-    warnings = check_leader(leader)
+    from ._budget import refuse_platoon
+
+    refuse_platoon(args.followers, len(leader.speed), f"--followers {args.followers}")
+    limits = limits_from_args(args)
     controller = _controller(args, headway)
     n_series = getattr(controller, "followers", None)
     if n_series is not None and n_series != args.followers:
@@ -175,10 +190,9 @@ def run(args: argparse.Namespace) -> int:
             f"--gains-file {args.gains_file} has gain series for followers 1..{n_series}; "
             f"expected --followers {n_series}, got {args.followers}"
         )
-    for w in warnings:
-        print(f"stringstab simulate: warning: {w}", file=sys.stderr)
+    warnings = checked_leaders(args, [leader], limits)
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
-                      length=args.length)
+                      length=args.length, limits=limits)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
                        ttc_star=args.ttc_star, warnings=warnings)
     metrics = doc
@@ -198,4 +212,11 @@ def run(args: argparse.Namespace) -> int:
           f"M_effi = {_fmt(metrics.get('M_effi'), '.3f', ' s')}, "
           f"m_fss = {_fmt(metrics['m_fss'], '.3f')} (share of vehicle-moments certified)")
     print(f"wrote {', '.join(files.values())} to {out.root}/")
+    if metrics["collisions"]:
+        first = np.asarray(result.first_collision_time, dtype=float).ravel()
+        who = int(np.nanargmin(first)) + 1
+        print(f"stringstab simulate: warning: {metrics['collisions']} collision(s): follower {who} "
+              f"first reached its predecessor at t = {float(np.nanmin(first)):.4g} s (m_fss = "
+              f"{_fmt(metrics['m_fss'], '.3f')}); exit status 1", file=sys.stderr)
+        return 1
     return 0

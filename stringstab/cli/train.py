@@ -49,6 +49,13 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+#: The largest step budget accepted (a year at ~300 steps/s).
+MAX_STEPS = 10**10
+#: Memory per parallel environment, rounded up from a measurement (train --algo idl, peak RSS
+#: 1022 MB with 4 and 1023 MB with 2048 environments: ~0.6 kB each).
+BYTES_PER_ENV = 2048
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``train``."""
     from ..rl.config import config_for
@@ -56,8 +63,16 @@ def run(args: argparse.Namespace) -> int:
 
     kw: dict[str, Any] = {"total_steps": _int("--steps", args.steps, 1),
                           "seed": _int("--seed", args.seed, 0)}
+    if kw["total_steps"] > MAX_STEPS:
+        raise StringStabError(
+            f"--steps {kw['total_steps']} is far beyond any training run (about a year at 300 "
+            f"steps/s is 1e10); expected at most {MAX_STEPS:.0e}")
     if args.num_envs is not None:
         kw["num_envs"] = _int("--num-envs", args.num_envs, 1)
+        from ._budget import refuse_if_too_big
+
+        refuse_if_too_big(f"--num-envs {kw['num_envs']}", BYTES_PER_ENV * kw["num_envs"],
+                          "expected fewer parallel environments (8 by default)")
     if args.stop_episodes is not None:
         kw["stop_episodes"] = _int("--stop-episodes", args.stop_episodes, 0)
     if args.repair is not None:
@@ -77,6 +92,15 @@ def run(args: argparse.Namespace) -> int:
                                      dt=config.dt)
     res = train(config, out=out, resume=args.resume, progress=not args.no_progress,
                 leaders=leaders, log=print)
+    if res.stopped_by == "interrupted":
+        import shlex
+        import sys
+
+        again = ["stringstab", "train", *_argv_of(args), "--resume"]
+        print(f"stringstab train: interrupted at step {res.steps} of {config.total_steps}; {out}/ "
+              f"holds its checkpoint, policy, train_log.csv and summary.json; continue with: "
+              f"{shlex.join(again)}", file=sys.stderr)
+        return 130
     n = len(res.episodes)
     coll = sum(e["collision"] for e in res.episodes)
     t = res.timing
@@ -84,4 +108,40 @@ def run(args: argparse.Namespace) -> int:
           f"ends), stopped by {res.stopped_by}; {t['steps_per_second']:.0f} steps/s this call, "
           f"repair {100 * t['repair_share']:.1f}% of the time")
     print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png and summary.json to {out}/")
+    _note_stale_evaluation(out)
     return 0
+
+
+def _note_stale_evaluation(out: Path) -> None:
+    """Say so when ``out/evaluation/`` evaluated another policy than the one just written."""
+    import json
+    import sys
+
+    from ..io import MANIFEST
+    from ._provenance import policy_identity
+
+    try:
+        prev = json.loads((out / "evaluation" / MANIFEST).read_text(encoding="utf-8")).get("policy")
+    except (OSError, ValueError, AttributeError):
+        return
+    now = policy_identity(out) or {}
+    if isinstance(prev, dict) and ((prev.get("policy_sha256"), prev.get("steps"))
+                                   != (now.get("policy_sha256"), now.get("steps"))):
+        print(f"stringstab train: note: {out}/evaluation/ evaluated the policy at step "
+              f"{prev.get('steps')}, not this one (step {now.get('steps')}); it is stale: run "
+              f"'stringstab evaluate {out}' to replace it", file=sys.stderr)
+
+
+def _argv_of(args: argparse.Namespace) -> list[str]:
+    """The options of this run that a resume must repeat (the configuration is checked)."""
+    out = ["--algo", args.algo, "--steps", str(args.steps), "--seed", str(args.seed),
+           "--out", str(args.out)]
+    for flag, name in (("--num-envs", "num_envs"), ("--stop-episodes", "stop_episodes"),
+                       ("--repair", "repair")):
+        if getattr(args, name, None) is not None:
+            out += [flag, str(getattr(args, name))]
+    if getattr(args, "paper", False):
+        out.append("--paper")
+    if getattr(args, "leaders", None):
+        out += ["--leaders", *map(str, args.leaders)]
+    return out

@@ -100,7 +100,8 @@ def add_parser(sub: Any) -> None:
                    help="margin m in k_x >= m, k_v + (T* - tau) k_x >= m (default: 1e-3)")
     q.add_argument("--eps", default="1e-4", metavar="E",
                    help="margin of the frequency constraints g(omega_j) >= E (default: 1e-4)")
-    p.add_argument("--format", choices=_FORMATS, default="table", help="output format (default: table)")
+    p.add_argument("--format", choices=_FORMATS, default=None,
+                   help="output format (default: the --out file's extension .json/.csv, else table)")
     p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
     p.set_defaults(func=run)
 
@@ -147,6 +148,10 @@ def run(args: argparse.Namespace) -> int:
             f"at one tau, delta, headway; expected --method projection with "
             f"{'--sample-time' if H is not None else 'an interval'}, got --method {args.method}")
     lo, hi = _numbers(args.bounds, 2, "--bounds")
+    from ..ranges import check_magnitude
+
+    for v in (lo, hi):
+        check_magnitude("gain", v, name="--bounds")
     if not lo < hi:
         raise StringStabError(f"--bounds expects LO,HI with LO < HI; got {args.bounds!r}")
     weights = _numbers(args.weights, 3, "--weights")
@@ -163,6 +168,9 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(
             f"--hurwitz-margin must be >= 0 and --eps > 0; got {args.hurwitz_margin!r}, {args.eps!r}"
         )
+    from ._common import resolve_format
+
+    args.format = resolve_format(args.format, args.out, _FORMATS)
     out = check_output_file(args.out, what="--out") if args.out else None
     table = gains_from_args(args)
     check_horizon(H, table)

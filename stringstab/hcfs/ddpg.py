@@ -172,6 +172,8 @@ def train_hcfs_ddpg(*, total_steps: int = 100_000, seed: int = 0, env: HCFSVecto
         kwargs["log"] = log
     try:
         result = rl.train(cfg, env=env, **kwargs)
+        if getattr(result, "stopped_by", None) == "interrupted":
+            raise KeyboardInterrupt
     except ModuleNotFoundError as e:
         if e.name != "torch":
             raise

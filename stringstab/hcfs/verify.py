@@ -186,6 +186,7 @@ def verify(
     n_followers: int,
     beta: float = BETA,
     modes: Sequence[str] = MODES,
+    progress: Any = None,
     **kwargs: Any,
 ) -> Verification:
     """Simulate and check the jerk theorem for every leader, jerk limit and mode.
@@ -204,6 +205,8 @@ def verify(
         β at a switch (eq 14).
     modes : sequence of str
         Subset of :data:`~stringstab.hcfs.simulate.MODES`.
+    progress : callable, optional
+        Called with 1 after each leader (a progress bar's ``update``).
     **kwargs
         Passed to :func:`~stringstab.hcfs.simulate.simulate_hcfs` (gains, delay, spacing, …).
 
@@ -252,4 +255,6 @@ def verify(
             if cfg.mode in ("safe", "cacc", "policy"):
                 bad_mask = bad_mask | (chk.rate_ddpg & chk.rate_cacc & ~chk.conclusion)
             ver.violations += _frames(run, i, chk, bad_mask)
+        if progress is not None:
+            progress(1)
     return ver

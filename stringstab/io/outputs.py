@@ -13,8 +13,10 @@ Three guarantees, for every command of the toolkit:
 3. **One run per folder.**  An :class:`OutputDir` writes every file of a run into a staging folder
    and moves them in only when the run succeeds, deleting the files its own earlier run (listed in
    the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A command whose outputs
-   have fixed names may instead declare them (``owns=``): then no manifest is written, and those
-   of its names this run did not write are deleted.  A failed run leaves the
+   have fixed names may instead declare them (``owns=``): then those of its names this run did
+   not write are deleted.  Every run writes the manifest: the command, the version, the files
+   and, from the command line (:func:`invocation`), the arguments and the inputs' hashes (a
+   policy's hash and step count for an evaluation).  A failed run leaves the
    previous outputs untouched; a folder written by a *different* command is refused; files the
    toolkit did not write are never deleted.
 """
@@ -22,6 +24,7 @@ Three guarantees, for every command of the toolkit:
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import json
 import os
 import shutil
@@ -41,6 +44,8 @@ __all__ = [
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
+    "deferred_interrupt",
+    "invocation",
 ]
 
 #: Name of the file in which an :class:`OutputDir` lists what it wrote.
@@ -205,6 +210,64 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "o
     return atomic_write_bytes(path, text.encode("utf-8"), what=what)
 
 
+#: What produced the outputs being written (the command line and its inputs' hashes), set by
+#: the command-line entry point (:func:`invocation`) and copied into every manifest.
+_INVOCATION: contextvars.ContextVar[Any] = contextvars.ContextVar(
+    "stringstab_invocation", default=None)
+
+
+@contextlib.contextmanager
+def invocation(doc: Any) -> Iterator[None]:
+    """Within the block, every :class:`OutputDir` manifest also records ``doc``.
+
+    Parameters
+    ----------
+    doc : dict or callable
+        JSON-serialisable entries, e.g. ``{"argv": [...], "inputs": {...}}``, or a callable
+        returning them (called when a manifest is written: hashing inputs only when needed).
+
+    Examples
+    --------
+    >>> with invocation({"argv": ["stringstab", "demo"]}):
+    ...     _INVOCATION.get()["argv"][1]
+    'demo'
+    """
+    token = _INVOCATION.set(doc)
+    try:
+        yield
+    finally:
+        _INVOCATION.reset(token)
+
+
+@contextlib.contextmanager
+def deferred_interrupt() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) until the block is done, then raise KeyboardInterrupt.
+
+    For the few milliseconds that move finished files into place: an interrupt there would
+    leave a mix of two runs.  Outside the main thread (where signals cannot be handled) the
+    block runs unprotected.
+
+    Examples
+    --------
+    >>> with deferred_interrupt():
+    ...     x = 1
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+    if caught:
+        raise KeyboardInterrupt
+
+
 class OutputDir:
     """An output folder written all-or-nothing, replacing only its own earlier run.
 
@@ -251,6 +314,9 @@ class OutputDir:
         self._staging: Path | None = None
         self._written: list[str] = []
         self._folders: list[str] = []
+        self._committed = False
+        #: More manifest entries (e.g. the policy an evaluation is of): :meth:`record`.
+        self.extra: dict[str, Any] = {}
         old = self._read_manifest()
         if old is not None and old.get("command") != command:
             raise StringStabError(
@@ -260,6 +326,14 @@ class OutputDir:
             )
 
     # -- manifest ---------------------------------------------------------------------------
+    def record(self, **entries: Any) -> None:
+        """Add JSON-serialisable ``entries`` to the manifest written on success."""
+        self.extra.update(entries)
+
+    def previous(self) -> dict[str, Any] | None:
+        """The manifest of the run this one replaces (None: none, or unreadable)."""
+        return self._read_manifest()
+
     def _read_manifest(self) -> dict[str, Any] | None:
         m = self.root / MANIFEST
         if not m.is_file():
@@ -273,6 +347,7 @@ class OutputDir:
     # -- context ------------------------------------------------------------------------------
     def __enter__(self) -> OutputDir:
         try:
+            self._created = [q for q in (self.root, *self.root.parents) if not q.exists()]
             self.root.mkdir(parents=True, exist_ok=True)
             self._staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.root))
         except OSError as e:
@@ -345,9 +420,22 @@ class OutputDir:
         if self._staging is not None:
             shutil.rmtree(self._staging, ignore_errors=True)
             self._staging = None
+            if not self._committed:  # the folders this run created go too (emptied, not absent)
+                for q in getattr(self, "_created", []):
+                    with contextlib.suppress(OSError):
+                        q.rmdir()
 
     def commit(self) -> None:
-        """Move the staged files in, remove this command's stale files, update the manifest."""
+        """Move the staged files in, remove this command's stale files, update the manifest.
+
+        Ctrl-C during the moves is held until they are done (:func:`deferred_interrupt`), so
+        the folder holds the whole new run or, interrupted before, the whole old one.
+        """
+        self._committed = True  # from here, the folder is kept (it receives the run)
+        with deferred_interrupt():
+            self._commit()
+
+    def _commit(self) -> None:
         staging = self.staging
         old = self._read_manifest() or {}
         new = [n for n in self._written if (staging / n).is_file()]
@@ -369,12 +457,13 @@ class OutputDir:
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.chmod(staging / name, mode)
                 os.replace(staging / name, dest)
-            if self.owns is None:
-                from .. import __version__
+            from .. import __version__
 
-                manifest = {"command": self.command, "version": __version__, "files": new}
-                atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
-                                  what=self.what)
+            inv = _INVOCATION.get()
+            manifest = {"command": self.command, "version": __version__, "files": new,
+                        **((inv() if callable(inv) else inv) or {}), **self.extra}
+            atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
+                              what=self.what)
         except OSError as e:
             raise StringStabError(
                 f"{self.what}: cannot move the outputs into {str(self.root)!r} ({_reason(e)})"

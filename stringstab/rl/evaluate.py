@@ -170,8 +170,12 @@ def _start(leader: Any, headway: float, standstill: float) -> tuple[Any, float, 
 
 def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delta: float,
              headway: float, name: str | None = None, standstill: float = STANDSTILL,
-             ttc_star: float = TTC_STAR) -> Evaluation:
+             ttc_star: float = TTC_STAR, limits: Any = None, progress: Any = None) -> Evaluation:
     """Run ``strategy`` (a policy, ``"cacc"`` or ``"idm"``) on every leader; see the module.
+
+    ``limits`` (a :class:`~stringstab.traffic.Limits`; default IDL Table 2) bound the
+    followers; ``progress``, a callable, receives the number of leaders done after each
+    group of equally long leaders (for a progress line).
 
     Returns
     -------
@@ -197,7 +201,8 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         trs = [starts[i][0] for i in idx]
         gap0 = np.array([[starts[i][1]] for i in idx])
         v0 = np.array([[starts[i][2]] for i in idx])
-        res = simulate(trs, ctrl, 1, tau=tau, delta=delta, initial_gap=gap0, initial_speed=v0)
+        res = simulate(trs, ctrl, 1, tau=tau, delta=delta, initial_gap=gap0, initial_speed=v0,
+                       limits=limits)
         dts.add(dt)
         assert res.speed is not None and res.accel is not None
         gap = res.gap[:, 0, :]
@@ -222,6 +227,8 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
                 f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt)
                 episodes[i]["M_fss"] = f["M_fss"]
                 gains_rows.append(np.column_stack([res.t, np.full(res.t.size, i), G[j]]))
+        if progress is not None:
+            progress(len(idx))
     mps = np.array([np.nan if e["m_p"] is None else e["m_p"] for e in episodes])
     ok = np.isfinite(mps)
     tits = np.array([e["TIT"] for e in episodes])
@@ -257,7 +264,7 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
 
 def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: float,
                  headway: float, dt: float = 0.1, hold: float = 100.0,
-                 standstill: float = STANDSTILL) -> dict[str, Any]:
+                 standstill: float = STANDSTILL, limits: Any = None) -> dict[str, Any]:
     """``n_vehicles`` running ``strategy`` behind the §5.1-style leader: m_p per vehicle and more.
 
     Returns ``{"n", "m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_fss"}`` (M_fss for gain
@@ -270,7 +277,7 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     leader = paper_mix(dt=dt).hold(hold)
     ctrl = controller_for(strategy, headway=headway, standstill=standstill)
     res = simulate(leader, ctrl, n_vehicles, tau=tau, delta=delta,
-                   initial_gap=standstill + headway * float(leader.speed[0]))
+                   initial_gap=standstill + headway * float(leader.speed[0]), limits=limits)
     m = platoon_metrics(res, certificate=False)
     out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
            "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],

@@ -23,6 +23,7 @@ would.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import os
 import time
@@ -190,7 +191,9 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     resume : bool
         Continue the newest checkpoint in ``out`` up to ``config.total_steps``.
     progress : bool, optional
-        tqdm bar (steps/s, rolling episode reward); default: when stderr is a terminal.
+        None or True: a tqdm bar (steps/s, rolling episode reward) when stderr is a terminal,
+        else one line every 10 s with the time left (:class:`stringstab.progress.Progress`);
+        False: silent.
     leaders : list, optional
         Training leaders of the default environment.
     log : callable, optional
@@ -199,6 +202,8 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     Returns
     -------
     TrainResult
+        ``stopped_by`` is ``"interrupted"`` when Ctrl-C stopped it (with ``out``: at a step
+        boundary, the run folder written as at the end of a budget, so resume continues it).
 
     Raises
     ------
@@ -213,6 +218,22 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     >>> res.steps, res.policy(np.zeros((2, 3))).shape
     (64, (2, 1))
     """
+    interrupt = _StepInterrupt(active=out is not None)
+    try:
+        result = _train(config, env=env, out=out, resume=resume, progress=progress,
+                        leaders=leaders, log=log, interrupt=interrupt)
+    finally:
+        interrupt.restore()
+    if interrupt.caught and result.stopped_by != "interrupted":
+        # Ctrl-C after the last step (while the outputs were written): the run is complete,
+        # and the caller still learns that the user asked to stop
+        result = dataclasses.replace(result, stopped_by="interrupted")
+    return result
+
+
+def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, resume: bool,
+           progress: bool | None, leaders: list[Any] | None, log: Any,
+           interrupt: _StepInterrupt) -> TrainResult:
     import torch
 
     from .agent import Agent
@@ -293,19 +314,20 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
             log(f"checkpoint at step {step}: {len(episodes)} episodes, rolling return "
                 f"{_rolling(returns):.3f}")
 
+    # Ctrl-C stops the loop at the next step boundary (interrupt.caught): the checkpoint,
+    # policy, log and summary are written as at the end of a budget, so resume continues there
     if out_path is not None and not resume:
         out_path.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out_path / "run.json", dumps_json(
             {"format": RUN_FORMAT, "algo": config.algo, "action": config.action}))
         atomic_write_text(out_path / "config.json", dumps_json(config.as_dict()))
 
-    show = progress if progress is not None else os.isatty(2)
-    bar: Any = None
-    if show:
-        from tqdm.auto import tqdm
+    # a bar on a terminal, one line every 10 s with the time left otherwise (False: silent)
+    from ..progress import Progress
 
-        bar = tqdm(total=config.total_steps, initial=step, unit="step", desc=f"train {config.algo}",
-                   mininterval=0.5)
+    meter = Progress(config.total_steps, f"train {config.algo}", unit="steps",
+                     enabled=progress is not False, initial=step)
+    bar: Any = meter.bar
     t_env = t_upd = 0.0
     steps_here = 0
     rep0 = float(repair.stats["seconds"]) if repair is not None else 0.0
@@ -314,6 +336,9 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     while step < config.total_steps:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
+            break
+        if interrupt.caught:
+            stopped_by = "interrupted"
             break
         if step < config.learning_starts:
             actions = rng.uniform(low, high, size=(n_env, act_dim))
@@ -352,8 +377,8 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
             for _ in range(config.updates_per_step):
                 agent.update(buffer.sample(config.batch_size))
             t_upd += time.perf_counter() - t0
+        meter.update(n_env)
         if bar is not None:
-            bar.update(n_env)
             el = max(bar.format_dict.get("elapsed", 0.0), 1e-9)
             bar.set_postfix({"steps/s": f"{steps_here / el:.0f}", "episodes": len(episodes),
                              "rolling": f"{_rolling(returns):.2f}"}, refresh=False)
@@ -363,8 +388,7 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     else:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
-    if bar is not None:
-        bar.close()
+    meter.close()
     seconds = time.perf_counter() - t_start
     rep_s = (float(repair.stats["seconds"]) - rep0) if repair is not None else 0.0
     timing = {"env_seconds": t_env, "repair_seconds": rep_s, "update_seconds": t_upd,
@@ -377,6 +401,32 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
         checkpoint()
         _write_outputs(result)
     return result
+
+
+class _StepInterrupt:
+    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only."""
+
+    def __init__(self, active: bool = True) -> None:
+        import signal
+        import threading
+
+        self.caught = False
+        self._old: Any = None
+        if active and threading.current_thread() is threading.main_thread():
+            self._old = signal.signal(signal.SIGINT, self._handle)
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        import signal
+
+        self.caught = True
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    def restore(self) -> None:
+        import signal
+
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._old)
+            self._old = None
 
 
 def _write_outputs(result: TrainResult) -> None:

@@ -62,6 +62,11 @@ def _shell(k: int, G: int, grow_ka: bool) -> npt.NDArray[np.int64]:
     return off
 
 
+#: The most grid points (summed over the regions R_k built) one region-growing search may
+#: build: R_155 with the default grid of 2 (r0 >= 0.026 covers the bounds [-2, 2] within it).
+MAX_POINTS = 1e8
+
+
 def region_growing(
     K0: Sequence[float] | Array,
     *,
@@ -202,7 +207,25 @@ def region_growing(
     h = r0 / G
     evaluated = 0
     k = 0
-    for k in range(1, int(max_iter) + 1):
+    # the shells R_k with k r0 short of the bounds hold no point inside them: start at the first
+    # that can (a K0 far outside the bounds would otherwise walk through millions of empty shells)
+    outside = max(max(lo - k0[i], k0[i] - hi, 0.0) for i in grow)
+    if outside > hi - lo:  # its shells would grow by O(outside / r0)² points each before any fits
+        raise StringStabError(
+            f"region growing searches the gain bounds [{lo:g}, {hi:g}] outward from K0; expected "
+            f"K0 within [{2 * lo - hi:g}, {2 * hi - lo:g}] (the bounds widened by their width); got "
+            f"K0 = ({k0[0]:g}, {k0[1]:g}, {k0[2]:g}); the projection method takes any K0")
+    k_first = max(1, math.floor((outside - 1e-12) / r0))
+    work = 0.0
+    for k in range(k_first, int(max_iter) + 1):
+        # _shell builds the (2kG+1)² x (2G+1) grid of R_k: a tiny r0 would take hours and
+        # gigabytes before covering the bounds
+        work += float(2 * k * G + 1) ** 2 * (2 * k * G + 1 if grow_ka else 2 * G + 1)
+        if work > MAX_POINTS:
+            raise StringStabError(
+                f"region growing reached region R_{k} of {float(k_cover):.4g} ({work:.3g} grid points) "
+                f"without a solution; expected at most {MAX_POINTS:.0e} points: a larger r0 "
+                f"(got {r0:g}), a smaller grid (got {G}) or --max-iter")
         off = _shell(k, G, grow_ka)
         if k == 1 and type0 == 3:  # Step 2: the type-III exclusion (into R_N)
             excl = (off[:, 0] == 0) & (off[:, 1] <= 0) & (off[:, 2] <= 0)

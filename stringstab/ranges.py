@@ -1,0 +1,109 @@
+"""Physically meaningful magnitudes of the toolkit's inputs: warned beyond, refused far beyond.
+
+Each quantity has a *sensible* range (the values a car-following study uses; beyond it a
+command runs and says so on stderr) and an *absurd* bound (beyond it no vehicle exists and the
+numerics lose their meaning — the certificate's polynomial coefficients are products of up to
+four gains and powers of τ, δ, T* up to 6, so 1e308 overflows to inf — and the input is refused
+with :class:`~stringstab.errors.StringStabError` before any solver sees it).
+
+=============  ================  ============  ==========================================
+quantity       sensible          refused       why
+=============  ================  ============  ==========================================
+gain k         \\|k\\| <= 10        \\|k\\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s² turns 1 m of
+                                               spacing error into 1e6 m/s²
+τ              (0, 2] s          > 100 s       actuator lags are 0.1-1 s
+δ              [0, 2] s          > 100 s       V2V delays are 0.01-0.5 s
+T*             [0, 5] s          > 100 s       time headways are 0.3-3 s
+H              (0, 1] s          > 100 s       control periods are 0.01-0.2 s
+duration       <= 1 day          > 1 year      a run, an episode, a cycle
+=============  ================  ============  ==========================================
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .errors import StringStabError
+
+__all__ = ["LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "RANGES", "check_magnitude",
+           "sensible_warning"]
+
+#: A leader (or a speed limit) faster than this, m/s (252 km/h), is no road vehicle: refused.
+LEADER_SPEED_ABSURD = 70.0
+#: A leader (or an acceleration limit) beyond ±this, m/s² (1.5 g), is no road vehicle: refused.
+LEADER_ACCEL_ABSURD = 15.0
+
+#: name -> (sensible upper bound, refused above, unit, what it is)
+RANGES: dict[str, tuple[float, float, str, str]] = {
+    "gain": (10.0, 1e6, "", "gain"),
+    "tau": (2.0, 100.0, " s", "actuator lag tau"),
+    "delta": (2.0, 100.0, " s", "communication delay delta"),
+    "headway": (5.0, 100.0, " s", "time headway T*"),
+    "sample_time": (1.0, 100.0, " s", "sample time H"),
+    "duration": (86_400.0, 3.2e7, " s", "duration"),
+}
+
+
+def check_magnitude(kind: str, value: Any, *, name: str | None = None) -> float:
+    """``value`` as a float, refused when its magnitude is beyond :data:`RANGES` ``[kind]``.
+
+    Parameters
+    ----------
+    kind : str
+        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``, ``sample_time``,
+        ``duration``).
+    value : float
+        The number (already checked finite by the caller's own parser; NaN is refused too).
+    name : str, optional
+        How the message names it (default: the quantity's name).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    StringStabError
+        When ``|value|`` exceeds the refusal bound, with the sensible range.
+
+    Examples
+    --------
+    >>> check_magnitude("tau", 0.1)
+    0.1
+    >>> check_magnitude("tau", 1e300)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: actuator lag tau = 1e+300 s is far outside the physically meaningful range (sensible: up to 2 s; refused above 100 s)
+    """
+    _sensible, absurd, unit, what = RANGES[kind]
+    x = float(value)
+    if not abs(x) <= absurd:
+        raise StringStabError(
+            f"{name or what} = {x:g}{unit} is far outside the physically meaningful range "
+            f"(sensible: {_range(kind)}; refused above {absurd:g}{unit})")
+    return x
+
+
+def sensible_warning(kind: str, value: Any, *, name: str | None = None) -> str | None:
+    """A one-sentence warning when ``value`` is beyond the sensible range of ``kind``, else None.
+
+    Examples
+    --------
+    >>> sensible_warning("gain", 0.5) is None
+    True
+    >>> sensible_warning("gain", 50.0, name="k_x")
+    'k_x = 50 is outside the sensible range (|k| up to 10; the IDL paper uses [-2, 2]); the result is computed but describes no practical vehicle or controller'
+    """
+    sensible, _, unit, what = RANGES[kind]
+    x = float(value)
+    if not math.isfinite(x) or abs(x) <= sensible:
+        return None
+    extra = "; the IDL paper uses [-2, 2]" if kind == "gain" else ""
+    return (f"{name or what} = {x:g}{unit} is outside the sensible range ({_range(kind)}{extra}); "
+            "the result is computed but describes no practical vehicle or controller")
+
+
+def _range(kind: str) -> str:
+    sensible, _, unit, _ = RANGES[kind]
+    return f"|k| up to {sensible:g}" if kind == "gain" else f"up to {sensible:g}{unit}"
