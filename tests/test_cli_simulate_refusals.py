@@ -102,10 +102,11 @@ def test_a_second_run_replaces_the_first(capsys, tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", "--duration", "10", "--followers", "2", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["damping.png", "metrics.json", "platoon.png",
-                                                     "trajectories.npz"]
+                                                     "report.html", "report.md", "trajectories.npz"]
     (out / "notes.txt").write_text("mine")
     assert main(["simulate", *SHORT, "--followers", "2", "--format", "csv", "--out", str(out)]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt", "trajectories.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt", "report.html",
+                                                     "report.md", "trajectories.csv"]
 
 
 def test_parquet_trajectories(tmp_path, capsys):

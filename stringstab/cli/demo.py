@@ -33,6 +33,8 @@ def run(args: argparse.Namespace) -> int:
     for o in args.only or []:
         if o not in names:
             raise StringStabError(f"--only: unknown step {show(o)}; expected one of {names}")
-    run_demo(args.out, only=args.only)
-    print(f"demo done: outputs in {args.out}/ (summary.json)")
+    from ..report import command_line
+
+    run_demo(args.out, only=args.only, command=command_line(args))
+    print(f"demo done: outputs in {args.out}/; open {args.out}/report.html (or report.md)")
     return 0

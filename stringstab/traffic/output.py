@@ -33,7 +33,8 @@ UNITS: dict[str, str] = {
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
 RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "trajectories.parquet",
-                              "metrics.json", "platoon.png", "damping.png")
+                              "metrics.json", "platoon.png", "damping.png", "report.md",
+                              "report.html")
 
 
 def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: str | None = None,
