@@ -115,7 +115,9 @@ def _step_simulate(out: Path, log: Log) -> dict[str, Any]:
         result = simulate(leader, controller, 10, tau=TAU, delta=DELTA)
         doc = run_document(result, leader=leader, controller=controller, spec="mix",
                            warnings=warnings)
-        files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {name}")
+        label = ("K = (1.2, 0.5, 0.6), certified" if name == "certified"
+                 else "CACC (gains not of the eq-4 form)")
+        files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {label}")
         cert = doc["certificate"] or {}
         m_p = ", ".join("n/a" if v is None else f"{v:.2f}" for v in doc["m_p"])
         log(f"{name}: K={cert.get('k_x')},{cert.get('k_v')},{cert.get('k_a')} "
@@ -194,7 +196,6 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     write_results(columns, out / "tune.txt", "table", params=params, summary=summary)
     drawn = plot_moves(results, tau=TAU, delta=DELTA, headway=HEADWAY, k_a=0.6, n=101)
     fig = drawn["ax"].figure
-    fig.tight_layout()
     with atomic_path(out / "tune_moves.png") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight")
     plt.close(fig)

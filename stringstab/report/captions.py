@@ -39,9 +39,11 @@ CAPTIONS: list[tuple[str, str]] = [
     ("*_3d.*", "The boundary of the certified region in (k_x, k_v, k_a): inside the surface the "
      "gains are string stable."),
     # simulate (traffic.output.write_run)
-    ("platoon.png", "The platoon behind the leader: speed, acceleration and gap of every "
-     "follower over time. String stability shows as the acceleration peaks shrinking from "
-     "follower to follower."),
+    ("platoon.png", "The platoon behind the leader (IDL Figs 7-8): speed, acceleration, "
+     "bumper-to-bumper spacing and time headway of every vehicle over time, coloured by position "
+     "(0 = leader). String stability shows as the acceleration peaks shrinking from follower to "
+     "follower; the headway panel's scale stops at the 99.5th percentile and says so when a peak "
+     "is clipped."),
     ("damping.png", "Disturbance damping along the platoon: m_p (eq 29, follower-to-predecessor "
      "acceleration energy) per follower; below 1 means the disturbance shrinks."),
     # tune

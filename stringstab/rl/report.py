@@ -169,14 +169,19 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
     n = len(first)
     fig = Figure(figsize=(4.0 * n, 3.4), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, n))
+    mp_all = np.concatenate([np.asarray(ev.samples["m_p"], dtype=float) for ev in first.values()])
+    mp_all = mp_all[np.isfinite(mp_all)]
+    span = (min(float(mp_all.min()), 1.0) - 0.02, max(float(mp_all.max()), 1.0) + 0.02) \
+        if mp_all.size else None  # one x-range (and bins) for every panel, 1 included
     for ax, (name, ev) in zip(axes, first.items()):
-        plot_mp_histogram(ev.samples["m_p"], ax=ax, label=name)
+        plot_mp_histogram(ev.samples["m_p"], ax=ax, label=name, bin_range=span)
     save(fig, "fig6_mp.png")
     for fname, fn, key in (("fig9_ttc.png", plot_ttc_distribution, "ttc"),
                            ("fig11_jerk.png", plot_jerk_ranges, "jerk_sq"),
                            ("fig12_headway.png", plot_headway_cdf, "headway")):
         fig = Figure(figsize=(6.4, 4.0), layout="constrained")
-        fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots())
+        kw: dict[str, Any] = {"t_star": headway} if key == "headway" else {}
+        fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots(), **kw)
         save(fig, fname)
     gains = {name: ev.gains[:, 2:] for name, ev in first.items() if ev.gains is not None}
     if gains:

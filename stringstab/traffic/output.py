@@ -172,7 +172,8 @@ def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: 
         fig = Figure(figsize=(6, 3.5), layout="constrained")
         ax = fig.subplots()
         plot_damping_ratios(result.damping_ratios, ax=ax)
-        ax.set_title("acceleration L2 damping ratio per follower (IDL eq 29)")
+        ax.set_title("acceleration L2 damping ratio per follower (IDL eq 29)"
+                     + (f"\n{title}" if title else ""), fontsize=10)
         fig.savefig(out.path("damping.png"), dpi=110)
         files["figure_platoon"] = "platoon.png"
         files["figure_damping"] = "damping.png"
