@@ -15,7 +15,8 @@ from ..io import OutputDir
 from .compare import table_csv, table_markdown, table_rows
 from .evaluate import PAPER_MP_10, PAPER_MP_100_MAX, Evaluation
 
-__all__ = ["evaluation_markdown", "platoon_markdown", "verdict", "write_comparison", "write_evaluation"]
+__all__ = ["EVALUATION_METRICS", "evaluation_markdown", "platoon_markdown", "verdict", "write_comparison",
+           "write_evaluation"]
 
 
 def _fmt(v: Any) -> str:
@@ -53,6 +54,25 @@ def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True
     return "".join(out)
 
 
+#: Each metric of an evaluation's summary: (what it is, unit).
+EVALUATION_METRICS: dict[str, tuple[str, str]] = {
+    "M_fss": ("executed gains certified, continuous time (eq 27; ↑)", "%"),
+    "M_fss_sampled": ("executed gains certified, sampled-data loop at dt (↑)", "%"),
+    "n_gains": ("executed gains checked", "count"),
+    "collisions": ("collisions", "count"),
+    "collided_episodes": ("episodes with a collision", "count"),
+    "min_gap": ("smallest gap", "m"),
+    "TIT": ("time-integrated TTC below TTC*, mean per episode (eqs 31-32; ↓)", "s²"),
+    "TIT_total": ("TIT summed over the episodes", "s²"),
+    "M_CI": ("comfort index, mean squared jerk (eq 34; ↓)", "m²/s⁶"),
+    "M_effi": ("mean time headway (eq 35; ↓)", "s"),
+    "median_headway": ("median time headway", "s"),
+    "M_lss": ("mean m_p over the episodes (eq 30; ↓)", "–"),
+    "share_m_p_below_1": ("share of episodes with m_p < 1 (↑)", "fraction"),
+    "m_p_undefined": ("episodes where m_p is undefined (no leader acceleration)", "count"),
+}
+
+
 def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                         run: Mapping[str, Any], verdict: str) -> str:
     """The Markdown report of ``stringstab evaluate``."""
@@ -61,12 +81,10 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
              f"**Verdict: {verdict}**\n\n",
              f"{s['episodes']} held-out episodes ({run.get('leaders', '')}); τ = {run['tau']} s, "
              f"δ = {run['delta']} s, T* = {run['headway']} s.\n\n",
-             "| metric | value |\n|---|---|\n"]
-    for k in ("M_fss", "M_fss_sampled", "n_gains", "collisions", "collided_episodes", "min_gap", "TIT",
-              "TIT_total", "M_CI", "M_effi", "median_headway", "M_lss", "share_m_p_below_1",
-              "m_p_undefined"):
+             "| metric | value | unit |\n|---|---|---|\n"]
+    for k, (what, unit) in EVALUATION_METRICS.items():
         if k in s:
-            lines.append(f"| {k} | {_fmt(s[k])} |\n")
+            lines.append(f"| {what} ({k}) | {_fmt(s[k])} | {unit} |\n")
     lines.append("\nM_fss: share of executed (episode, moment) gains certified by the exact, "
                  "delay-aware certificate (continuous time, frozen gains); M_fss_sampled: by the "
                  "sampled-data certificate of the zero-order-hold loop at the control step "
@@ -144,10 +162,12 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
                  for name, evs in groups.items()}
     rows = table_rows(summaries, reference)
     md = ["# Comparison on the held-out episodes (IDL paper Table 4 layout)\n\n",
-          "All metrics: lower is better. Rows 'X compared to Y': 100 (Y − X)/Y %, positive when "
-          "X is better. Mean ± standard deviation over seeds where several runs are given.\n\n",
-          table_markdown(rows), "\n| strategy | collisions | share of m_p < 1 | median headway (s) | "
-          "M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
+          "↓: lower is better (TIT, M_CI, M_effi, M_lss); ↑: higher is better (M_fss, the share of "
+          "executed gains certified; CACC and IDM execute no certified gains). Rows 'X compared "
+          "to Y': 100 (Y − X)/Y %, positive when X is better; where Y is 0 the row gives both "
+          "values. Mean ± standard deviation over seeds where several runs are given.\n\n",
+          table_markdown(rows), "\n| strategy | collisions | share of episodes with m_p < 1 | "
+          "median headway (s) | M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
     md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
            f"{_ms(s['median_headway'])} | {_ms(s['M_fss_sampled'])} |\n"
            for n, s in summaries.items()]
