@@ -33,9 +33,11 @@ CAPTIONS: list[tuple[str, str]] = [
     ("*_sup_gain.*", "sup_ω |Γ(jω)| (log colour scale, from 1) over the internally stable gains, "
      "with the certified boundary sup |Γ| = 1 drawn: darkest blue is certified; the brighter, the "
      "more a disturbance grows from vehicle to vehicle."),
-    ("*_overlay.*", "The gains a policy executed, over the certified region: each marker is "
-     "coloured by the exact verdict of its own (k_x, k_v, k_a); the background is the slice "
-     "stated in the title (see its note on k_a)."),
+    ("*_overlay.*", "The gains a policy executed, over the certified region: each marker shows "
+     "the exact verdict of its own (k_x, k_v, k_a). The points do not share one k_a, so the "
+     "background is not a slice: it is the certified region projected over the points' own k_a "
+     "values (certified at every one, at some, at none), so a certified point never sits in "
+     "the 'none' area."),
     ("*_3d.*", "The boundary of the certified region in (k_x, k_v, k_a): inside the surface the "
      "gains are string stable."),
     # simulate (traffic.output.write_run)
@@ -47,8 +49,9 @@ CAPTIONS: list[tuple[str, str]] = [
     ("damping.png", "Disturbance damping along the platoon: m_p (eq 29, follower-to-predecessor "
      "acceleration energy) per follower; below 1 means the disturbance shrinks."),
     # tune
-    ("tune_moves.png", "Each uncertified triple (start) and where each repair moved it "
-     "(end), over the certified region; the move lengths are in the table."),
+    ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
+     "(square: certified, cross: not), over the certified region projected over the repaired "
+     "gains' own k_a values; the moves' lengths and the output k_a are in the table."),
     # hcfs verify
     ("speed_*", "Speeds of the leader and every follower (HCFS paper Fig. 4 layout), one panel "
      "per switching mode."),
@@ -59,14 +62,16 @@ CAPTIONS: list[tuple[str, str]] = [
     ("rolling_reward.png", "Training curve: rolling mean episode reward over environment steps."),
     ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode and follower with its CDF; "
      "mass left of 1 means disturbances shrink."),
-    ("fig9_ttc.png", "IDL paper Fig. 9: distribution of the time to collision; small TTC "
-     "values are the safety-relevant range."),
-    ("fig11_jerk.png", "IDL paper Fig. 11: range of the squared jerk per strategy (comfort; "
-     "lower is better)."),
+    ("fig9_ttc.png", "IDL paper Fig. 9: distribution of the time to collision at closing "
+     "moments, on a log axis; the shaded range below TTC* is the safety-relevant one (counted "
+     "in TIT), and the legend gives each strategy's share there."),
+    ("fig11_jerk.png", "IDL paper Fig. 11: share of squared-jerk samples in each range per "
+     "strategy, counts on the bars (comfort: more mass in the low ranges is better)."),
     ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy, with the "
      "desired headway T*."),
-    ("gains_region.png", "The gains each strategy executed over the certified region; each "
-     "point is coloured by the exact verdict of its own gains."),
+    ("gains_region.png", "The gains each strategy executed (coloured by strategy) over the "
+     "certified region projected over the executed k_a values (certified at every one, at some, "
+     "at none); the axes extend past the ±2 gain bounds so gains on a bound are visible."),
 ]
 
 

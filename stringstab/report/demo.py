@@ -7,6 +7,7 @@ re-reading their files; the figures are the files the steps wrote, found in the 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -30,7 +31,12 @@ stable and ‖Γ‖_H∞ ≤ 1 with the exact delay e^{−δs}; "printed" means 
 
 
 def _k(K: Any) -> str:
-    return "(" + ", ".join(f"{float(x):g}" for x in K) + ")"
+    return "(" + ", ".join(f"{float(x):.4g}" for x in K) + ")"
+
+
+def _natural(name: str) -> list[Any]:
+    """Sort key: fig6 before fig11 (numbers compared as numbers)."""
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
 def _files(root: Path, step: str, summary: Mapping[str, Any], sub: str = "") -> list[str]:
@@ -38,7 +44,8 @@ def _files(root: Path, step: str, summary: Mapping[str, Any], sub: str = "") -> 
     names = [f for f in summary.get("files", []) if str(f).endswith(".png")]
     found = [f"{step}/{f}" for f in names if (root / step / f).is_file()]
     if sub:
-        found += sorted(p.relative_to(root).as_posix() for p in (root / step / sub).glob("*.png"))
+        found += sorted((p.relative_to(root).as_posix() for p in (root / step / sub).glob("*.png")),
+                        key=_natural)
     return found
 
 
@@ -78,7 +85,7 @@ def _certify(rep: Report, s: Mapping[str, Any]) -> None:
     if rows:
         sec.table(rows, caption="Gain triples at τ = 0.1 s, δ = 0.2 s, T* = 1.1 s "
                                 "(`certify/triples.txt`); sup |Γ| > 1 means some frequency is "
-                                "amplified, n/a that the loop is not internally stable.")
+                                "amplified, inf that the loop is not internally stable.")
         sec.verdict("the printed Proposition 1 agrees with the exact certificate on these triples",
                     misled == 0, f"{misled} triple(s) called stable by the paper's test are not "
                                  "string stable" if misled else "no triple misjudged")

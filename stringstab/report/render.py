@@ -69,8 +69,13 @@ def format_value(v: Any, digits: int = 4) -> str:
 
 
 def _cell(text: str) -> str:
-    """Markdown-table-safe text: pipes escaped, no line breaks."""
-    return str(text).replace("|", "\\|").replace("\n", " ")
+    """Markdown-table-safe plain text: pipes and asterisks (T*, not emphasis) escaped, one line."""
+    return _plain(str(text)).replace("|", "\\|").replace("\n", " ")
+
+
+def _plain(text: str) -> str:
+    """Plain text inside Markdown: an asterisk is a character (T*), not emphasis."""
+    return text.replace("\\*", "*").replace("*", "\\*")
 
 
 def command_line(args: Any = None) -> str:
@@ -371,7 +376,7 @@ class Report:
                     parts.append(f"```{d['language']}\n{d['text']}\n```")
                 elif b.kind == "table":
                     n_tab += 1
-                    cap = f"*Table {n_tab}. {d['caption']}*\n\n" if d["caption"] else ""
+                    cap = f"*Table {n_tab}. {_plain(d['caption'])}*\n\n" if d["caption"] else ""
                     head = "| " + " | ".join(_cell(h) for h in d["head"]) + " |"
                     rule = "|" + "---|" * len(d["head"])
                     body = "\n".join("| " + " | ".join(_cell(c) for c in r) + " |" for r in d["rows"])
@@ -379,7 +384,7 @@ class Report:
                 elif b.kind == "figure":
                     n_fig += 1
                     parts.append(f"![Figure {n_fig}]({d['path']})\n\n"
-                                 f"*Figure {n_fig}. {d['caption']}* (`{d['path']}`)")
+                                 f"*Figure {n_fig}. {_plain(d['caption'])}* (`{d['path']}`)")
             _flush_verdicts(pending, parts)
             sections.append({"title": s.title, "parts": parts})
         return sections
