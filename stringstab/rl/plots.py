@@ -99,14 +99,12 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
     ax = _ax(ax)
     x = np.asarray(m_p, dtype=np.float64)
     x = x[np.isfinite(x)]
-    _, _, patches = ax.hist(x, bins=bins, range=bin_range, color="tab:orange", alpha=0.8,
-                            label="episodes per bin")
+    _, _, patches = ax.hist(x, bins=bins, range=bin_range, color="tab:orange", alpha=0.8)
     if bin_range is not None:
         ax.set_xlim(*bin_range)
     ax2 = ax.twinx()
     xs = np.sort(x)
-    (cdf,) = ax2.plot(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue",
-                      label="CDF")
+    (cdf,) = ax2.plot(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue")
     ax2.fill_between(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue", alpha=0.15)
     ax2.set_ylim(0, 1.02)
     ax2.set_ylabel("CDF")
