@@ -462,7 +462,19 @@ def check(
     ----------
     k_x, k_v, k_a : array_like
         Gains, broadcast together and flattened.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
 
@@ -538,7 +550,19 @@ def certify_batch(
     ----------
     k_x, k_v, k_a : array_like
         Gains, broadcast together and flattened.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     method : {{"exact", "pade"}}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`certify_pade`) per triple and warns where it disagrees; the
@@ -696,7 +720,19 @@ def certify(
     ----------
     k_x, k_v, k_a : float
         The gains.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     method, pade_order
         As for :func:`certify_batch`.
 
