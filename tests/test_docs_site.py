@@ -68,7 +68,7 @@ def test_python_examples_run(page, blocks, tmp_path, monkeypatch):
         if marker:
             assert reason.strip(), f"{page}: a skipped example must say why"
             continue
-        exec(compile(code, f"docs/{page}", "exec"), ns)  # noqa: S102 - the docs' own examples
+        exec(compile(code, f"docs/{page}", "exec"), ns)
         ran += 1
     import matplotlib.pyplot as plt
 
