@@ -124,3 +124,12 @@ def test_evaluation_table_has_names_and_units():
 
     assert EVALUATION_METRICS["TIT"][1] == "s²" and EVALUATION_METRICS["M_CI"][1] == "m²/s⁶"
     assert all(unit for _, unit in EVALUATION_METRICS.values())
+
+
+def test_tune_report(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["tune", "0.9,-0.5,1.1", "--method", "projection", "--report", str(out)]) == 0
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert "| every output certified | **yes** | 1 of 1 certified |" in md
+    data, other = _embedded((out / "report.html").read_text(encoding="utf-8"))
+    assert other == [] and data == [(out / "tune_moves.png").read_bytes()]
