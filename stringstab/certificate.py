@@ -796,6 +796,25 @@ def certify_pade(
     approximation (Padé) and a cross-check only.  ``norm_tol`` is passed to
     ``control.norm`` (its default, 1e-6, cannot resolve sup |Γ| = 1).
 
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        The gains.
+    tau, delta, headway : float
+        Actuator lag τ, delay δ, desired headway T*, s.
+    order : int
+        Order of the Padé approximant of e^{−δs}.
+    tol : float
+        Slack on the norm for the verdict.
+    norm_tol : float
+        Tolerance passed to ``control.norm``.
+
+    Returns
+    -------
+    PadeResult
+        ``stable``, ``hinf`` (the Padé model's H∞ norm) and ``verdict``.
+
     Examples
     --------
     >>> r = certify_pade(1.5, 0.3, -0.1, tau=0.1, delta=0.2, headway=1.1)

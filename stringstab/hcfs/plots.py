@@ -42,6 +42,15 @@ def _title(run: HCFSRun, i: int) -> str:
 def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     """Speed of the leader (dashed black) and every follower over time (Fig. 4).
 
+    Parameters
+    ----------
+    run : HCFSRun
+        The verified run.
+    i : int
+        Index of the configuration (mode and J) in ``run.configs``.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+
     Returns
     -------
     list
@@ -68,6 +77,15 @@ def plot_jerk(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     Every frame is drawn (no decimation), so single-frame spikes show.  The scale fits the data
     and ±J; the paper's ±2a_max/T (which the acceleration bounds guarantee alone) is drawn only
     when the data reach it, and named in the title otherwise, so it does not squash the data.
+
+    Parameters
+    ----------
+    run : HCFSRun
+        The verified run.
+    i : int
+        Index of the configuration (mode and J) in ``run.configs``.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
 
     Returns
     -------
@@ -103,6 +121,15 @@ def plot_switching(run: HCFSRun, i: int, *, ax: Any = None) -> Any:
     """Weight λ of the learned candidate per follower over time (Fig. 6): 0 CACC, 1 policy.
 
     Soft switches (λ = β or 1 − β) show as intermediate shades.
+
+    Parameters
+    ----------
+    run : HCFSRun
+        The verified run.
+    i : int
+        Index of the configuration (mode and J) in ``run.configs``.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
 
     Returns
     -------

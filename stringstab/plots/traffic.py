@@ -167,6 +167,17 @@ def plot_damping_ratios(m_p: npt.ArrayLike, *, ax: Any = None, label: str | None
                         marker: str = "o") -> PlotResult:
     """m_p of each follower relative to its predecessor (IDL eq 29), with the m_p = 1 line.
 
+    Parameters
+    ----------
+    m_p : array_like
+        m_p of each follower (IDL eq 29), in platoon order.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    label : str, optional
+        Legend label of the line (a legend is drawn when given).
+    marker : str
+        Marker of the points.
+
     Returns
     -------
     PlotResult

@@ -28,6 +28,17 @@ METRICS: tuple[tuple[str, str], ...] = (("TIT", "TIT (s², ↓)"), ("M_CI", "M_C
 def improvement(reference: float | None, other: float | None) -> float | None:
     """100 (other − reference)/other, the reference's gain over ``other`` (None if undefined).
 
+
+    Parameters
+    ----------
+    reference, other : float or None
+        The metric of the reference strategy and of the other one (lower is better).
+
+    Returns
+    -------
+    float or None
+        The improvement in %, None when either is missing or ``other`` is 0.
+
     Examples
     --------
     >>> round(improvement(0.32, 9.13), 2)
@@ -46,6 +57,19 @@ def table_rows(summaries: Mapping[str, Mapping[str, Any]],
 
     ``summaries`` maps a strategy label to its summary (mean ± spread entries may be given as
     ``{"mean": .., "std": ..}``; the mean is compared).
+
+    Parameters
+    ----------
+    summaries : mapping
+        ``{strategy: summary}`` (keys of :data:`METRICS` and ``share_m_p_below_1``).
+    reference : str, optional
+        The strategy whose improvements are listed.
+
+    Returns
+    -------
+    list of dict
+        One row per strategy, then one "compared to" row per other strategy (``improvement``
+        True; a cell is a % or, where undefined, a sentence).
     """
     def val(v: Any) -> float | None:
         if isinstance(v, Mapping):
@@ -98,7 +122,18 @@ def _cell(key: str, v: Any, improvement_row: bool, row: Mapping[str, Any] | None
 
 
 def table_markdown(rows: list[dict[str, Any]]) -> str:
-    """Table 4 as Markdown (improvement rows show ± percentages, positive = reference better)."""
+    """Table 4 as Markdown (improvement rows show ± percentages, positive = reference better).
+
+    Parameters
+    ----------
+    rows : list of dict
+        From :func:`table_rows`.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     head = "| strategy | " + " | ".join(t for _, t in METRICS) + " |\n"
     head += "|---|" + "---|" * len(METRICS) + "\n"
     body = "".join(
@@ -110,7 +145,18 @@ def table_markdown(rows: list[dict[str, Any]]) -> str:
 
 
 def table_csv(rows: list[dict[str, Any]]) -> str:
-    """Table 4 as CSV: metric means (and ``_std`` columns when given), improvements in %."""
+    """Table 4 as CSV: metric means (and ``_std`` columns when given), improvements in %.
+
+    Parameters
+    ----------
+    rows : list of dict
+        From :func:`table_rows`.
+
+    Returns
+    -------
+    str
+        The CSV text (an undefined improvement is an empty cell).
+    """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     cols = ["strategy"]

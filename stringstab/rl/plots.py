@@ -42,6 +42,25 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
     The paper's window is 10; episodes on different leaders differ widely in return, so a
     ``long_window`` mean is drawn too (None: only the paper's).
 
+
+    Parameters
+    ----------
+    episodes : sequence of mappings
+        Training episodes in order, each with a ``"return"``.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    window : int
+        The paper's rolling window (episodes).
+    long_window : int or None
+        A second, longer window (None: not drawn).
+    label : str, optional
+        Name of the run in the legend.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``line`` and (with ``long_window``) ``line_long``.
+
     Examples
     --------
     >>> rows = [{"return": -float(i)} for i in range(30)]
@@ -173,6 +192,15 @@ def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
     Linear bars of the percentage of each strategy's samples (from a zero baseline), each bar
     labelled with its count, so small ranges stay readable without a logarithmic axis (whose
     baseline would be arbitrary).
+
+    Parameters
+    ----------
+    jerk_sq : mapping
+        ``{strategy: squared-jerk samples}``, m²/s⁶.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    ranges : sequence of (lo, hi)
+        The ranges (the last one closed).
 
     Returns
     -------

@@ -28,7 +28,20 @@ def _fmt(v: Any) -> str:
 
 
 def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True) -> str:
-    """m_p per vehicle of each platoon test next to the paper's values (§5.1)."""
+    """m_p per vehicle of each platoon test next to the paper's values (§5.1).
+
+    Parameters
+    ----------
+    platoons : sequence of mappings
+        Platoon tests (:func:`stringstab.rl.evaluate.platoon_test`).
+    note : bool
+        Add the paragraph on what m_p shows for a switching policy.
+
+    Returns
+    -------
+    str
+        Markdown.
+    """
     out = []
     for p in platoons:
         mp = p["m_p"]
@@ -75,7 +88,24 @@ EVALUATION_METRICS: dict[str, tuple[str, str]] = {
 
 def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                         run: Mapping[str, Any], verdict: str) -> str:
-    """The Markdown report of ``stringstab evaluate``."""
+    """The Markdown report of ``stringstab evaluate``.
+
+    Parameters
+    ----------
+    ev : Evaluation
+        The evaluation.
+    platoons : sequence of mappings
+        Its platoon tests.
+    run : mapping
+        The run's folder, leaders, τ, δ, T*, dt.
+    verdict : str
+        The one-line verdict (:func:`verdict`).
+
+    Returns
+    -------
+    str
+        Markdown: the verdict, the metrics with names and units, the platoon tests.
+    """
     s = ev.summary
     lines = [f"# Evaluation of {run.get('folder', ev.name)} ({ev.name})\n\n",
              f"**Verdict: {verdict}**\n\n",
@@ -95,7 +125,22 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
 
 def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) -> tuple[str, bool]:
     """The one-line verdict of an evaluation and whether it passes (``stringstab evaluate``'s
-    exit 0): every executed gain certified and no collision, on the episodes and platoons."""
+    exit 0): every executed gain certified and no collision, on the episodes and platoons.
+
+    Parameters
+    ----------
+    ev : Evaluation
+        The evaluation.
+    platoons : sequence of mappings
+        Its platoon tests.
+    action : str
+        The policy's action (``"gains"`` or an acceleration).
+
+    Returns
+    -------
+    (str, bool)
+        The verdict and whether it passes.
+    """
     s = ev.summary
     gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
         q["M_fss"] == 100.0 for q in platoons)
@@ -110,7 +155,20 @@ def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) 
 
 def write_evaluation(out: OutputDir, ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                      run: Mapping[str, Any], verdict: str) -> list[str]:
-    """Stage ``evaluation.json``, ``evaluation.md``, ``episodes.csv`` and ``gains.csv``."""
+    """Stage ``evaluation.json``, ``evaluation.md``, ``episodes.csv`` and ``gains.csv``.
+
+    Parameters
+    ----------
+    out : OutputDir
+        The open output folder.
+    ev, platoons, run, verdict
+        As for :func:`evaluation_markdown`.
+
+    Returns
+    -------
+    list of str
+        The names staged so far.
+    """
     doc = {"run": dict(run), "verdict": verdict, "summary": ev.summary,
            "platoons": list(platoons), "episodes": ev.episodes}
     out.write_json("evaluation.json", doc)
@@ -145,6 +203,24 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
     ``gains_region.png``.
 
     ``groups`` maps a strategy label to its evaluations (several seeds give mean ± spread).
+
+    Parameters
+    ----------
+    out : OutputDir
+        The open output folder.
+    groups : mapping
+        ``{strategy: evaluations}``.
+    reference : str or None
+        The strategy whose improvements are listed.
+    tau, delta, headway : float
+        The loop's parameters (for the executed-gains figure).
+    platoons : mapping, optional
+        ``{strategy: {"run": ..., "tests": [...]}}``.
+
+    Returns
+    -------
+    list of str
+        The names staged so far.
     """
     from matplotlib.figure import Figure
 
