@@ -439,6 +439,9 @@ class Report:
                                extension_configs={"toc": {"toc_depth": "2"}})
         body = conv.convert(text)
         body = _embed_images(body, Path(root))
+        for word in ("yes", "no", "finding"):  # colour the verdicts' result cells
+            body = body.replace(f"<td><strong>{word}</strong></td>",
+                                f'<td class="{word}"><strong>{word}</strong></td>')
         return environment().from_string(HTML).render(title=self.title, body=body,
                                                      toc=getattr(conv, "toc", ""))
 

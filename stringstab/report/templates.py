@@ -53,6 +53,9 @@ pre { background: #f5f5f5; padding: .6rem; overflow-x: auto; }
 img { max-width: 100%; height: auto; display: block; margin: 1rem auto .3rem;
       border: 1px solid #e3e3e3; }
 p > em:only-child { color: #444; }
+td.yes { background: #e6f4ea !important; color: #1b5e20; }
+td.no { background: #fde8e8 !important; color: #b71c1c; }
+td.finding { background: #eef3fb !important; color: #1a3e72; }
 nav.toc { background: #f7f7fb; border: 1px solid #dde; padding: .4rem 1rem; font-size: .92rem; }
 nav.toc ul { margin: .2rem 0; }
 </style>

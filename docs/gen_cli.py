@@ -1,7 +1,7 @@
 """The command-line reference (``docs/cli.md``), generated from the argparse parsers.
 
-Not a sub-command: ``python -m stringstab.cli.reference > docs/cli.md`` regenerates the page,
-and a test checks that the page is current.  Each command's description and every argument
+A script beside the pages (not part of the package): ``python docs/gen_cli.py > docs/cli.md``
+regenerates the page, and a test (tests/test_docs_site.py) checks that the page is current.  Each command's description and every argument
 (flags, value, default, help) are read from the parser the ``stringstab`` command itself uses,
 so the page cannot drift from the tool; the text does not depend on the Python version or the
 terminal width (argparse's own ``--help`` layout does).
@@ -69,13 +69,13 @@ def cli_reference() -> str:
     str
         The page (``docs/cli.md``).
     """
-    from . import COMMANDS, HELP, build_parser
+    from stringstab.cli import COMMANDS, HELP, build_parser
 
     parser = build_parser()
     subs = _subparsers(parser)
     out = ["# Command-line reference\n",
            "Generated from the argument parsers of the `stringstab` command "
-           "(`python -m stringstab.cli.reference > docs/cli.md`); `stringstab COMMAND --help` "
+           "(`python docs/gen_cli.py > docs/cli.md`); `stringstab COMMAND --help` "
            "prints the same. Every command checks its inputs before it starts and answers bad "
            "input with one line on standard error and exit code 2.\n",
            "| command | what it does |\n|---|---|"]
