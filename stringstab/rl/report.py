@@ -245,7 +245,8 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
           table_markdown(rows), "\n| strategy | collisions | share of episodes with m_p < 1 | "
           "median headway (s) | M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
     md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
-           f"{_ms(s['median_headway'])} | {_ms(s['M_fss_sampled'])} |\n"
+           f"{_ms(s['median_headway'])} | "
+           f"{'0 (no certified gains executed)' if s['M_fss_sampled'] is None else _ms(s['M_fss_sampled'])} |\n"
            for n, s in summaries.items()]
     if platoons:
         md.append("\n## Platoon tests (§5.1)\n\n")
