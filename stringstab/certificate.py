@@ -560,7 +560,19 @@ def check(
     ----------
     k_x, k_v, k_a : array_like
         Gains, broadcast together and flattened.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
 
@@ -636,7 +648,19 @@ def certify_batch(
     ----------
     k_x, k_v, k_a : array_like
         Gains, broadcast together and flattened.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     method : {{"exact", "pade"}}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`certify_pade`) per triple and warns where it disagrees; the
@@ -810,7 +834,19 @@ def certify(
     ----------
     k_x, k_v, k_a : float
         The gains.
-    {loop}
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
     method, pade_order
         As for :func:`certify_batch`.
 
@@ -873,6 +909,25 @@ def certify_pade(
     verdict is ``"certified"`` when stable and the norm ≤ 1 + ``tol``; it is an
     approximation (Padé) and a cross-check only.  ``norm_tol`` is passed to
     ``control.norm`` (its default, 1e-6, cannot resolve sup |Γ| = 1).
+
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        The gains.
+    tau, delta, headway : float
+        Actuator lag τ, delay δ, desired headway T*, s.
+    order : int
+        Order of the Padé approximant of e^{−δs}.
+    tol : float
+        Slack on the norm for the verdict.
+    norm_tol : float
+        Tolerance passed to ``control.norm``.
+
+    Returns
+    -------
+    PadeResult
+        ``stable``, ``hinf`` (the Padé model's H∞ norm) and ``verdict``.
 
     Examples
     --------

@@ -133,6 +133,21 @@ def hurwitz(
     k_x > 0 and k_v + (T* − τ)k_x > 0 (with τ > 0).  ``rtol`` demands each
     condition exceed ``rtol`` times the scale of its terms (a margin).
 
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains (k_a does not enter the denominator; accepted for a uniform call).
+    tau, headway : float
+        Actuator lag τ > 0 and desired headway T*, s.
+    rtol : float
+        Relative margin each condition must exceed (0: strict inequalities).
+
+    Returns
+    -------
+    ndarray of bool
+        True where the closed loop is internally stable.
+
     Examples
     --------
     >>> hurwitz([1.0, -1.0, 1.0], [0.5, 0.5, -1.2], tau=0.1, headway=1.1)
@@ -201,6 +216,17 @@ def stability_type(psi2: npt.ArrayLike, psi3: npt.ArrayLike, lam: npt.ArrayLike)
 
     I: Ψ2 ≥ 0 and Ψ3 ≥ 0; II: Ψ3 ≥ 0, Ψ2 < 0, Λ ≤ 0; III: Ψ3 < 0;
     IV: Ψ3 ≥ 0, Ψ2 < 0, Λ > 0.
+
+
+    Parameters
+    ----------
+    psi2, psi3, lam : array_like
+        Ψ2, Ψ3 and Λ = Ψ2² − 4Ψ1Ψ3 (IDL eqs 13-15), broadcast together.
+
+    Returns
+    -------
+    ndarray of int8
+        1, 2, 3 or 4 for types I-IV.
 
     Examples
     --------

@@ -11,6 +11,7 @@ new one replaces it whole.
 
 from __future__ import annotations
 
+import inspect
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -40,7 +41,10 @@ def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     wrong = [f"eq {e['equation']} ({e['key']})" for e in doc["errata"] if not e["matches"]]
     log(f"derived Γ(s) = {doc['gamma']}")
     log(f"errata: {len(wrong)} printed formulas differ from the derivation: {', '.join(wrong)}")
-    return {"files": ["derive.json", "derive.tex", "derive.txt"], "errata": wrong}
+    return {"files": ["derive.json", "derive.tex", "derive.txt"], "errata": wrong,
+            "gamma": doc["gamma"],
+            "errata_table": [{k: e[k] for k in ("equation", "name", "matches", "explanation")}
+                             for e in doc["errata"]]}
 
 
 #: Paper-style gain triples for the certify step: the two of ``stringstab certify --help``,
@@ -87,6 +91,7 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
         "params": params,
         "triples": [{"K": [float(triples.k_x[i]), float(triples.k_v[i]), float(triples.k_a[i])],
                      "verdict": str(triples.verdict[i]),
+                     "sup_gain": float(triples.sup_gain[i]),
                      "taylor_printed": triples[i].taylor_printed["verdict"]}
                     for i in range(len(triples))],
         "rollout": s,
@@ -112,7 +117,9 @@ def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
         result = simulate(leader, controller, 10, tau=TAU, delta=DELTA, limits=limits)
         doc = run_document(result, leader=leader, controller=controller, spec="mix",
                            warnings=warnings)
-        files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {name}")
+        label = ("K = (1.2, 0.5, 0.6), certified" if name == "certified"
+                 else "CACC (gains not of the eq-4 form)")
+        files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {label}")
         cert = doc["certificate"] or {}
         m_p = ", ".join("n/a" if v is None else f"{v:.2f}" for v in doc["m_p"])
         log(f"{name}: K={cert.get('k_x')},{cert.get('k_v')},{cert.get('k_a')} "
@@ -191,14 +198,17 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     write_results(columns, out / "tune.txt", "table", params=params, summary=summary)
     drawn = plot_moves(results, tau=TAU, delta=DELTA, headway=HEADWAY, k_a=0.6, n=101)
     fig = drawn["ax"].figure
-    fig.tight_layout()
     with atomic_path(out / "tune_moves.png") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight")
     plt.close(fig)
-    return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": summary}
+    moves = [{"method": r["method"], "from": [r["k_x_in"], r["k_v_in"], r["k_a_in"]],
+              "to": [r["k_x"], r["k_v"], r["k_a"]], "distance": r["distance"],
+              "certified": r["certified"], "status": r["status"]} for r in records]
+    return {"files": ["tune.json", "tune.txt", "tune_moves.png"], "summary": summary,
+            "moves": moves}
 
 
-def _step_hcfs(out: Path, log: Log) -> dict[str, Any]:
+def _step_hcfs(out: Path, log: Log, *, final: Path | None = None) -> dict[str, Any]:
     """``hcfs verify`` with the bundled DDPG behind the paper's case 1 (its analogue on UDDS at
     half speed, 20 s, 8 followers): the jerk theorem at every frame for J = 2.5 m/s³."""
     import matplotlib
@@ -208,8 +218,11 @@ def _step_hcfs(out: Path, log: Log) -> dict[str, Any]:
 
     leader, n = case_leader("hcfs-case1")
     ver = verify([leader], load_bundled_ddpg(), jerk_limits=[2.5], n_followers=n)
-    files = write_report(ver, out, command=f"stringstab hcfs verify --jerk-limit 2.5 --followers {n} "
-                                           "--leader hcfs-case1 --out hcfs")
+    import shlex
+
+    files = write_report(ver, out, command=shlex.join([
+        "stringstab", "hcfs", "verify", "--jerk-limit", "2.5", "--followers", str(n), "--leader",
+        "hcfs-case1", "--out", str(final if final is not None else out)]))
     log(f"a1 = {ver.runs[0].params['policy_label']}; leader {leader.name}, {n} followers")
     rows = {}
     for x in ver.results:
@@ -312,7 +325,7 @@ STEPS: list[tuple[str, Step]] = [
 
 
 def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None,
-             limits: Any = None) -> dict[str, Any]:
+             limits: Any = None, command: str = "stringstab demo") -> dict[str, Any]:
     """Run every demo step, writing outputs under ``out``.
 
     Parameters
@@ -327,11 +340,15 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
         Run only the named steps.
     limits : Limits, optional
         The followers' limits of the simulate step (default: IDL Table 2).
+    command : str, optional
+        The command line shown in the report (``report.md``, ``report.html``).
 
     Returns
     -------
     dict
-        ``{step: summary}``, also written to ``out/summary.json``.
+        ``{step: summary}``, also written to ``out/summary.json``; the report of the run
+        (:func:`stringstab.report.demo.demo_report`) is written to ``out/report.md`` and
+        ``out/report.html``.
 
     Raises
     ------
@@ -349,19 +366,24 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
     from .progress import duration
 
     todo = sum(1 for n in names if not only or n in only)
-    done, start = 0, time.perf_counter()
+    done, started = 0, time.perf_counter()
     with OutputDir(out, command="demo", what="demo output folder") as d:
         for name, step in STEPS:
             if only and name not in only:
                 continue
             t0 = time.perf_counter()
             done += 1
-            log(f"== {name} == (step {done} of {todo}, {duration(time.perf_counter() - start)} "
+            log(f"== {name} == (step {done} of {todo}, {duration(time.perf_counter() - started)} "
                 "elapsed)")
-            kw = {"limits": limits} if name in LIMITED_STEPS else {}
+            kw: dict[str, Any] = {"limits": limits} if name in LIMITED_STEPS else {}
+            if "final" in inspect.signature(step).parameters:
+                kw["final"] = d.final(name)
             result = step(d.folder(name), log, **kw)
             result["seconds"] = round(time.perf_counter() - t0, 2)
             summary[name] = result
             log(f"   ({result['seconds']} s, outputs in {d.final(name)})")
         d.write_json("summary.json", summary)
+        from .report.demo import demo_report
+
+        demo_report(summary, d.staging, command=command, params=PARAMS, started=started).write(d)
     return summary

@@ -34,6 +34,21 @@ def gamma_jw(
 ) -> npt.NDArray[np.complex128]:
     """Γ(jω) with the exact delay e^{−jδω} (IDL eq 11, derived form).
 
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequency ω, rad/s.
+    k_x, k_v, k_a : array_like
+        Gains of eq 4 (broadcast together).
+    tau, delta, headway : array_like
+        Actuator lag τ, delay δ and desired headway T*, s.
+
+    Returns
+    -------
+    ndarray of complex
+        Γ(jω) = N(jω)/D(jω), broadcast over the inputs.
+
     Examples
     --------
     >>> abs(gamma_jw(0.0, 1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1))
@@ -56,7 +71,22 @@ def gain(
     omega: ArrayLike, k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> Array:
-    """|Γ(jω)|: the amplitude ratio of follower to predecessor acceleration at ω."""
+    """|Γ(jω)|: the amplitude ratio of follower to predecessor acceleration at ω.
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequency ω, rad/s.
+    k_x, k_v, k_a : array_like
+        Gains of eq 4 (broadcast together).
+    tau, delta, headway : array_like
+        Actuator lag τ, delay δ and desired headway T*, s.
+
+    Returns
+    -------
+    ndarray
+        |Γ(jω)|, broadcast over the inputs.
+    """
     return np.abs(gamma_jw(omega, k_x, k_v, k_a, tau=tau, delta=delta, headway=headway))
 
 
@@ -106,6 +136,21 @@ def margin_g(
     """g(ω) = (|D(jω)|² − |N(jω)|²)/ω², continuous at ω = 0 where g(0) = Ψ3 (:func:`stringstab.margin.g`).
 
     |Γ(jω)| ≤ 1 at ω > 0 iff g(ω) ≥ 0.
+
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequency ω, rad/s.
+    k_x, k_v, k_a : array_like
+        Gains of eq 4 (broadcast together).
+    tau, delta, headway : array_like
+        Actuator lag τ, delay δ and desired headway T*, s.
+
+    Returns
+    -------
+    ndarray
+        g(ω); ≥ 0 where |Γ(jω)| ≤ 1.
 
     Examples
     --------

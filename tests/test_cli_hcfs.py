@@ -21,7 +21,7 @@ def test_verify_tiny_run(tmp_path, capsys):
                "stop-and-go:waves=1", "--duration", "60", "--no-figures", "--out", str(out)])
     assert rc == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
-        "report.json", "report.md"]
+        "report.html", "report.json", "report.md"]
     doc = json.loads((out / "report.json").read_text())
     assert doc["ok"] is True and doc["exit_code"] == 0 and doc["violations"] == []
     assert doc["setup"]["n_followers"] == 4 and doc["setup"]["jerk_limits"] == [2.5, 5.0]

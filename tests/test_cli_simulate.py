@@ -14,8 +14,8 @@ def test_simulate_tiny_run(tmp_path, capsys):
     rc = main(["simulate", "--leader", "us06", "--duration", "50", "--hold", "10", "--followers", "3",
                "--gains", "1.2,0.5,0.6", "--tau", "0.1", "--delta", "0.2", "--out", str(out)])
     assert rc == 0
-    assert sorted(p.name for p in out.iterdir() if p.name != MANIFEST) == ["damping.png", "metrics.json", "platoon.png",
-                                                      "trajectories.npz"]
+    assert sorted(p.name for p in out.iterdir() if p.name != MANIFEST) == [
+        "damping.png", "metrics.json", "platoon.png", "report.html", "report.md", "trajectories.npz"]
     doc = json.loads((out / "metrics.json").read_text())
     assert len(doc["m_p"]) == 3 and doc["max_m_p"] < 1.0 and doc["collisions"] == 0
     assert doc["M_fss"] == 100.0 and doc["certificate"]["verdict"] == "certified"
@@ -33,7 +33,8 @@ def test_simulate_csv_leader_cacc_kinematic(tmp_path):
     rc = main(["simulate", "--leader", str(leader), "--followers", "2", "--controller", "cacc",
                "--model", "kinematic", "--format", "csv", "--no-figures", "--out", str(out)])
     assert rc == 0
-    assert sorted(p.name for p in out.iterdir() if p.name != MANIFEST) == ["metrics.json", "trajectories.csv"]
+    assert sorted(p.name for p in out.iterdir() if p.name != MANIFEST) == [
+        "metrics.json", "report.html", "report.md", "trajectories.csv"]
     lines = (out / "trajectories.csv").read_text().splitlines()
     assert lines[0] == "t,vehicle,position,speed,accel,gap,headway,command"
     assert len(lines) == 1 + 201 * 3

@@ -108,11 +108,12 @@ def test_a_second_run_replaces_the_first(capsys, tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", "--duration", "10", "--followers", "2", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "damping.png", "metrics.json",
-                                                     "platoon.png", "trajectories.npz"]
+                                                     "platoon.png", "report.html", "report.md",
+                                                     "trajectories.npz"]
     (out / "notes.txt").write_text("mine")
     assert main(["simulate", *SHORT, "--followers", "2", "--format", "csv", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "metrics.json", "notes.txt",
-                                                     "trajectories.csv"]
+                                                     "report.html", "report.md", "trajectories.csv"]
 
 
 def test_parquet_trajectories(tmp_path, capsys):

@@ -58,7 +58,7 @@ def test_rerun_replaces_the_earlier_demo(tmp_path, capsys):
     assert list(summary) == ["derive"]
     files = json.loads((out / MANIFEST).read_text())["files"]
     assert sorted(files) == ["derive/derive.json", "derive/derive.tex", "derive/derive.txt",
-                             "summary.json"]
+                             "report.html", "report.md", "summary.json"]
 
 
 def test_demo_calls_the_library_once_per_triple(tmp_path, monkeypatch):

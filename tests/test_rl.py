@@ -335,6 +335,14 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
               "fig11_jerk.png", "fig12_headway.png", "gains_region.png"):
         assert (out / f).is_file(), f
     assert "idl compared to cacc" in (out / "table.md").read_text()
+    # each folder holds its report, every figure embedded in the HTML
+    report = (out / "report.md").read_text(encoding="utf-8")
+    assert all(f"]({p.name})" in report for p in out.glob("*.png"))
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert html.count('src="data:image/png;base64,') == len(list(out.glob("*.png")))
+    ev_report = (run / "evaluation" / "report.md").read_text(encoding="utf-8")
+    assert "every executed gain certified and no collision" in ev_report
+    assert (run / "evaluation" / "report.html").is_file()
     import matplotlib.pyplot as plt
 
     plt.close("all")

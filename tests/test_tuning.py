@@ -365,7 +365,17 @@ def test_plot_moves():
     rs = [f((0.9, -0.5, 1.1), **P) for f in (region_growing, project)]
     out = plot_moves(rs, **P, n=21)
     assert len(out["arrows"]) == 2
-    assert out["ax"].get_xlabel() == "k_x"
+    assert out["ax"].get_xlabel() == "$k_x$ (s$^{-2}$)"  # the gain with its unit
+    # the background is the region projected over the outputs' own k_a: each certified output
+    # lies in a cell certified at some (or every) evaluated k_a
+    img = out["region"].get_array()
+    x0, x1, y0, y1 = out["region"].get_extent()
+    for r in rs:
+        if r.certified:
+            i = int((r.k[1] - y0) / (y1 - y0) * img.shape[0])
+            j = int((r.k[0] - x0) / (x1 - x0) * img.shape[1])
+            near = img[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2]
+            assert near.max() >= 1  # class 'some' or 'every'
     plt.close(out["ax"].figure)
 
 

@@ -39,11 +39,14 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``."""
+    import time
+
     from ..io import OutputDir
     from ..rl.evaluate import BASELINES, evaluate, platoon_test
     from ..rl.report import write_comparison
     from ..rl.runs import open_run, test_leaders
 
+    t0 = time.perf_counter()
     base = [] if args.baselines.strip().lower() == "none" else [
         b.strip() for b in args.baselines.split(",") if b.strip()]
     bad = [b for b in base if b not in BASELINES]
@@ -88,6 +91,11 @@ def run(args: argparse.Namespace) -> int:
     with out:
         files = write_comparison(out, groups, reference=ref, tau=tau, delta=delta,
                                  headway=headway, platoons=platoons or None)
+        from ..report import command_line
+        from ..report.commands import compare_report
+
+        files += compare_report((out.staging / "table.md").read_text(encoding="utf-8"), files,
+                                command=command_line(args), started=t0).write(out)
     print(f"compared {', '.join(groups)} on {len(leaders)} held-out episodes ({desc})")
     print(f"wrote {', '.join(files)} to {out.root}/")
     return 0

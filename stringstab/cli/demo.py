@@ -36,8 +36,9 @@ def run(args: argparse.Namespace) -> int:
     for o in args.only or []:
         if o not in names:
             raise StringStabError(f"--only: unknown step {show(o)}; expected one of {names}")
+    from ..report import command_line
     from ._common import limits_from_args
 
-    run_demo(args.out, only=args.only, limits=limits_from_args(args))
-    print(f"demo done: outputs in {args.out}/ (summary.json)")
+    run_demo(args.out, only=args.only, limits=limits_from_args(args), command=command_line(args))
+    print(f"demo done: outputs in {args.out}/; open {args.out}/report.html (or report.md)")
     return 0

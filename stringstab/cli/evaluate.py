@@ -54,12 +54,15 @@ def _sizes(text: str) -> list[int]:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``evaluate``."""
+    import time
+
     from ..io import OutputDir
     from ..rl.evaluate import evaluate, platoon_test
     from ..rl.report import verdict as report_verdict
     from ..rl.report import write_evaluation
     from ..rl.runs import open_run, test_leaders
 
+    t0 = time.perf_counter()
     sizes = _sizes(args.platoon)
     limits = limits_from_args(args)
     info, policy = open_run(args.run)
@@ -91,6 +94,13 @@ def run(args: argparse.Namespace) -> int:
                "policy_sha256": policy_doc["policy_sha256"], "steps": policy_doc["steps"]}
     with out:
         files = write_evaluation(out, ev, platoons, run_doc, verdict)
+        from ..report import command_line
+        from ..report.commands import evaluate_report
+        from ..rl.report import evaluation_markdown
+
+        files += evaluate_report(evaluation_markdown(ev, platoons, run_doc, verdict), files,
+                                 command=command_line(args), verdict=verdict, passed=passed,
+                                 started=t0).write(out)
     print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
     fss = "n/a" if s["M_fss"] is None else f"{s['M_fss']:.2f}%"
     mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"

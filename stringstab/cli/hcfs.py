@@ -110,6 +110,8 @@ def add_parser(sub: Any) -> None:
 
 def run_verify(args: argparse.Namespace) -> int:
     """Run ``hcfs verify``: validate everything, simulate, check, write the report."""
+    import time
+
     from ..hcfs.constants import DT
     from ..hcfs.ddpg import candidate
     from ..hcfs.leaders import hcfs_leader
@@ -119,6 +121,7 @@ def run_verify(args: argparse.Namespace) -> int:
     from ..io import OutputDir
     from ..params import positive
 
+    t0 = time.perf_counter()
     Js = [positive("--jerk-limit J", s, unit=" m/s^3") for s in args.jerk_limit]
     beta = check_beta(args.beta)
     if args.followers < 1:
@@ -157,7 +160,7 @@ def run_verify(args: argparse.Namespace) -> int:
                      progress=bar.update, accel_min=limits.accel_min,
                      accel_max=limits.accel_max, speed_max=limits.speed_max)
     with out:
-        files = write_report(ver, out, figures=not args.no_figures, command=command)
+        files = write_report(ver, out, figures=not args.no_figures, command=command, started=t0)
     print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")
     for x in ver.results:
         if x["mode"] in ("paper", "safe"):

@@ -229,10 +229,13 @@ def run(args: argparse.Namespace) -> int:
     replaced, never mixed with the new ones.  The files are written by
     :func:`stringstab.plots.save_region_outputs` (two processes share the work).
     """
+    import time
+
     from ..io import OutputDir
     from ..plots import FIGURE_FORMATS
     from ..regions import region_map
 
+    t0 = time.perf_counter()
     axes, fixed = _grid(args)
     model, H = loop_params(args)
     methods = args.method
@@ -286,6 +289,10 @@ def run(args: argparse.Namespace) -> int:
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
                                       verdicts=verdicts, dpi=dpi)
+        from ..report import command_line
+        from ..report.commands import region_report
+
+        region_report(rmap, written, command=command_line(args), started=t0).write(out)
     print(rmap.report())
     print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
     return 0

@@ -155,11 +155,14 @@ def _fmt(v: Any, spec: str, unit: str = "") -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``simulate``."""
+    import time
+
     from ..io import OutputDir
     from ..traffic.leaders import leader_by_name
     from ..traffic.output import RUN_FILES, run_document, write_run
     from ..traffic.platoon import simulate
 
+    t0 = time.perf_counter()
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
     if args.followers < 1:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
@@ -201,6 +204,11 @@ def run(args: argparse.Namespace) -> int:
     with out:
         files = write_run(result, out, metrics=doc, fmt=args.format, figures=not args.no_figures,
                           title=title)
+        from ..report import command_line
+        from ..report.commands import simulate_report
+
+        simulate_report(doc, files, command=command_line(args), title=title,
+                        started=t0).write(out)
     mp = metrics["m_p"]
     print(f"simulated {leader.name} ({leader.duration:g} s, dt = {args.dt:g} s), "
           f"{args.followers} followers, {args.controller} controller, model = {args.model}")

@@ -103,6 +103,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--format", choices=_FORMATS, default=None,
                    help="output format (default: the --out file's extension .json/.csv, else table)")
     p.add_argument("--out", "-o", metavar="FILE", help="write to FILE instead of standard output")
+    p.add_argument("--report", metavar="DIR",
+                   help="also write report.md, report.html (self-contained) and tune_moves.png "
+                        "(the moves over the certified region) into the folder DIR")
     p.set_defaults(func=run)
 
 
@@ -168,10 +171,18 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(
             f"--hurwitz-margin must be >= 0 and --eps > 0; got {args.hurwitz_margin!r}, {args.eps!r}"
         )
+    import time
+
     from ._common import resolve_format
 
+    t0 = time.perf_counter()
     args.format = resolve_format(args.format, args.out, _FORMATS)
     out = check_output_file(args.out, what="--out") if args.out else None
+    report_dir = None
+    if args.report:
+        from ..io import OutputDir
+
+        report_dir = OutputDir(args.report, command="tune", what="--report")  # checked first
     table = gains_from_args(args)
     check_horizon(H, table)
 
@@ -224,11 +235,36 @@ def run(args: argparse.Namespace) -> int:
     else:
         text = format_results(repaired.columns(), "json", params=params, summary=summary)
     write_text(text, out if out is not None else sys.stdout, what="--out")
+    if report_dir is not None:
+        _write_report(report_dir, results, params, general, t0, args)
     n_cert = int(repaired.certified.sum())
     if out is not None:
         print(f"stringstab tune: {n_cert} of {len(repaired)} outputs certified; "
               f"wrote {args.format} to {out}", file=sys.stderr)
     return 0 if n_cert == len(repaired) else 1
+
+
+def _write_report(out: Any, results: list[Any], params: dict[str, Any], general: bool,
+                  t0: float, args: argparse.Namespace) -> None:
+    """``--report DIR``: the moves figure (continuous loop at one τ, δ, T*) and the report."""
+    from ..report import command_line
+    from ..report.commands import tune_report
+
+    with out:
+        figure = None
+        if not general:
+            from matplotlib.figure import Figure
+
+            from ..plots.tuning import plot_moves
+
+            fig = Figure(figsize=(6.4, 6.4), layout="constrained")
+            plot_moves(results, tau=params["tau"], delta=params["delta"],
+                       headway=params["headway"], bounds=tuple(params["bounds"]), n=81,
+                       ax=fig.subplots())
+            fig.savefig(out.path("tune_moves.png"), dpi=110, bbox_inches="tight")
+            figure = "tune_moves.png"
+        tune_report(results, command=command_line(args), params=params, figure=figure,
+                    started=t0).write(out)
 
 
 def _seconds(v: Any) -> str:

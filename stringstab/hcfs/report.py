@@ -173,10 +173,11 @@ def report_markdown(ver: Verification, *, command: str | None = None,
         add("| leader | J | vehicle | frame k | t (s) | jerk (m/s³) | \\|a1−a2\\| at k−1 (m/s²) | "
             "switch state | \\|Δλ\\| | bound / (J T) |")
         add("|---|---|---|---|---|---|---|---|---|---|")
-        add(_frame_row(sm) + "  ← smallest")
-        for f in sorted(ver.counterexamples, key=lambda f: -f.excess)[:15]:
+        add("| smallest → " + _frame_row(sm)[2:])
+        for f in [f for f in sorted(ver.counterexamples, key=lambda f: -f.excess)
+                  if f is not sm][:15]:
             add(_frame_row(f))
-        add("\n(largest excesses listed; all frames are in report.json.)\n")
+        add("\n(the smallest, then the largest excesses; all frames are in report.json.)\n")
         case: Case = "switch" if sm.switch and not sm.prev_switch else (
             "after-switch" if sm.prev_switch and not sm.switch else "double-switch")
         a1, a2, c = tight_example(sm.jerk_limit, gap=sm.gap_prev, case=case, beta=b, dt=T)
@@ -210,11 +211,27 @@ def report_markdown(ver: Verification, *, command: str | None = None,
 
 
 def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: bool = True,
-                 command: str | None = None) -> dict[str, str]:
+                 command: str | None = None, started: float | None = None) -> dict[str, str]:
     """Write ``report.md``, ``report.json`` and (optionally) the figures into ``out``.
 
     ``out`` is a folder path or an open :class:`~stringstab.io.OutputDir`; a path is written
     all-or-nothing through one (command ``"hcfs verify"``): a failure leaves the folder as it was.
+
+    ``report.md`` and its self-contained ``report.html`` are rendered by
+    :class:`stringstab.report.Report`, every figure with its caption.
+
+    Parameters
+    ----------
+    ver : Verification
+        The verification.
+    out : path or OutputDir
+        The folder.
+    figures : bool, optional
+        Draw the figures (speed, jerk, switching per leader and J).
+    command : str, optional
+        The command that reproduces the run, shown in the report.
+    started : float, optional
+        ``time.perf_counter()`` at the start of the run, for the report's wall time.
 
     Returns
     -------
@@ -223,7 +240,7 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
     """
     if not isinstance(out, OutputDir):
         with OutputDir(out, command="hcfs verify") as od:
-            return write_report(ver, od, figures=figures, command=command)
+            return write_report(ver, od, figures=figures, command=command, started=started)
     files: dict[str, str] = {}
     figs = _figure_names(ver) if figures else None
     if figs:
@@ -240,6 +257,20 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
                 files[name] = name
     out.write_json("report.json", report_dict(ver, command=command))
     files["json"] = "report.json"
-    out.write_text("report.md", report_markdown(ver, command=command, figures=figs))
+    from ..report import Report, caption_for
+
+    body = report_markdown(ver, command=None, figures=None).split("\n", 1)[1]
+    rep = Report("HCFS jerk theorem: closed-loop verification",
+                 command=command or "stringstab hcfs verify", started=started)
+    rep.section("Verification").markdown(body, shift=1)
+    if figs:
+        sec = rep.section("Figures", "Speed (Fig. 4), jerk (Fig. 5) and the switching pattern "
+                                     "(Fig. 6) for every mode.")
+        for r, J, names in figs:
+            for name in names.values():
+                sec.figure(name, caption=f"{ver.runs[r].leader.name}, J = {J:g} m/s³. "
+                                         + caption_for(name))
+    rep.write(out)
     files["markdown"] = "report.md"
+    files["html"] = "report.html"
     return files

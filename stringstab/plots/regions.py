@@ -379,7 +379,11 @@ def plot_sup_gain(
     leg = legend_below(ax, handles, ncol=1)
     cb = None
     if colorbar:
-        cb = ax.figure.colorbar(im, ax=ax, extend="max", label=tex)
+        # in an inset beside the axes: exactly the axes' height (a layout colorbar spans the
+        # whole figure cell, taller than the square axes)
+        cax = ax.inset_axes((1.04, 0.0, 0.045, 1.0))
+        cb = ax.figure.colorbar(im, cax=cax, extend="max")
+        cb.set_label(tex)
     _label_axes(ax, rmap)
     if title:
         at = " at the witness member" if rmap.is_box else ""
@@ -864,7 +868,7 @@ def plot_trajectory(
             handles = [*old.legend_handles, *handles]
             for h, t in zip(old.legend_handles, old.get_texts()):
                 h.set_label(t.get_text())
-            title = f"{old.get_title().get_text()}; {title}"
+            title = f"{old.get_title().get_text()}\n{title}"
         leg = legend_below(ax, handles, title=title)
     return PlotResult.of({"ax": ax, "lines": lines, "markers": markers, "verdicts": verdicts, "legend": leg})
 
@@ -898,7 +902,21 @@ def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = N
     if stem == "sup_gain":
         return plot_sup_gain(rmap).figure
     if stem == "overlay":
-        ax = plot_class_map(rmap, rmap.methods[0]).ax
+        # not the map's slice: the points need not share its fixed gain, so the background is
+        # the certified region projected over the points' own values of that gain
+        from .projection import plot_projected_region, projected_region
+
+        K, _ = _gain_rows(gains)
+        xy = K[:, [("k_x", "k_v", "k_a").index(a) for a in rmap.axis_names]]
+        lo = min(min(float(a[0]) for a in rmap.axes.values()), float(xy.min()))
+        hi = max(max(float(a[-1]) for a in rmap.axes.values()), float(xy.max()))
+        pad = 0.03 * (hi - lo)
+        p = rmap.params
+        proj = projected_region(K, tau=p.tau, delta=p.delta, headway=p.headway,
+                                plane=(rmap.axis_names[0], rmap.axis_names[1]), bounds=(lo - pad, hi + pad),
+                                sample_time=rmap.sample_time, n=81)
+        loop = "; ".join(t for t in rmap.title().split("; ") if not t.startswith(tuple(rmap.fixed)))
+        ax = plot_projected_region(proj, title=f"{_method_title(rmap, 'exact')}; {loop}").ax
         plot_trajectory(rmap, gains, ax=ax, verdicts=verdicts)
         return ax.figure
     if stem.startswith("slices_"):
@@ -1002,10 +1020,10 @@ class _FigureJob:
         fig = draw_figure(self.rmap, stem, self.gains, self.verdicts)
         try:
             for f, path in targets:
-                # constrained layout keeps titles, labels and legends of 2-D axes inside the
-                # figure, so no tight bounding box (a second drawing per file) but for 3-D axes
-                tight = {"bbox_inches": "tight", "pad_inches": 0.1} if stem.startswith("3d_") else {}
-                fig.savefig(path, dpi=self.dpi, metadata=self.file_meta[f], **tight)
+                # a tight bounding box: whatever the layout engine could not fit (a long title,
+                # a wide legend under the axes) is kept in the file rather than cut off
+                fig.savefig(path, dpi=self.dpi, metadata=self.file_meta[f], bbox_inches="tight",
+                            pad_inches=0.1)
         finally:
             pyplot().close(fig)
 

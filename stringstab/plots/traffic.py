@@ -147,7 +147,15 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
         axes[3].legend(loc="upper right")
     finite = hw[np.isfinite(hw)]
     if finite.size:
-        axes[3].set_ylim(0.0, min(float(np.percentile(finite, 99.5)) * 1.1, 10.0))
+        top = min(float(np.percentile(finite, 99.5)) * 1.1, 10.0)
+        axes[3].set_ylim(0.0, top)
+        if float(finite.max()) > top:  # say so: the scale leaves out the largest headways
+            k = np.unravel_index(np.nanargmax(np.where(np.isfinite(hw), hw, -np.inf)), hw.shape)
+            axes[3].annotate(f"clipped: h up to {float(finite.max()):.3g} s "
+                             f"(vehicle {k[0] + 1}, t = {float(result.t[k[1]]):.4g} s)",
+                             xy=(0.01, 0.97), xycoords="axes fraction", ha="left", va="top",
+                             fontsize=8, color="0.25",
+                             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9})
     cb = fig.colorbar(lc, ax=list(axes), shrink=0.8, pad=0.01)
     cb.set_label("position in platoon (0 = leader)")
     if title:
@@ -158,6 +166,17 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
 def plot_damping_ratios(m_p: npt.ArrayLike, *, ax: Any = None, label: str | None = None,
                         marker: str = "o") -> PlotResult:
     """m_p of each follower relative to its predecessor (IDL eq 29), with the m_p = 1 line.
+
+    Parameters
+    ----------
+    m_p : array_like
+        m_p of each follower (IDL eq 29), in platoon order.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    label : str, optional
+        Legend label of the line (a legend is drawn when given).
+    marker : str
+        Marker of the points.
 
     Returns
     -------

@@ -49,20 +49,37 @@ def plot_moves(
     n: int = 121,
     ax: Any = None,
 ) -> PlotResult:
-    """Draw repairs as arrows K0 → K on a k_x–k_v slice of the certified region.
+    """Draw repairs as arrows K0 → K over the certified region in the (k_x, k_v) plane.
 
-    The background shades the gains certified by the exact certificate on the slice
-    ``region`` (a 2-D k_x–k_v :class:`~stringstab.regions.RegionMap` with ``exact``,
-    computed beforehand, e.g. by :func:`moves_region`); the arrows are the moves projected
-    onto (k_x, k_v), coloured by method; the output k_a is written next to each arrow head.
-    Without ``region``, it is computed first from ``tau, delta, headway, k_a, bounds, n``
-    (:func:`moves_region`), as python-control's plot functions compute the response they
-    draw.
+    Without ``region`` the background is the exact certified region *projected over the output
+    k_a values* (:func:`stringstab.plots.projection.projected_region`: certified at every / some
+    / none of them), so every repaired gain lies where its own verdict says, whatever its k_a;
+    with ``region`` (a 2-D k_x–k_v :class:`~stringstab.regions.RegionMap` with ``exact``,
+    e.g. from :func:`moves_region`) it is that one slice, and the title says so.  The arrows are
+    the moves projected onto (k_x, k_v), coloured by method; each input is numbered in the
+    order of ``results`` (the report's table gives its output k_a and distance moved).
+
+    Parameters
+    ----------
+    results : sequence of TuneResult
+        The repairs.
+    region : RegionMap, optional
+        A slice to draw instead of the projection.
+    tau, delta, headway : float, optional
+        The loop's parameters (needed without ``region``).
+    k_a : float, optional
+        Unused without ``region`` (kept for :func:`moves_region`'s callers).
+    bounds : (float, float)
+        Gain bounds of the background's axes (padded so gains on a bound are not clipped).
+    n : int
+        Grid points per axis of the background.
+    ax : matplotlib Axes, optional
+        Where to draw.
 
     Returns
     -------
     PlotResult
-        ``ax``, ``region`` (the QuadMesh of the certified region) and ``arrows``.
+        ``ax``, ``region`` (the background image) and ``arrows``.
 
     Raises
     ------
@@ -70,38 +87,56 @@ def plot_moves(
         If ``region`` is not a k_x–k_v slice with the exact verdicts, or neither it nor the
         parameters are given.
     """
+    from ._common import GAIN_LABELS
+
+    if ax is None:
+        _, ax = pyplot().subplots(figsize=(6.4, 6.4), layout="constrained")
     if region is None:
         if tau is None or delta is None or headway is None:
             raise StringStabError("plot_moves needs region= (a RegionMap) or tau, delta and headway")
-        region = moves_region(results, tau=tau, delta=delta, headway=headway, k_a=k_a,
-                              bounds=bounds, n=n)
-    if region.axis_names != ("k_x", "k_v") or "exact" not in region.methods:
-        raise StringStabError(
-            f"plot_moves draws over a k_x-k_v slice with the exact verdicts; got axes "
-            f"{list(region.axis_names)} and methods {list(region.methods)}")
-    if ax is None:
-        _, ax = pyplot().subplots(figsize=(6, 5))
-    KX, KV, _ = region.gains()
-    k_a_fixed = region.fixed["k_a"]
-    mesh = ax.pcolormesh(KX, KV, region.stable("exact").astype(float), cmap="Greens",
-                         vmin=0.0, vmax=1.6, shading="auto")
-    colours = {"region-growing": "tab:orange", "projection": "tab:blue"}
+        from ..tuning.inputs import as_bounds
+        from .projection import plot_projected_region, projected_region
+
+        lo, hi = as_bounds(bounds)
+        pad = 0.05 * (hi - lo)
+        ends = np.array([r.k for r in results], dtype=float).reshape(-1, 3)
+        proj = projected_region(ends, tau=tau, delta=delta, headway=headway,
+                                bounds=(lo - pad, hi + pad), n=min(n, 101))
+        mesh = plot_projected_region(proj, ax=ax, title="repairs K0 → K (arrows, by method)")["image"]
+    else:
+        if region.axis_names != ("k_x", "k_v") or "exact" not in region.methods:
+            raise StringStabError(
+                f"plot_moves draws over a k_x-k_v slice with the exact verdicts; got axes "
+                f"{list(region.axis_names)} and methods {list(region.methods)}")
+        KX, KV, _ = region.gains()
+        mesh = ax.pcolormesh(KX, KV, region.stable("exact").astype(float), cmap="Greens",
+                             vmin=0.0, vmax=1.6, shading="auto")
+        ax.set_title(f"repairs K0 → K over the certified slice k_a = {region.fixed['k_a']:g} "
+                     "(the outputs' own k_a may differ)", fontsize=9)
+        ax.set_xlabel(GAIN_LABELS["k_x"])
+        ax.set_ylabel(GAIN_LABELS["k_v"])
+    colours = {"region-growing": "tab:orange", "projection": "tab:red"}
     arrows = []
     labelled: set[str] = set()
+    starts: dict[tuple[float, float], int] = {}
     for r in results:
         c = colours.get(r.method, "k")
         x0, y0, x1, y1 = r.k_in[0], r.k_in[1], r.k[0], r.k[1]
-        ax.plot([x0], [y0], "o", color="k", ms=3)
-        label = None if r.method in labelled else r.method
+        key = (round(float(x0), 9), round(float(y0), 9))
+        if key not in starts:  # one number per input triple, however many methods repair it
+            starts[key] = len(starts) + 1
+            ax.plot([x0], [y0], "o", color="k", ms=3.5, zorder=5)
+            ax.annotate(str(starts[key]), (x0, y0), xytext=(-3, 3), textcoords="offset points",
+                        ha="right", fontsize=8, zorder=6,
+                        bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.8})
+        label = None if r.method in labelled else f"{r.method} (■ certified, × not)"
         labelled.add(r.method)
-        arrows.append(ax.annotate("", xy=(x1, y1), xytext=(x0, y0),
+        arrows.append(ax.annotate("", xy=(x1, y1), xytext=(x0, y0), zorder=5,
                                   arrowprops={"arrowstyle": "->", "color": c, "lw": 1.4}))
-        ax.plot([x1], [y1], "s" if r.certified else "x", color=c, ms=4, label=label)
-        ax.text(x1, y1, f" {r.k[2]:.2f}", fontsize=7, color=c)
-    ax.set_xlabel("k_x")
-    ax.set_ylabel("k_v")
-    ax.set_title(f"repairs K0 → K over the certified region (shaded) at k_a = {k_a_fixed:g}\n"
-                 "arrows projected on (k_x, k_v); label: output k_a; ■ certified, × not",
-                 fontsize=9)
-    ax.legend(loc="lower right", fontsize=8)
+        ax.plot([x1], [y1], "s" if r.certified else "x", color=c, ms=5, label=label, zorder=6)
+    from matplotlib.legend import Legend
+
+    handles = [h for h in ax.get_lines() if not h.get_label().startswith("_")]
+    ax.add_artist(Legend(ax, handles, [h.get_label() for h in handles], loc="lower left",
+                         fontsize=8))
     return PlotResult.of({"ax": ax, "region": mesh, "arrows": arrows})

@@ -42,6 +42,25 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
     The paper's window is 10; episodes on different leaders differ widely in return, so a
     ``long_window`` mean is drawn too (None: only the paper's).
 
+
+    Parameters
+    ----------
+    episodes : sequence of mappings
+        Training episodes in order, each with a ``"return"``.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    window : int
+        The paper's rolling window (episodes).
+    long_window : int or None
+        A second, longer window (None: not drawn).
+    label : str, optional
+        Name of the run in the legend.
+
+    Returns
+    -------
+    dict
+        ``ax``, ``line`` and (with ``long_window``) ``line_long``.
+
     Examples
     --------
     >>> rows = [{"return": -float(i)} for i in range(30)]
@@ -73,12 +92,35 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
 
 
 def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
-                      label: str | None = None) -> dict[str, Any]:
-    """Histogram of per-episode m_p with its CDF on a twin axis (Fig. 6); m_p = 1 marked."""
+                      label: str | None = None,
+                      bin_range: tuple[float, float] | None = None) -> dict[str, Any]:
+    """Histogram of per-episode m_p with its CDF on a twin axis (Fig. 6); m_p = 1 marked.
+
+    Parameters
+    ----------
+    m_p : array_like
+        m_p per episode (IDL eq 29); non-finite values are left out.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    bins : int
+        Number of bins.
+    label : str, optional
+        The strategy, in the title.
+    bin_range : (float, float), optional
+        Range of the bins and of the x axis: give the same to panels drawn side by side so
+        they compare (default: the data's range).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``ax_cdf``, ``patches``, ``cdf`` and ``share_below_1``.
+    """
     ax = _ax(ax)
     x = np.asarray(m_p, dtype=np.float64)
     x = x[np.isfinite(x)]
-    _, _, patches = ax.hist(x, bins=bins, color="tab:orange", alpha=0.8)
+    _, _, patches = ax.hist(x, bins=bins, range=bin_range, color="tab:orange", alpha=0.8)
+    if bin_range is not None:
+        ax.set_xlim(*bin_range)
     ax2 = ax.twinx()
     xs = np.sort(x)
     (cdf,) = ax2.plot(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue")
@@ -94,26 +136,77 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
 
 
 def plot_ttc_distribution(ttc: Mapping[str, npt.ArrayLike], *, ax: Any = None,
-                          max_ttc: float = 100.0, bins: int = 50) -> dict[str, Any]:
-    """Distribution of finite TTC values in [0, max_ttc] s per strategy (Fig. 9)."""
+                          max_ttc: float = 100.0, bins: int = 40, min_ttc: float = 0.1,
+                          ttc_star: float | None = None) -> dict[str, Any]:
+    """Distribution of finite TTC values per strategy (Fig. 9), on a logarithmic TTC axis so
+    the safety-relevant short times are visible; the range below TTC* is shaded.
+
+    Parameters
+    ----------
+    ttc : mapping
+        ``{strategy: TTC samples}`` (s; closing moments only, non-finite values left out).
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    max_ttc, min_ttc : float
+        The TTC range drawn, s (values below ``min_ttc`` fall in the first bin).
+    bins : int
+        Logarithmically spaced bins.
+    ttc_star : float, optional
+        TTC* of the TIT metric, s (default :data:`stringstab.constants.TTC_STAR`).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``lines`` and ``share_below_ttc_star`` per strategy.
+    """
+    from ..constants import TTC_STAR
+
+    star = TTC_STAR if ttc_star is None else ttc_star
     ax = _ax(ax)
     lines = {}
-    edges = np.linspace(0.0, max_ttc, bins + 1)
+    below = {}
+    edges = np.geomspace(min_ttc, max_ttc, bins + 1)
     for name, v in ttc.items():
         x = np.asarray(v, dtype=np.float64)
         x = x[np.isfinite(x) & (x >= 0) & (x <= max_ttc)]
-        h, _ = np.histogram(x, bins=edges)
-        h = h / (h.sum() * np.diff(edges)) if h.sum() else h.astype(np.float64)
-        (lines[name],) = ax.plot(0.5 * (edges[1:] + edges[:-1]), h, label=name)
-    ax.set_xlabel("TTC (s, closing moments only)")
-    ax.set_ylabel("density")
-    ax.legend()
-    return {"ax": ax, "lines": lines}
+        below[name] = float(np.mean(x < star)) if x.size else float("nan")
+        h, _ = np.histogram(np.clip(x, min_ttc, None), bins=edges)
+        h = h / h.sum() if h.sum() else h.astype(np.float64)
+        (lines[name],) = ax.plot(np.sqrt(edges[1:] * edges[:-1]), h, marker=".",
+                                 label=f"{name} ({100 * below[name]:.1f} % below TTC*)")
+    ax.set_xscale("log")
+    ax.axvspan(min_ttc, star, color="tab:red", alpha=0.12, label=f"TTC < TTC* = {star:g} s (TIT)")
+    ax.set_xlim(min_ttc, max_ttc)
+    ax.set_xlabel("time to collision TTC (s, log scale; closing moments only)")
+    ax.set_ylabel("share of closing moments per bin")
+    ax.set_title("IDL Fig. 9: distribution of the time to collision")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    return {"ax": ax, "lines": lines, "share_below_ttc_star": below}
 
 
 def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
                      ranges: Sequence[tuple[float, float]] = JERK_RANGES) -> dict[str, Any]:
-    """Counts of squared-jerk samples c (eq 33) in the ranges of Fig. 11, per strategy."""
+    """Share of squared-jerk samples c (eq 33) in the ranges of Fig. 11, per strategy.
+
+    Linear bars of the percentage of each strategy's samples (from a zero baseline), each bar
+    labelled with its count, so small ranges stay readable without a logarithmic axis (whose
+    baseline would be arbitrary).
+
+    Parameters
+    ----------
+    jerk_sq : mapping
+        ``{strategy: squared-jerk samples}``, m²/s⁶.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    ranges : sequence of (lo, hi)
+        The ranges (the last one closed).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``bars`` and ``counts`` per strategy.
+    """
     ax = _ax(ax)
     names = list(jerk_sq)
     width = 0.8 / max(len(names), 1)
@@ -124,28 +217,52 @@ def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
         counts[name] = [int(np.count_nonzero((c >= lo) & (c < hi) if k < len(ranges) - 1
                                              else (c >= lo) & (c <= hi)))
                         for k, (lo, hi) in enumerate(ranges)]
-        bars[name] = ax.bar(np.arange(len(ranges)) + j * width, counts[name], width, label=name)
+        total = max(sum(counts[name]), 1)
+        bars[name] = ax.bar(np.arange(len(ranges)) + j * width,
+                            [100.0 * k / total for k in counts[name]], width, label=name)
+        ax.bar_label(bars[name], labels=[f"{k:,}" for k in counts[name]], fontsize=7, padding=1)
     ax.set_xticks(np.arange(len(ranges)) + 0.4 - width / 2,
                   [f"[{lo:g}, {hi:g}]" for lo, hi in ranges])
     ax.set_xlabel("squared jerk c (m²/s⁶)")
-    ax.set_ylabel("samples")
-    ax.set_yscale("log")
+    ax.set_ylabel("share of samples (%); count on each bar")
+    ax.set_ylim(0, 108)
+    ax.set_title("IDL Fig. 11: squared jerk by range (comfort; lower ranges are better)")
     ax.legend()
     return {"ax": ax, "bars": bars, "counts": counts}
 
 
 def plot_headway_cdf(headway: Mapping[str, npt.ArrayLike], *, ax: Any = None,
-                     max_h: float = 3.0) -> dict[str, Any]:
-    """CDF of the time headway in [0, max_h] s per strategy (Fig. 12)."""
+                     max_h: float = 3.0, t_star: float | None = None) -> dict[str, Any]:
+    """CDF of the time headway in [0, max_h] s per strategy (Fig. 12), with T* marked.
+
+    Parameters
+    ----------
+    headway : mapping
+        ``{strategy: headway samples}``, s.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    max_h : float
+        Largest headway drawn, s.
+    t_star : float, optional
+        The desired headway T*, s, drawn as a vertical line.
+
+    Returns
+    -------
+    dict
+        ``ax`` and ``lines``.
+    """
     ax = _ax(ax)
     lines = {}
     for name, v in headway.items():
         x = np.sort(np.asarray(v, dtype=np.float64)[np.isfinite(np.asarray(v, dtype=np.float64))])
         x = x[(x >= 0) & (x <= max_h)]
         (lines[name],) = ax.plot(x, np.arange(1, x.size + 1) / max(x.size, 1), label=name)
+    if t_star is not None:
+        ax.axvline(t_star, color="k", ls="--", lw=0.8, label=f"T* = {t_star:g} s")
     ax.set_xlabel("time headway h (s, eq 22)")
     ax.set_ylabel("CDF")
     ax.set_xlim(0, max_h)
+    ax.set_title("IDL Fig. 12: CDF of the time headway")
     ax.legend()
     return {"ax": ax, "lines": lines}
 
@@ -155,19 +272,39 @@ def plot_gains_over_region(gains: Mapping[str, npt.ArrayLike], *, tau: float, de
                            max_points: int = 4000) -> dict[str, Any]:
     """Executed gains of each policy over the certified region in the (k_x, k_v) plane.
 
-    The region is the exact certificate's map at k_a fixed to the median executed k_a
-    (:func:`stringstab.regions.region_map`); the points are coloured by policy.
+    The executed gains do not share one k_a, so the background is not a slice: it is the exact
+    certified region projected over the executed k_a values
+    (:func:`stringstab.plots.projection.projected_region`: certified at every / some / none of
+    them), on axes that extend past the ±2 gain bounds so gains on a bound are not clipped; the
+    points are coloured by policy.
+
+    Parameters
+    ----------
+    gains : mapping
+        ``{strategy: (m, 3) executed gains}``.
+    tau, delta, headway : float
+        The loop's parameters.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    n : int
+        Grid points per axis of the background.
+    max_points : int
+        Points drawn per strategy at most (a random subset beyond).
+
+    Returns
+    -------
+    dict
+        ``ax``, ``region`` (the projection drawn), ``points`` per strategy and ``k_a`` (the
+        projected values).
     """
-    from ..plots import plot_class_map
-    from ..regions import region_map
+    from ..plots.projection import plot_projected_region, projected_region
 
     ax = _ax(ax, (6.4, 6.4))
     allk = np.concatenate([np.asarray(g, dtype=np.float64).reshape(-1, 3) for g in gains.values()])
-    ka = float(np.median(allk[:, 2])) if allk.size else 0.5
-    g = np.linspace(-2.0, 2.0, n)
-    rmap = region_map({"k_x": g, "k_v": g}, {"k_a": round(ka, 3)}, tau=tau, delta=delta,
-                      headway=headway, methods=("exact",), progress=False)
-    drawn = plot_class_map(rmap, "exact", ax=ax)
+    proj = projected_region(allk, tau=tau, delta=delta, headway=headway, n=min(n, 81),
+                            max_values=24)
+    drawn = plot_projected_region(proj, ax=ax, title="executed gains over the exact certified region")
+    ka = proj.values
     pts = {}
     rng = np.random.default_rng(0)
     colors = ["black", "magenta", "yellow", "cyan"]
@@ -182,5 +319,4 @@ def plot_gains_over_region(gains: Mapping[str, npt.ArrayLike], *, tau: float, de
     # a second legend beside the region's (which stays the axes' legend, under the map)
     ax.add_artist(Legend(ax, list(pts.values()), [h.get_label() for h in pts.values()],
                          loc="lower left", fontsize=8))
-    ax.set_title(f"executed gains over the exact certified region (slice k_a = {ka:.3g})")
     return {"ax": ax, "region": drawn, "points": pts, "k_a": ka}

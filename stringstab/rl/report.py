@@ -15,7 +15,8 @@ from ..io import OutputDir
 from .compare import table_csv, table_markdown, table_rows
 from .evaluate import PAPER_MP_10, PAPER_MP_100_MAX, Evaluation
 
-__all__ = ["evaluation_markdown", "platoon_markdown", "verdict", "write_comparison", "write_evaluation"]
+__all__ = ["EVALUATION_METRICS", "evaluation_markdown", "platoon_markdown", "verdict", "write_comparison",
+           "write_evaluation"]
 
 
 def _fmt(v: Any) -> str:
@@ -27,7 +28,20 @@ def _fmt(v: Any) -> str:
 
 
 def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True) -> str:
-    """m_p per vehicle of each platoon test next to the paper's values (§5.1)."""
+    """m_p per vehicle of each platoon test next to the paper's values (§5.1).
+
+    Parameters
+    ----------
+    platoons : sequence of mappings
+        Platoon tests (:func:`stringstab.rl.evaluate.platoon_test`).
+    note : bool
+        Add the paragraph on what m_p shows for a switching policy.
+
+    Returns
+    -------
+    str
+        Markdown.
+    """
     out = []
     for p in platoons:
         mp = p["m_p"]
@@ -53,20 +67,54 @@ def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True
     return "".join(out)
 
 
+#: Each metric of an evaluation's summary: (what it is, unit).
+EVALUATION_METRICS: dict[str, tuple[str, str]] = {
+    "M_fss": ("executed gains certified, continuous time (eq 27; ↑)", "%"),
+    "M_fss_sampled": ("executed gains certified, sampled-data loop at dt (↑)", "%"),
+    "n_gains": ("executed gains checked", "count"),
+    "collisions": ("collisions", "count"),
+    "collided_episodes": ("episodes with a collision", "count"),
+    "min_gap": ("smallest gap", "m"),
+    "TIT": ("time-integrated TTC below TTC*, mean per episode (eqs 31-32; ↓)", "s²"),
+    "TIT_total": ("TIT summed over the episodes", "s²"),
+    "M_CI": ("comfort index, mean squared jerk (eq 34; ↓)", "m²/s⁶"),
+    "M_effi": ("mean time headway (eq 35; ↓)", "s"),
+    "median_headway": ("median time headway", "s"),
+    "M_lss": ("mean m_p over the episodes (eq 30; ↓)", "–"),
+    "share_m_p_below_1": ("share of episodes with m_p < 1 (↑)", "fraction"),
+    "m_p_undefined": ("episodes where m_p is undefined (no leader acceleration)", "count"),
+}
+
+
 def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                         run: Mapping[str, Any], verdict: str) -> str:
-    """The Markdown report of ``stringstab evaluate``."""
+    """The Markdown report of ``stringstab evaluate``.
+
+    Parameters
+    ----------
+    ev : Evaluation
+        The evaluation.
+    platoons : sequence of mappings
+        Its platoon tests.
+    run : mapping
+        The run's folder, leaders, τ, δ, T*, dt.
+    verdict : str
+        The one-line verdict (:func:`verdict`).
+
+    Returns
+    -------
+    str
+        Markdown: the verdict, the metrics with names and units, the platoon tests.
+    """
     s = ev.summary
     lines = [f"# Evaluation of {run.get('folder', ev.name)} ({ev.name})\n\n",
              f"**Verdict: {verdict}**\n\n",
              f"{s['episodes']} held-out episodes ({run.get('leaders', '')}); τ = {run['tau']} s, "
              f"δ = {run['delta']} s, T* = {run['headway']} s.\n\n",
-             "| metric | value |\n|---|---|\n"]
-    for k in ("M_fss", "M_fss_sampled", "n_gains", "collisions", "collided_episodes", "min_gap", "TIT",
-              "TIT_total", "M_CI", "M_effi", "median_headway", "M_lss", "share_m_p_below_1",
-              "m_p_undefined"):
+             "| metric | value | unit |\n|---|---|---|\n"]
+    for k, (what, unit) in EVALUATION_METRICS.items():
         if k in s:
-            lines.append(f"| {k} | {_fmt(s[k])} |\n")
+            lines.append(f"| {what} ({k}) | {_fmt(s[k])} | {unit} |\n")
     lines.append("\nM_fss: share of executed (episode, moment) gains certified by the exact, "
                  "delay-aware certificate (continuous time, frozen gains); M_fss_sampled: by the "
                  "sampled-data certificate of the zero-order-hold loop at the control step "
@@ -77,7 +125,22 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
 
 def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) -> tuple[str, bool]:
     """The one-line verdict of an evaluation and whether it passes (``stringstab evaluate``'s
-    exit 0): every executed gain certified and no collision, on the episodes and platoons."""
+    exit 0): every executed gain certified and no collision, on the episodes and platoons.
+
+    Parameters
+    ----------
+    ev : Evaluation
+        The evaluation.
+    platoons : sequence of mappings
+        Its platoon tests.
+    action : str
+        The policy's action (``"gains"`` or an acceleration).
+
+    Returns
+    -------
+    (str, bool)
+        The verdict and whether it passes.
+    """
     s = ev.summary
     gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
         q["M_fss"] == 100.0 for q in platoons)
@@ -92,7 +155,20 @@ def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) 
 
 def write_evaluation(out: OutputDir, ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
                      run: Mapping[str, Any], verdict: str) -> list[str]:
-    """Stage ``evaluation.json``, ``evaluation.md``, ``episodes.csv`` and ``gains.csv``."""
+    """Stage ``evaluation.json``, ``evaluation.md``, ``episodes.csv`` and ``gains.csv``.
+
+    Parameters
+    ----------
+    out : OutputDir
+        The open output folder.
+    ev, platoons, run, verdict
+        As for :func:`evaluation_markdown`.
+
+    Returns
+    -------
+    list of str
+        The names staged so far.
+    """
     doc = {"run": dict(run), "verdict": verdict, "summary": ev.summary,
            "platoons": list(platoons), "episodes": ev.episodes}
     out.write_json("evaluation.json", doc)
@@ -127,6 +203,24 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
     ``gains_region.png``.
 
     ``groups`` maps a strategy label to its evaluations (several seeds give mean ± spread).
+
+    Parameters
+    ----------
+    out : OutputDir
+        The open output folder.
+    groups : mapping
+        ``{strategy: evaluations}``.
+    reference : str or None
+        The strategy whose improvements are listed.
+    tau, delta, headway : float
+        The loop's parameters (for the executed-gains figure).
+    platoons : mapping, optional
+        ``{strategy: {"run": ..., "tests": [...]}}``.
+
+    Returns
+    -------
+    list of str
+        The names staged so far.
     """
     from matplotlib.figure import Figure
 
@@ -144,12 +238,15 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
                  for name, evs in groups.items()}
     rows = table_rows(summaries, reference)
     md = ["# Comparison on the held-out episodes (IDL paper Table 4 layout)\n\n",
-          "All metrics: lower is better. Rows 'X compared to Y': 100 (Y − X)/Y %, positive when "
-          "X is better. Mean ± standard deviation over seeds where several runs are given.\n\n",
-          table_markdown(rows), "\n| strategy | collisions | share of m_p < 1 | median headway (s) | "
-          "M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
+          "↓: lower is better (TIT, M_CI, M_effi, M_lss); ↑: higher is better (M_fss, the share of "
+          "executed gains certified; CACC and IDM execute no certified gains). Rows 'X compared "
+          "to Y': 100 (Y − X)/Y %, positive when X is better; where Y is 0 the row gives both "
+          "values. Mean ± standard deviation over seeds where several runs are given.\n\n",
+          table_markdown(rows), "\n| strategy | collisions | share of episodes with m_p < 1 | "
+          "median headway (s) | M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
     md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
-           f"{_ms(s['median_headway'])} | {_ms(s['M_fss_sampled'])} |\n"
+           f"{_ms(s['median_headway'])} | "
+           f"{'0 (no certified gains executed)' if s['M_fss_sampled'] is None else _ms(s['M_fss_sampled'])} |\n"
            for n, s in summaries.items()]
     if platoons:
         md.append("\n## Platoon tests (§5.1)\n\n")
@@ -169,14 +266,19 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
     n = len(first)
     fig = Figure(figsize=(4.0 * n, 3.4), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, n))
+    mp_all = np.concatenate([np.asarray(ev.samples["m_p"], dtype=float) for ev in first.values()])
+    mp_all = mp_all[np.isfinite(mp_all)]
+    span = (min(float(mp_all.min()), 1.0) - 0.02, max(float(mp_all.max()), 1.0) + 0.02) \
+        if mp_all.size else None  # one x-range (and bins) for every panel, 1 included
     for ax, (name, ev) in zip(axes, first.items()):
-        plot_mp_histogram(ev.samples["m_p"], ax=ax, label=name)
+        plot_mp_histogram(ev.samples["m_p"], ax=ax, label=name, bin_range=span)
     save(fig, "fig6_mp.png")
     for fname, fn, key in (("fig9_ttc.png", plot_ttc_distribution, "ttc"),
                            ("fig11_jerk.png", plot_jerk_ranges, "jerk_sq"),
                            ("fig12_headway.png", plot_headway_cdf, "headway")):
         fig = Figure(figsize=(6.4, 4.0), layout="constrained")
-        fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots())
+        kw: dict[str, Any] = {"t_star": headway} if key == "headway" else {}
+        fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots(), **kw)
         save(fig, fname)
     gains = {name: ev.gains[:, 2:] for name, ev in first.items() if ev.gains is not None}
     if gains:

@@ -33,7 +33,8 @@ UNITS: dict[str, str] = {
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
 RUN_FILES: tuple[str, ...] = ("trajectories.npz", "trajectories.csv", "trajectories.parquet",
-                              "metrics.json", "platoon.png", "damping.png")
+                              "metrics.json", "platoon.png", "damping.png", "report.md",
+                              "report.html")
 
 
 def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: str | None = None,
@@ -171,7 +172,8 @@ def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: 
         fig = Figure(figsize=(6, 3.5), layout="constrained")
         ax = fig.subplots()
         plot_damping_ratios(result.damping_ratios, ax=ax)
-        ax.set_title("acceleration L2 damping ratio per follower (IDL eq 29)")
+        ax.set_title("acceleration L2 damping ratio per follower (IDL eq 29)"
+                     + (f"\n{title}" if title else ""), fontsize=10)
         fig.savefig(out.path("damping.png"), dpi=110)
         files["figure_platoon"] = "platoon.png"
         files["figure_damping"] = "damping.png"

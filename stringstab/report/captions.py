@@ -1,0 +1,102 @@
+"""What to see in each figure the toolkit writes, keyed by file-name pattern.
+
+A command adds a figure to its report by path; the caption comes from here unless it gives one,
+so a figure says the same thing in every report.  Patterns are :mod:`fnmatch` patterns on the file
+name (not the folder), tried in order.
+"""
+
+from __future__ import annotations
+
+from fnmatch import fnmatch
+from pathlib import PurePosixPath
+
+__all__ = ["CAPTIONS", "caption_for"]
+
+#: ``(pattern, caption)``: the first pattern matching a figure's file name gives its caption.
+CAPTIONS: list[tuple[str, str]] = [
+    # region maps (stringstab region; plots.save_region_outputs)
+    ("*_class_exact.*", "The exact, delay-aware certificate on the gain slice: blue gains are "
+     "string stable (‖Γ‖∞ ≤ 1, internally stable), orange are internally stable but amplify "
+     "some frequency, grey are not internally stable; black cells are inconclusive (on the "
+     "boundary within rounding). The legend gives each class's share of the grid."),
+    ("*_class_taylor.*", "What the second-order Taylor criteria (Ψ1–Ψ3 derived from the model) "
+     "say on the same slice: an approximation, shown to compare with the exact map, never a "
+     "verdict."),
+    ("*_class_printed.*", "What the IDL paper's printed Proposition 1 says on the same slice "
+     "(its printed Ψ formulas, errata included): compare with the exact map to see where a reader "
+     "of the paper would be misled."),
+    ("*_class_continuous.*", "The continuous-time certificate on the same slice, to compare with "
+     "the sampled-data map: the gains it certifies that sampling loses are the difference."),
+    ("*_compare.*", "Where the three verdicts (exact, Taylor, printed) agree and where they "
+     "differ; each disagreement class is a colour with its count. Few coloured cells outside "
+     "'all 3 agree' means the approximations are right on this slice."),
+    ("*_sup_gain.*", "sup_ω |Γ(jω)| (log colour scale, from 1) over the internally stable gains, "
+     "with the certified boundary sup |Γ| = 1 drawn: darkest blue is certified; the brighter, the "
+     "more a disturbance grows from vehicle to vehicle."),
+    ("*_overlay.*", "The gains a policy executed, over the certified region: each marker shows "
+     "the exact verdict of its own (k_x, k_v, k_a). The points do not share one k_a, so the "
+     "background is not a slice: it is the certified region projected over the points' own k_a "
+     "values (certified at every one, at some, at none), so a certified point never sits in "
+     "the 'none' area."),
+    ("*_3d.*", "The boundary of the certified region in (k_x, k_v, k_a): inside the surface the "
+     "gains are string stable."),
+    # simulate (traffic.output.write_run)
+    ("platoon.png", "The platoon behind the leader (IDL Figs 7-8): speed, acceleration, "
+     "bumper-to-bumper spacing and time headway of every vehicle over time, coloured by position "
+     "(0 = leader). String stability shows as the acceleration peaks shrinking from follower to "
+     "follower; the headway panel's scale stops at the 99.5th percentile and says so when a peak "
+     "is clipped."),
+    ("damping.png", "Disturbance damping along the platoon: m_p (eq 29, follower-to-predecessor "
+     "acceleration energy) per follower; below 1 means the disturbance shrinks."),
+    # tune
+    ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
+     "(square: certified, cross: not), over the certified region projected over the repaired "
+     "gains' own k_a values; the moves' lengths and the output k_a are in the table."),
+    # hcfs verify
+    ("speed_*", "Speeds of the leader and every follower (HCFS paper Fig. 4 layout), one panel "
+     "per switching mode."),
+    ("jerk_*", "Jerk of each follower, with the jerk limit J: the paper's switch may exceed J "
+     "(its theorem needs a1 = a2); the jerk-safe variant stays within it."),
+    ("switching_*", "Which controller (DDPG or CACC) each follower uses over time, per mode."),
+    # train / evaluate / compare
+    ("rolling_reward.png", "Training curve: rolling mean episode reward over environment steps."),
+    ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode and follower with its CDF; "
+     "mass left of 1 means disturbances shrink."),
+    ("fig9_ttc.png", "IDL paper Fig. 9: distribution of the time to collision at closing "
+     "moments, on a log axis; the shaded range below TTC* is the safety-relevant one (counted "
+     "in TIT), and the legend gives each strategy's share there."),
+    ("fig11_jerk.png", "IDL paper Fig. 11: share of squared-jerk samples in each range per "
+     "strategy, counts on the bars (comfort: more mass in the low ranges is better)."),
+    ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy, with the "
+     "desired headway T*."),
+    ("gains_region.png", "The gains each strategy executed (coloured by strategy) over the "
+     "certified region projected over the executed k_a values (certified at every one, at some, "
+     "at none); the axes extend past the ±2 gain bounds so gains on a bound are visible."),
+]
+
+
+def caption_for(path: str) -> str:
+    """The registered caption of a figure file.
+
+    Parameters
+    ----------
+    path : str
+        The figure's path (only the file name is matched).
+
+    Returns
+    -------
+    str
+        Its caption, or a neutral one naming the file when none is registered.
+
+    Examples
+    --------
+    >>> caption_for("maps/region_sup_gain.png").startswith("sup_ω |Γ(jω)|")
+    True
+    >>> caption_for("x/unknown.png")
+    'Figure unknown.png.'
+    """
+    name = PurePosixPath(path).name
+    for pattern, caption in CAPTIONS:
+        if fnmatch(name, pattern):
+            return caption
+    return f"Figure {name}."

@@ -1,0 +1,135 @@
+"""The run report (stringstab.report): Markdown and a self-contained HTML from result objects."""
+
+import base64
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import pytest
+
+from stringstab import demo
+from stringstab.cli import main
+from stringstab.report import Report, caption_for
+
+
+def _figure(path):
+    fig, ax = plt.subplots(figsize=(2, 2))
+    ax.plot([0, 1], [0, 1])
+    fig.savefig(path, dpi=40)
+    plt.close(fig)
+
+
+def _embedded(html):
+    """The bytes of every image embedded in an HTML page, and any non-data image source."""
+    srcs = re.findall(r'<img\b[^>]*\bsrc="([^"]+)"', html)
+    data = [base64.b64decode(s.split(",", 1)[1]) for s in srcs if s.startswith("data:image/")]
+    other = [s for s in srcs if not s.startswith("data:image/")]
+    return data, other
+
+
+def test_report_markdown_and_html(tmp_path):
+    _figure(tmp_path / "region_sup_gain.png")
+    rep = Report("A run", command="stringstab region --fix k_a=0.5", params={"tau": 0.1},
+                 version="9.9")
+    sec = rep.section("Verdicts", "Some *text*.")
+    sec.verdict("K string stable", True, "sup|Γ| = 0.93").verdict("other", False, "no")
+    sec.table([{"k_x": 1.25, "verdict": "certified", "missing": None}], caption="Gains",
+              units={"k_x": "s⁻²"})
+    sec.figure("region_sup_gain.png")
+    assert rep.write(tmp_path) == ["report.md", "report.html"]
+    md = (tmp_path / "report.md").read_text(encoding="utf-8")
+    for text in ("# A run", "`stringstab region --fix k_a=0.5`", "| stringstab version | 9.9 |",
+                 "| K string stable | **yes** | sup\\|Γ\\| = 0.93 |", "| other | **no** | no |",
+                 "*Table 1. Gains*", "| k_x (s⁻²) | verdict | missing |", "| 1.25 | certified | n/a |",
+                 "![Figure 1](region_sup_gain.png)", "wall time"):
+        assert text in md, text
+    assert f"*Figure 1. {caption_for('region_sup_gain.png')}*" in md
+    html = (tmp_path / "report.html").read_text(encoding="utf-8")
+    data, other = _embedded(html)
+    assert other == [] and data == [(tmp_path / "region_sup_gain.png").read_bytes()]
+    assert "<table>" in html and "<strong>yes</strong>" in html
+    assert not re.search(r'(src|href)="https?://', html)  # nothing loaded from the network
+
+
+def test_markdown_block_headings_nest(tmp_path):
+    rep = Report("T", command="c", version="0")
+    rep.section("Results").markdown("# Title\n\n## Sub\n\n```\n# not a heading\n```\n", shift=2)
+    md = rep.markdown(wall_time=0.0)
+    assert "### Title" in md and "#### Sub" in md and "\n# not a heading" in md
+
+
+def test_demo_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out), "--only", "derive", "--only", "certify",
+                 "--only", "tune"]) == 0
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert "## The findings at a glance" in md
+    assert "| the paper's printed formulas match the model | **no** |" in md
+    assert "0.9, -0.5, 1.1" in md  # the triple the printed Proposition 1 misjudges
+    assert "tune/tune_moves.png" in md and "`stringstab demo (called from Python with" in md
+    html = (out / "report.html").read_text(encoding="utf-8")
+    data, other = _embedded(html)
+    assert other == [] and data == [(out / "tune" / "tune_moves.png").read_bytes()]
+    assert "report.html" in capsys.readouterr().out
+
+
+def test_region_command_report(tmp_path, capsys):
+    out = tmp_path / "maps"
+    assert main(["region", "--fix", "k_a=0.5", "--n", "11", "--out", str(out), "--no-progress"]) == 0
+    md = (out / "report.md").read_text(encoding="utf-8")
+    pngs = sorted(p.name for p in out.glob("*.png"))
+    assert pngs and all(f"]({p})" in md for p in pngs)
+    data, other = _embedded((out / "report.html").read_text(encoding="utf-8"))
+    assert other == [] and sorted(data) == sorted((out / p).read_bytes() for p in pngs)
+    assert "exact vs taylor agree on every decided point" in md
+
+
+@pytest.mark.parametrize("name", ["region_class_exact.png", "platoon.png", "fig9_ttc.png",
+                                  "jerk_1-us06_J2.5.png"])
+def test_every_figure_kind_has_a_caption(name):
+    assert not caption_for(name).startswith("Figure ")
+
+
+def test_demo_steps_have_report_sections():
+    from stringstab.report.demo import demo_report
+
+    rep = demo_report({}, ".", command="stringstab demo")
+    assert [s.title for s in rep.sections] == ["The findings at a glance", "Run time per step"]
+    assert {n for n, _ in demo.STEPS} >= {"derive", "certify", "region", "tune", "simulate",
+                                          "hcfs", "train"}
+
+
+def test_comparison_table_states_what_it_used_to_hide():
+    from stringstab.rl.compare import table_markdown, table_rows
+
+    summaries = {"idl": {"TIT": 0.294, "M_CI": 0.79, "M_effi": 2.04, "M_lss": 0.875,
+                         "M_fss": 100.0, "share_m_p_below_1": 1.0},
+                 "cacc": {"TIT": 0.0, "M_CI": 1.91, "M_effi": 2.75, "M_lss": 0.975,
+                          "M_fss": None, "share_m_p_below_1": 0.7857}}
+    md = table_markdown(table_rows(summaries, "idl"))
+    lines = {line.split(" | ")[0].strip("| "): line for line in md.splitlines()}
+    assert "M_fss (%, ↑)" in lines["strategy"] and "TIT (s², ↓)" in lines["strategy"]
+    assert "0% (no certified gains executed)" in lines["cacc"]  # not "–"
+    assert "m_p > 1 in 21% of episodes" in lines["cacc"] and "stable" not in lines["cacc"]
+    assert "m_p < 1 in every episode" in lines["idl"]
+    # TIT: CACC's is 0, so the percentage is undefined; the row says IDL is worse
+    assert "worse: 0.294 vs 0" in lines["idl compared to cacc"]
+    assert "+58." in lines["idl compared to cacc"]  # M_CI: 100 (1.91 − 0.79)/1.91
+
+
+def test_evaluation_table_has_names_and_units():
+    from stringstab.rl.report import EVALUATION_METRICS
+
+    assert EVALUATION_METRICS["TIT"][1] == "s²" and EVALUATION_METRICS["M_CI"][1] == "m²/s⁶"
+    assert all(unit for _, unit in EVALUATION_METRICS.values())
+
+
+def test_tune_report(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["tune", "0.9,-0.5,1.1", "--method", "projection", "--report", str(out)]) == 0
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert "| every output certified | **yes** | 1 of 1 certified |" in md
+    data, other = _embedded((out / "report.html").read_text(encoding="utf-8"))
+    assert other == [] and data == [(out / "tune_moves.png").read_bytes()]
