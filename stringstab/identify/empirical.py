@@ -1,0 +1,131 @@
+"""The data's own verdict: how a follower's speed responds to its predecessor's, without a model.
+
+* **Empirical transfer** Ĝ(ω) = P_xy(ω)/P_xx(ω) from the predecessor's speed x to the follower's
+  speed y (Welch's averaged cross- and auto-spectra, :func:`scipy.signal.csd` and
+  :func:`scipy.signal.welch`, linear detrending, Hann windows), with the magnitude-squared
+  coherence C(ω) = |P_xy|²/(P_xx P_yy).  For a linear follower Ĝ estimates the speed transfer,
+  which equals Γ(jω) (accelerations and speeds share it), so |Ĝ| is set beside the fitted
+  model's |Γ(jω)|.  Spectra are averaged over the clean segments (weighted by their Welch
+  segment counts); frequencies where C < 0.5 are noise, not dynamics, and are left out of the
+  empirical peak, as are those above :data:`OMEGA_MAX`.
+* **Peak-to-peak amplification**: the follower's speed range over the predecessor's, on the
+  samples used.
+* **Energy amplification**: √(Σ a_f² / Σ a_p²) with a = Δv/Δt, the acceleration energy ratio
+  (the square root of the IDL paper's m_p, eq 29, on measured data).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ..io.platoon_logs import Segment
+
+__all__ = ["COHERENCE_MIN", "Empirical", "empirical_transfer"]
+
+Array = npt.NDArray[np.float64]
+
+#: Coherence below which a frequency is not used for the empirical peak.
+COHERENCE_MIN = 0.5
+#: Highest frequency of the empirical peak, rad/s (0.5 Hz): car following lives below it; above
+#: it GPS noise (common to neighbouring receivers) can be coherent without being dynamics.
+OMEGA_MAX = 3.0
+
+
+@dataclass
+class Empirical:
+    """The empirical transfer of one follower.
+
+    Attributes
+    ----------
+    omega : array
+        Frequencies, rad/s.
+    transfer : complex array
+        Ĝ(jω), follower speed over predecessor speed.
+    coherence : array
+        C(ω) in [0, 1].
+    gain : float
+        max |Ĝ| where C ≥ :data:`COHERENCE_MIN` (NaN if nowhere).
+    gain_omega : float
+        Its frequency, rad/s.
+    peak_to_peak, energy : float
+        Peak-to-peak speed and acceleration-energy amplification (module docstring).
+    nperseg : int
+        Welch segment length, samples.
+    """
+
+    omega: Array
+    transfer: npt.NDArray[np.complex128]
+    coherence: Array
+    gain: float
+    gain_omega: float
+    peak_to_peak: float
+    energy: float
+    nperseg: int
+
+
+def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | list[Segment], dt: float,
+                       *, nperseg: int | None = None) -> Empirical:
+    """Welch estimate of the predecessor-speed → follower-speed transfer and the amplifications.
+
+    Parameters
+    ----------
+    v_pred, v : array (T,)
+        Predecessor's and follower's speeds, m/s.
+    segments : sequence of Segment
+        Clean segments (spectra are computed within each, never across a gap).
+    dt : float
+        Step, s.
+    nperseg : int, optional
+        Welch segment length; default the power of two nearest to 60 s, at most the shortest
+        segment.
+
+    Returns
+    -------
+    Empirical
+    """
+    from scipy.signal import csd, welch
+
+    shortest = min(len(s) for s in segments)
+    n = nperseg or int(2 ** round(math.log2(max(60.0 / dt, 16))))
+    n = max(min(n, shortest), 16)
+    fs = 1.0 / dt
+    pxx = pyy = 0.0
+    pxy: complex | npt.NDArray[np.complex128] = 0.0
+    f: Array = np.zeros(1)
+    wsum = 0.0
+    for s in segments:
+        x = v_pred[s.start:s.stop]
+        y = v[s.start:s.stop]
+        if x.size < n:
+            continue
+        k = 1 + (x.size - n) // (n // 2)  # Welch segments in this piece
+        f, sxx = welch(x, fs=fs, nperseg=n, detrend="linear")
+        _, syy = welch(y, fs=fs, nperseg=n, detrend="linear")
+        _, sxy = csd(x, y, fs=fs, nperseg=n, detrend="linear")
+        pxx = pxx + k * sxx
+        pyy = pyy + k * syy
+        pxy = pxy + k * sxy
+        wsum += k
+    omega = 2 * np.pi * np.asarray(f)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        G = np.asarray(pxy / pxx, dtype=np.complex128)
+        C = np.asarray(np.abs(pxy) ** 2 / (pxx * pyy), dtype=float)
+    C = np.nan_to_num(C, nan=0.0)
+    good = (C >= COHERENCE_MIN) & (omega > 0) & (omega <= OMEGA_MAX) & np.isfinite(np.abs(G))
+    if good.any():
+        i = int(np.flatnonzero(good)[np.argmax(np.abs(G[good]))])
+        gain, gw = float(abs(G[i])), float(omega[i])
+    else:
+        gain, gw = math.nan, math.nan
+    xs = np.concatenate([v_pred[s.start:s.stop] for s in segments])
+    ys = np.concatenate([v[s.start:s.stop] for s in segments])
+    p2p = float(np.ptp(ys) / np.ptp(xs)) if np.ptp(xs) > 0 else math.nan
+    ax = np.concatenate([np.diff(v_pred[s.start:s.stop]) for s in segments])
+    ay = np.concatenate([np.diff(v[s.start:s.stop]) for s in segments])
+    ex = float(ax @ ax)
+    energy = math.sqrt(float(ay @ ay) / ex) if ex > 0 else math.nan
+    return Empirical(omega, G, C, gain, gw, p2p, energy, n)
