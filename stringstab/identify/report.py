@@ -174,3 +174,49 @@ def _fig_platoon(res: IdentifyResult) -> Any:
     ax.set_ylabel("amplification")
     ax.legend(fontsize=8)
     return fig
+
+
+def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, Any]]:
+    """The fitted vehicles of an ``identify.json`` (for ``certify --from`` and ``simulate --from``).
+
+    Parameters
+    ----------
+    path : str
+        The file written by ``stringstab identify``.
+    vehicle : int, optional
+        Keep only the follower at this platoon position.
+
+    Returns
+    -------
+    list of dict
+        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill.
+
+    Raises
+    ------
+    StringStabError
+        If the file is not an ``identify.json`` or the vehicle is not in it.
+    """
+    import json
+    from pathlib import Path
+
+    from ..errors import StringStabError
+
+    need = ("position", "name", "k_x", "k_v", "k_a", "tau", "delta", "headway", "standstill")
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError) as e:
+        raise StringStabError(f"--from {path!r}: expected an identify.json written by 'stringstab "
+                              f"identify'; cannot read it ({e})") from e
+    rows = doc.get("vehicles") if isinstance(doc, dict) else None
+    if doc.get("command") != "identify" or not isinstance(rows, list) or not rows:  # type: ignore[union-attr]
+        raise StringStabError(f"--from {path!r}: expected an identify.json with a non-empty 'vehicles' list")
+    for r in rows:
+        bad = [k for k in need if k not in r or (k != "name" and not isinstance(r[k], (int, float)))]
+        if bad:
+            raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} lacks numeric {bad}")
+    if vehicle is not None:
+        rows = [r for r in rows if r["position"] == vehicle]
+        if not rows:
+            raise StringStabError(f"--from {path!r}: no follower at position {vehicle}; found positions "
+                                  f"{[r['position'] for r in doc['vehicles']]}")
+    return rows
