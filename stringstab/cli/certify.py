@@ -203,12 +203,14 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
         loop = parameter_model(*(given.get(k, r[k]) for k in ("tau", "delta", "headway")))
         b = certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]], tau=loop.tau, delta=loop.delta,
                           headway=loop.headway, sample_time=H)
-        c = b.records()[0]
-        records.append({"position": r["position"], "name": r["name"],
-                        "tau": given.get("tau", r["tau"]), "delta": given.get("delta", r["delta"]),
-                        "headway": given.get("headway", r["headway"]),
-                        **{k: c[k] for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega")
-                           if k in c}})
+        c: dict[str, Any] = b.records()[0]
+        rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
+        for k in ("tau", "delta", "headway"):
+            rec[k] = given.get(k, f"{r[k]:.6g}")
+        for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega"):
+            if k in c:
+                rec[k] = c[k]
+        records.append(rec)
     table = [TableColumn("pos", "position", "%d"), TableColumn("name", "name", "%s"),
              TableColumn("k_x", "k_x"), TableColumn("k_v", "k_v"), TableColumn("k_a", "k_a"),
              TableColumn("τ[s]", "tau", "%s"), TableColumn("δ[s]", "delta", "%s"),
