@@ -39,7 +39,15 @@ import numpy.typing as npt
 from ..errors import StringStabError, show
 from ..io.platoon_logs import PlatoonLog, Segment, clean_segments
 from .empirical import Empirical, empirical_transfer
-from .fit import PARAMETERS, FitResult, FollowerData, fit_follower, model_of, simulate_segments
+from .fit import (
+    PARAMETERS,
+    FitResult,
+    FollowerData,
+    fit_follower,
+    model_of,
+    profile_headway,
+    simulate_segments,
+)
 
 __all__ = ["IdentifyResult", "VehicleResult", "identify", "statement"]
 
@@ -68,6 +76,7 @@ class VehicleResult:
     empirical: Empirical
     data: FollowerData
     notes: list[str] = field(default_factory=list)
+    profile: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def certified_share(self) -> float:
@@ -156,6 +165,7 @@ class IdentifyResult:
                               "samples": len(s)} for s in v.segments]
             r["notes"] = v.fit.notes + v.notes
             r["correlation"] = v.fit.correlation
+            r["headway_profile"] = v.profile
             vehicles.append(r)
         return {"command": "identify", "model": self.model, "sample_time": self.sample_time,
                 "sources": self.sources, "settings": self.settings, "skipped": self.skipped,
@@ -344,6 +354,9 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
             emp = empirical_transfer(data.v_pred, data.v, segs, lg.dt)
             vr = VehicleResult(li, p, lg.name(p), lg.name(p - 1), fit, list(segs), cert, bp, verdicts,
                                box, emp, data)
+            if _weak_headway(fit):
+                vr.profile, note = _profile(data, model, fit, sample_time, n_starts, seed)
+                vr.notes.append(note)
             vr.notes += _disagreement(vr)
             out.append(vr)
     finally:
@@ -351,6 +364,50 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     settings = {"bootstrap": B, "block": block, "starts": n_starts, "seed": seed,
                 "min_duration": min_duration, "bootstrap_method": "moving-block over time within clean segments"}
     return IdentifyResult(out, model, sample_time, settings, [lg.source for lg in logs], skipped)
+
+
+def _weak_headway(fit: FitResult) -> bool:
+    """T* is at a bound or weakly separated from l_0 (a note of the fit says so)."""
+    return "headway" in fit.at_bound or any("headway" in n and "standstill" in n for n in fit.notes) \
+        or any("T* and the standstill" in n for n in fit.notes)
+
+
+#: Time headways of the profile (those above what the data's gaps allow are dropped), s.
+PROFILE_GRID = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
+
+
+def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_starts: int,
+             seed: int) -> tuple[list[dict[str, Any]], str]:
+    """Refit with T* held on :data:`PROFILE_GRID`, certify each: does the verdict depend on T*?"""
+    import stringstab as ss
+
+    v = np.concatenate([data.v[s.start:s.stop] for s in data.segments])
+    g = np.concatenate([data.gap[s.start:s.stop] for s in data.segments])
+    moving = v > 1.0
+    t_max = float(np.percentile(g[moving] / v[moving], 5)) if moving.sum() > 10 else 0.0
+    grid = np.array([T for T in PROFILE_GRID if T <= t_max] or [0.0])
+    rows: list[dict[str, Any]] = []
+    for T, r in zip(grid, profile_headway(data, model, grid, n_starts=max(1, min(n_starts, 2)), seed=seed)):
+        q = r.params
+        c = ss.certify(q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"], headway=q["headway"],
+                       sample_time=H)
+        rows.append({"headway": float(T), "k_x": q["k_x"], "k_v": q["k_v"], "tau": q["tau"],
+                     "standstill": q["standstill"], "rmse_speed": r.rmse_speed, "rmse_gap": r.rmse_gap,
+                     "verdict": c.verdict, "sup_gain": float(c.sup_gain), "at_bound": r.at_bound})
+    verdicts = {r["verdict"] for r in rows}
+    Ts = ", ".join(f"{r['headway']:g}" for r in rows)
+    lo = min(r["rmse_speed"] for r in rows)
+    hi = max(r["rmse_speed"] for r in rows)
+    sups = [r["sup_gain"] for r in rows]
+    if len(verdicts) == 1:
+        note = (f"profile over T*: with T* held at {Ts} s (the others refitted; speed RMSE "
+                f"{lo:.3g}-{hi:.3g} m/s, sup|Γ| {min(sups):.3g}-{max(sups):.3g}) the verdict is "
+                f"{verdicts.pop()} at every value: the T*/l_0 ambiguity does not change it")
+    else:
+        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (RMSE {r['rmse_speed']:.3g} m/s)"
+                          for r in rows)
+        note = f"profile over T*: the verdict depends on T*, which this log does not pin down ({which})"
+    return rows, note
 
 
 def _sup(q: dict[str, float], H: float | None, point: Any) -> float:

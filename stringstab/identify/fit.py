@@ -175,7 +175,8 @@ class FitResult:
     theta: Array | None = None
 
 
-def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.Generator) -> list[Array]:
+def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.Generator,
+            fixed: dict[str, float] | None = None) -> list[Array]:
     """Starting points: a typical ACC first, then draws from plausible ranges; l_0 from the
     data's mean gap at the drawn T*."""
     vbar = float(np.mean([data.v[s.start:s.stop].mean() for s in data.segments]))
@@ -186,7 +187,9 @@ def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.G
     out = []
     for i in range(n):
         p = dict(typical) if i == 0 else {k: float(rng.uniform(lo[k], hi[k])) for k in lo}
-        p["headway"] = min(p["headway"], max(gbar / max(vbar, 0.1), 0.0))
+        p.update(fixed or {})
+        if "headway" not in (fixed or {}):
+            p["headway"] = min(p["headway"], max(gbar / max(vbar, 0.1), 0.0))
         p["standstill"] = min(max(gbar - p["headway"] * vbar, 0.5), BOUNDS["standstill"][1] - 1)
         out.append(np.array([p[k] for k in names]))
     return out
@@ -194,7 +197,7 @@ def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.G
 
 def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, seed: int = 0,
                  x0: Array | None = None, counts: Array | None = None,
-                 identifiability: bool = True) -> FitResult:
+                 identifiability: bool = True, fixed: dict[str, float] | None = None) -> FitResult:
     """Fit the eq-4 law and the lag to one follower by closed-loop simulation error.
 
     Parameters
@@ -214,6 +217,8 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
         Per-sample multiplicities (the block bootstrap); default 1.
     identifiability : bool
         Compute the correlation and speed-range notes.
+    fixed : dict, optional
+        Parameters held at a value (e.g. ``{"headway": 1.0}`` for a profile).
 
     Returns
     -------
@@ -228,9 +233,13 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
         raise StringStabError("--model cacc needs the predecessor's acceleration; this log has none")
     sv, sg = data.scales()
     w = None if counts is None else residual_weights(data, counts)
-    lb = np.array([BOUNDS[k][0] for k in names])
-    ub = np.array([BOUNDS[k][1] for k in names])
-    xs = [x0] if x0 is not None else _starts(names, data, max(n_starts, 1), np.random.default_rng(seed))
+    box = dict(BOUNDS)
+    for k, val in (fixed or {}).items():
+        box[k] = (float(val), float(val) + 1e-9)
+    lb = np.array([box[k][0] for k in names])
+    ub = np.array([box[k][1] for k in names])
+    xs = [x0] if x0 is not None else _starts(names, data, max(n_starts, 1), np.random.default_rng(seed),
+                                                   fixed)
     best: Any = None
     nfev = 0
     for x in xs:
@@ -247,7 +256,7 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     eg = np.concatenate([g - data.gap[s.start:s.stop] for s, g in zip(data.segments, gaps)])
     width = ub - lb
     at_bound = [k for k, x, lo_, hi_, wd in zip(names, theta, lb, ub, width)
-                if x - lo_ < 1e-3 * wd or hi_ - x < 1e-3 * wd]
+                if k not in (fixed or {}) and (x - lo_ < 1e-3 * wd or hi_ - x < 1e-3 * wd)]
     params = {"k_x": m.k_x, "k_v": m.k_v, "k_a": m.k_a, "tau": m.tau, "delta": m.delta,
               "headway": m.headway, "standstill": m.standstill}
     out = FitResult(params, float(np.sqrt(np.mean(ev ** 2))), float(np.sqrt(np.mean(eg ** 2))),
@@ -295,3 +304,27 @@ def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
 def rms(x: Array) -> float:
     """Root mean square."""
     return float(math.sqrt(float(np.mean(np.square(x))))) if x.size else math.nan
+
+
+def profile_headway(data: FollowerData, model: str, grid: Array, *, n_starts: int = 2,
+                    seed: int = 0) -> list[FitResult]:
+    """Refit with T* held at each value of ``grid`` (a profile over the time headway).
+
+    When T* and l_0 are weakly separated (the speed varies little), the best fit may pick any T*
+    at a small cost; the profile shows how much each fixed T* costs in RMSE and whether the
+    verdict depends on it.
+
+    Parameters
+    ----------
+    data, model, n_starts, seed
+        As for :func:`fit_follower`.
+    grid : array
+        Values of T*, s.
+
+    Returns
+    -------
+    list of FitResult
+        One per grid value (T* at the grid value, the other parameters refitted).
+    """
+    return [fit_follower(data, model, n_starts=n_starts, seed=seed, identifiability=False,
+                         fixed={"headway": float(T)}) for T in grid]
