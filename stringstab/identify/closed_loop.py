@@ -74,13 +74,26 @@ def delayed(a: Array, delta: float, dt: float) -> Array:
     return np.asarray((1.0 - f) * a[i0] + f * a[i1])
 
 
-def _lsim(F: Array, B: Array, u: Array) -> Array:
-    """Zero-state outputs (s, v) of x_{k+1} = F x_k + B u_k, y_k = (x_k[0], x_k[1])."""
-    from scipy.signal import lfilter, ss2tf
+def _charpoly(M: Array) -> Array:
+    """det(zI − M) of a 3×3 matrix: [1, −tr M, Σ principal 2×2 minors, −det M]."""
+    m = M.tolist()
+    (a, b, c), (d, e, f), (g, h, i) = m
+    minors = (a * e - b * d) + (a * i - c * g) + (e * i - f * h)
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    return np.array([1.0, -(a + e + i), minors, -det])
 
-    C = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    num, den = ss2tf(F, B[:, None], C, np.zeros((2, 1)))
-    return np.stack([lfilter(num[r], den, u) for r in range(2)])
+
+def _numerators(F: Array, B: Array) -> Array:
+    """Numerators (s and v rows) over det(zI − F) of x_{k+1} = F x_k + B u_k, y = (x[0], x[1]):
+    the SISO identity C adj(zI − F) B = det(zI − F + B C) − det(zI − F) (as in
+    :func:`scipy.signal.ss2tf`, without its checks)."""
+    den = _charpoly(F)
+    out = np.empty((2, den.size))
+    for r in range(2):
+        c = np.zeros(3)
+        c[r] = 1.0
+        out[r] = _charpoly(F - np.outer(B, c)) - den
+    return out
 
 
 def simulate_follower(m: FollowerModel, v_pred: Array, dt: float, *, s0: float, v0: float,
@@ -124,10 +137,20 @@ def simulate_follower(m: FollowerModel, v_pred: Array, dt: float, *, s0: float, 
     d = np.empty(T)
     d[:-1] = np.diff(x_pred) if x_pred is not None else 0.5 * dt * (v_pred[1:] + v_pred[:-1])
     d[-1] = 0.0
+    from scipy.signal import lfilter
+
+    den = _charpoly(F)
+    # y = Σ_inputs num_i(z)/den(z) u_i: each numerator's FIR part per input, then one all-pole
+    # pass over both outputs (one lfilter call instead of one per input and output)
     with np.errstate(all="ignore"):
-        y = _lsim(F, b, w)
-        y += _lsim(F, np.array([1.0, 0.0, 0.0]), d)
-        imp = np.zeros(T + 1)
-        imp[0] = 1.0
-        y += _lsim(F, np.array([s0, v0, a0]), imp)[:, 1:]
+        z = np.zeros((2, T))
+        for B, u in ((b, w), (np.array([1.0, 0.0, 0.0]), d)):
+            nums = _numerators(F, B)
+            for r in range(2):
+                z[r] += np.convolve(nums[r], u)[:T]
+        # the free response C F^k x0 is the impulse response of (F, x0, C) one step later
+        nums = _numerators(F, np.array([s0, v0, a0]))
+        n0 = min(T, nums.shape[1] - 1)
+        z[:, :n0] += nums[:, 1:n0 + 1]
+        y = lfilter([1.0], den, z, axis=1)
     return y[0], y[1]

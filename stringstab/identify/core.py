@@ -354,7 +354,7 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
             emp = empirical_transfer(data.v_pred, data.v, segs, lg.dt)
             vr = VehicleResult(li, p, lg.name(p), lg.name(p - 1), fit, list(segs), cert, bp, verdicts,
                                box, emp, data)
-            if _weak_headway(fit):
+            if _weak_headway(fit, bp["headway"]):
                 vr.profile, note = _profile(data, model, fit, sample_time, n_starts, seed)
                 vr.notes.append(note)
             vr.notes += _disagreement(vr)
@@ -366,10 +366,11 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     return IdentifyResult(out, model, sample_time, settings, [lg.source for lg in logs], skipped)
 
 
-def _weak_headway(fit: FitResult) -> bool:
-    """T* is at a bound or weakly separated from l_0 (a note of the fit says so)."""
-    return "headway" in fit.at_bound or any("headway" in n and "standstill" in n for n in fit.notes) \
-        or any("T* and the standstill" in n for n in fit.notes)
+def _weak_headway(fit: FitResult, boot_headway: Array) -> bool:
+    """T* is at a bound, the speed barely varies, or the bootstrap moves T* by over 0.5 s."""
+    spread = (boot_headway.size >= 2
+              and float(np.subtract(*np.percentile(boot_headway, [95, 5]))) > 0.5)
+    return "headway" in fit.at_bound or any("T* and the standstill" in n for n in fit.notes) or spread
 
 
 #: Time headways of the profile (those above what the data's gaps allow are dropped), s.
@@ -387,26 +388,28 @@ def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_
     t_max = float(np.percentile(g[moving] / v[moving], 5)) if moving.sum() > 10 else 0.0
     grid = np.array([T for T in PROFILE_GRID if T <= t_max] or [0.0])
     rows: list[dict[str, Any]] = []
-    for T, r in zip(grid, profile_headway(data, model, grid, n_starts=max(1, min(n_starts, 2)), seed=seed)):
-        q = r.params
+    best = fit.rmse_speed
+    for T, pf in zip(grid, profile_headway(data, model, grid, n_starts=max(1, min(n_starts, 2)), seed=seed)):
+        q = pf.params
         c = ss.certify(q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"], headway=q["headway"],
                        sample_time=H)
         rows.append({"headway": float(T), "k_x": q["k_x"], "k_v": q["k_v"], "tau": q["tau"],
-                     "standstill": q["standstill"], "rmse_speed": r.rmse_speed, "rmse_gap": r.rmse_gap,
-                     "verdict": c.verdict, "sup_gain": float(c.sup_gain), "at_bound": r.at_bound})
+                     "standstill": q["standstill"], "rmse_speed": pf.rmse_speed, "rmse_gap": pf.rmse_gap,
+                     "rmse_speed_increase": pf.rmse_speed / best - 1.0 if best > 0 else math.nan,
+                     "verdict": c.verdict, "sup_gain": float(c.sup_gain), "at_bound": pf.at_bound})
     verdicts = {r["verdict"] for r in rows}
     Ts = ", ".join(f"{r['headway']:g}" for r in rows)
-    lo = min(r["rmse_speed"] for r in rows)
-    hi = max(r["rmse_speed"] for r in rows)
+    inc = [100 * r["rmse_speed_increase"] for r in rows]
     sups = [r["sup_gain"] for r in rows]
     if len(verdicts) == 1:
         note = (f"profile over T*: with T* held at {Ts} s (the others refitted; speed RMSE "
-                f"{lo:.3g}-{hi:.3g} m/s, sup|Γ| {min(sups):.3g}-{max(sups):.3g}) the verdict is "
-                f"{verdicts.pop()} at every value: the T*/l_0 ambiguity does not change it")
+                f"{min(inc):+.0f} to {max(inc):+.0f} % of the best fit's, sup|Γ| {min(sups):.3g}-{max(sups):.3g}) "
+                f"the verdict is {verdicts.pop()} at every value: the T*/l_0 ambiguity does not change it")
     else:
-        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (RMSE {r['rmse_speed']:.3g} m/s)"
+        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (speed RMSE {100 * r['rmse_speed_increase']:+.0f} %)"
                           for r in rows)
-        note = f"profile over T*: the verdict depends on T*, which this log does not pin down ({which})"
+        note = ("profile over T*: the verdict depends on T* (the others refitted; speed RMSE relative to "
+                f"the best fit): {which}")
     return rows, note
 
 
