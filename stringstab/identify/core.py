@@ -203,7 +203,7 @@ def statement(point_verdict: str, boot: Sequence[str], at_bound: Sequence[str] =
     return text
 
 
-def _block_counts(segments: Sequence[Segment], T: int, L: int, rng: np.random.Generator) -> Array:
+def block_counts(segments: Sequence[Segment], T: int, L: int, rng: np.random.Generator) -> Array:
     """Per-sample multiplicities of one moving-block bootstrap draw (module docstring)."""
     starts: list[tuple[int, int]] = []  # (first valid start, number of starts) per segment
     for s in segments:
@@ -339,7 +339,7 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
             boot: dict[str, list[float]] = {k: [] for k in (*PARAMETERS["cacc"], "sup_gain")}
             verdicts: list[str] = []
             for _ in range(B):
-                counts = _block_counts(segs, data.v.size, L, rng)
+                counts = block_counts(segs, data.v.size, L, rng)
                 bf = fit_follower(data, model, x0=fit.theta, counts=counts, identifiability=False)
                 q = bf.params
                 chk = ss.check(q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"],
