@@ -122,6 +122,10 @@ def test_identify_bootstrap_and_verdicts() -> None:
     # the measured transfer: at most ~1 for the stable car, above 1 for the unstable one
     assert unstable.empirical.gain > 1.05
     assert stable.empirical.gain < 1.05
+    # ... beyond the estimate's random error (±2ε) for the unstable car, never above for the stable
+    assert unstable.empirical.amplifies == "yes"
+    assert stable.empirical.amplifies != "yes"
+    assert any(n.startswith("model and data agree") for n in unstable.notes)
     doc = res.document()
     need = {"position", "name", "k_x", "k_v", "k_a", "tau", "delta", "headway", "standstill",
             "rmse_speed", "rmse_gap", "sup_gain", "peak_omega", "verdict", "certified_share",

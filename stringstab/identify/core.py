@@ -113,6 +113,7 @@ class VehicleResult:
                                     / len(self.boot_verdicts)) if self.boot_verdicts else math.nan,
             "box_verdict": None if self.box is None else self.box.verdict,
             "empirical_gain": e.gain, "empirical_omega": e.gain_omega,
+            "empirical_gain_error": 2 * e.gain_error * e.gain, "data_amplifies": e.amplifies,
             "peak_to_peak": e.peak_to_peak, "energy_gain": e.energy,
             "at_bound": ",".join(self.fit.at_bound),
             "samples": self.data.n_samples,
@@ -318,8 +319,6 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
                     raise StringStabError(
                         f"--model cacc needs the predecessor's acceleration (an a column); "
                         f"{show(lg.source)} has none for {lg.name(p - 1)}")
-            if np.nanmin(g) <= 0:
-                skipped.append(f"{lg.name(p)} (position {p}): a gap <= 0 m in the record")
             jobs.append((li, lg, p, tuple(segs), FollowerData(vp, v, g, ap, tuple(segs), lg.dt)))
     if not jobs:
         raise StringStabError(
@@ -357,7 +356,7 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
             if _weak_headway(fit, bp["headway"]):
                 vr.profile, note = _profile(data, model, fit, sample_time, n_starts, seed)
                 vr.notes.append(note)
-            vr.notes += _disagreement(vr)
+            vr.notes += _disagreement(vr) + _quality(vr)
             out.append(vr)
     finally:
         bar.close()
@@ -403,10 +402,10 @@ def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_
     sups = [r["sup_gain"] for r in rows]
     if len(verdicts) == 1:
         note = (f"profile over T*: with T* held at {Ts} s (the others refitted; speed RMSE "
-                f"{min(inc):+.0f} to {max(inc):+.0f} % of the best fit's, sup|Γ| {min(sups):.3g}-{max(sups):.3g}) "
+                f"{min(inc):+.1f} to {max(inc):+.1f} % of the best fit's, sup|Γ| {min(sups):.4g}-{max(sups):.4g}) "
                 f"the verdict is {verdicts.pop()} at every value: the T*/l_0 ambiguity does not change it")
     else:
-        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (speed RMSE {100 * r['rmse_speed_increase']:+.0f} %)"
+        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (speed RMSE {100 * r['rmse_speed_increase']:+.1f} %)"
                           for r in rows)
         note = ("profile over T*: the verdict depends on T* (the others refitted; speed RMSE relative to "
                 f"the best fit): {which}")
@@ -443,21 +442,46 @@ def _box(p: dict[str, float], bp: dict[str, Array], model: str, H: float | None)
 
 
 def _disagreement(v: VehicleResult) -> list[str]:
-    """Where the model's verdict and the data's own amplification part ways."""
+    """Where the model's verdict and the data's own amplification part ways
+    (:mod:`stringstab.identify.empirical`: ±2ε around |Ĝ|)."""
     e = v.empirical
     sup = float(v.certificate.sup_gain)
+    model_amplifies = v.certificate.verdict == "not_certified"
+    shown = f"max |Ĝ| = {e.gain:.3g} ± {2 * e.gain_error * e.gain:.2g} at {e.gain_omega:.3g} rad/s"
+    if not math.isfinite(e.gain):
+        return ["the measured transfer has no frequency with coherence >= 0.5 below 3 rad/s: the "
+                "data give no verdict of their own"]
+    if e.amplifies == "undecided":
+        return [f"the data alone do not decide ({shown}, coherence >= 0.5): within their error of 1"]
+    if model_amplifies and e.amplifies == "no":
+        return [f"model and data disagree: the fitted model amplifies (sup|Γ| = {sup:.4g} at "
+                f"{float(v.certificate.peak_omega):.3g} rad/s) but the measured transfer stays below 1 "
+                f"where coherent ({shown})"]
+    if not model_amplifies and e.amplifies == "yes":
+        return [f"model and data disagree: the fitted model is certified (sup|Γ| = {sup:.4g}) but the "
+                f"measured transfer exceeds 1 ({shown}, coherence >= 0.5)"]
+    return [f"model and data agree: the measured transfer {'exceeds 1' if e.amplifies == 'yes' else 'stays below 1'} "
+            f"({shown})"]
+
+
+def _quality(v: VehicleResult) -> list[str]:
+    """Notes on the fit's quality and on the record itself."""
     notes = []
-    if math.isfinite(e.gain):
-        if sup > 1.0 + 1e-6 and e.gain <= 1.0:
-            notes.append(f"model and data disagree: the fitted model amplifies (sup|Γ| = {sup:.3g} at "
-                         f"{float(v.certificate.peak_omega):.3g} rad/s) but the measured transfer "
-                         f"stays at or below 1 where coherent (max {e.gain:.3g})")
-        elif sup <= 1.0 + 1e-6 and e.gain > 1.0:
-            notes.append(f"model and data disagree: the fitted model does not amplify but the measured "
-                         f"transfer reaches {e.gain:.3g} at {e.gain_omega:.3g} rad/s (coherence >= 0.5)")
-    else:
-        notes.append("the measured transfer has no frequency with coherence >= 0.5: the data give "
-                     "no verdict of their own")
+    d = v.data
+    g = np.concatenate([d.gap[s.start:s.stop] for s in v.segments])
+    if g.min() <= 0:
+        notes.append(f"the recorded gap drops to {g.min():.3g} m (GPS error or a collision): the "
+                     "record is used as it is")
+    gaps, _ = simulated(v)
+    smin = min(float(x.min()) for x in gaps)
+    if smin <= 0 < g.min():
+        notes.append(f"the fitted model's simulated gap reaches {smin:.3g} m where the measured one "
+                     f"stays above {g.min():.3g} m: the linear law misses part of this car's response "
+                     "(large, asymmetric manoeuvres)")
+    rel = v.fit.rmse_gap / max(float(g.mean()), 1.0)
+    if rel > 0.15:
+        notes.append(f"poor fit: the gap RMSE is {100 * rel:.0f} % of the mean gap; the verdict "
+                     "describes the best linear law, not necessarily this car")
     return notes
 
 

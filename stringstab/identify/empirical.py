@@ -8,6 +8,11 @@
   model's |Γ(jω)|.  Spectra are averaged over the clean segments (weighted by their Welch
   segment counts); frequencies where C < 0.5 are noise, not dynamics, and are left out of the
   empirical peak, as are those above :data:`OMEGA_MAX`.
+* **Its uncertainty**: the normalised random error of a gain estimate from n_d independent
+  spectral averages, ε = √(1 − C)/(√C √(2 n_d)) (Bendat & Piersol, *Random Data*, 4th ed.,
+  eq 9.90), with n_d counted conservatively as non-overlapping segments; the data say
+  "amplifies" where |Ĝ|(1 − 2ε) > 1 at a coherent frequency, "does not amplify" where
+  |Ĝ|(1 + 2ε) ≤ 1 at every coherent frequency, and are undecided otherwise.
 * **Peak-to-peak amplification**: the follower's speed range over the predecessor's, on the
   samples used.
 * **Energy amplification**: √(Σ a_f² / Σ a_p²) with a = Δv/Δt, the acceleration energy ratio
@@ -55,6 +60,10 @@ class Empirical:
         Peak-to-peak speed and acceleration-energy amplification (module docstring).
     nperseg : int
         Welch segment length, samples.
+    gain_error : float
+        ε at the peak (module docstring).
+    amplifies : str
+        ``"yes"``, ``"no"`` or ``"undecided"`` (module docstring).
     """
 
     omega: Array
@@ -65,6 +74,8 @@ class Empirical:
     peak_to_peak: float
     energy: float
     nperseg: int
+    gain_error: float = math.nan
+    amplifies: str = "undecided"
 
 
 def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | list[Segment], dt: float,
@@ -115,12 +126,21 @@ def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | 
         G = np.asarray(pxy / pxx, dtype=np.complex128)
         C = np.asarray(np.abs(pxy) ** 2 / (pxx * pyy), dtype=float)
     C = np.nan_to_num(C, nan=0.0)
+    n_d = max(sum(len(s) for s in segments if len(s) >= n) / n, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eps = np.sqrt(np.clip(1 - C, 0, None)) / (np.sqrt(C) * math.sqrt(2 * n_d))
     good = (C >= COHERENCE_MIN) & (omega > 0) & (omega <= OMEGA_MAX) & np.isfinite(np.abs(G))
+    amplifies = "undecided"
     if good.any():
         i = int(np.flatnonzero(good)[np.argmax(np.abs(G[good]))])
-        gain, gw = float(abs(G[i])), float(omega[i])
+        gain, gw, err = float(abs(G[i])), float(omega[i]), float(eps[i])
+        mag = np.abs(G[good])
+        if (mag * (1 - 2 * eps[good]) > 1).any():
+            amplifies = "yes"
+        elif (mag * (1 + 2 * eps[good]) <= 1).all():
+            amplifies = "no"
     else:
-        gain, gw = math.nan, math.nan
+        gain, gw, err = math.nan, math.nan, math.nan
     xs = np.concatenate([v_pred[s.start:s.stop] for s in segments])
     ys = np.concatenate([v[s.start:s.stop] for s in segments])
     p2p = float(np.ptp(ys) / np.ptp(xs)) if np.ptp(xs) > 0 else math.nan
@@ -128,4 +148,4 @@ def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | 
     ay = np.concatenate([np.diff(v[s.start:s.stop]) for s in segments])
     ex = float(ax @ ax)
     energy = math.sqrt(float(ay @ ay) / ex) if ex > 0 else math.nan
-    return Empirical(omega, G, C, gain, gw, p2p, energy, n)
+    return Empirical(omega, G, C, gain, gw, p2p, energy, n, err, amplifies)

@@ -43,6 +43,7 @@ TABLE = [
     TableColumn("certified", "certified_share", "%.2f"),
     TableColumn("box", "box_verdict", "%s"),
     TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),
+    TableColumn("data>1", "data_amplifies", "%s"),
     TableColumn("p2p", "peak_to_peak", "%.3g"),
     TableColumn("energy", "energy_gain", "%.3g"),
 ]
