@@ -168,3 +168,23 @@ def test_identify_refuses_a_log_without_usable_segment() -> None:
     bad = PlatoonLog(log.t, log.positions, log.names, speed, log.gap, None, "<x>", "csv", {})
     with pytest.raises(ss.StringStabError, match="no follower has a usable segment"):
         identify(bad, bootstrap=0, progress=False)
+
+
+def test_cacc_recovers_k_a_and_delta() -> None:
+    """--model cacc: k_a and δ from a log with the predecessor's acceleration (noise-free, 3 min):
+    k_a within 10 %, δ within 0.05 s, the certificate of the fit equal to the truth's."""
+    lead = _leader(180.0)
+    truth = dict(k_x=0.25, k_v=0.5, k_a=0.6, tau=0.4, delta=0.3)
+    c = LinearController(truth["k_x"], truth["k_v"], truth["k_a"], headway=1.2, standstill=3.0)
+    r = simulate(lead, c, 1, tau=truth["tau"], delta=truth["delta"])
+    log = PlatoonLog(r.t, (0, 1), ("lead", "cacc"), r.speed, {1: r.gap[0]}, r.accel, "<sim>", "csv", {})
+    vp, v, g, ap = log.pair(1)
+    fit = fit_follower(FollowerData(vp, v, g, ap, tuple(clean_segments(log, 1)), log.dt), "cacc", n_starts=2)
+    p = fit.params
+    assert p["k_a"] == pytest.approx(truth["k_a"], rel=0.10)
+    assert p["delta"] == pytest.approx(truth["delta"], abs=0.05)
+    assert p["k_x"] == pytest.approx(truth["k_x"], rel=0.10)
+    want = ss.certify(truth["k_x"], truth["k_v"], truth["k_a"], tau=truth["tau"], delta=truth["delta"], headway=1.2)
+    got = ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"], headway=p["headway"])
+    assert got.verdict == want.verdict
+    assert got.sup_gain == pytest.approx(want.sup_gain, rel=0.05)

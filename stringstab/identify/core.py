@@ -487,9 +487,6 @@ def _quality(v: VehicleResult) -> list[str]:
 
 def simulated(v: VehicleResult) -> tuple[list[Array], list[Array]]:
     """Simulated gap and speed of the point fit on each segment (for figures)."""
-    return simulate_segments(model_of(v.fit.theta, PARAMETERS[_model_of(v)]), v.data)  # type: ignore[arg-type]
-
-
-def _model_of(v: VehicleResult) -> str:
-    assert v.fit.theta is not None
-    return "cacc" if v.fit.theta.size == len(PARAMETERS["cacc"]) else "acc"
+    f = v.fit
+    assert f.theta is not None
+    return simulate_segments(model_of(f.theta[:len(f.names)], f.names), v.data, f.initial)

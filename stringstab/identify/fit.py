@@ -1,11 +1,17 @@
 """Closed-loop simulation-error fit of the eq-4 law to one follower's record.
 
 The follower is driven by its *measured* predecessor (speed, and acceleration for ``cacc``)
-from its measured initial gap, speed and acceleration at the start of each clean segment
-(:func:`stringstab.identify.closed_loop.simulate_follower`); the parameters minimise the sum of
+from an initial gap, speed and acceleration at the start of each clean segment
+(:func:`stringstab.identify.closed_loop.simulate_follower`).  Those initial states are fitted
+too, as nuisance parameters within :data:`INITIAL_SLACK` of the measured ones (standard in
+output-error identification): a start taken from two noisy samples, or an acceleration the
+log does not hold, leaves a transient that a lightly damped follower carries for tens of
+seconds, and a fit would bend the law's parameters to reproduce it.  The parameters minimise the sum of
 squares of the simulated-minus-measured speed and gap over every sample of every segment, each
 normalised by the spread of its measured signal so that neither dominates by its unit
-(:func:`scipy.optimize.least_squares`, trust-region reflective, bounds below).  This is the
+(:func:`scipy.optimize.least_squares`, trust-region reflective with the LSMR sub-solver,
+bounds below; the dense-SVD sub-solver was up to 60x slower on a shared machine, where the
+multi-threaded BLAS of a 5000 × 11 SVD contends with other processes).  This is the
 simulation (not one-step prediction) error used for car-following calibration in the
 literature (Punzo et al. 2012; Gunter et al. 2021): a one-step fit rewards models that track
 the data with feedback they do not have.
@@ -97,32 +103,48 @@ INITIAL_WINDOW = 20
 def initial_state(v: Array, dt: float) -> tuple[float, float]:
     """Initial speed and acceleration of a segment: the straight line fitted by least squares
     to its first :data:`INITIAL_WINDOW` speeds (a difference of two noisy GPS speeds would make
-    a0 err by ~σ√2/Δt, 0.7 m/s² for σ = 0.05 m/s at 10 Hz, and a lightly damped follower
-    carries that transient a long way)."""
+    a0 err by ~σ√2/Δt, 0.7 m/s² for σ = 0.05 m/s at 10 Hz)."""
     n = min(v.size, INITIAL_WINDOW)
     slope, icpt = np.polyfit(np.arange(n) * dt, v[:n], 1)
     return float(icpt), float(slope)
 
 
-def simulate_segments(m: FollowerModel, data: FollowerData) -> tuple[list[Array], list[Array]]:
-    """Simulated gap and speed on every segment, from the measured state at its start."""
+def measured_initial(data: FollowerData) -> Array:
+    """(s0, v0, a0) of each segment from the data: straight lines fitted to its first
+    :data:`INITIAL_WINDOW` gaps and speeds; the starting values of the fit's initial states."""
+    out = np.empty((len(data.segments), 3))
+    for i, s in enumerate(data.segments):
+        n = min(len(s), INITIAL_WINDOW)
+        v0, a0 = initial_state(data.v[s.start:s.stop], data.dt)
+        g0 = float(np.polyval(np.polyfit(np.arange(n) * data.dt, data.gap[s.start:s.start + n], 1), 0.0))
+        out[i] = (g0, v0, a0)
+    return out
+
+
+#: How far the fitted initial state of a segment may move from the measured one: gap (m),
+#: speed (m/s), acceleration (m/s²).
+INITIAL_SLACK = (3.0, 1.0, 2.0)
+
+
+def simulate_segments(m: FollowerModel, data: FollowerData,
+                      initial: Array | None = None) -> tuple[list[Array], list[Array]]:
+    """Simulated gap and speed on every segment from its initial state (default the measured
+    one, :func:`measured_initial`)."""
+    init = measured_initial(data) if initial is None else np.asarray(initial).reshape(-1, 3)
     gaps, speeds = [], []
-    for s in data.segments:
+    for s, (g0, v0, a0) in zip(data.segments, init):
         vp = data.v_pred[s.start:s.stop]
-        v = data.v[s.start:s.stop]
-        v0, a0 = initial_state(v, data.dt)
         ap = None if data.a_pred is None else data.a_pred[s.start:s.stop]
-        g0 = float(np.polyval(np.polyfit(np.arange(min(v.size, INITIAL_WINDOW)) * data.dt,
-                                         data.gap[s.start:s.start + min(v.size, INITIAL_WINDOW)], 1), 0.0))
-        g, vs = simulate_follower(m, vp, data.dt, s0=g0, v0=v0, a0=a0, a_pred=ap)
+        g, vs = simulate_follower(m, vp, data.dt, s0=float(g0), v0=float(v0), a0=float(a0), a_pred=ap)
         gaps.append(g)
         speeds.append(vs)
     return gaps, speeds
 
 
-def _residuals(theta: Array, names: tuple[str, ...], data: FollowerData, sv: float, sg: float,
+def _residuals(x: Array, names: tuple[str, ...], data: FollowerData, sv: float, sg: float,
                w: Array | None) -> Array:
-    gaps, speeds = simulate_segments(model_of(theta, names), data)
+    p = len(names)
+    gaps, speeds = simulate_segments(model_of(x[:p], names), data, x[p:])
     parts = []
     for s, g, v in zip(data.segments, gaps, speeds):
         parts.append((v - data.v[s.start:s.stop]) / sv)
@@ -165,6 +187,11 @@ class FitResult:
         Correlations of the estimates above :data:`CORRELATION_LIMIT` in absolute value.
     starts : int
         Starting points tried; ``nfev`` evaluations in all.
+    theta, names : array, tuple of str
+        The whole solution vector (the parameters ``names``, then the initial states) and
+        the parameter names.
+    initial : array (n_segments, 3)
+        Fitted initial gap, speed and acceleration of each segment.
     """
 
     params: dict[str, float]
@@ -177,6 +204,8 @@ class FitResult:
     starts: int = 1
     nfev: int = 0
     theta: Array | None = None
+    names: tuple[str, ...] = ()
+    initial: Array | None = None
 
 
 def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.Generator,
@@ -240,22 +269,29 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     box = dict(BOUNDS)
     for k, val in (fixed or {}).items():
         box[k] = (float(val), float(val) + 1e-9)
-    lb = np.array([box[k][0] for k in names])
-    ub = np.array([box[k][1] for k in names])
-    xs = [x0] if x0 is not None else _starts(names, data, max(n_starts, 1), np.random.default_rng(seed),
-                                                   fixed)
+    init0 = measured_initial(data)
+    slack = np.tile(INITIAL_SLACK, len(data.segments))
+    p = len(names)
+    lb = np.r_[[box[k][0] for k in names], init0.ravel() - slack]
+    ub = np.r_[[box[k][1] for k in names], init0.ravel() + slack]
+    if x0 is not None:
+        xs = [np.asarray(x0, dtype=float)]
+    else:
+        xs = [np.r_[x, init0.ravel()]
+              for x in _starts(names, data, max(n_starts, 1), np.random.default_rng(seed), fixed)]
     best: Any = None
     nfev = 0
     for x in xs:
-        xc = np.clip(np.asarray(x, dtype=float), lb + 1e-9 * (ub - lb), ub - 1e-9 * (ub - lb))
+        xc = np.clip(x, lb + 1e-9 * (ub - lb), ub - 1e-9 * (ub - lb))
         res = least_squares(_residuals, xc, bounds=(lb, ub), args=(names, data, sv, sg, w),
-                            x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8)
+                            x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8, tr_solver="lsmr")
         nfev += int(res.nfev)
         if best is None or res.cost < best.cost:
             best = res
     theta = best.x
-    m = model_of(theta, names)
-    gaps, speeds = simulate_segments(m, data)
+    m = model_of(theta[:p], names)
+    init = theta[p:].reshape(-1, 3)
+    gaps, speeds = simulate_segments(m, data, init)
     ev = np.concatenate([v - data.v[s.start:s.stop] for s, v in zip(data.segments, speeds)])
     eg = np.concatenate([g - data.gap[s.start:s.stop] for s, g in zip(data.segments, gaps)])
     width = ub - lb
@@ -264,7 +300,8 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     params = {"k_x": m.k_x, "k_v": m.k_v, "k_a": m.k_a, "tau": m.tau, "delta": m.delta,
               "headway": m.headway, "standstill": m.standstill}
     out = FitResult(params, float(np.sqrt(np.mean(ev ** 2))), float(np.sqrt(np.mean(eg ** 2))),
-                    float(best.cost), at_bound, starts=len(xs), nfev=nfev, theta=theta)
+                    float(best.cost), at_bound, starts=len(xs), nfev=nfev, theta=theta, names=names,
+                    initial=init)
     if identifiability:
         out.notes, out.correlation = _identifiability(best.jac, names, data, at_bound)
     return out
@@ -276,18 +313,23 @@ def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
     corr: dict[str, float] = {}
     J = np.asarray(J, dtype=float)
     # parameters at a bound are fixed for this analysis (their column is not free)
+    # (the initial states are free nuisance columns: the covariance of the parameters is the
+    # corresponding block of the inverse over all free columns)
     free = [i for i, k in enumerate(names) if k not in at_bound]
+    n_par = len(free)
+    free += list(range(len(names), J.shape[1]))
     Jf = J[:, free]
-    s = np.linalg.svd(Jf, compute_uv=False)
-    if s.size == 0 or s[-1] <= s[0] * 1e-10:
+    JtJ = Jf.T @ Jf
+    ev = np.linalg.eigvalsh(JtJ)  # on the small normal matrix: no SVD of the tall Jacobian
+    if ev.size == 0 or ev[0] <= ev[-1] * 1e-20:
         notes.append("the Jacobian is (numerically) rank deficient: some parameter does not "
                      "affect the simulated speed or gap on this log")
     else:
-        cov = np.linalg.pinv(Jf.T @ Jf)
+        cov = np.linalg.pinv(JtJ)
         d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
         R = cov / np.outer(d, d)
-        for a in range(len(free)):
-            for b in range(a + 1, len(free)):
+        for a in range(n_par):
+            for b in range(a + 1, n_par):
                 if abs(R[a, b]) > CORRELATION_LIMIT:
                     ka, kb = names[free[a]], names[free[b]]
                     corr[f"{ka}/{kb}"] = float(R[a, b])
