@@ -23,6 +23,9 @@ Per follower (a vehicle whose predecessor and gap are in the log):
    the model's |Γ(jω)|, with a note where they disagree.
 
 The verdict is worded no more confidently than the bootstrap allows (:func:`statement`).
+The certificates are the façade's functions (``stringstab.certify``, ``stringstab.check``),
+imported from :mod:`stringstab.certificate` because a sub-package does not import the root
+package (``tests/test_house.py``).
 """
 
 from __future__ import annotations
@@ -253,7 +256,7 @@ class _Progress:
 
 
 def _certify(p: dict[str, float], H: float | None) -> Any:
-    import stringstab as ss
+    from .. import certificate as ss
 
     return ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
                       headway=p["headway"], sample_time=H)
@@ -296,7 +299,7 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     StringStabError
         If no follower has a usable segment, or an option is out of range.
     """
-    import stringstab as ss
+    from .. import certificate as ss
 
     logs = [log] if isinstance(log, PlatoonLog) else list(log)
     if model not in PARAMETERS:
@@ -379,7 +382,7 @@ PROFILE_GRID = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
 def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_starts: int,
              seed: int) -> tuple[list[dict[str, Any]], str]:
     """Refit with T* held on :data:`PROFILE_GRID`, certify each: does the verdict depend on T*?"""
-    import stringstab as ss
+    from .. import certificate as ss
 
     v = np.concatenate([data.v[s.start:s.stop] for s in data.segments])
     g = np.concatenate([data.gap[s.start:s.stop] for s in data.segments])
@@ -426,7 +429,7 @@ def _sup(q: dict[str, float], H: float | None, point: Any) -> float:
 
 def _box(p: dict[str, float], bp: dict[str, Array], model: str, H: float | None) -> Any:
     """The robust certificate at the point gains over the 5-95 % bootstrap box of τ, T* (and δ)."""
-    import stringstab as ss
+    from .. import certificate as ss
 
     def iv(k: str) -> Any:
         lo, hi = (float(x) for x in np.percentile(bp[k], [5, 95]))
