@@ -452,7 +452,7 @@ def _disagreement(v: VehicleResult) -> list[str]:
     model_amplifies = v.certificate.verdict == "not_certified"
     shown = f"max |Ĝ| = {e.gain:.3g} ± {2 * e.gain_error * e.gain:.2g} at {e.gain_omega:.3g} rad/s"
     if not math.isfinite(e.gain):
-        return ["the measured transfer has no frequency with coherence >= 0.5 below 3 rad/s: the "
+        return ["the measured transfer has no frequency with coherence >= 0.5 below 1 rad/s: the "
                 "data give no verdict of their own"]
     if e.amplifies == "undecided":
         return [f"the data alone do not decide ({shown}, coherence >= 0.5): within their error of 1"]

@@ -146,6 +146,12 @@ def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
     ax1.loglog(e.omega[good], np.abs(e.transfer[good]), "o", ms=3, color="k",
                label="empirical |Ĝ| (coherence ≥ 0.5)")
     ax1.axhline(1.0, color="0.3", lw=0.6, ls=":")
+    from .empirical import OMEGA_MAX
+
+    for ax in (ax1, ax2):
+        ax.axvspan(OMEGA_MAX, 10.0, color="0.92", zorder=0)
+    ax1.text(OMEGA_MAX * 1.1, ax1.get_ylim()[0] * 1.5, "not used for the data's verdict\n(common-mode GPS error)",
+             fontsize=7, color="0.4")
     ax1.set_ylabel("|follower speed / predecessor speed|")
     ax1.legend(fontsize=8)
     ax1.set_title(f"{v.position} {v.name}: sup|Γ| = {float(v.certificate.sup_gain):.3g} ({v.certificate.verdict})"
