@@ -188,3 +188,17 @@ def test_cacc_recovers_k_a_and_delta() -> None:
     got = ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"], headway=p["headway"])
     assert got.verdict == want.verdict
     assert got.sup_gain == pytest.approx(want.sup_gain, rel=0.05)
+
+
+def test_single_threaded_blas_restores_the_thread_count() -> None:
+    import scipy.optimize  # noqa: F401  (loads SciPy's OpenBLAS too)
+
+    from stringstab.identify.blas import _libraries, single_threaded_blas
+
+    libs = _libraries()
+    if not libs:
+        pytest.skip("no OpenBLAS library found in this process")
+    before = [g() for g, _ in libs]
+    with single_threaded_blas():
+        assert [g() for g, _ in libs] == [1] * len(libs)
+    assert [g() for g, _ in libs] == before

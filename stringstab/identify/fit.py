@@ -37,6 +37,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..io.platoon_logs import Segment
+from .blas import single_threaded_blas
 from .closed_loop import FollowerModel, simulate_follower
 
 __all__ = ["BOUNDS", "PARAMETERS", "FitResult", "FollowerData", "fit_follower", "model_of"]
@@ -281,13 +282,14 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
               for x in _starts(names, data, max(n_starts, 1), np.random.default_rng(seed), fixed)]
     best: Any = None
     nfev = 0
-    for x in xs:
-        xc = np.clip(x, lb + 1e-9 * (ub - lb), ub - 1e-9 * (ub - lb))
-        res = least_squares(_residuals, xc, bounds=(lb, ub), args=(names, data, sv, sg, w),
-                            x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8, tr_solver="lsmr")
-        nfev += int(res.nfev)
-        if best is None or res.cost < best.cost:
-            best = res
+    with single_threaded_blas():
+        for x in xs:
+            xc = np.clip(x, lb + 1e-9 * (ub - lb), ub - 1e-9 * (ub - lb))
+            res = least_squares(_residuals, xc, bounds=(lb, ub), args=(names, data, sv, sg, w),
+                                x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8, tr_solver="lsmr")
+            nfev += int(res.nfev)
+            if best is None or res.cost < best.cost:
+                best = res
     theta = best.x
     m = model_of(theta[:p], names)
     init = theta[p:].reshape(-1, 3)
