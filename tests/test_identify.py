@@ -7,8 +7,9 @@ Recovery tolerances (stated once, checked below): k_x within 15 % of the truth, 
 certificate of the fit equal to the certificate of the truth, for a string-stable and a
 string-unstable car, from 4 min of 10 Hz data with speed noise σ = 0.05 m/s, gap noise
 σ = 0.2 m and two 1.5-s dropouts.  The unstable car's k_v and τ trade off under the noise on
-its predecessor's measured speed (the input of the simulation: errors in variables bias k_v down
-to ~0.15 and τ to ~0.5 over seeds 1-3), while its sup|Γ| stays within 1 % of the truth.
+its predecessor's measured speed (the input of the simulation: errors in variables); over seeds
+1-4 its k_v fell in 0.18-0.25 (truth 0.2) and τ in 0.56-0.71 s (truth 0.6) while its sup|Γ|
+stayed within 1 % of the truth, and the fits' RMSE equalled the noise added (0.05 m/s, 0.20 m).
 """
 
 from __future__ import annotations
