@@ -247,16 +247,18 @@ def _numeric(rows: list[list[str]], ncol: int, path: Path, first_line: int) -> A
 def _read_openacc(path: Path, rows: list[list[str]]) -> PlatoonLog:
     meta: dict[str, Any] = {}
     k = 0
-    while k < len(rows) and rows[k][0].strip() != "Time":
+    while k < len(rows) and rows[k][0].strip().lower() != "time":
         meta[rows[k][0].strip()] = [c.strip() for c in rows[k][1:] if c.strip()]
         k += 1
     header = [c.strip() for c in rows[k]]
     data = _numeric(rows[k + 1:], len(header), path, k + 2)
     t = _check_time(data[:, 0], path)
-    speed_cols = {int(m.group(1)): j for j, c in enumerate(header) if (m := re.fullmatch(r"Speed(\d+)", c))}
+    speed_cols = {int(m.group(1)): j for j, c in enumerate(header)
+                  if (m := re.fullmatch(r"speed(\d+)", c, re.IGNORECASE))}
     if not speed_cols:
         raise StringStabError(f"{_where(path)}: OpenACC header without Speedk columns; found {header[:8]}")
-    ivs_cols = {int(m.group(1)): j for j, c in enumerate(header) if (m := re.fullmatch(r"IVS(\d+)", c))}
+    ivs_cols = {int(m.group(1)): j for j, c in enumerate(header)
+                if (m := re.fullmatch(r"ivs(\d+)", c, re.IGNORECASE))}
     if not ivs_cols:
         raise StringStabError(
             f"{_where(path)}: no spacing columns IVSk; expected the inter-vehicle spacing of each pair")
@@ -268,8 +270,9 @@ def _read_openacc(path: Path, rows: list[list[str]]) -> PlatoonLog:
     # units: the E/N displacement per step against the speed column
     notes = []
     for n, nm, v in zip(nums, names, speed):
-        if f"E{n}" in header and f"N{n}" in header:
-            e, nn = data[:, header.index(f"E{n}")], data[:, header.index(f"N{n}")]
+        low = [c.lower() for c in header]
+        if f"e{n}" in low and f"n{n}" in low:
+            e, nn = data[:, low.index(f"e{n}")], data[:, low.index(f"n{n}")]
             rate = np.hypot(np.diff(e), np.diff(nn)) / np.diff(t)
             vm = 0.5 * (v[1:] + v[:-1])
             ratio = _unit_ratio(vm, rate)
@@ -479,10 +482,10 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0) -> list[P
     rows = _read_rows(p)
     if len(rows) < 2:
         raise StringStabError(f"{_where(p)}: expected a header and data rows; found {len(rows)} line(s)")
-    first = rows[0][0].strip().lower()
     header_low = [c.strip().lower() for c in rows[0]]
-    if first in ("date", "vehicle_order", "number_of_vehicles", "acc", "time") and any(
-            r and r[0].strip() == "Time" for r in rows[:20]):
+    if any(r and r[0].strip().lower() == "time"
+           and any(re.fullmatch(r"speed\d+", c.strip(), re.IGNORECASE) for c in r)
+           and any(re.fullmatch(r"ivs\d+", c.strip(), re.IGNORECASE) for c in r) for r in rows[:30]):
         logs = [_read_openacc(p, rows)]
     elif "vehicle_id" in header_low and "frame_id" in header_low:
         logs = _read_ngsim(p, min_duration)
