@@ -335,6 +335,18 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
         for li, lg, p, segs_t, data in jobs:
             segs = list(segs_t)
             fit = fit_follower(data, model, n_starts=n_starts, seed=seed)
+            pre: list[str] = []
+            prof: list[dict[str, Any]] = []
+            if _weak_headway(fit, np.empty(0)):
+                prof, pfits = _profile(data, model, sample_time, n_starts, seed)
+                alt = min(pfits, key=lambda f: f.cost)
+                if alt.cost < fit.cost * (1 - 1e-6):  # the starts missed a better optimum
+                    refit = fit_follower(data, model, x0=alt.theta, seed=seed)
+                    if refit.cost < fit.cost:
+                        pre.append(f"the profile over T* found a better optimum than the {fit.starts} "
+                                   f"starts (cost {100 * (refit.cost / fit.cost - 1):+.1f} %); the point "
+                                   "fit was restarted from it")
+                        fit = refit
             bar.step(f"{lg.name(p)} fitted")
             cert = _certify(fit.params, sample_time)
             L = max(round(block / lg.dt), 2)
@@ -356,9 +368,12 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
             emp = empirical_transfer(data.v_pred, data.v, segs, lg.dt)
             vr = VehicleResult(li, p, lg.name(p), lg.name(p - 1), fit, list(segs), cert, bp, verdicts,
                                box, emp, data)
-            if _weak_headway(fit, bp["headway"]):
-                vr.profile, note = _profile(data, model, fit, sample_time, n_starts, seed)
-                vr.notes.append(note)
+            vr.notes += pre
+            if not prof and _weak_headway(fit, bp["headway"]):
+                prof, _ = _profile(data, model, sample_time, n_starts, seed)
+            if prof:
+                vr.profile = prof
+                vr.notes.append(_profile_note(prof, fit.rmse_speed))
             vr.notes += _disagreement(vr) + _quality(vr)
             out.append(vr)
     finally:
@@ -379,9 +394,9 @@ def _weak_headway(fit: FitResult, boot_headway: Array) -> bool:
 PROFILE_GRID = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
 
 
-def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_starts: int,
-             seed: int) -> tuple[list[dict[str, Any]], str]:
-    """Refit with T* held on :data:`PROFILE_GRID`, certify each: does the verdict depend on T*?"""
+def _profile(data: FollowerData, model: str, H: float | None, n_starts: int,
+             seed: int) -> tuple[list[dict[str, Any]], list[FitResult]]:
+    """Refit with T* held on :data:`PROFILE_GRID` and certify each refit."""
     from .. import certificate as ss
 
     v = np.concatenate([data.v[s.start:s.stop] for s in data.segments])
@@ -389,30 +404,34 @@ def _profile(data: FollowerData, model: str, fit: FitResult, H: float | None, n_
     moving = v > 1.0
     t_max = float(np.percentile(g[moving] / v[moving], 5)) if moving.sum() > 10 else 0.0
     grid = np.array([T for T in PROFILE_GRID if T <= t_max] or [0.0])
+    fits = profile_headway(data, model, grid, n_starts=max(1, min(n_starts, 2)), seed=seed)
     rows: list[dict[str, Any]] = []
-    best = fit.rmse_speed
-    for T, pf in zip(grid, profile_headway(data, model, grid, n_starts=max(1, min(n_starts, 2)), seed=seed)):
+    for T, pf in zip(grid, fits):
         q = pf.params
         c = ss.certify(q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"], headway=q["headway"],
                        sample_time=H)
         rows.append({"headway": float(T), "k_x": q["k_x"], "k_v": q["k_v"], "tau": q["tau"],
                      "standstill": q["standstill"], "rmse_speed": pf.rmse_speed, "rmse_gap": pf.rmse_gap,
-                     "rmse_speed_increase": pf.rmse_speed / best - 1.0 if best > 0 else math.nan,
                      "verdict": c.verdict, "sup_gain": float(c.sup_gain), "at_bound": pf.at_bound})
+    return rows, fits
+
+
+def _profile_note(rows: list[dict[str, Any]], best: float) -> str:
+    """Does the verdict depend on T*? (speed RMSE of each fixed T* relative to the point fit's)."""
+    for r in rows:
+        r["rmse_speed_increase"] = r["rmse_speed"] / best - 1.0 if best > 0 else math.nan
     verdicts = {r["verdict"] for r in rows}
     Ts = ", ".join(f"{r['headway']:g}" for r in rows)
     inc = [100 * r["rmse_speed_increase"] for r in rows]
     sups = [r["sup_gain"] for r in rows]
     if len(verdicts) == 1:
-        note = (f"profile over T*: with T* held at {Ts} s (the others refitted; speed RMSE "
-                f"{min(inc):+.1f} to {max(inc):+.1f} % of the best fit's, sup|Γ| {min(sups):.4g}-{max(sups):.4g}) "
+        return (f"profile over T*: with T* held at {Ts} s (the others refitted; speed RMSE "
+                f"{min(inc):+.1f} to {max(inc):+.1f} % of the point fit's, sup|Γ| {min(sups):.4g}-{max(sups):.4g}) "
                 f"the verdict is {verdicts.pop()} at every value: the T*/l_0 ambiguity does not change it")
-    else:
-        which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (speed RMSE {100 * r['rmse_speed_increase']:+.1f} %)"
-                          for r in rows)
-        note = ("profile over T*: the verdict depends on T* (the others refitted; speed RMSE relative to "
-                f"the best fit): {which}")
-    return rows, note
+    which = "; ".join(f"T* = {r['headway']:g} s: {r['verdict']} (speed RMSE {100 * r['rmse_speed_increase']:+.1f} %)"
+                      for r in rows)
+    return ("profile over T*: the verdict depends on T* (the others refitted; speed RMSE relative to "
+            f"the point fit): {which}")
 
 
 def _sup(q: dict[str, float], H: float | None, point: Any) -> float:
