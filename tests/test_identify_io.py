@@ -152,7 +152,11 @@ def test_ngsim_pairs(tmp_path: Path) -> None:
         rows.append(f"2,{f},{y:.4f},{v:.4f},{a:.4f},1,15\n")
     p = tmp_path / "ngsim.csv"
     p.write_text(head + "".join(rows))
-    [log] = read_platoon_logs(p)
+    with pytest.raises(StringStabError, match="is an NGSIM file; read it with"):
+        read_platoon_logs(p)  # the bottom I/O layer does not import the simulator's parser
+    from stringstab.identify import read_logs
+
+    [log] = read_logs(p)
     assert log.fmt == "ngsim" and log.names == ("ngsim-1", "ngsim-2")
     assert np.allclose(log.gap[1], (80.0 - 15.0) * 0.3048, atol=1e-3)  # 65 ft bumper to bumper
     assert log.accel is not None

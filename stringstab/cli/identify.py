@@ -83,8 +83,8 @@ def _seconds(name: str, text: str) -> float:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``identify``; 0 when it ran, bad input raises (exit 2)."""
+    from ..identify.logs import read_logs
     from ..io import OutputDir
-    from ..io.platoon_logs import read_platoon_logs
 
     H = None if args.sample_time is None else _seconds("--sample-time", args.sample_time)
     B = integer("--bootstrap", args.bootstrap, 0)
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     seed = integer("--seed", args.seed, 0)
     min_seg = _seconds("--min-segment", args.min_segment)
     out = OutputDir(args.out, command="identify", what="--out")
-    logs = read_platoon_logs(args.log, min_duration=min_seg)
+    logs = read_logs(args.log, min_duration=min_seg)
     from ..identify import identify
     from ..identify.report import render, write_outputs
 

@@ -8,7 +8,8 @@
 * :mod:`~stringstab.identify.core` — :func:`identify`: fits, certificates, block bootstrap;
 * :mod:`~stringstab.identify.report` — the table, ``identify.json``, CSV/Parquet and figures.
 
-Readers of the logs: :func:`stringstab.io.platoon_logs.read_platoon_logs`.
+Readers of the logs: :func:`read_logs` (:func:`stringstab.io.platoon_logs.read_platoon_logs`
+with the NGSIM pair parser of :mod:`stringstab.traffic`).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from .closed_loop import FollowerModel, simulate_follower
 from .core import IdentifyResult, VehicleResult, identify, statement
 from .empirical import Empirical, empirical_transfer
 from .fit import BOUNDS, PARAMETERS, FitResult, FollowerData, fit_follower
+from .logs import read_logs
 
 __all__ = [
     "BOUNDS",
@@ -34,6 +36,7 @@ __all__ = [
     "empirical_transfer",
     "fit_follower",
     "identify",
+    "read_logs",
     "read_platoon_logs",
     "simulate_follower",
     "statement",

@@ -18,7 +18,9 @@ Formats (:func:`read_platoon_logs` tells them apart from the header):
   in platoon order, the leader first, its gap empty); optional ``a``/``a_lead``/``a0``... columns
   (m/s²).  A unit in the header (``v [km/h]``, ``v_kmh``) is converted; anything else is SI.
 * **NGSIM** (US-101 / I-80 trajectory files): the leader–follower pairs of
-  :func:`stringstab.traffic.load_ngsim_pairs`, one two-vehicle log per pair.
+  :func:`stringstab.traffic.load_ngsim_pairs`, one two-vehicle log per pair (through the
+  ``ngsim`` reader that :func:`stringstab.identify.read_logs` passes in: the parser lives in
+  the simulator's package, above this bottom layer).
 
 Units are checked against the data itself: the speeds must agree with the positions (OpenACC:
 E/N displacement per step) or with the spacing (CSV: d gap/dt = v_pred − v).  A speed column that
@@ -30,6 +32,7 @@ from __future__ import annotations
 import csv
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -430,31 +433,11 @@ def _finish_plain(path: Path, t: Array, positions: tuple[int, ...], names: tuple
     return PlatoonLog(t, positions, names, speed, gaps, acc, str(path), "csv", {})
 
 
-# --------------------------------------------------------------------------- NGSIM
-
-
-def _read_ngsim(path: Path, min_duration: float) -> list[PlatoonLog]:
-    from ..traffic.loaders import load_ngsim_pairs
-
-    logs = []
-    for pr in load_ngsim_pairs(path, min_duration=min_duration):
-        n = pr.leader.n_steps
-        t = np.arange(n, dtype=np.float64) * pr.leader.dt
-        speed = np.stack([pr.leader.speed, pr.follower.speed])
-        acc = np.stack([pr.leader.accel, pr.follower.accel])
-        names = (f"ngsim-{pr.leader_id}", f"ngsim-{pr.follower_id}")
-        logs.append(PlatoonLog(t, (0, 1), names, speed, {1: pr.gap}, acc, str(path), "ngsim",
-                               {"start_frame": pr.start_frame, "location": pr.location}))
-    if not logs:
-        raise StringStabError(
-            f"{_where(path)}: no leader-follower pair of at least {min_duration:g} s in this NGSIM file")
-    return logs
-
-
 # --------------------------------------------------------------------------- entry point
 
 
-def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0) -> list[PlatoonLog]:
+def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
+                      ngsim: Callable[[Path, float], list[PlatoonLog]] | None = None) -> list[PlatoonLog]:
     """Read a recorded platoon (OpenACC, plain CSV) or the pairs of an NGSIM file.
 
     Parameters
@@ -463,6 +446,11 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0) -> list[P
         The file; its format is recognised from its first lines (module docstring).
     min_duration : float
         For NGSIM files, the shortest leader–follower pair kept, s.
+    ngsim : callable, optional
+        ``ngsim(path, min_duration) -> list of PlatoonLog``, the reader of NGSIM files.  The
+        NGSIM parser lives with the simulator's leaders (:mod:`stringstab.traffic.loaders`),
+        above this bottom layer, so :func:`stringstab.identify.read_logs` passes it in;
+        without it an NGSIM file is refused with a pointer there.
 
     Returns
     -------
@@ -488,7 +476,10 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0) -> list[P
            and any(re.fullmatch(r"ivs\d+", c.strip(), re.IGNORECASE) for c in r) for r in rows[:30]):
         logs = [_read_openacc(p, rows)]
     elif "vehicle_id" in header_low and "frame_id" in header_low:
-        logs = _read_ngsim(p, min_duration)
+        if ngsim is None:
+            raise StringStabError(f"{_where(p)} is an NGSIM file; read it with "
+                                  "stringstab.identify.read_logs (or stringstab identify)")
+        logs = ngsim(p, min_duration)
     else:
         logs = [_read_plain(p, rows)]
     for log in logs:
