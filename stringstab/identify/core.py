@@ -14,7 +14,8 @@ Per follower (a vehicle whose predecessor and gap are in the log):
    Blocks, not single samples, because simulation errors are strongly correlated over seconds
    (an i.i.d. bootstrap would treat a 10-s excursion as a hundred independent errors and
    understate the spread); within segments, because a block that bridged a data gap would join
-   two unrelated stretches.  Each refit is certified (:func:`stringstab.check`); the shares
+   two unrelated stretches.  Each refit is certified (:func:`stringstab.certify`, the point's
+   loop: continuous or sampled), which gives its verdict and sup|Γ|; the shares
    certified / not certified are the uncertainty of the verdict;
 4. the robust certificate (:func:`stringstab.certify` with intervals) at the point gains over the
    5-95 % bootstrap intervals of τ, T* (and δ for ``cacc``): the box certificate covers those
@@ -299,7 +300,6 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     StringStabError
         If no follower has a usable segment, or an option is out of range.
     """
-    from .. import certificate as ss
 
     logs = [log] if isinstance(log, PlatoonLog) else list(log)
     if model not in PARAMETERS:
@@ -356,12 +356,11 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
                 counts = block_counts(segs, data.v.size, L, rng)
                 bf = fit_follower(data, model, x0=fit.theta, counts=counts, identifiability=False)
                 q = bf.params
-                chk = ss.check(q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"],
-                               headway=q["headway"], sample_time=sample_time)
-                verdicts.append(str(chk.verdict[0]))
+                bc = _certify(q, sample_time)  # the same certificate as the point's
+                verdicts.append(str(bc.verdict))
                 for k in PARAMETERS["cacc"]:
                     boot[k].append(q[k])
-                boot["sup_gain"].append(float(_sup(q, sample_time, cert)))
+                boot["sup_gain"].append(float(bc.sup_gain))
                 bar.step(f"{lg.name(p)} bootstrap")
             bp = {k: np.asarray(v) for k, v in boot.items()}
             box = _box(fit.params, bp, model, sample_time) if B >= 2 else None
@@ -432,18 +431,6 @@ def _profile_note(rows: list[dict[str, Any]], best: float) -> str:
                       for r in rows)
     return ("profile over T*: the verdict depends on T* (the others refitted; speed RMSE relative to "
             f"the point fit): {which}")
-
-
-def _sup(q: dict[str, float], H: float | None, point: Any) -> float:
-    """sup|Γ| of a bootstrap fit on a frequency grid (for its interval; the verdicts are the
-    certificates')."""
-    from ..frequency import gain
-
-    w = np.geomspace(1e-3, 30.0, 600)
-    if H is not None:
-        w = w[w < math.pi / H]
-    g = gain(w, q["k_x"], q["k_v"], q["k_a"], tau=q["tau"], delta=q["delta"], headway=q["headway"])
-    return float(max(1.0, float(np.max(g))))
 
 
 def _box(p: dict[str, float], bp: dict[str, Array], model: str, H: float | None) -> Any:
