@@ -37,6 +37,7 @@ COMMANDS: list[str] = [
     "evaluate",
     "compare",
     "hcfs",
+    "identify",
     "demo",
     "sumo",
 ]
@@ -54,6 +55,7 @@ HELP: dict[str, str] = {
     "evaluate": "evaluate a trained policy on held-out leaders; certify every executed gain",
     "compare": "compare trained runs and baselines on held-out leaders (Table 4, Figs 6, 9, 11, 12)",
     "hcfs": "the HCFS hybrid DDPG/CACC strategy: verify its jerk theorem in closed loop",
+    "identify": "identify and certify the car-following law of recorded vehicles (OpenACC, CSV, NGSIM)",
     "demo": "run a demo of the whole pipeline on bundled data",
     "sumo": "run certified and learned controllers inside Eclipse SUMO (check, run, cacc)",
 }

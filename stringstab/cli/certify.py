@@ -95,6 +95,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--pade-order", default="5", metavar="N",
                    help="Padé order of the delay for --method pade (default: 5)")
     add_output_arguments(p)
+    p.add_argument("--from", dest="from_identify", metavar="IDENTIFY_JSON",
+                   help="certify the vehicles fitted by 'stringstab identify' (identify.json), each "
+                        "with its own τ, δ, T* (intervals --tau/--delta/--headway LO:HI replace them)")
     p.add_argument("--no-progress", action="store_true",
                    help=f"never show the progress bar (default: shown on a terminal or > {PROGRESS_ROWS} rows)")
     p.set_defaults(func=run)
@@ -141,6 +144,8 @@ def run(args: argparse.Namespace) -> int:
             "--method pade (python-control's cross-check) is for the continuous loop at one τ, δ, "
             f"T*; got {'--sample-time ' + args.sample_time if H is not None else 'an interval'}")
     out = check_output(args)
+    if getattr(args, "from_identify", None):
+        return _run_identified(args, out, H)
     table = gains_from_args(args)
     check_horizon(H, table)
     from ._budget import refuse_if_too_big
@@ -195,3 +200,41 @@ def run(args: argparse.Namespace) -> int:
 def _for_table(params: dict[str, Any]) -> dict[str, Any]:
     """Intervals as the command line writes them (``0.1:0.5``) in the table's header line."""
     return {k: f"{v[0]:g}:{v[1]:g}" if isinstance(v, list) else v for k, v in params.items()}
+
+
+def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
+    """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
+    from ..certificate import certify_batch
+    from ..identify.report import read_identified
+    from ..io import columns_from_records, write_results
+    from ..io.results import TableColumn
+
+    if args.triples or args.file:
+        raise StringStabError("expected --from or gain triples/--file, not both")
+    rows = read_identified(args.from_identify)
+    given = {k: str(getattr(args, k)) for k in ("tau", "delta", "headway") if ":" in str(getattr(args, k))}
+    records = []
+    for r in rows:
+        from ..params import parameter_model
+
+        loop = parameter_model(*(given.get(k, r[k]) for k in ("tau", "delta", "headway")))
+        b = certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]], tau=loop.tau, delta=loop.delta,
+                          headway=loop.headway, sample_time=H)
+        c: dict[str, Any] = b.records()[0]
+        rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
+        for k in ("tau", "delta", "headway"):
+            rec[k] = given.get(k, f"{r[k]:.6g}")
+        for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega"):
+            if k in c:
+                rec[k] = c[k]
+        records.append(rec)
+    table = [TableColumn("pos", "position", "%d"), TableColumn("name", "name", "%s"),
+             TableColumn("k_x", "k_x"), TableColumn("k_v", "k_v"), TableColumn("k_a", "k_a"),
+             TableColumn("τ[s]", "tau", "%s"), TableColumn("δ[s]", "delta", "%s"),
+             TableColumn("T*[s]", "headway", "%s"), TableColumn("sup|Γ|", "sup_gain"),
+             TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"), TableColumn("verdict", "verdict", "%s")]
+    n_ok = sum(r["verdict"] == "certified" for r in records)
+    write_results(columns_from_records(records), out, args.format,
+                  params={"from": args.from_identify, "sample_time": H},
+                  summary={"n": len(records), "certified": n_ok}, table=table, what="--out")
+    return 0 if n_ok == len(records) else 1

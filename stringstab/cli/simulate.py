@@ -64,6 +64,11 @@ def add_parser(sub: Any) -> None:
                    help="time-varying gains: a gain file (as for certify --file) with columns "
                         "t,k_x,k_v,k_a held between rows; with a vehicle column, one series per "
                         "follower 1..N")
+    p.add_argument("--from", dest="from_identify", metavar="IDENTIFY_JSON",
+                   help="take k_x, k_v, k_a, tau, delta, headway and standstill of a vehicle fitted by "
+                        "'stringstab identify' (with --vehicle POS) for every follower")
+    p.add_argument("--vehicle", type=int, default=None, metavar="POS",
+                   help="with --from: the platoon position of the fitted vehicle (default: the only one)")
     p.add_argument("--tau", type=float, default=DEFAULT_TAU, help=f"actuator lag, s (default {DEFAULT_TAU})")
     p.add_argument("--delta", type=float, default=DEFAULT_DELTA,
                    help=f"communication delay, s (default {DEFAULT_DELTA})")
@@ -153,6 +158,21 @@ def _fmt(v: Any, spec: str, unit: str = "") -> str:
     return f"{v:{spec}}{unit}"
 
 
+def _from_identified(args: argparse.Namespace) -> None:
+    """``--from identify.json``: the gains and vehicle parameters of one fitted vehicle."""
+    from ..identify.report import read_identified
+
+    if args.gains or args.gains_file or args.controller != "linear":
+        raise StringStabError("--from replaces --gains/--gains-file and needs --controller linear")
+    rows = read_identified(args.from_identify, vehicle=args.vehicle)
+    if len(rows) != 1:
+        raise StringStabError(f"--from {args.from_identify}: {len(rows)} vehicles; expected --vehicle POS, "
+                              f"one of {[r['position'] for r in rows]}")
+    r = rows[0]
+    args.gains = f"{r['k_x']!r},{r['k_v']!r},{r['k_a']!r}"
+    args.tau, args.delta, args.headway, args.standstill = r["tau"], r["delta"], r["headway"], r["standstill"]
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``simulate``."""
     import time
@@ -163,6 +183,8 @@ def run(args: argparse.Namespace) -> int:
     from ..traffic.platoon import simulate
 
     t0 = time.perf_counter()
+    if getattr(args, "from_identify", None):
+        _from_identified(args)
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
     if args.followers < 1:
         raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")

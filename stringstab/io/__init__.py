@@ -1,6 +1,8 @@
 """The I/O home: result tables, JSON-safe values and safe, all-or-nothing output files and folders.
 
 :mod:`~stringstab.io.gains` reads gain files for every command;
+:mod:`~stringstab.io.platoon_logs` reads recorded platoons (OpenACC, plain CSV, NGSIM pairs) for
+``stringstab identify``;
 :mod:`~stringstab.io.results` writes every command's result columns (table, JSON, CSV,
 Parquet, NPZ) with one vectorised writer.
 
@@ -30,6 +32,7 @@ from .outputs import (
     check_output_file,
 )
 from .plain import dumps_json, to_plain
+from .platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
 from .results import (
     BINARY_FORMATS,
     RESULT_FORMATS,
@@ -54,18 +57,22 @@ __all__ = [
     "Categorical",
     "GainTable",
     "OutputDir",
+    "PlatoonLog",
+    "Segment",
     "TableColumn",
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
+    "clean_segments",
     "columns_from_records",
     "dumps_json",
     "flatten_columns",
     "format_results",
     "parse_triple",
     "read_gains",
+    "read_platoon_logs",
     "records_from_columns",
     "render_table",
     "to_plain",

@@ -1,0 +1,107 @@
+"""``stringstab identify``: fit the eq-4 law to each follower of a recorded platoon and certify it.
+
+Reads a log (OpenACC, plain CSV or NGSIM: :func:`stringstab.io.platoon_logs.read_platoon_logs`),
+identifies every follower (:func:`stringstab.identify.identify`: closed-loop simulation-error fit,
+certificate, moving-block bootstrap, the data's own transfer), prints the table and writes
+``identify.json``, ``identify.csv``, ``identify.parquet`` and figures into ``--out``
+(:mod:`stringstab.identify.report`).  Exit 0 when it ran (whatever the verdicts), 2 on bad input
+(one line; nothing written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+from ..errors import StringStabError, show
+from ._common import integer
+
+__all__ = ["add_parser", "run"]
+
+_EPILOG = """\
+examples:
+  stringstab identify ../shared/data/openacc/zalazone_acc_short_dynamic_part1.csv --out runs/acc
+  stringstab identify platoon.csv --model cacc --bootstrap 200 --out runs/cacc
+  stringstab identify log.csv --sample-time 0.1 --out runs/sampled   # certify the 10 Hz loop
+  stringstab certify --from runs/acc/identify.json                    # re-certify the fits
+  stringstab simulate --from runs/acc/identify.json --vehicle 2 --followers 10 --out runs/sim
+
+log formats: OpenACC (metadata lines, Time, Speedk, Ek, Nk, ..., IVSk); CSV with columns
+t,v_lead,v,gap (one follower), t,v0,v1,gap1,v2,gap2,... (a platoon) or a long table
+vehicle,t,v,gap (platoon order, leader first); optional a columns (needed by --model cacc);
+units SI unless the header says '[km/h]'; an NGSIM US-101/I-80 trajectory file (its
+leader-follower pairs). Missing cells split the record; nothing is interpolated.
+
+See docs/identify.md.
+"""
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``identify``."""
+    p = sub.add_parser(
+        "identify",
+        help="identify and certify the car-following law of recorded vehicles (OpenACC, CSV, NGSIM)",
+        description=(
+            "For each follower of a recorded platoon, fit u = k_x Δp + k_v Δv [+ k_a a_{i-1}(t-δ)] "
+            "and the actuator lag τ, T*, l0 by closed-loop simulation error (driven by the measured "
+            "predecessor), certify the fit (exact delay), bootstrap it (moving blocks over time), "
+            "and set the model's |Γ(jω)| beside the measured speed transfer and amplification."
+        ),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("log", metavar="LOG", help="the recorded platoon (OpenACC, CSV or NGSIM file)")
+    p.add_argument("--model", choices=("acc", "cacc"), default="acc",
+                   help="acc: k_a = 0 (default); cacc: also k_a and δ (needs the predecessor's acceleration)")
+    p.add_argument("--sample-time", metavar="H",
+                   help="certify the sampled-data loop (period H s, zero-order hold); default continuous")
+    p.add_argument("--bootstrap", default="50", metavar="N",
+                   help="moving-block bootstrap refits per follower (default 50; 0: none)")
+    p.add_argument("--block", default="20", metavar="S", help="bootstrap block length, s (default 20)")
+    p.add_argument("--starts", default="4", metavar="N", help="starting points of each fit (default 4)")
+    p.add_argument("--seed", default="0", metavar="N", help="random seed (default 0)")
+    p.add_argument("--min-segment", default="30", metavar="S",
+                   help="shortest clean segment used, s (default 30)")
+    p.add_argument("--no-figures", action="store_true", help="skip the figures")
+    p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output folder (an earlier identify run's files in it are replaced)")
+    p.set_defaults(func=run)
+
+
+def _seconds(name: str, text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError as e:
+        raise StringStabError(f"{name} must be a number of seconds > 0; got {show(text)}") from e
+    if not (math.isfinite(v) and v > 0):
+        raise StringStabError(f"{name} must be a number of seconds > 0; got {show(text)}")
+    return v
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``identify``; 0 when it ran, bad input raises (exit 2)."""
+    from ..identify.logs import read_logs
+    from ..io import OutputDir
+
+    H = None if args.sample_time is None else _seconds("--sample-time", args.sample_time)
+    B = integer("--bootstrap", args.bootstrap, 0)
+    block = _seconds("--block", args.block)
+    starts = integer("--starts", args.starts, 1)
+    seed = integer("--seed", args.seed, 0)
+    min_seg = _seconds("--min-segment", args.min_segment)
+    out = OutputDir(args.out, command="identify", what="--out")
+    logs = read_logs(args.log, min_duration=min_seg)
+    from ..identify import identify
+    from ..identify.report import render, write_outputs
+
+    res = identify(logs, args.model, sample_time=H, bootstrap=B, block=block, n_starts=starts,
+                   seed=seed, min_duration=min_seg, progress=not args.no_progress)
+    with out:
+        names = write_outputs(res, out, figures=not args.no_figures)
+    sys.stdout.write(render(res))
+    print(f"wrote {len(names)} files to {out.root}/ (identify.json, identify.csv, identify.parquet"
+          + (", figures" if not args.no_figures else "") + ")")
+    return 0

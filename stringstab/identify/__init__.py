@@ -1,0 +1,43 @@
+"""Identify recorded vehicles and certify them: ``stringstab identify``.
+
+* :mod:`~stringstab.identify.closed_loop` — one follower behind a measured predecessor (the
+  simulator's exact ZOH lag, as a linear filter);
+* :mod:`~stringstab.identify.fit` — closed-loop simulation-error fit, multi-start, bounds,
+  identifiability notes;
+* :mod:`~stringstab.identify.empirical` — the data's own transfer and amplifications;
+* :mod:`~stringstab.identify.core` — :func:`identify`: fits, certificates, block bootstrap;
+* :mod:`~stringstab.identify.report` — the table, ``identify.json``, CSV/Parquet and figures.
+
+Readers of the logs: :func:`read_logs` (:func:`stringstab.io.platoon_logs.read_platoon_logs`
+with the NGSIM pair parser of :mod:`stringstab.traffic`).
+"""
+
+from __future__ import annotations
+
+from ..io.platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
+from .closed_loop import FollowerModel, simulate_follower
+from .core import IdentifyResult, VehicleResult, identify, statement
+from .empirical import Empirical, empirical_transfer
+from .fit import BOUNDS, PARAMETERS, FitResult, FollowerData, fit_follower
+from .logs import read_logs
+
+__all__ = [
+    "BOUNDS",
+    "PARAMETERS",
+    "Empirical",
+    "FitResult",
+    "FollowerData",
+    "FollowerModel",
+    "IdentifyResult",
+    "PlatoonLog",
+    "Segment",
+    "VehicleResult",
+    "clean_segments",
+    "empirical_transfer",
+    "fit_follower",
+    "identify",
+    "read_logs",
+    "read_platoon_logs",
+    "simulate_follower",
+    "statement",
+]

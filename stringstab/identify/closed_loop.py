@@ -1,0 +1,156 @@
+"""One follower driven by its measured predecessor: the closed loop as a linear filter.
+
+The follower obeys the toolkit's vehicle model (IDL eqs 5-7, lag τ) under the eq-4 law,
+u = k_x (s − T* v − l_0) + k_v (v_p − v) + k_a a_p(t − δ), with the command held over each step
+(zero-order hold) and the lag integrated exactly, as :class:`stringstab.traffic.Platoon` does
+(``model="lag"``): with e = exp(−Δt/τ), c_1 = τ(1 − e), c_2 = τ(Δt − c_1),
+
+    a_{k+1} = e a_k + (1 − e) u_k,
+    v_{k+1} = v_k + c_1 a_k + (Δt − c_1) u_k,
+    s_{k+1} = s_k + d_k − (Δt v_k + c_2 a_k + (Δt²/2 − c_2) u_k),
+
+where d_k is the predecessor's measured displacement over the step (the trapezoid of its speed,
+exact for piecewise-constant acceleration) and a_p(t − δ) is read like the simulator's default
+``fractional_delay="linear"``.  Without the simulator's limits this is a linear time-invariant
+system x_{k+1} = F x_k + b w_k + e_1 d_k in the state x = (s, v, a), with
+w_k = k_v v_{p,k} − k_x l_0 + k_a a_p(t_k − δ); its response is computed with
+:func:`scipy.signal.lfilter` (compiled) instead of a Python loop over samples, which makes it
+cheap enough for the inner loop of a least-squares fit.  ``tests/test_identify.py`` checks it
+against :func:`stringstab.traffic.simulate` on the same predecessor.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["FollowerModel", "delayed", "simulate_follower"]
+
+Array = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class FollowerModel:
+    """The eq-4 law and the follower's lag: the parameters the fit estimates.
+
+    Attributes
+    ----------
+    k_x, k_v, k_a : float
+        Gains (IDL eq 4).
+    tau : float
+        Actuator lag τ, s (eq 7).
+    delta : float
+        Delay on the predecessor's acceleration δ, s (eq 4).
+    headway, standstill : float
+        T* (s) and l_0 (m) of the spacing policy (eq 3).
+    """
+
+    k_x: float
+    k_v: float
+    k_a: float
+    tau: float
+    delta: float
+    headway: float
+    standstill: float
+
+
+def delayed(a: Array, delta: float, dt: float) -> Array:
+    """a(t_k − δ), linearly interpolated between samples, history before t_0 held at a_0.
+
+    The simulator's default reading of a delay that is not a multiple of Δt
+    (:class:`stringstab.traffic.Platoon`, ``fractional_delay="linear"``).
+    """
+    q = delta / dt
+    n = math.floor(q + 1e-9)
+    f = q - n
+    if f < 1e-9:
+        f = 0.0
+    k = np.arange(a.size)
+    i0 = np.clip(k - n, 0, None)
+    i1 = np.clip(k - n - 1, 0, None)
+    return np.asarray((1.0 - f) * a[i0] + f * a[i1])
+
+
+def _charpoly(M: Array) -> Array:
+    """det(zI − M) of a 3×3 matrix: [1, −tr M, Σ principal 2×2 minors, −det M]."""
+    m = M.tolist()
+    (a, b, c), (d, e, f), (g, h, i) = m
+    minors = (a * e - b * d) + (a * i - c * g) + (e * i - f * h)
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    return np.array([1.0, -(a + e + i), minors, -det])
+
+
+def _numerators(F: Array, B: Array) -> Array:
+    """Numerators (s and v rows) over det(zI − F) of x_{k+1} = F x_k + B u_k, y = (x[0], x[1]):
+    the SISO identity C adj(zI − F) B = det(zI − F + B C) − det(zI − F) (as in
+    :func:`scipy.signal.ss2tf`, without its checks)."""
+    den = _charpoly(F)
+    out = np.empty((2, den.size))
+    for r in range(2):
+        c = np.zeros(3)
+        c[r] = 1.0
+        out[r] = _charpoly(F - np.outer(B, c)) - den
+    return out
+
+
+def simulate_follower(m: FollowerModel, v_pred: Array, dt: float, *, s0: float, v0: float,
+                      a0: float = 0.0, a_pred: Array | None = None,
+                      x_pred: Array | None = None) -> tuple[Array, Array]:
+    """Gap and speed of a follower behind a measured predecessor (module docstring).
+
+    Parameters
+    ----------
+    m : FollowerModel
+        The law and the lag.
+    v_pred : array (T,)
+        Predecessor's speed at t_k, m/s.
+    dt : float
+        Step, s.
+    s0, v0, a0 : float
+        Follower's gap (m), speed (m/s) and acceleration (m/s²) at t_0.
+    a_pred : array (T,), optional
+        Predecessor's acceleration (needed when k_a ≠ 0).
+    x_pred : array (T,), optional
+        Predecessor's position; its differences replace the trapezoid of ``v_pred``.
+
+    Returns
+    -------
+    gap, speed : array (T,)
+        Simulated at t_k (non-finite values of a diverging loop are kept).
+    """
+    T = v_pred.size
+    e = math.exp(-dt / m.tau)
+    c1 = m.tau * (1.0 - e)
+    c2 = m.tau * (dt - c1)
+    A0 = np.array([[1.0, -dt, -c2], [0.0, 1.0, c1], [0.0, 0.0, e]])
+    b = np.array([-(0.5 * dt * dt - c2), dt - c1, 1.0 - e])
+    K = np.array([m.k_x, -(m.k_x * m.headway + m.k_v), 0.0])
+    F = A0 + np.outer(b, K)
+    w = m.k_v * v_pred - m.k_x * m.standstill
+    if m.k_a != 0.0:
+        if a_pred is None:
+            raise ValueError("k_a != 0 needs the predecessor's acceleration")
+        w = w + m.k_a * delayed(a_pred, m.delta, dt)
+    d = np.empty(T)
+    d[:-1] = np.diff(x_pred) if x_pred is not None else 0.5 * dt * (v_pred[1:] + v_pred[:-1])
+    d[-1] = 0.0
+    from scipy.signal import lfilter
+
+    den = _charpoly(F)
+    # y = Σ_inputs num_i(z)/den(z) u_i: each numerator's FIR part per input, then one all-pole
+    # pass over both outputs (one lfilter call instead of one per input and output)
+    with np.errstate(all="ignore"):
+        z = np.zeros((2, T))
+        for B, u in ((b, w), (np.array([1.0, 0.0, 0.0]), d)):
+            nums = _numerators(F, B)
+            for r in range(2):
+                z[r] += np.convolve(nums[r], u)[:T]
+        # the free response C F^k x0 is the impulse response of (F, x0, C) one step later
+        nums = _numerators(F, np.array([s0, v0, a0]))
+        n0 = min(T, nums.shape[1] - 1)
+        z[:, :n0] += nums[:, 1:n0 + 1]
+        y = lfilter([1.0], den, z, axis=1)
+    return y[0], y[1]

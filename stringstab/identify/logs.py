@@ -1,0 +1,75 @@
+"""Reading recorded platoons for identification: :func:`read_logs`.
+
+The formats are read by :func:`stringstab.io.platoon_logs.read_platoon_logs` (the bottom I/O
+layer); NGSIM trajectory files are cut into leader–follower pairs by the parser the simulator
+already uses for its leaders (:func:`stringstab.traffic.load_ngsim_pairs`), which this module
+hands to the reader, so the I/O layer does not import the simulator.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import StringStabError, show
+from ..io.platoon_logs import PlatoonLog, read_platoon_logs
+
+__all__ = ["read_logs", "read_ngsim"]
+
+
+def read_ngsim(path: Path, min_duration: float) -> list[PlatoonLog]:
+    """One two-vehicle :class:`PlatoonLog` per leader–follower pair of an NGSIM file.
+
+    Parameters
+    ----------
+    path : Path
+        The US-101 / I-80 trajectory file.
+    min_duration : float
+        Shortest pair kept, s.
+
+    Returns
+    -------
+    list of PlatoonLog
+        In the order of :func:`stringstab.traffic.load_ngsim_pairs` (SI units; the recorded
+        accelerations kept; gap bumper to bumper with the leader's length).
+
+    Raises
+    ------
+    StringStabError
+        When the file has no pair of that length.
+    """
+    from ..traffic.loaders import load_ngsim_pairs
+
+    logs = []
+    for pr in load_ngsim_pairs(path, min_duration=min_duration):
+        n = pr.leader.n_steps
+        t = np.arange(n, dtype=np.float64) * pr.leader.dt
+        speed = np.stack([pr.leader.speed, pr.follower.speed])
+        acc = np.stack([pr.leader.accel, pr.follower.accel])
+        names = (f"ngsim-{pr.leader_id}", f"ngsim-{pr.follower_id}")
+        logs.append(PlatoonLog(t, (0, 1), names, speed, {1: pr.gap}, acc, str(path), "ngsim",
+                               {"start_frame": pr.start_frame, "location": pr.location}))
+    if not logs:
+        raise StringStabError(
+            f"platoon log {show(str(path))}: no leader-follower pair of at least {min_duration:g} s "
+            "in this NGSIM file")
+    return logs
+
+
+def read_logs(path: str | Path, *, min_duration: float = 30.0) -> list[PlatoonLog]:
+    """Read an OpenACC, plain CSV or NGSIM log (:func:`stringstab.io.read_platoon_logs` with the
+    NGSIM reader :func:`read_ngsim`).
+
+    Parameters
+    ----------
+    path : path
+        The file.
+    min_duration : float
+        For NGSIM files, the shortest pair kept, s.
+
+    Returns
+    -------
+    list of PlatoonLog
+    """
+    return read_platoon_logs(path, min_duration=min_duration, ngsim=read_ngsim)

@@ -1,0 +1,229 @@
+"""Outputs of ``stringstab identify``: the table, ``identify.json``, CSV/Parquet, figures.
+
+Files (all written through one :class:`stringstab.io.OutputDir`, all-or-nothing):
+
+* ``identify.json`` — :meth:`IdentifyResult.document`: settings, ``vehicles`` (the per-follower
+  fields with ``segments`` and ``notes``), followers ``skipped``;
+* ``identify.csv`` and ``identify.parquet`` — the same rows, through
+  :func:`stringstab.io.write_results`;
+* ``fit_<position>.png`` — measured vs simulated speed and gap of each follower;
+* ``transfer_<position>.png`` — the model's |Γ(jω)| beside the empirical |Ĝ(jω)| and coherence;
+* ``sup_gain.png`` — sup|Γ| with its bootstrap interval and the empirical amplification along
+  the platoon.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..io import OutputDir, TableColumn, columns_from_records, format_results, write_results
+from .core import IdentifyResult, VehicleResult, simulated
+
+__all__ = ["TABLE", "render", "write_outputs"]
+
+#: The human table.
+TABLE = [
+    TableColumn("pos", "position", "%d"),
+    TableColumn("name", "name", "%s"),
+    TableColumn("k_x[1/s²]", "k_x", "%.3g"),
+    TableColumn("k_v[1/s]", "k_v", "%.3g"),
+    TableColumn("k_a", "k_a", "%.3g"),
+    TableColumn("τ[s]", "tau", "%.3g"),
+    TableColumn("T*[s]", "headway", "%.3g"),
+    TableColumn("l0[m]", "standstill", "%.3g"),
+    TableColumn("rmse_v[m/s]", "rmse_speed", "%.3g"),
+    TableColumn("rmse_gap[m]", "rmse_gap", "%.3g"),
+    TableColumn("sup|Γ|", "sup_gain", "%.4g"),
+    TableColumn("sup|Γ| 5-95%", "sup_interval", "%s"),
+    TableColumn("ω_peak[rad/s]", "peak_omega", "%.3g"),
+    TableColumn("verdict", "verdict", "%s"),
+    TableColumn("certified", "certified_share", "%.2f"),
+    TableColumn("box", "box_verdict", "%s"),
+    TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),
+    TableColumn("data>1", "data_amplifies", "%s"),
+    TableColumn("p2p", "peak_to_peak", "%.3g"),
+    TableColumn("energy", "energy_gain", "%.3g"),
+]
+
+#: Every file name the command may write (figures are added per follower).
+FILES = ("identify.json", "identify.csv", "identify.parquet", "sup_gain.png")
+
+
+def _table_rows(res: IdentifyResult) -> list[dict[str, Any]]:
+    rows = []
+    for r in res.rows():
+        lo, hi = r["sup_gain_lo"], r["sup_gain_hi"]
+        r["sup_interval"] = f"{lo:.3g}-{hi:.3g}" if math.isfinite(lo) else "-"
+        rows.append(r)
+    return rows
+
+
+def render(res: IdentifyResult) -> str:
+    """The per-follower table, its settings line, and a statement per follower below it."""
+    rows = _table_rows(res)
+    params = {"model": res.model, "sample_time": res.sample_time or "continuous",
+              "bootstrap": res.settings["bootstrap"], "block_s": res.settings["block"]}
+    text = format_results(columns_from_records(rows), "table", params=params, table=TABLE)
+    lines = [text.rstrip("\n")]
+    for v in res.vehicles:
+        lines.append(f"# {v.position} {v.name}: {v.statement()}")
+        for n in v.fit.notes + v.notes:
+            lines.append(f"#   note: {n}")
+    for s in res.skipped:
+        lines.append(f"# skipped: {s}")
+    return "\n".join(lines) + "\n"
+
+
+def write_outputs(res: IdentifyResult, out: OutputDir, *, figures: bool = True) -> list[str]:
+    """Write the JSON, CSV, Parquet (and figures) into a staged :class:`OutputDir`.
+
+    Returns
+    -------
+    list of str
+        The names written.
+    """
+    out.write_json("identify.json", res.document())
+    cols = columns_from_records(res.rows())
+    params = {"model": res.model, "sample_time": res.sample_time}
+    write_results(cols, out.path("identify.csv"), "csv", params=params)
+    write_results(cols, out.path("identify.parquet"), "parquet", params=params)
+    if figures:
+        for v in res.vehicles:
+            tag = f"{v.platoon}_{v.position}" if len(res.sources) > 1 else f"{v.position}"
+            _fig_fit(v).savefig(out.path(f"fit_{tag}.png"), dpi=110)
+            _fig_transfer(v, res.sample_time).savefig(out.path(f"transfer_{tag}.png"), dpi=110)
+        _fig_platoon(res).savefig(out.path("sup_gain.png"), dpi=110)
+    return out.written
+
+
+def _figure(w: float, h: float) -> Any:
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(w, h), layout="constrained")
+
+
+def _fig_fit(v: VehicleResult) -> Any:
+    fig = _figure(9, 5.5)
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    gaps, speeds = simulated(v)
+    dt = v.data.dt
+    for i, (s, g, sp) in enumerate(zip(v.segments, gaps, speeds)):
+        t = np.arange(s.start, s.stop) * dt
+        lab = (lambda x: x) if i == 0 else (lambda x: None)
+        ax1.plot(t, v.data.v_pred[s.start:s.stop], color="0.6", lw=0.8, label=lab("predecessor (measured)"))
+        ax1.plot(t, v.data.v[s.start:s.stop], color="k", lw=1.0, label=lab("follower (measured)"))
+        ax1.plot(t, sp, color="#D55E00", lw=1.0, ls="--", label=lab("follower (simulated)"))
+        ax2.plot(t, v.data.gap[s.start:s.stop], color="k", lw=1.0, label=lab("measured"))
+        ax2.plot(t, g, color="#D55E00", lw=1.0, ls="--", label=lab("simulated"))
+    ax1.set_ylabel("speed (m/s)")
+    ax2.set_ylabel("gap (m)")
+    ax2.set_xlabel("time from the log's start (s)")
+    ax1.legend(fontsize=8)
+    ax2.legend(fontsize=8)
+    p = v.fit.params
+    ax1.set_title(f"{v.position} {v.name}: k_x={p['k_x']:.3g}, k_v={p['k_v']:.3g}, τ={p['tau']:.3g} s, "
+                  f"T*={p['headway']:.3g} s, l0={p['standstill']:.3g} m; RMSE {v.fit.rmse_speed:.3g} m/s, "
+                  f"{v.fit.rmse_gap:.3g} m", fontsize=9)
+    return fig
+
+
+def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
+    from ..frequency import gain
+
+    fig = _figure(7, 5.5)
+    ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
+    e = v.empirical
+    p = v.fit.params
+    w = np.geomspace(max(float(e.omega[1]) if e.omega.size > 1 else 0.01, 1e-3), 10.0, 500)
+    ax1.loglog(w, gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
+                       headway=p["headway"]), color="#D55E00", label="model |Γ(jω)| (continuous)")
+    m = (e.omega > 0) & (e.omega <= 10.0)
+    good = m & (e.coherence >= 0.5)
+    ax1.loglog(e.omega[m], np.abs(e.transfer[m]), color="0.7", lw=0.8, label="empirical |Ĝ| (all)")
+    ax1.loglog(e.omega[good], np.abs(e.transfer[good]), "o", ms=3, color="k",
+               label="empirical |Ĝ| (coherence ≥ 0.5)")
+    ax1.axhline(1.0, color="0.3", lw=0.6, ls=":")
+    from .empirical import OMEGA_MAX
+
+    for ax in (ax1, ax2):
+        ax.axvspan(OMEGA_MAX, 10.0, color="0.92", zorder=0)
+    ax1.text(OMEGA_MAX * 1.1, ax1.get_ylim()[0] * 1.5, "not used for the data's verdict\n(common-mode GPS error)",
+             fontsize=7, color="0.4")
+    ax1.set_ylabel("|follower speed / predecessor speed|")
+    ax1.legend(fontsize=8)
+    ax1.set_title(f"{v.position} {v.name}: sup|Γ| = {float(v.certificate.sup_gain):.3g} ({v.certificate.verdict})"
+                  + ("" if H is None else f", certified sampled at H = {H:g} s"), fontsize=9)
+    ax2.semilogx(e.omega[m], e.coherence[m], color="k", lw=0.8)
+    ax2.axhline(0.5, color="0.3", lw=0.6, ls=":")
+    ax2.set_ylim(0, 1.05)
+    ax2.set_ylabel("coherence")
+    ax2.set_xlabel("ω (rad/s)")
+    return fig
+
+
+def _fig_platoon(res: IdentifyResult) -> Any:
+    fig = _figure(7, 4)
+    ax = fig.add_subplot()
+    x = np.arange(len(res.vehicles))
+    sup = np.array([float(v.certificate.sup_gain) for v in res.vehicles])
+    iv = np.array([v.interval("sup_gain") for v in res.vehicles]).reshape(-1, 2)
+    lo = np.where(np.isfinite(iv[:, 0]), np.minimum(sup - iv[:, 0], sup - 0), 0.0)
+    hi = np.where(np.isfinite(iv[:, 1]), iv[:, 1] - sup, 0.0)
+    ax.errorbar(x, sup, yerr=np.clip(np.vstack([lo, hi]), 0, None), fmt="o", color="#D55E00",
+                capsize=3, label="model sup|Γ| (5-95 % bootstrap)")
+    ax.plot(x, [v.empirical.gain for v in res.vehicles], "s", color="k", label="empirical max |Ĝ|")
+    ax.plot(x, [v.empirical.energy for v in res.vehicles], "^", color="0.5", label="energy amplification")
+    ax.axhline(1.0, color="0.3", lw=0.6, ls=":")
+    ax.set_xticks(x, [f"{v.position}\n{v.name[:12]}" for v in res.vehicles], fontsize=7)
+    ax.set_ylabel("amplification")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, Any]]:
+    """The fitted vehicles of an ``identify.json`` (for ``certify --from`` and ``simulate --from``).
+
+    Parameters
+    ----------
+    path : str
+        The file written by ``stringstab identify``.
+    vehicle : int, optional
+        Keep only the follower at this platoon position.
+
+    Returns
+    -------
+    list of dict
+        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill.
+
+    Raises
+    ------
+    StringStabError
+        If the file is not an ``identify.json`` or the vehicle is not in it.
+    """
+    import json
+    from pathlib import Path
+
+    from ..errors import StringStabError
+
+    need = ("position", "name", "k_x", "k_v", "k_a", "tau", "delta", "headway", "standstill")
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError) as e:
+        raise StringStabError(f"--from {path!r}: expected an identify.json written by 'stringstab "
+                              f"identify'; cannot read it ({e})") from e
+    rows = doc.get("vehicles") if isinstance(doc, dict) else None
+    if doc.get("command") != "identify" or not isinstance(rows, list) or not rows:  # type: ignore[union-attr]
+        raise StringStabError(f"--from {path!r}: expected an identify.json with a non-empty 'vehicles' list")
+    for r in rows:
+        bad = [k for k in need if k not in r or (k != "name" and not isinstance(r[k], (int, float)))]
+        if bad:
+            raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} lacks numeric {bad}")
+    if vehicle is not None:
+        rows = [r for r in rows if r["position"] == vehicle]
+        if not rows:
+            raise StringStabError(f"--from {path!r}: no follower at position {vehicle}; found positions "
+                                  f"{[r['position'] for r in doc['vehicles']]}")
+    return rows
