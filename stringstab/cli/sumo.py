@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import time
 from typing import Any
 
 import numpy as np
@@ -267,6 +268,7 @@ def run_platoon(args: argparse.Namespace) -> int:
                               f"got {'--sumocfg' if args.sumocfg else '--controlled'} alone")
     if args.sumocfg:
         return _run_scenario(args)
+    t0 = time.perf_counter()
     out = OutputDir(args.out, command="sumo run", owns=RUN_FILES, what="--out")
     case = _case(args)
     for w in case["warnings"]:
@@ -297,6 +299,11 @@ def run_platoon(args: argparse.Namespace) -> int:
     with out:
         files = write_run(result, out, metrics=doc, fmt=args.format, figures=not args.no_figures,
                           title=title)
+        from ..report import command_line
+        from ..report.commands import simulate_report
+
+        simulate_report(doc, files, command=command_line(args), title=title,
+                        started=t0).write(out)
     _print_summary(f"ran {leader.name} ({leader.duration:g} s, dt = {case['dt']:g} s) in SUMO "
                    f"{result.params['sumo_version']} via {args.api}, {args.followers} followers, "
                    f"{case['label']}", doc)
