@@ -36,6 +36,7 @@ COMMANDS: list[str] = [
     "compare",
     "hcfs",
     "demo",
+    "sweep",
 ]
 
 #: One-line help of each sub-command, shown by ``stringstab --help`` without importing it
@@ -52,6 +53,7 @@ HELP: dict[str, str] = {
     "compare": "compare trained runs and baselines on held-out leaders (Table 4, Figs 6, 9, 11, 12)",
     "hcfs": "the HCFS hybrid DDPG/CACC strategy: verify its jerk theorem in closed loop",
     "demo": "run a demo of the whole pipeline on bundled data",
+    "sweep": "run a study (a TOML sweep spec) as Dask tasks; resumable, one record per point",
 }
 
 
