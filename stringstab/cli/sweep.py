@@ -60,9 +60,8 @@ def _terminate(signum: int, frame: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``sweep``; 0 when every point is done, 1 when some failed, 130 when interrupted."""
     from ..io import check_output_dir
-    from ..sweep import dask_client, load_spec, run_sweep
+    from ..sweep import dask_client, load_spec, read_records, run_sweep
     from ..sweep.cluster import dashboard_address
-    from ..sweep.runner import read_records
 
     spec = load_spec(args.spec)
     if args.check:

@@ -17,8 +17,9 @@ Dask (the ``dask`` extra) is imported only when a sweep runs.
 from __future__ import annotations
 
 from .cluster import dask_client
+from .records import read_records
 from .report import sweep_table, write_outputs
-from .runner import read_records, run_sweep
+from .runner import run_sweep
 from .spec import KINDS, STUDIES, Point, SweepSpec, load_spec, parse_spec
 from .tasks import run_point
 

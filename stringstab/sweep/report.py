@@ -34,6 +34,7 @@ import numpy as np
 
 from ..io import OutputDir, write_results
 from .paper import FIG5_BEST_SIGMA, TABLE3, TABLE5, TABLE_METRICS
+from .records import read_records
 from .spec import SweepSpec
 
 __all__ = ["grouped", "sweep_table", "write_outputs"]
@@ -49,8 +50,6 @@ def _cell(v: Any) -> Any:
 
 def sweep_table(spec: SweepSpec, root: str | Path) -> list[dict[str, Any]]:
     """One flat row per point of ``spec`` in spec order (status ``pending`` when not run yet)."""
-    from .runner import read_records
-
     recs = read_records(root, spec)
     varied_keys: dict[str, None] = {}
     metric_keys: dict[str, None] = {}

@@ -14,46 +14,19 @@ and the study's report are written (:mod:`stringstab.sweep.report`).
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
 from ..io import atomic_write_text, check_output_dir, dumps_json
+from .records import POINT_FORMAT, read_records, record_path
 from .spec import SweepSpec
 from .tasks import run_point
 
-__all__ = ["POINT_FORMAT", "read_records", "run_sweep"]
-
-#: Format tag of a point's record file.
-POINT_FORMAT = "stringstab-sweep-point/1"
-
-
-def _record_path(out: Path, pid: str) -> Path:
-    return out / "points" / f"{pid}.json"
-
-
-def read_records(out: str | os.PathLike[str], spec: SweepSpec) -> dict[str, dict[str, Any]]:
-    """The records in ``out`` of the points of ``spec`` (by id); absent points are left out.
-
-    A record file that cannot be read (it cannot be partial: records are written atomically,
-    but it could be damaged by hand) counts as absent, so its point runs again.
-    """
-    recs: dict[str, dict[str, Any]] = {}
-    for p in spec.points:
-        f = _record_path(Path(out), p.id)
-        try:
-            doc = json.loads(f.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            continue
-        if isinstance(doc, dict) and doc.get("format") == POINT_FORMAT and doc.get("id") == p.id:
-            recs[p.id] = doc
-    return recs
-
+__all__ = ["run_sweep"]
 
 class _Progress:
     """A tqdm bar on a terminal; otherwise a line per finished point (at most every ``every`` s)."""
@@ -166,7 +139,7 @@ def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retr
                 exc = fut.exception()
                 rec = _lost_record(point, f"{type(exc).__name__}: {exc}".replace("\n", " "))
             rec = {"format": POINT_FORMAT, **rec, "settings": point["settings"]}
-            atomic_write_text(_record_path(root, point["id"]), dumps_json(rec))
+            atomic_write_text(record_path(root, point["id"]), dumps_json(rec))
             fut.release()
             done += rec["status"] == "done"
             failed += rec["status"] != "done"
