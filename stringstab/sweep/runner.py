@@ -54,7 +54,8 @@ class _Progress:
             if rec["status"] != "done":
                 self.bar.write(f"point {rec['id']} failed: {rec.get('error')}")
             return
-        if rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
+        first = self.last == self.t0
+        if first or rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
             what = "done" if rec["status"] == "done" else f"FAILED ({rec.get('error')})"
             self.log(f"[{self.n}/{self.total}] point {rec['id']} {rec['label'] or ''} {what} in "
                      f"{rec['seconds']:.1f} s on {rec['worker']}; {self.failed} failed, "

@@ -99,7 +99,7 @@ def _train_fields() -> tuple[str, ...]:
 def allowed_fields(kind: str) -> tuple[str, ...]:
     """The fields a point of ``kind`` accepts (``label`` aside)."""
     if kind == "train":
-        return (*KIND_FIELDS["train"], *_train_fields())
+        return tuple(dict.fromkeys((*KIND_FIELDS["train"], *_train_fields())))
     return KIND_FIELDS[kind]
 
 
@@ -341,8 +341,11 @@ def parse_spec(text: str, *, source: str = "spec") -> SweepSpec:
         raise StringStabError(f"{source}: [sweep] field name must be a non-empty string; got {show(name)}")
     allowed = allowed_fields(kind)
     base = dict(doc.get("base", {}))
-    axes = {k: expand_axis(k, v) for k, v in doc.get("axes", {}).items()}
-    zipped = {k: expand_axis(k, v) for k, v in doc.get("zip", {}).items()}
+    try:
+        axes = {k: expand_axis(k, v) for k, v in doc.get("axes", {}).items()}
+        zipped = {k: expand_axis(k, v) for k, v in doc.get("zip", {}).items()}
+    except StringStabError as e:
+        raise StringStabError(f"{source}: {e}") from e
     for table, d in (("base", base), ("axes", axes), ("zip", zipped)):
         for k in d:
             if k != "label" and k not in allowed:
@@ -361,7 +364,10 @@ def parse_spec(text: str, *, source: str = "spec") -> SweepSpec:
     if "seeds" in head:
         if kind not in ("train", "probe"):
             raise StringStabError(f"{source}: [sweep] seeds apply to kind train or probe; got kind {kind}")
-        seeds = expand_axis("seeds", head["seeds"])
+        try:
+            seeds = expand_axis("seeds", head["seeds"])
+        except StringStabError as e:
+            raise StringStabError(f"{source}: [sweep] {e}") from e
         if any(isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
             raise StringStabError(f"{source}: [sweep] seeds must be integers >= 0; got {show(seeds)}")
         if "seed" in base or "seed" in axes or "seed" in zipped:
