@@ -167,8 +167,7 @@ def _fig5(rows: list[dict[str, Any]], out: OutputDir) -> list[str]:
     for ax in axs.ravel():
         ax.legend()
     fig.suptitle("Exploration noise σ (IDL paper Fig. 5 layout); lower is better")
-    with out.path("fig5_noise.png") as tmp:
-        fig.savefig(tmp, dpi=120)
+    fig.savefig(out.path("fig5_noise.png"), dpi=120)
     md += ["\nBest σ (the paper prints no values for Fig. 5, only the best σ of each agent):\n\n",
            *best_lines]
     out.write_text("fig5.md", "".join(md))
@@ -200,8 +199,7 @@ def _fig4(rows: list[dict[str, Any]], root: Path, out: OutputDir) -> list[str]:
     ax.set_ylabel("rolling episode reward (window 10)")
     ax.set_title("Reward convergence per architecture (IDL paper Fig. 4 layout)")
     ax.legend()
-    with out.path("fig4_architectures.png") as tmp:
-        fig.savefig(tmp, dpi=120)
+    fig.savefig(out.path("fig4_architectures.png"), dpi=120)
     gs = grouped(rows, ["hidden"], (*TABLE_METRICS, "final_rolling_return"))
     md = ["# Fig. 4: network architectures\n\n",
           "| hidden | n | final rolling reward | " + " | ".join(TABLE_METRICS) + " |\n",
