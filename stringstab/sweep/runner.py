@@ -136,9 +136,15 @@ def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retr
             point = by_key[fut.key]
             if fut.status == "finished":
                 rec = fut.result()
-            else:  # e.g. KilledWorker after every retry: the task never returned
-                exc = fut.exception()
-                rec = _lost_record(point, f"{type(exc).__name__}: {exc}".replace("\n", " "))
+            else:  # e.g. KilledWorker after every retry, or cancelled: the task never returned
+                try:
+                    exc = fut.exception()
+                    why = f"{type(exc).__name__}: {exc}"
+                except BaseException as e:  # a cancelled future raises here
+                    if isinstance(e, KeyboardInterrupt):
+                        raise
+                    why = f"{type(e).__name__}: {e}"
+                rec = _lost_record(point, why.replace("\n", " "))
             rec = {"format": POINT_FORMAT, **rec, "settings": point["settings"]}
             atomic_write_text(record_path(root, point["id"]), dumps_json(rec))
             fut.release()
