@@ -175,3 +175,25 @@ def test_interrupted_cli_sweep_resumes(tmp_path: Path) -> None:
     assert len(after) == 6
     for name, v in first.items():
         assert after[name] == v  # not redone
+
+
+def test_region_cli_on_local_cluster_same_map(tmp_path: Path) -> None:
+    from stringstab.regions import load_npz, region_map
+
+    base = [sys.executable, "-m", "stringstab", "region", "--fix", "k_a=0.5", "--n", "41",
+            "--method", "exact,taylor", "--format", "png", "--no-progress"]
+    dask = subprocess.run([*base, "--out", str(tmp_path / "dask"), "--scheduler", "local",
+                           "--workers", "2"], capture_output=True, text=True, timeout=120)
+    assert dask.returncode == 0, dask.stderr
+    here = region_map({g: np.linspace(-2, 2, 41) for g in ("k_x", "k_v")}, {"k_a": 0.5},
+                      tau=0.1, delta=0.2, headway=1.1, methods="exact,taylor", workers=1,
+                      progress=False)
+    there = load_npz(tmp_path / "dask" / "region.npz")
+    a, b = here.fields(), there.fields()
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    bad = subprocess.run([*base, "--out", str(tmp_path / "bad"), "--scheduler", "127.0.0.1"],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "--scheduler must be an address like tcp://HOST:8786" in bad.stderr
+    assert not (tmp_path / "bad").exists()
