@@ -84,7 +84,16 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
 
 
 def dashboard_address(client: Any) -> str | None:
-    """The dashboard's address, or None when the scheduler serves none (no ``bokeh``)."""
+    """The dashboard's address, or None when the scheduler serves none.
+
+    Parameters
+    ----------
+    client : distributed.Client
+
+    Returns
+    -------
+    str or None
+    """
     try:
         services = client.scheduler_info().get("services", {})
     except Exception:

@@ -49,7 +49,21 @@ def _cell(v: Any) -> Any:
 
 
 def sweep_table(spec: SweepSpec, root: str | Path) -> list[dict[str, Any]]:
-    """One flat row per point of ``spec`` in spec order (status ``pending`` when not run yet)."""
+    """One flat row per point of ``spec`` in spec order (status ``pending`` when not run yet).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep's spec.
+    root : path
+        The sweep folder.
+
+    Returns
+    -------
+    list of dict
+        ``id``, ``label``, ``kind``, ``status``, the varied fields (lists as text), the metrics,
+        ``seconds``, ``worker``, ``error``.
+    """
     recs = read_records(root, spec)
     varied_keys: dict[str, None] = {}
     metric_keys: dict[str, None] = {}
@@ -82,8 +96,22 @@ def grouped(rows: Sequence[dict[str, Any]], key: Sequence[str],
             metrics: Sequence[str]) -> list[dict[str, Any]]:
     """Mean, standard deviation (ddof 1) and count over seeds of each group of finished rows.
 
-    Groups keep the order of their first row; a metric that is not finite in some row (e.g. TIT
-    ∞) makes its mean ∞.
+    Groups keep the order of their first row; a metric that is missing in some row (e.g. TIT
+    ∞, stored as null) makes its mean ∞ and its sd None.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        :func:`sweep_table` rows.
+    key : sequence of str
+        The columns that define a group (e.g. ``["label"]``).
+    metrics : sequence of str
+        The columns to average.
+
+    Returns
+    -------
+    list of dict
+        The key columns, ``n``, and ``<metric>`` and ``<metric>_sd`` per metric.
     """
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
     for r in rows:

@@ -97,7 +97,17 @@ def _train_fields() -> tuple[str, ...]:
 
 
 def allowed_fields(kind: str) -> tuple[str, ...]:
-    """The fields a point of ``kind`` accepts (``label`` aside)."""
+    """The fields a point of ``kind`` accepts (``label`` aside).
+
+    Parameters
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+
+    Returns
+    -------
+    tuple of str
+    """
     if kind == "train":
         return tuple(dict.fromkeys((*KIND_FIELDS["train"], *_train_fields())))
     return KIND_FIELDS[kind]
@@ -148,6 +158,25 @@ class SweepSpec:
 # --------------------------------------------------------------------------- axes
 def expand_axis(name: str, value: Any) -> list[Any]:
     """The values of axis ``name``: a non-empty list, or a range table.
+
+    Parameters
+    ----------
+    name : str
+        The field the axis varies (for the error messages).
+    value : list or dict
+        A non-empty list, ``{start, stop, step}`` (``stop`` included when it falls on a step;
+        a tolerance of 1e-9 steps) or ``{start, stop, num}`` (evenly spaced, both ends).
+
+    Returns
+    -------
+    list
+        The values; integers when every bound is an integer, else floats rounded to 12
+        decimals (so 0.1 + 2 × 0.05 is 0.2, and ids do not depend on round-off).
+
+    Raises
+    ------
+    StringStabError
+        For an empty list, an unknown range key, a non-finite bound or a step of the wrong sign.
 
     Examples
     --------
