@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import signal
 from typing import Any
 
@@ -76,8 +77,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         with dask_client(args.scheduler, workers) as client:
             dash = dashboard_address(client)
+            if dash is not None and importlib.util.find_spec("bokeh") is None:
+                dash += " (its pages need bokeh: pip install bokeh)"
             print(f"dask scheduler {client.scheduler.address}; dashboard: "
-                  + (dash or "not served (install bokeh for it)"), flush=True)
+                  + (dash or "not served"), flush=True)
             summary = run_sweep(spec, args.out, client=client, retries=retries,
                                 progress=False if args.no_progress else None,
                                 log=lambda s: print(s, flush=True))
