@@ -57,7 +57,8 @@ class _Progress:
         first = self.last == self.t0
         if first or rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
             what = "done" if rec["status"] == "done" else f"FAILED ({rec.get('error')})"
-            self.log(f"[{self.n}/{self.total}] point {rec['id']} {rec['label'] or ''} {what} in "
+            name = rec["label"] or " ".join(f"{k}={v}" for k, v in rec.get("varied", {}).items())
+            self.log(f"[{self.n}/{self.total}] point {rec['id']} {name} {what} in "
                      f"{rec['seconds']:.1f} s on {rec['worker']}; {self.failed} failed, "
                      f"{now - self.t0:.0f} s elapsed")
             self.last = now
