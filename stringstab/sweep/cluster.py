@@ -76,9 +76,15 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
         raise StringStabError(f"--workers must be >= 1; got {workers!r}")
     # the scheduler's HTTP server (the dashboard with bokeh; health and metrics without) always
     # runs: on 127.0.0.1 and a free port, never the default :8787 on every interface
-    cluster = distributed.LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-        dashboard_address="127.0.0.1:0", env=dict(THREAD_ENV), silence_logs=logging.ERROR)
+    # Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in every worker by default, which turns
+    # off glibc's dynamic mmap threshold: every large NumPy temporary is then a fresh mmap, and
+    # the certificates ran 2.4x slower in a worker than in this process (analysis/bench_sweep.py)
+    import dask
+
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": dict(THREAD_ENV)}):
+        cluster = distributed.LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+            dashboard_address="127.0.0.1:0", env=dict(THREAD_ENV), silence_logs=logging.ERROR)
     with cluster, distributed.Client(cluster) as client:
         yield client
 
