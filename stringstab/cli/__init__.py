@@ -38,8 +38,9 @@ COMMANDS: list[str] = [
     "compare",
     "hcfs",
     "identify",
-    "demo",
     "sumo",
+    "sweep",
+    "demo",
 ]
 
 #: One-line help of each sub-command, shown by ``stringstab --help`` without importing it
@@ -58,6 +59,7 @@ HELP: dict[str, str] = {
     "identify": "identify and certify the car-following law of recorded vehicles (OpenACC, CSV, NGSIM)",
     "demo": "run a demo of the whole pipeline on bundled data",
     "sumo": "run certified and learned controllers inside Eclipse SUMO (check, run, cacc)",
+    "sweep": "run a study (a TOML sweep spec) as Dask tasks; resumable, one record per point",
 }
 
 

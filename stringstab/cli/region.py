@@ -10,7 +10,9 @@ exit code 2 and nothing written.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +38,7 @@ examples:
   stringstab region --fix k_a=0.3 --range k_x=0,1.5 --range k_v=-1,1 --overlay rollout.csv
   stringstab region --fix k_a=0.5 --sample-time 0.1 --compare continuous --out maps_dt01/
   stringstab region --fix k_a=0.5 --tau 0.1:0.3 --delta 0.1:0.3 --n 101 --out maps_box/
+  stringstab region --3d --n 81 --method exact --scheduler tcp://head:8786 --out maps3d/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
 in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
@@ -90,6 +93,10 @@ def add_parser(sub: Any) -> None:
                    help="figure formats among png, pdf, svg (default: png,pdf)")
     p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
     p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
+    p.add_argument("--scheduler", metavar="ADDRESS|local",
+                   help="evaluate the grid's chunks as Dask tasks: on the scheduler at ADDRESS "
+                        "(tcp://HOST:8786), or 'local' for a local cluster of --workers processes "
+                        "on 127.0.0.1 (the dask extra); same outputs bit for bit")
     p.add_argument("--no-progress", action="store_true", help="never show the progress bar")
     p.set_defaults(func=run)
 
@@ -221,6 +228,20 @@ def _warm_up_outputs() -> None:
     warm_up_writer()
 
 
+@contextlib.contextmanager
+def _executor(scheduler: str | None, workers: int | None) -> Iterator[tuple[Any, int | None]]:
+    """(executor, its workers) of ``--scheduler``, or (None, None): the local process pool."""
+    if scheduler is None:
+        yield None, None
+        return
+    from ..sweep import dask_client
+
+    address = None if scheduler == "local" else scheduler
+    with dask_client(address, workers) as client:
+        n = len(client.scheduler_info().get("workers", {})) or 1
+        yield client.get_executor(pure=False), n
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``region``; returns 0, or raises StringStabError (exit 2) before writing anything.
 
@@ -273,9 +294,11 @@ def run(args: argparse.Namespace) -> int:
     warm.start()
     try:
         # region_map validates the methods before computing anything
-        rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
-                          headway=model.headway, sample_time=H, methods=methods,
-                          workers=workers, progress=False if args.no_progress else None)
+        with _executor(args.scheduler, workers) as (executor, n_dask):
+            rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
+                              headway=model.headway, sample_time=H, methods=methods,
+                              workers=n_dask or workers, executor=executor,
+                              progress=False if args.no_progress else None)
     finally:
         warm.join()
     verdicts = None

@@ -264,6 +264,7 @@ def region_map(
     block: int | None = None,
     progress: bool | None = None,
     heterogeneous: bool = True,
+    executor: Any = None,
 ) -> RegionMap:
     """Evaluate every method on a grid of gains (see the module docstring).
 
@@ -297,6 +298,10 @@ def region_map(
         take more than 5 s.
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently.
+    executor : concurrent.futures.Executor, optional
+        Evaluate the blocks there instead of the local pool, ``2 × workers`` in flight (e.g.
+        a Dask client's ``get_executor()``: the blocks as tasks of a cluster).  The map is the
+        same bit for bit: every block is evaluated by the same function and put in its place.
 
     Returns
     -------
@@ -341,11 +346,11 @@ def region_map(
     cost = _COST[H is not None, box] + (CONTINUOUS in ms)
     seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:
-        workers = 1 if seconds < _PARALLEL_SECONDS else cpu_count()
+        workers = 1 if seconds < _PARALLEL_SECONDS and executor is None else cpu_count()
     if int(workers) < 1:
         raise StringStabError(f"workers must be >= 1; got {workers!r}")
     workers = min(int(workers), len(blocks))
-    if in_daemon():  # e.g. inside another pool: no children allowed
+    if in_daemon() and executor is None:  # e.g. inside another pool: no children allowed
         workers = 1
     if progress is None:
         progress = seconds / workers > 5.0
@@ -373,7 +378,8 @@ def region_map(
 
         bar = tqdm(total=n, desc="region map", unit="pt", unit_scale=True, file=sys.stderr)
     try:
-        for (i0, i1, j0, j1), out in run_blocks(_eval_block, spec, blocks, workers, warm=_warm):
+        for (i0, i1, j0, j1), out in run_blocks(_eval_block, spec, blocks, workers, warm=_warm,
+                                                executor=executor):
             for k, v in out.items():
                 res[k][i0:i1, j0:j1] = v
             if bar is not None:

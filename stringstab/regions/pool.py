@@ -36,13 +36,19 @@ def in_daemon() -> bool:
 
 def run_blocks(
     evaluate: Callable[..., dict[str, Any]], spec: Any, blocks: Sequence[Block], workers: int,
-    warm: Callable[[Any], None] | None = None,
+    warm: Callable[[Any], None] | None = None, executor: cf.Executor | None = None,
 ) -> Iterator[tuple[Block, dict[str, Any]]]:
     """``evaluate(spec, *block)`` for every block, yielding ``(block, result)`` as they finish.
 
     With ``workers`` > 1 the blocks go to a pool of forked processes (``warm(spec)`` runs
     first here, so the workers inherit its imports and caches, and once in each worker).
+    With ``executor`` (any :class:`concurrent.futures.Executor`, e.g. a Dask client's
+    ``get_executor()``) they go there instead, ``2 × workers`` in flight (``evaluate`` and
+    ``spec`` are pickled; no warm-up).
     """
+    if executor is not None:
+        yield from _submit_all(executor, evaluate, spec, blocks, max(int(workers), 1))
+        return
     if workers <= 1:
         for b in blocks:
             yield b, evaluate(spec, *b)
@@ -55,8 +61,15 @@ def run_blocks(
     args: Any = (spec,) if warm is not None else ()
     with cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=init,
                                 initargs=args) as ex:
-        pending: dict[cf.Future[dict[str, Any]], Block] = {}
-        it = iter(blocks)
+        yield from _submit_all(ex, evaluate, spec, blocks, workers)
+
+
+def _submit_all(ex: cf.Executor, evaluate: Callable[..., dict[str, Any]], spec: Any,
+                blocks: Sequence[Block], workers: int) -> Iterator[tuple[Block, dict[str, Any]]]:
+    """The blocks through ``ex``, at most two per worker in flight, as they finish."""
+    pending: dict[cf.Future[dict[str, Any]], Block] = {}
+    it = iter(blocks)
+    try:
         for b in it:
             pending[ex.submit(evaluate, spec, *b)] = b
             if len(pending) >= 2 * workers:
@@ -69,6 +82,9 @@ def run_blocks(
                 nxt = next(it, None)
                 if nxt is not None:
                     pending[ex.submit(evaluate, spec, *nxt)] = nxt
+    finally:
+        for fut in pending:
+            fut.cancel()
 
 
 def in_background(fn: Callable[..., Any], *args: Any) -> Callable[[], None]:

@@ -1,0 +1,98 @@
+"""``stringstab sweep``: run a sweep spec on Dask (a local cluster, or a scheduler's address)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import signal
+from typing import Any
+
+from ._common import integer as _int
+
+__all__ = ["add_parser", "run"]
+
+_EPILOG = """\
+examples:
+  stringstab sweep analysis/sweeps/smoke.toml --out sweeps/smoke              # local cluster, all cores
+  stringstab sweep analysis/sweeps/table3_reduced.toml --out sweeps/t3 --workers 2
+  stringstab sweep analysis/sweeps/table3_paper.toml --out /shared/t3 --scheduler tcp://head:8786
+
+outputs in --out: points/<id>.json (one record per point, written as it finishes),
+points/<id>/ (its artefacts), spec.toml, results.csv, results.parquet, report/.
+Re-running the same command skips the finished points (an interrupted sweep resumes).
+With --scheduler, --out must be on a filesystem every worker sees. See docs/sweeps.md.
+"""
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``sweep``."""
+    p = sub.add_parser(
+        "sweep",
+        help="run a study (a TOML sweep spec) as Dask tasks; resumable, one record per point",
+        description=(
+            "Run every point of a sweep spec (trainings, region maps, certified shares) as a Dask "
+            "task: on a local cluster of --workers processes (127.0.0.1 only), or on the cluster "
+            "of the scheduler at --scheduler. Each point's record is written atomically when it "
+            "finishes; a re-run skips finished points; a failed point is recorded and the others "
+            "go on; a task whose worker dies is retried. Ends with results.csv/.parquet and the "
+            "study's report (Table 3, Table 5, Fig. 4, Fig. 5 or the certificate table)."),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("spec", metavar="SPEC", help="TOML sweep spec (see analysis/sweeps/)")
+    p.add_argument("--out", required=True, metavar="DIR", help="sweep folder (new, or to resume)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    where.add_argument("--workers", metavar="N",
+                       help="worker processes of the local cluster (default: the cores)")
+    p.add_argument("--retries", default="2", metavar="N",
+                   help="extra attempts of a task whose workers died (default 2)")
+    p.add_argument("--check", action="store_true",
+                   help="check the spec and list its points; run nothing")
+    p.add_argument("--no-progress", action="store_true", help="progress lines instead of a bar")
+    p.set_defaults(func=run)
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``sweep``; 0 when every point is done, 1 when some failed, 130 when interrupted."""
+    from ..io import check_output_dir
+    from ..sweep import dask_client, load_spec, read_records, run_sweep
+    from ..sweep.cluster import dashboard_address
+
+    spec = load_spec(args.spec)
+    if args.check:
+        print(f"{args.spec}: {len(spec)} points of kind {spec.kind}, study {spec.study}")
+        for pt in spec.points:
+            print(f"  {pt.id}  {pt.label}  " + ", ".join(f"{k}={v}" for k, v in pt.varied.items()))
+        return 0
+    workers = None if args.workers is None else _int("--workers", args.workers, 1)
+    retries = _int("--retries", args.retries, 0)
+    check_output_dir(args.out, what="--out")
+    old = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        with dask_client(args.scheduler, workers) as client:
+            dash = dashboard_address(client)
+            if dash is not None and importlib.util.find_spec("bokeh") is None:
+                dash += " (its pages need bokeh: pip install bokeh)"
+            print(f"dask scheduler {client.scheduler.address}; dashboard: "
+                  + (dash or "not served"), flush=True)
+            summary = run_sweep(spec, args.out, client=client, retries=retries,
+                                progress=False if args.no_progress else None,
+                                log=lambda s: print(s, flush=True))
+    except KeyboardInterrupt:
+        recs = read_records(args.out, spec)
+        n = sum(r.get("status") == "done" for r in recs.values())
+        print(f"interrupted: {n} of {len(spec)} points are finished in {args.out}; run the same "
+              "command again to resume", flush=True)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    print(f"sweep {spec.name}: {summary['done']} points done, {summary['failed']} failed, "
+          f"{summary['skipped']} finished before; {summary['seconds']:.1f} s")
+    print(f"wrote {', '.join(summary['files'])} in {args.out}/")
+    return 0 if summary["failed"] == 0 else 1

@@ -1,0 +1,163 @@
+"""Running a sweep on Dask: one task per point, each result written the moment it finishes.
+
+:func:`run_sweep` submits every point not finished before (a point is finished when
+``DIR/points/<id>.json`` says ``"status": "done"``) as a task of :func:`~stringstab.sweep.tasks.run_point`
+and writes each record atomically (:func:`stringstab.io.atomic_write_text`) as the tasks
+complete, in completion order (:func:`distributed.as_completed`).  So a sweep interrupted at any
+moment — Ctrl-C, a killed process, a lost machine — loses only the points in flight, and the
+same command resumes it.  A point that raises is recorded as failed with its error and the
+others go on (a failed point is tried again by the next run); a worker that dies mid-task has
+its task rescheduled on another worker by the scheduler, and ``retries`` more times after the
+scheduler gives up on it (``KilledWorker``).  At the end the table of all the spec's points
+and the study's report are written (:mod:`stringstab.sweep.report`).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+from ..errors import StringStabError
+from ..io import atomic_write_text, check_output_dir, dumps_json
+from .records import POINT_FORMAT, read_records, record_path
+from .spec import SweepSpec
+from .tasks import run_point
+
+__all__ = ["run_sweep"]
+
+class _Progress:
+    """A tqdm bar on a terminal; otherwise a line per finished point (at most every ``every`` s)."""
+
+    def __init__(self, total: int, done: int, log: Callable[[str], None], bar: bool | None,
+                 every: float = 5.0) -> None:
+        self.total, self.n, self.log, self.every = total, done, log, every
+        self.failed = 0
+        self.t0 = self.last = time.perf_counter()
+        self.bar = None
+        if bar is None:
+            bar = sys.stderr.isatty()
+        if bar:
+            from tqdm.auto import tqdm
+
+            self.bar = tqdm(total=total, initial=done, desc="sweep", unit="point", file=sys.stderr)
+
+    def update(self, rec: dict[str, Any]) -> None:
+        self.n += 1
+        self.failed += rec["status"] != "done"
+        now = time.perf_counter()
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.set_postfix(failed=self.failed)
+            if rec["status"] != "done":
+                self.bar.write(f"point {rec['id']} failed: {rec.get('error')}")
+            return
+        first = self.last == self.t0
+        if first or rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
+            what = "done" if rec["status"] == "done" else f"FAILED ({rec.get('error')})"
+            name = rec["label"] or " ".join(f"{k}={v}" for k, v in rec.get("varied", {}).items())
+            self.log(f"[{self.n}/{self.total}] point {rec['id']} {name} {what} in "
+                     f"{rec['seconds']:.1f} s on {rec['worker']}; {self.failed} failed, "
+                     f"{now - self.t0:.0f} s elapsed")
+            self.last = now
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _lost_record(point: dict[str, Any], error: str) -> dict[str, Any]:
+    return {"id": point["id"], "kind": point["kind"], "label": point["label"],
+            "varied": point["varied"], "status": "failed", "metrics": {}, "artefacts": {},
+            "error": error, "seconds": float("nan"), "worker": None, "pid": None}
+
+
+def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retries: int = 2,
+              progress: bool | None = None, log: Callable[[str], None] = print) -> dict[str, Any]:
+    """Run the points of ``spec`` not finished in ``out`` on a Dask ``client``; see the module.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The loaded spec (:func:`stringstab.sweep.load_spec`).
+    out : path
+        The sweep folder: ``points/<id>.json`` (records), ``points/<id>/`` (artefacts),
+        ``spec.toml``, ``results.csv``, ``results.parquet`` and ``report/``.
+    client : distributed.Client
+        Where the tasks run (:func:`stringstab.sweep.dask_client`).
+    retries : int
+        Extra attempts of a task whose workers died (``distributed.Client.submit(retries=)``).
+    progress : bool, optional
+        tqdm bar (default: when standard error is a terminal); else progress lines via ``log``.
+    log : callable
+        Receives the progress lines.
+
+    Returns
+    -------
+    dict
+        ``points``, ``skipped`` (finished before), ``done``, ``failed``, ``seconds``, ``files``.
+
+    Raises
+    ------
+    StringStabError
+        When ``out`` cannot be written.  KeyboardInterrupt passes through after the tasks in
+        flight are cancelled (the finished points are already on disk).
+    """
+    from distributed import as_completed
+
+    from .report import write_outputs
+
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise StringStabError(f"retries must be an integer >= 0; got {retries!r}")
+    root = check_output_dir(out, what="--out")
+    (root / "points").mkdir(parents=True, exist_ok=True)
+    atomic_write_text(root / "spec.toml", spec.text)
+    before = read_records(root, spec)
+    skipped = [pid for pid, r in before.items() if r.get("status") == "done"]
+    todo = [p for p in spec.points if p.id not in set(skipped)]
+    t0 = time.perf_counter()
+    n_workers = len(client.scheduler_info().get("workers", {}))
+    log(f"sweep {spec.name}: {len(spec)} points ({spec.kind}); {len(skipped)} finished before "
+        f"(skipped), {len(todo)} to run on {n_workers} workers")
+    bar = _Progress(len(spec), len(skipped), log, progress)
+    root_abs = str(root.resolve())
+    futures = {}
+    by_key: dict[str, dict[str, Any]] = {}
+    done = failed = 0
+    try:
+        for p in todo:
+            d = p.as_dict()
+            fut = client.submit(run_point, d, root_abs, key=f"stringstab-point-{p.id}", pure=False,
+                                retries=retries)
+            futures[fut.key] = fut
+            by_key[fut.key] = {**d, "settings": p.settings}
+        for fut in as_completed(list(futures.values())):
+            point = by_key[fut.key]
+            if fut.status == "finished":
+                rec = fut.result()
+            else:  # e.g. KilledWorker after every retry, or cancelled: the task never returned
+                try:
+                    exc = fut.exception()
+                    why = f"{type(exc).__name__}: {exc}"
+                except BaseException as e:  # a cancelled future raises here
+                    if isinstance(e, KeyboardInterrupt):
+                        raise
+                    why = f"{type(e).__name__}: {e}"
+                rec = _lost_record(point, why.replace("\n", " "))
+            rec = {"format": POINT_FORMAT, **rec, "settings": point["settings"]}
+            atomic_write_text(record_path(root, point["id"]), dumps_json(rec))
+            fut.release()
+            done += rec["status"] == "done"
+            failed += rec["status"] != "done"
+            bar.update(rec)
+    except BaseException:
+        for fut in futures.values():
+            fut.cancel()
+        raise
+    finally:
+        bar.close()
+    files = write_outputs(spec, root)
+    return {"points": len(spec), "skipped": len(skipped), "done": done, "failed": failed,
+            "seconds": time.perf_counter() - t0, "files": files}
