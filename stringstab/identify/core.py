@@ -32,7 +32,6 @@ package (``tests/test_house.py``).
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -42,6 +41,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError, show
 from ..io.platoon_logs import PlatoonLog, Segment, clean_segments
+from ..progress import Progress
 from .empirical import Empirical, empirical_transfer
 from .fit import (
     PARAMETERS,
@@ -228,32 +228,19 @@ def block_counts(segments: Sequence[Segment], T: int, L: int, rng: np.random.Gen
 
 
 class _Progress:
-    """A tqdm bar on a terminal; a line every 10 % otherwise (stderr)."""
+    """Count the fits through :class:`stringstab.progress.Progress`, naming the last one on the bar."""
 
     def __init__(self, total: int, show_it: bool | None) -> None:
-        self.total, self.done, self.bar, self.next = total, 0, None, 0.1
-        self.on = total > 0 and (show_it if show_it is not None else True)
-        if self.on and sys.stderr.isatty():
-            from tqdm.auto import tqdm
-
-            self.bar = tqdm(total=total, unit="fit", desc="identify", mininterval=0.5)
+        self.p = Progress(total, "identify", unit="fit",
+                          enabled=total > 0 and (show_it if show_it is not None else True))
 
     def step(self, what: str) -> None:
-        self.done += 1
-        if not self.on:
-            return
-        if self.bar is not None:
-            self.bar.update(1)
-            self.bar.set_postfix_str(what, refresh=False)
-        elif self.done / self.total >= self.next - 1e-12 or self.done == self.total:
-            print(f"identify: {self.done}/{self.total} fits ({100 * self.done / self.total:.0f} %), {what}",
-                  file=sys.stderr, flush=True)
-            while self.next <= self.done / self.total:
-                self.next += 0.1
+        self.p.update(1)
+        if self.p.bar is not None:
+            self.p.bar.set_postfix_str(what, refresh=False)
 
     def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
+        self.p.close()
 
 
 def _certify(p: dict[str, float], H: float | None) -> Any:

@@ -33,9 +33,9 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
+from ..progress import Progress
 from ..traffic import Limits, Platoon
 from ..traffic.controllers import Controller, Observation
-from .progress import Progress
 from .runtime import SumoSession, check_config
 
 __all__ = ["LOOKAHEAD", "ScenarioRun", "run_scenario"]
@@ -149,7 +149,7 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
         "t", "vehicle", "controlled", "leader", "gap", "speed", "accel", "pred_speed",
         "pred_accel", "pred_accel_delayed", "command", "k_x", "k_v", "k_a")}
     total = steps if steps is not None else None
-    bar = Progress(total or 0, "sumo scenario", enabled=progress and total is not None)
+    bar = Progress(total or 0, "sumo scenario", unit="step", enabled=progress and total is not None)
     cfg = Path(sumocfg).resolve()
     min_gap: dict[str, float] = {}
     try:

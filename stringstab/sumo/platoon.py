@@ -35,9 +35,9 @@ import numpy.typing as npt
 
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
+from ..progress import Progress
 from ..traffic import Limits, Platoon, PlatoonResult, Trajectory
 from ..traffic.controllers import Controller, Observation
-from .progress import Progress
 from .runtime import SumoSession
 from .scenario import LEADER_ID, follower_ids, straight_road
 
@@ -336,7 +336,7 @@ def run_loop(plat: Any, controller: Controller, T: int, *, progress: bool = Fals
     cmd = np.empty((T, N))
     min_gap = np.full((1, N), np.inf)
     gains_rec: Array | None = None
-    bar = Progress(T, desc, enabled=progress)
+    bar = Progress(T, desc, unit="step", enabled=progress)
     try:
         for k in range(T):
             obs = plat.observe()

@@ -22,6 +22,7 @@ from typing import Any
 
 from ..errors import StringStabError
 from ..io import atomic_write_text, check_output_dir, dumps_json
+from ..progress import Progress, duration
 from .records import POINT_FORMAT, read_records, record_path
 from .spec import SweepSpec
 from .tasks import run_point
@@ -29,27 +30,28 @@ from .tasks import run_point
 __all__ = ["run_sweep"]
 
 class _Progress:
-    """A tqdm bar on a terminal; otherwise a line per finished point (at most every ``every`` s)."""
+    """A tqdm bar on a terminal (:class:`stringstab.progress.Progress`); otherwise a log line per
+    finished point (at most every ``every`` s; every failure), with the time left."""
 
     def __init__(self, total: int, done: int, log: Callable[[str], None], bar: bool | None,
                  every: float = 5.0) -> None:
         self.total, self.n, self.log, self.every = total, done, log, every
         self.failed = 0
         self.t0 = self.last = time.perf_counter()
-        self.bar = None
         if bar is None:
             bar = sys.stderr.isatty()
-        if bar:
-            from tqdm.auto import tqdm
+        self.p = Progress(total, "sweep", unit="point", initial=done, enabled=bool(bar), tty=bool(bar))
 
-            self.bar = tqdm(total=total, initial=done, desc="sweep", unit="point", file=sys.stderr)
+    @property
+    def bar(self) -> Any:
+        return self.p.bar
 
     def update(self, rec: dict[str, Any]) -> None:
         self.n += 1
         self.failed += rec["status"] != "done"
+        self.p.update(1)
         now = time.perf_counter()
         if self.bar is not None:
-            self.bar.update(1)
             self.bar.set_postfix(failed=self.failed)
             if rec["status"] != "done":
                 self.bar.write(f"point {rec['id']} failed: {rec.get('error')}")
@@ -58,14 +60,16 @@ class _Progress:
         if first or rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
             what = "done" if rec["status"] == "done" else f"FAILED ({rec.get('error')})"
             name = rec["label"] or " ".join(f"{k}={v}" for k, v in rec.get("varied", {}).items())
+            el = now - self.t0
+            rate = (self.p.done - self.p.initial) / el if el > 0 else 0.0
+            left = f", ~{duration((self.total - self.n) / rate)} left" if rate > 0 and self.n < self.total else ""
             self.log(f"[{self.n}/{self.total}] point {rec['id']} {name} {what} in "
                      f"{rec['seconds']:.1f} s on {rec['worker']}; {self.failed} failed, "
-                     f"{now - self.t0:.0f} s elapsed")
+                     f"{duration(el)} elapsed{left}")
             self.last = now
 
     def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
+        self.p.close()
 
 
 def _lost_record(point: dict[str, Any], error: str) -> dict[str, Any]:
