@@ -38,7 +38,22 @@ def test_identify_cli_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert rc == 0
     names = {p.name for p in out.iterdir()}
     assert {"identify.json", "identify.csv", "identify.parquet", "fit_1.png", "fit_2.png",
-            "transfer_1.png", "transfer_2.png", "sup_gain.png"} <= names
+            "transfer_1.png", "transfer_2.png", "sup_gain.png", "report.md", "report.html"} <= names
+    # the report: every figure embedded as a data: URI, nothing loaded from the network
+    import base64
+    import re
+
+    md = (out / "report.md").read_text(encoding="utf-8")
+    html = (out / "report.html").read_text(encoding="utf-8")
+    pngs = sorted(p.name for p in out.glob("*.png"))
+    assert all(f"]({p})" in md for p in pngs)
+    srcs = re.findall(r'<img\b[^>]*\bsrc="([^"]+)"', html)
+    assert all(s.startswith("data:image/png;base64,") for s in srcs)
+    assert sorted(base64.b64decode(s.split(",", 1)[1]) for s in srcs) == sorted(
+        (out / p).read_bytes() for p in pngs)
+    assert not re.search(r'(?:src|href)="https?://', html)
+    assert "vehicle2: fitted gains certified string stable" in md and "2 of 2 bootstrap fits" in md
+    assert "The data's own amplification" in md
     doc = json.loads((out / "identify.json").read_text())
     rows = doc["vehicles"]
     assert [r["position"] for r in rows] == [1, 2] and rows[0]["name"] == "vehicle1"

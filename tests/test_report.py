@@ -86,7 +86,8 @@ def test_region_command_report(tmp_path, capsys):
     assert "exact vs taylor agree on every decided point" in md
 
 
-@pytest.mark.parametrize("name", ["region_class_exact.png", "platoon.png", "fig9_ttc.png",
+@pytest.mark.parametrize("name", ["region_class_exact.png", "platoon.png", "fig9_ttc.png", "fit_1.png",
+                                  "transfer_2_3.png", "sup_gain.png",
                                   "jerk_1-us06_J2.5.png"])
 def test_every_figure_kind_has_a_caption(name):
     assert not caption_for(name).startswith("Figure ")

@@ -111,3 +111,37 @@ hidden = [[64, 64], [128, 128]]
     assert "| [64, 64] | 1 | -1.000 |" in (root / "report" / "fig4.md").read_text()
     rec = json.loads(record_path(root, spec4.points[0].id).read_text())
     assert rec["status"] == "done"
+
+
+def test_sweep_run_report(tmp_path: Path) -> None:
+    """report.md/report.html in the sweep folder: the results table, the failures, the study's
+    table and its figure embedded as a data: URI (nothing loaded from the network)."""
+    import base64
+    import re
+
+    from stringstab.report.commands import sweep_report
+
+    spec = parse_spec("""
+[sweep]
+kind = "train"
+study = "fig5"
+[base]
+total_steps = 10
+[axes]
+algo = ["idl", "td3"]
+exploration_noise = [0.1, 0.2]
+""")
+    root = tmp_path / "s"
+    _write(root, spec, lambda p: None if p.varied["exploration_noise"] == 0.2 and p.varied["algo"] == "td3"
+           else dict.fromkeys(("TIT", "M_CI", "M_effi", "M_lss"), p.varied["exploration_noise"]))
+    files = write_outputs(spec, root)
+    assert sweep_report(spec, sweep_table(spec, root), files, root,
+                        command="stringstab sweep s.toml --out s").write(root) == ["report.md", "report.html"]
+    md = (root / "report.md").read_text(encoding="utf-8")
+    assert "every point finished" in md and "3 done, 1 failed" in md and "boom" in md
+    assert "](report/fig5_noise.png)" in md and "lowest mean rank" in md
+    html = (root / "report.html").read_text(encoding="utf-8")
+    srcs = re.findall(r'<img\b[^>]*\bsrc="([^"]+)"', html)
+    assert len(srcs) == 1 and srcs[0].startswith("data:image/png;base64,")
+    assert base64.b64decode(srcs[0].split(",", 1)[1]) == (root / "report" / "fig5_noise.png").read_bytes()
+    assert not re.search(r'(?:src|href)="https?://', html)

@@ -175,6 +175,8 @@ def test_interrupted_cli_sweep_resumes(tmp_path: Path) -> None:
     assert len(after) == 6
     for name, v in first.items():
         assert after[name] == v  # not redone
+    assert {"report.md", "report.html"} <= {f.name for f in out.iterdir()}
+    assert "every point finished" in (out / "report.md").read_text(encoding="utf-8")
 
 
 def test_region_cli_on_local_cluster_same_map(tmp_path: Path) -> None:

@@ -83,9 +83,12 @@ def _seconds(name: str, text: str) -> float:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``identify``; 0 when it ran, bad input raises (exit 2)."""
+    import time
+
     from ..identify.logs import read_logs
     from ..io import OutputDir
 
+    t0 = time.perf_counter()
     H = None if args.sample_time is None else _seconds("--sample-time", args.sample_time)
     B = integer("--bootstrap", args.bootstrap, 0)
     block = _seconds("--block", args.block)
@@ -100,8 +103,12 @@ def run(args: argparse.Namespace) -> int:
     res = identify(logs, args.model, sample_time=H, bootstrap=B, block=block, n_starts=starts,
                    seed=seed, min_duration=min_seg, progress=not args.no_progress)
     with out:
-        names = write_outputs(res, out, figures=not args.no_figures)
+        names = list(write_outputs(res, out, figures=not args.no_figures))
+        from ..report import command_line
+        from ..report.commands import identify_report
+
+        names += identify_report(res, names, command=command_line(args), started=t0).write(out)
     sys.stdout.write(render(res))
     print(f"wrote {len(names)} files to {out.root}/ (identify.json, identify.csv, identify.parquet"
-          + (", figures" if not args.no_figures else "") + ")")
+          + (", figures" if not args.no_figures else "") + ", report.md, report.html)")
     return 0

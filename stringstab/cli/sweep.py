@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import signal
+import time
 from typing import Any
 
 from ._common import integer as _int
@@ -64,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     from ..sweep import dask_client, load_spec, read_records, run_sweep
     from ..sweep.cluster import dashboard_address
 
+    t0 = time.perf_counter()
     spec = load_spec(args.spec)
     if args.check:
         print(f"{args.spec}: {len(spec)} points of kind {spec.kind}, study {spec.study}")
@@ -92,6 +94,12 @@ def run(args: argparse.Namespace) -> int:
         return 130
     finally:
         signal.signal(signal.SIGTERM, old)
+    from ..report import command_line
+    from ..report.commands import sweep_report
+    from ..sweep.report import sweep_table
+
+    summary["files"] += sweep_report(spec, sweep_table(spec, args.out), summary["files"], args.out,
+                                     command=command_line(args), started=t0).write(args.out)
     print(f"sweep {spec.name}: {summary['done']} points done, {summary['failed']} failed, "
           f"{summary['skipped']} finished before; {summary['seconds']:.1f} s")
     print(f"wrote {', '.join(summary['files'])} in {args.out}/")

@@ -48,6 +48,19 @@ CAPTIONS: list[tuple[str, str]] = [
      "is clipped."),
     ("damping.png", "Disturbance damping along the platoon: m_p (eq 29, follower-to-predecessor "
      "acceleration energy) per follower; below 1 means the disturbance shrinks."),
+    # identify
+    ("fit_*", "A fitted follower: measured speeds of the predecessor and the follower and the "
+     "follower's speed and gap simulated by the fitted model from the predecessor's measured "
+     "speed, on each clean segment; the title gives the fitted parameters and the RMSE. The "
+     "dashed curves tracking the black ones means the model explains the data."),
+    ("transfer_*", "The fitted model's |Γ(jω)| (string stable where it stays below the dotted line "
+     "at 1) beside the data's own speed transfer |Ĝ(jω)| with its coherence; only coherent "
+     "points (black) below the grey band count for the data's verdict (above it common-mode GPS "
+     "error dominates). Agreement of the curve and the points means the verdict is the data's, "
+     "not only the model's."),
+    ("sup_gain.png", "Along the identified platoon: the model's sup|Γ| per follower with its 5-95 % "
+     "bootstrap interval, and the data's own amplification (max |Ĝ| and the energy ratio); "
+     "points above the dotted line at 1 amplify disturbances."),
     # tune
     ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
      "(square: certified, cross: not), over the certified region projected over the repaired "

@@ -13,8 +13,8 @@ from typing import Any
 
 from .render import Report
 
-__all__ = ["compare_report", "evaluate_report", "region_report", "simulate_report",
-           "tune_report"]
+__all__ = ["compare_report", "evaluate_report", "identify_report", "region_report",
+           "simulate_report", "sweep_report", "tune_report"]
 
 #: Metrics of a run with their meaning and unit, in the order a report lists them.
 METRICS: list[tuple[str, str, str]] = [
@@ -235,6 +235,135 @@ def compare_report(markdown: str, files: Sequence[str], *, command: str,
     rep = Report("Comparison of strategies on held-out episodes", command=command, started=started)
     body = "\n".join(line for line in markdown.splitlines() if not line.startswith("# "))
     rep.section("Table 4 layout").markdown(body, shift=1)
+    figs = _pngs(files)
+    if figs:
+        rep.section("Figures").figures(figs)
+    return rep
+
+
+def identify_report(res: Any, files: Sequence[Any], *, command: str,
+                    started: float | None = None) -> Report:
+    """The report of ``stringstab identify``: the per-follower table with the verdicts and the
+    bootstrap shares, the data's own amplification, the notes, and every figure.
+
+    Parameters
+    ----------
+    res : IdentifyResult
+        The identification (:func:`stringstab.identify.identify`).
+    files : sequence of path-like
+        The files written (only their names are used; images become figures).
+    command : str
+        The command line.
+    started : float, optional
+        ``time.perf_counter()`` at the start of the command.
+
+    Returns
+    -------
+    Report
+        The report.
+    """
+    st = res.settings
+    rep = Report("Identified followers", command=command,
+                 params={"logs": ", ".join(res.sources), "model": res.model,
+                         "sample time H": res.sample_time or "continuous",
+                         **{k: st[k] for k in ("bootstrap", "block", "starts", "seed", "min_duration")
+                            if k in st}},
+                 intro="Each follower's controller is fitted to the logged speeds and gaps, its "
+                       "gains are certified with the exact delay (‖Γ‖∞ ≤ 1, internally stable), "
+                       "and moving-block bootstrap refits give the share of plausible fits that "
+                       "are certified. The data's own speed transfer is estimated beside the "
+                       "model's, so a verdict can be checked against what the platoon did.",
+                 started=started)
+    sec = rep.section("Verdicts")
+    for v in res.vehicles:
+        r = v.row()
+        sec.verdict(f"{v.position} {v.name}: fitted gains certified string stable (exact delay)",
+                    r["verdict"] == "certified",
+                    f"{r['verdict']}; sup|Γ| = {r['sup_gain']:.4g}; {v.statement()}")
+    rows = []
+    for v in res.vehicles:
+        r = v.row()
+        rows.append({"pos": r["position"], "name": r["name"], "k_x": r["k_x"], "k_v": r["k_v"],
+                     "k_a": r["k_a"], "τ": r["tau"], "T*": r["headway"], "l0": r["standstill"],
+                     "RMSE v": r["rmse_speed"], "RMSE gap": r["rmse_gap"], "sup|Γ|": r["sup_gain"],
+                     "sup|Γ| 5 %": r["sup_gain_lo"], "sup|Γ| 95 %": r["sup_gain_hi"],
+                     "verdict": r["verdict"], "certified share (%)": 100 * r["certified_share"],
+                     "not certified share (%)": 100 * r["not_certified_share"]})
+    rep.section("Fitted followers").table(
+        rows, caption="Per follower: the fitted parameters, the fit's error, sup|Γ| with its "
+        "5-95 % bootstrap interval, the certificate's verdict and the shares of bootstrap fits "
+        "certified / not certified.",
+        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "T*": "s", "l0": "m", "RMSE v": "m/s",
+               "RMSE gap": "m"})
+    amp = [{"pos": v.position, "name": v.name, "max |Ĝ|": v.empirical.gain,
+            "at ω": v.empirical.gain_omega, "± (2ε)": 2 * v.empirical.gain_error * v.empirical.gain,
+            "the data": v.empirical.amplifies, "peak-to-peak": v.empirical.peak_to_peak,
+            "energy": v.empirical.energy} for v in res.vehicles]
+    rep.section("The data's own amplification").table(
+        amp, caption="From the logged speeds alone (no model): the largest coherent |Ĝ(jω)| with "
+        "its ± two-standard-error band and whether it is above 1 beyond that band, the speed "
+        "range ratio and the acceleration-energy ratio of follower to predecessor.",
+        units={"at ω": "rad/s"})
+    notes = [f"{v.position} {v.name}: {n}" for v in res.vehicles for n in v.fit.notes + v.notes]
+    notes += [f"skipped: {s}" for s in res.skipped]
+    if notes:
+        rep.section("Notes").text("\n".join(f"- {n}" for n in notes))
+    figs = _pngs(Path(str(f)).name for f in files)
+    if figs:
+        rep.section("Figures").figures(figs)
+    return rep
+
+
+def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[str],
+                 root: str | Path, *, command: str, started: float | None = None) -> Report:
+    """The report of ``stringstab sweep``: how many points finished, the results table, the
+    failures, and the study's tables and figures (``report/``) the sweep already wrote.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep's spec.
+    rows : sequence of mappings
+        :func:`stringstab.sweep.sweep_table` (one row per point).
+    files : sequence of str
+        The files the sweep wrote, relative to ``root`` (study tables ``report/*.md`` are
+        included as they are; images become figures).
+    root : path-like
+        The sweep folder.
+    command : str
+        The command line.
+    started : float, optional
+        ``time.perf_counter()`` at the start of the command.
+
+    Returns
+    -------
+    Report
+        The report, to :meth:`~stringstab.report.Report.write` into ``root``.
+    """
+    rep = Report(f"Sweep {spec.name}", command=command,
+                 params={"spec": spec.source or spec.name, "kind": spec.kind, "study": spec.study,
+                         "points": len(spec)}, started=started)
+    status: dict[str, int] = {}
+    for r in rows:
+        status[str(r["status"])] = status.get(str(r["status"]), 0) + 1
+    sec = rep.section("Verdicts")
+    sec.verdict("every point finished", status.get("done", 0) == len(rows),
+                ", ".join(f"{n} {k}" for k, n in status.items()))
+    cols = [c for c in (rows[0] if rows else {}) if c not in ("kind", "error", "worker")]
+    rep.section("Results").table(
+        [{c: r.get(c) for c in cols} for r in rows],
+        caption="One row per point, in the spec's order: its varied settings, its metrics (as in "
+                "results.csv) and its wall time (s).")
+    failed = [r for r in rows if r["status"] not in ("done", "pending")]
+    if failed:
+        rep.section("Failed points").table(
+            [{"id": r["id"], "label": r["label"], "error": r.get("error")} for r in failed],
+            caption="Points that did not finish, with the error; run the same command again to "
+                    "retry them.")
+    for f in files:
+        if f.endswith(".md"):
+            text = (Path(root) / f).read_text(encoding="utf-8")
+            rep.section(f"Study: {Path(f).stem}").markdown(text)
     figs = _pngs(files)
     if figs:
         rep.section("Figures").figures(figs)
