@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 
 import numpy as np
 import pytest
@@ -58,6 +59,13 @@ def test_scenario_cli_writes_its_files(tmp_path, capsys):
     with open(out / "scenario.csv") as f:
         rows = list(csv.DictReader(f))
     assert rows and {r["vehicle"] for r in rows} == {"c1"} and rows[0]["leader"] == "exiting"
+    names = {p.name for p in out.iterdir() if not p.name.startswith(".")}
+    assert names == {"scenario.csv", "metrics.json", "report.md", "report.html"}
+    md = (out / "report.md").read_text(encoding="utf-8")
+    steps = doc["vehicles"][0]["steps_controlled"]
+    assert f"| c1 | {steps} | exiting | 0 |" in md.split("## Driven vehicles")[1]
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "<img" not in html and not re.search(r'(?:src|href)="https?://', html)  # no figures here
 
 
 def test_scenario_traci_equals_libsumo():

@@ -328,14 +328,17 @@ def _print_summary(head: str, doc: dict[str, Any]) -> None:
 
 
 #: The files of an in-scenario run.
-SCENARIO_FILES = ("scenario.csv", "metrics.json")
+SCENARIO_FILES = ("scenario.csv", "metrics.json", "report.md", "report.html")
 
 
 def _run_scenario(args: argparse.Namespace) -> int:
     """``sumo run --sumocfg F --controlled IDS``: the vehicles IDS of F driven by the controller."""
+    import time
+
     from ..io import OutputDir, write_results
     from ..sumo.inscenario import run_scenario
 
+    t0 = time.perf_counter()
     if args.steps is not None and args.steps < 1:
         raise StringStabError(f"--steps must be an integer >= 1; got {args.steps}")
     ids = [i.strip() for i in str(args.controlled).split(",")]
@@ -355,6 +358,10 @@ def _run_scenario(args: argparse.Namespace) -> int:
     with out:
         write_results(cols, out.path("scenario.csv"), "csv", what="scenario.csv")
         out.write_json("metrics.json", doc)
+        from ..report import command_line
+        from ..report.commands import scenario_report
+
+        scenario_report(doc, command=command_line(args), started=t0).write(out)
     s = res.summary
     print(f"ran {args.sumocfg} with {', '.join(res.ids)} driven by {case['label']} "
           f"(tau = {case['tau']:g} s, delta = {case['delta']:g} s, dt = {case['dt']:g} s) via {args.api}")

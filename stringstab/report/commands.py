@@ -14,7 +14,7 @@ from typing import Any
 from .render import Report
 
 __all__ = ["compare_report", "evaluate_report", "identify_report", "region_report",
-           "simulate_report", "sweep_report", "tune_report"]
+           "scenario_report", "simulate_report", "sweep_report", "tune_report"]
 
 #: Metrics of a run with their meaning and unit, in the order a report lists them.
 METRICS: list[tuple[str, str, str]] = [
@@ -367,4 +367,47 @@ def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[s
     figs = _pngs(files)
     if figs:
         rep.section("Figures").figures(figs)
+    return rep
+
+
+def scenario_report(doc: Mapping[str, Any], *, command: str, started: float | None = None) -> Report:
+    """The report of ``stringstab sumo run --sumocfg``: the scenario, the vehicles driven, what
+    each met (leaders, smallest gap, collisions, m_p) and the share of executed gains certified.
+
+    Parameters
+    ----------
+    doc : mapping
+        The run's ``metrics.json`` document (``run`` settings and the summary of
+        :func:`stringstab.sumo.inscenario.run_scenario`).
+    command : str
+        The command line.
+    started : float, optional
+        ``time.perf_counter()`` at the start of the command.
+
+    Returns
+    -------
+    Report
+        The report.
+    """
+    run = dict(doc.get("run", {}))
+    rep = Report(f"SUMO scenario {Path(str(run.get('sumocfg', ''))).name}", command=command,
+                 params={k: (", ".join(v) if isinstance(v, list) else v) for k, v in run.items()},
+                 intro="Named vehicles of a SUMO scenario driven by the controller, each following "
+                       "the vehicle SUMO reports as its leader at every step.", started=started)
+    sec = rep.section("Verdicts")
+    sec.verdict("no collision of a driven vehicle", doc.get("collisions", 0) == 0,
+                f"{doc.get('collisions', 0)} collisions")
+    if doc.get("M_fss") is not None:
+        sec.verdict("every executed gain triple certified string stable (exact delay)",
+                    doc["M_fss"] >= 100.0,
+                    f"M_fss = {doc['M_fss']:.2f} % (exact), {doc['M_fss_sampled']:.2f} % sampled-data, "
+                    f"of {doc.get('n_gains')} gain triples")
+    rep.section("Driven vehicles").table(
+        [{"vehicle": v["vehicle"], "steps driven": v["steps_controlled"],
+          "leaders": " → ".join(v["leaders"]) or "none", "leader changes": v["leader_changes"],
+          "min gap": v["min_gap"], "collisions": v["collisions"], "m_p": v["m_p"]}
+         for v in doc.get("vehicles", [])],
+        caption="Per driven vehicle: the steps it was driven, the leaders it followed in turn, its "
+                "smallest gap, its collisions and m_p (IDL eq 29: follower-to-leader acceleration "
+                "energy; < 1: disturbances shrink).", units={"min gap": "m"})
     return rep
