@@ -47,7 +47,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError, show
 from ..traffic import Trajectory
-from .runtime import SumoSession
+from .runtime import SumoSession, read_xml
 from .scenario import LEADER_ID, follower_ids, straight_road
 
 __all__ = ["DEFAULTS", "MODES", "NO_LAG_TAU", "CACCType", "ModeLaw", "certify_modes",
@@ -115,13 +115,7 @@ def read_vtype(spec: str) -> CACCType:
     if ":" not in str(spec):
         raise StringStabError(f"--vtype must be FILE.rou.xml:TYPE; got {show(spec)}")
     fname, tid = str(spec).rsplit(":", 1)
-    path = Path(fname)
-    if not path.is_file():
-        raise StringStabError(f"--vtype: expected a route file; {fname!r} does not exist")
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as e:
-        raise StringStabError(f"--vtype {fname}: expected a SUMO route file (XML); {e}") from e
+    root = read_xml(fname, "--vtype", "a route file", "a SUMO route file (XML)")
     found = [el for el in root.iter("vType") if el.get("id") == tid]
     if not found:
         ids = [el.get("id") for el in root.iter("vType")]
@@ -151,7 +145,7 @@ def read_vtype(spec: str) -> CACCType:
         raise StringStabError(
             f"--vtype {spec}: expected tau > 0, minGap >= 0, length > 0; got tau = "
             f"{params['tau']:g}, minGap = {params['minGap']:g}, length = {params['length']:g}")
-    return CACCType(tid, str(path), params, ET.tostring(el, encoding="unicode").strip())
+    return CACCType(tid, str(Path(fname)), params, ET.tostring(el, encoding="unicode").strip())
 
 
 @dataclass(frozen=True)

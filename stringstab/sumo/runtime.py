@@ -32,7 +32,8 @@ from typing import Any, Literal
 
 from ..errors import StringStabError, show
 
-__all__ = ["API", "EXTRA", "SUMO_SERIES", "SumoSession", "binary", "check_config", "import_api"]
+__all__ = ["API", "EXTRA", "SUMO_SERIES", "SumoSession", "binary", "check_config", "import_api",
+           "read_xml"]
 
 API = Literal["libsumo", "traci"]
 #: The optional extra that installs SUMO.
@@ -90,6 +91,39 @@ def _truthy(text: str | None) -> bool:
     return str(text).strip().lower() in ("true", "1", "yes", "on", "x")
 
 
+def read_xml(path: str | os.PathLike[str], option: str, expected: str, kind: str) -> ET.Element:
+    """The root element of a SUMO XML file, or a one-line error naming the option.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    option : str
+        The command-line option that gave it (e.g. ``"--sumocfg"``), for the message.
+    expected : str
+        What was expected when the file is missing (e.g. ``"a SUMO configuration file"``).
+    kind : str
+        What was expected when it does not parse (e.g. ``"a SUMO configuration (XML)"``).
+
+    Returns
+    -------
+    xml.etree.ElementTree.Element
+        The document's root.
+
+    Raises
+    ------
+    StringStabError
+        The file is missing or is not well-formed XML.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise StringStabError(f"{option}: expected {expected}; {str(p)!r} does not exist")
+    try:
+        return ET.parse(p).getroot()
+    except (ET.ParseError, OSError) as e:
+        raise StringStabError(f"{option} {p}: expected {kind}; {e}") from e
+
+
 def check_config(sumocfg: str | os.PathLike[str], dt: float) -> None:
     """Refuse a ``.sumocfg`` whose step length is not ``dt`` or that uses the Euler update.
 
@@ -104,12 +138,7 @@ def check_config(sumocfg: str | os.PathLike[str], dt: float) -> None:
         A missing or unreadable file, a step that differs from ``dt``, or no ballistic update.
     """
     path = Path(sumocfg)
-    if not path.is_file():
-        raise StringStabError(f"--sumocfg: expected a SUMO configuration file; {str(path)!r} does not exist")
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as e:
-        raise StringStabError(f"--sumocfg {path}: expected a SUMO configuration (XML); {e}") from e
+    root = read_xml(path, "--sumocfg", "a SUMO configuration file", "a SUMO configuration (XML)")
     values = {el.tag: el.get("value") for el in root.iter()}
     step = float(values.get("step-length") or 1.0)
     if abs(step - dt) > 1e-9 * max(1.0, dt):
