@@ -107,13 +107,19 @@ class Progress:
             self._last = now
             self._line(now)
 
-    def _line(self, now: float) -> None:
-        el = now - self._t0
-        share = self.done / self.total if self.total else 1.0
+    def timing(self, now: float | None = None) -> str:
+        """``"<elapsed> elapsed, ~<left> left"`` (the time left from this call's pace; omitted
+        before the first unit and once all are done)."""
+        el = (time.perf_counter() if now is None else now) - self._t0
         rate = (self.done - self.initial) / el if el > 0 else 0.0  # this call's pace
-        eta = f", ~{duration((self.total - self.done) / rate)} left" if rate > 0 else ""
+        eta = (f", ~{duration((self.total - self.done) / rate)} left"
+               if rate > 0 and self.done < self.total else "")
+        return f"{duration(el)} elapsed{eta}"
+
+    def _line(self, now: float) -> None:
+        share = self.done / self.total if self.total else 1.0
         print(f"{self.desc}: {self.done}/{self.total} {self.unit} ({100 * share:.0f}%), "
-              f"{duration(el)} elapsed{eta}", file=self.stream, flush=True)
+              f"{self.timing(now)}", file=self.stream, flush=True)
 
     def close(self) -> None:
         """Close the bar, or print the last line (the time it took) when lines were printed or

@@ -22,7 +22,7 @@ from typing import Any
 
 from ..errors import StringStabError
 from ..io import atomic_write_text, check_output_dir, dumps_json
-from ..progress import Progress, duration
+from ..progress import Progress
 from .records import POINT_FORMAT, read_records, record_path
 from .spec import SweepSpec
 from .tasks import run_point
@@ -60,12 +60,9 @@ class _Progress:
         if first or rec["status"] != "done" or now - self.last >= self.every or self.n == self.total:
             what = "done" if rec["status"] == "done" else f"FAILED ({rec.get('error')})"
             name = rec["label"] or " ".join(f"{k}={v}" for k, v in rec.get("varied", {}).items())
-            el = now - self.t0
-            rate = (self.p.done - self.p.initial) / el if el > 0 else 0.0
-            left = f", ~{duration((self.total - self.n) / rate)} left" if rate > 0 and self.n < self.total else ""
             self.log(f"[{self.n}/{self.total}] point {rec['id']} {name} {what} in "
                      f"{rec['seconds']:.1f} s on {rec['worker']}; {self.failed} failed, "
-                     f"{duration(el)} elapsed{left}")
+                     f"{self.p.timing(now)}")
             self.last = now
 
     def close(self) -> None:
