@@ -76,6 +76,33 @@ def integer(name: str, text: Any, minimum: int) -> int:
     return v
 
 
+def add_vehicle_arguments(p: argparse.ArgumentParser, *, defaults: bool = True) -> None:
+    """``--tau --delta --headway --standstill --length`` of a simulated platoon's vehicles.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add them to.
+    defaults : bool, optional
+        True: τ, δ and T* default to the toolkit's values; False: to None (the command fills
+        them, e.g. from a trained policy), the help still naming the toolkit's value.
+    """
+    from ..constants import STANDSTILL
+
+    def default(v: float) -> float | None:
+        return v if defaults else None
+
+    p.add_argument("--tau", type=float, default=default(DEFAULT_TAU),
+                   help=f"actuator lag, s (default {DEFAULT_TAU})")
+    p.add_argument("--delta", type=float, default=default(DEFAULT_DELTA),
+                   help=f"communication delay, s (default {DEFAULT_DELTA})")
+    p.add_argument("--headway", type=float, default=default(DEFAULT_HEADWAY),
+                   help=f"desired time headway T*, s (default {DEFAULT_HEADWAY})")
+    p.add_argument("--standstill", type=float, default=STANDSTILL,
+                   help=f"standstill spacing l0, m (default {STANDSTILL:g})")
+    p.add_argument("--length", type=float, default=5.0, help="vehicle length, m (default 5)")
+
+
 def add_model_arguments(p: argparse.ArgumentParser) -> None:
     """``--tau --delta --headway`` (numbers or ``LO:HI`` intervals) and ``--sample-time``."""
     p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S|LO:HI",

@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, STANDSTILL, TTC_STAR
+from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
-from ._common import add_limit_arguments, checked_leaders, limits_from_args
+from ..params import check_params
+from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, limits_from_args
 
 __all__ = ["DEFAULT_GAINS", "add_parser", "parse_gains", "run"]
 
@@ -69,14 +69,7 @@ def add_parser(sub: Any) -> None:
                         "'stringstab identify' (with --vehicle POS) for every follower")
     p.add_argument("--vehicle", type=int, default=None, metavar="POS",
                    help="with --from: the platoon position of the fitted vehicle (default: the only one)")
-    p.add_argument("--tau", type=float, default=DEFAULT_TAU, help=f"actuator lag, s (default {DEFAULT_TAU})")
-    p.add_argument("--delta", type=float, default=DEFAULT_DELTA,
-                   help=f"communication delay, s (default {DEFAULT_DELTA})")
-    p.add_argument("--headway", type=float, default=DEFAULT_HEADWAY,
-                   help=f"desired time headway T*, s (default {DEFAULT_HEADWAY})")
-    p.add_argument("--standstill", type=float, default=STANDSTILL,
-                   help=f"standstill spacing l0, m (default {STANDSTILL:g})")
-    p.add_argument("--length", type=float, default=5.0, help="vehicle length, m (default 5)")
+    add_vehicle_arguments(p)
     p.add_argument("--dt", type=float, default=DT,
                    help=f"simulation step, s, at most tau and delta (default {DT:g})")
     p.add_argument("--duration", type=float, default=None, help="keep only the first seconds of the leader")

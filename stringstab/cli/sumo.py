@@ -30,8 +30,8 @@ HELP = "run certified and learned controllers inside Eclipse SUMO (check, run, c
 
 
 def _case_arguments(p: argparse.ArgumentParser, *, policy: bool) -> None:
-    from ..constants import DT, STANDSTILL
-    from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+    from ..constants import DT
+    from ._common import add_vehicle_arguments
     from .simulate import DEFAULT_GAINS
 
     p.add_argument("--leader", default="udds", metavar="SPEC",
@@ -47,14 +47,7 @@ def _case_arguments(p: argparse.ArgumentParser, *, policy: bool) -> None:
         g.add_argument("--policy", metavar="RUN",
                        help="a run folder of 'stringstab train' (gain policies: each executed "
                             "gain is certified; tau, delta, T* and dt are the policy's)")
-    p.add_argument("--tau", type=float, default=None, help=f"actuator lag, s (default {DEFAULT_TAU})")
-    p.add_argument("--delta", type=float, default=None,
-                   help=f"communication delay, s (default {DEFAULT_DELTA})")
-    p.add_argument("--headway", type=float, default=None,
-                   help=f"desired time headway T*, s (default {DEFAULT_HEADWAY})")
-    p.add_argument("--standstill", type=float, default=STANDSTILL,
-                   help=f"standstill spacing l0, m (default {STANDSTILL:g})")
-    p.add_argument("--length", type=float, default=5.0, help="vehicle length, m (default 5)")
+    add_vehicle_arguments(p, defaults=False)  # None: the policy's, else the toolkit's
     p.add_argument("--dt", type=float, default=None,
                    help=f"step of the controller and of SUMO, s (default {DT:g})")
     p.add_argument("--duration", type=float, default=None, metavar="S",
