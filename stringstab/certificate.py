@@ -205,7 +205,7 @@ def _peak(
 
 
 def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, ka: npt.ArrayLike,
-                   tau: float, delta: float, headway: float) -> Array:
+                   tau: npt.ArrayLike, delta: npt.ArrayLike, headway: npt.ArrayLike) -> Array:
     """|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
 
     g (:mod:`stringstab.margin`) is evaluated from its coefficients, so an excess of 1e-20,
@@ -222,8 +222,8 @@ def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, k
         Frequencies in rad/s (broadcast against the gains).
     kx, kv, ka : array_like
         The gains.
-    tau, delta, headway : float
-        τ, δ, T* in s.
+    tau, delta, headway : float or array_like
+        τ, δ, T* in s (broadcast against ω and the gains).
 
     Returns
     -------
@@ -239,7 +239,8 @@ def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, k
     True
     """
     w = np.asarray(omega, dtype=float)
-    kx, kv, ka = (np.asarray(k, dtype=float) for k in (kx, kv, ka))
+    kx, kv, ka, tau, delta, headway = (np.asarray(k, dtype=float)
+                                       for k in (kx, kv, ka, tau, delta, headway))
     co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
     gv = _margin.g_from_coefficients(w, co, delta)
     re_d = kx - w * w
@@ -250,7 +251,7 @@ def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, k
     return np.asarray(np.where(d2 > 0, out, np.inf))
 
 
-def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float,
+def _violation_peak(kx: Array, kv: Array, ka: Array, tau: Any, delta: Any, headway: Any,
                     Om: Array, cand: Array) -> tuple[Array, Array]:
     """max over ω of |Γ(jω)|² − 1 (:func:`excess_squared`) and where, for not-certified rows.
 
@@ -258,9 +259,12 @@ def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, h
     ω = √(−Ψ3/(2g₂)), which can be 10⁻⁷ rad/s), at the candidates ``cand`` (the peak of
     :func:`_peak` and the branch and bound's witness, where g < 0 was proven) and at that
     small-ω estimate, then refined on a log scale.  Reporting only: the verdict is the
-    branch and bound's.
+    branch and bound's.  τ, δ, T* are floats or one value per row (the robust certificate's
+    witness members).
     """
     n = kx.size
+    tau, delta, headway = (np.asarray(v, dtype=float) for v in (tau, delta, headway))
+    prm = tuple(col(v) if v.ndim else v for v in (tau, delta, headway))
     rows = np.arange(n)
     Om = np.maximum(Om, 1.0)
     co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
@@ -270,7 +274,7 @@ def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, h
         w_small = np.where((psi3 < 0) & (g2 > 0), np.sqrt(-psi3 / (2.0 * g2)), 0.0)
     u = np.linspace(-12.0, 0.0, 241)
     W = np.concatenate([col(Om) * 10.0 ** u[None, :], cand, col(w_small)], axis=1)
-    E = excess_squared(W, col(kx), col(kv), col(ka), tau, delta, headway)
+    E = excess_squared(W, col(kx), col(kv), col(ka), *prm)
     E = np.where(np.isnan(E) | (W <= 0), -np.inf, E)
     j = np.argmax(E, axis=1)
     best_w, best = W[rows, j], E[rows, j]
@@ -278,7 +282,7 @@ def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, h
     v = np.linspace(-1.0, 1.0, 9)
     for _ in range(12):
         Wl = (best_w[:, None] * 10.0 ** (step[:, None] * v[None, :]))
-        El = excess_squared(Wl, col(kx), col(kv), col(ka), tau, delta, headway)
+        El = excess_squared(Wl, col(kx), col(kv), col(ka), *prm)
         El = np.where(np.isnan(El), -np.inf, El)
         k = np.argmax(El, axis=1)
         better = El[rows, k] > best

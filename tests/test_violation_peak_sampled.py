@@ -24,11 +24,12 @@ TAU, DELTA, T = 0.1, 0.2, 1.1
 DPS = 60
 
 
-def _excess_mp(theta, kx, kv, ka, H, tau=TAU, delta=DELTA, T=T):
+def _excess_mp(theta, kx, kv, ka, H, tau=TAU, delta=DELTA, T=T, tau_prev=None):
     """|H(e^{jθ})|² − 1 in 60 digits from the exact discretisation of [Δp, Δv, a_i, a_p]."""
     with mpmath.workdps(DPS):
         f = mpmath.mpf
-        tau, tp, T, H, delta = f(tau), f(tau), f(T), f(H), f(delta)
+        tp = f(tau if tau_prev is None else tau_prev)
+        tau, T, H, delta = f(tau), f(T), f(H), f(delta)
         kx, kv, ka = f(kx), f(kv), f(ka)
         A = mpmath.zeros(6, 6)
         A[0, 1], A[0, 2] = 1, -T
@@ -122,3 +123,41 @@ def test_every_not_certified_schur_row_reports_an_excess():
 
 def test_the_table_shows_the_excess():
     assert "sup_gain_excess" in [c.key for c in sampled.TABLE_COLUMNS]
+
+
+@pytest.mark.parametrize("H", [None, 0.1])
+@pytest.mark.parametrize("kv, ka", [(1.3422768660010966, -0.8724886905418314),
+                                    (0.9058944412494818, -0.5399709459657642)])
+def test_robust_witness_reports_its_excess(H, kv, ka):
+    """A box whose worst member has Ψ3 just below 0: the robust row reports the witness
+    member's sup gain − 1 > 0 where it is attained (60-digit truth at that member)."""
+    kx = _just_below_psi3_zero(kv, ka, 1e-10)
+    r = ss.certify(kx, kv, ka, tau=(TAU, TAU * 1.001), delta=(DELTA, DELTA), headway=(T, T),
+                   sample_time=H)
+    assert r.verdict == "not_certified" and r.stable
+    assert r.sup_gain_excess > 0 and r.witness_omega > 0
+    reported = r.sup_gain_excess * (2 + r.sup_gain_excess)
+    if H is None:
+        from test_violation_peak import _excess_mp as continuous_excess_mp
+
+        truth = continuous_excess_mp(r.witness_omega, kx, kv, ka, tau=r.witness_tau,
+                                     delta=r.witness_delta, T=r.witness_headway)
+    else:
+        truth = _excess_mp(r.witness_theta, kx, kv, ka, H, tau=r.witness_tau,
+                           delta=r.witness_delta, T=r.witness_headway,
+                           tau_prev=r.witness_tau_prev)
+    assert truth > 0 and reported == pytest.approx(truth, rel=1e-4)
+    assert r.as_dict()["sup_gain_excess"] == pytest.approx(r.sup_gain_excess)
+
+
+@pytest.mark.parametrize("H", [None, 0.1])
+def test_every_not_certified_stable_robust_row_reports_an_excess(H):
+    k = np.random.default_rng(8).uniform(-2.0, 2.0, (3, 150))
+    b = ss.certify_batch(*k, tau=(0.1, 0.12), delta=(0.15, 0.2), headway=(1.0, 1.1),
+                         sample_time=H)
+    ex = b.columns()["sup_gain_excess"]
+    viol = (b.verdict == "not_certified") & b.stable
+    assert viol.sum() > 10
+    assert (ex[viol] > 0).all() and (b.witness_omega[viol] > 0).all()
+    assert (ex[b.verdict == "certified"] == 0).all()
+    assert np.isinf(ex[(b.verdict == "not_certified") & ~b.stable]).all()
