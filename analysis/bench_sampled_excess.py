@@ -3,7 +3,8 @@
 Times :func:`stringstab.sampled.certify_sampled_batch` on 20,000 random triples in [−2, 2]³
 (τ = 0.1, δ = 0.2, T* = 1.1, H = 0.1) with the violation-peak search of not-certified Schur
 rows, and in the same run with that search replaced by a no-op (the code before it), and
-prints the ratio and the machine load.  Run: ``.venv/bin/python analysis/bench_sampled_excess.py``.
+prints the ratio and the machine load; then, on rows whose Ψ3 is just below 0, how many
+report sup|H| = 1.0 at θ = 0 without the search and how many have an excess > 0 with it.  Run: ``.venv/bin/python analysis/bench_sampled_excess.py``.
 """
 
 from __future__ import annotations
@@ -46,5 +47,41 @@ def main(n: int = 20_000, repeats: int = 3) -> None:
           f"min excess over violating rows {new.sup_gain_excess[viol].min():.3g}")
 
 
+
+def near_zero(n: int = 86, H: float = 0.1) -> None:
+    """Rows whose Ψ3 is just below 0 (k_x a relative 1e-10 past the root, random k_v, k_a):
+    how many report sup|H| = 1.0 at θ = 0, and how many have sup_gain_excess > 0 and θ > 0."""
+    from scipy.optimize import brentq
+
+    from stringstab.margin import coefficients
+
+    def psi3(kx: float, kv: float, ka: float) -> float:
+        c = coefficients(kx, kv, ka, tau=0.1, delta=0.2, headway=1.1)
+        return float(c.b + c.cx)
+
+    rng = np.random.default_rng(86)
+    rows: list[tuple[float, float, float]] = []
+    while len(rows) < n:
+        kv, ka = rng.uniform(-2.0, 2.0, 2)
+        try:
+            x0 = brentq(psi3, 1e-3, 2.0, args=(kv, ka), xtol=1e-15)
+        except ValueError:
+            continue
+        rows += [(x, kv, ka) for x in (x0 * (1 + 1e-10), x0 * (1 - 1e-10)) if psi3(x, kv, ka) < 0]
+    k = np.array(rows[:n]).T
+    kw = dict(tau=0.1, delta=0.2, headway=1.1, sample_time=H)
+    with mock.patch.object(sampled, "_violation_peak", _no_search):
+        old = sampled.certify_sampled_batch(*k, **kw)
+    new = sampled.certify_sampled_batch(*k, **kw)
+    v = (new.verdict == "not_certified") & new.schur
+    print(f"Ψ3 just below 0, H = {H}: {n} rows, {int(v.sum())} not certified and Schur; "
+          f"without the search {int((v & (old.sup_gain == 1.0) & (old.peak_theta == 0)).sum())} "
+          f"report sup|H| = 1.0 at θ = 0; with it {int((v & (new.sup_gain_excess > 0)).sum())} "
+          f"have sup_gain_excess > 0 and {int((v & (new.peak_theta > 0)).sum())} θ_peak > 0 "
+          f"(excess from {new.sup_gain_excess[v].min():.2g} to {new.sup_gain_excess[v].max():.2g})")
+
+
 if __name__ == "__main__":
     main()
+    for h in (0.05, 0.1, 0.2):
+        near_zero(H=h)

@@ -64,6 +64,7 @@ import numpy.typing as npt
 
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max
 from .criteria import hurwitz_bands
+from .excess import violation_peak as _violation_peak_continuous
 from .frequency import gain_squared, margin_g_coefficients
 from .io.results import TableColumn
 from .margin import curvature_bound, separable, tail_bound
@@ -255,8 +256,6 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
     out["sup_gain_excess"] = sup - 1.0
     small = np.flatnonzero((v == _NOT) & sure & (sup - 1.0 < _EXCESS_SEARCH))
     if small.size:
-        from .certificate import _violation_peak as _violation_peak_continuous
-
         t, d, h = (out[k][small] for k in ("tau", "delta", "headway"))
         co = margin_g_coefficients(kx[small], kv[small], ka[small], tau=t, delta=d, headway=h)
         Om = tail_bound(*(np.broadcast_to(np.asarray(c, float), small.shape) for c in co))
