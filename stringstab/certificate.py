@@ -684,10 +684,12 @@ def _continuous_batch(
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
         e1 = e2 / (1.0 + np.sqrt(1.0 + np.maximum(e2, 0.0)))  # sup|Γ| − 1
-        take = e1 >= excess[viol]
+        # the candidates include the direct peak, so the search's value replaces the direct
+        # |Γ| − 1, whose last bits are round-off when it is tiny (2.2e-16 for a 1e-20 excess)
+        take = (e1 > 0) | (e1 >= excess[viol])
         excess[viol] = np.where(take, e1, excess[viol])
         peak_w[viol] = np.where(take, w_e, peak_w[viol])
-        sup[viol] = np.maximum(sup[viol], 1.0 + excess[viol])
+        sup[viol] = np.where(take, 1.0 + e1, sup[viol])
     excess = np.where(hz_sure, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")
