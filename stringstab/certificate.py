@@ -57,6 +57,7 @@ from . import margin as _margin
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
+from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
 from .io.results import TableColumn, columns_from_records
 from .margin import tail_bound
@@ -202,90 +203,6 @@ def _peak(
                                 headway=headway),
         best_w, best, Om / (W.shape[1] - 1))
     return np.sqrt(best), best_w
-
-
-def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, ka: npt.ArrayLike,
-                   tau: float, delta: float, headway: float) -> Array:
-    """|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
-
-    g (:mod:`stringstab.margin`) is evaluated from its coefficients, so an excess of 1e-20,
-    which |Γ|² computed directly rounds to exactly 1, keeps its sign and its digits.  Near
-    ω = 0, g(ω) = Ψ3 + g₂ω² + O(ω⁴) with g₂ = a − c_x δ²/2 − c_v δ and |D(0)|² = k_x², so
-
-    .. math:: |Γ(jω)|^2 = 1 − \\frac{Ψ_3}{k_x^2} ω^2 − \\frac{g_2 k_x^2 − Ψ_3 d_1}{k_x^4} ω^4 + …
-
-    (d₁ the ω² coefficient of |D|²): Ψ3 < 0 makes |Γ| > 1 on a neighbourhood of 0.
-
-    Parameters
-    ----------
-    omega : array_like
-        Frequencies in rad/s (broadcast against the gains).
-    kx, kv, ka : array_like
-        The gains.
-    tau, delta, headway : float
-        τ, δ, T* in s.
-
-    Returns
-    -------
-    ndarray
-        |Γ(jω)|² − 1 (``inf`` where D(jω) = 0).
-
-    Examples
-    --------
-    >>> float(excess_squared(0.0, 1.0, 0.5, 0.2, 0.1, 0.2, 1.1))
-    0.0
-    >>> bool(np.isclose(excess_squared(2.0, 0.9, -0.5, 1.1, 0.1, 0.2, 1.1),
-    ...                 gain_squared(2.0, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1) - 1))
-    True
-    """
-    w = np.asarray(omega, dtype=float)
-    kx, kv, ka = (np.asarray(k, dtype=float) for k in (kx, kv, ka))
-    co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
-    gv = _margin.g_from_coefficients(w, co, delta)
-    re_d = kx - w * w
-    im_d = w * (kv + headway * kx - tau * w * w)
-    d2 = re_d * re_d + im_d * im_d
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        out = -(w * w) * gv / d2
-    return np.asarray(np.where(d2 > 0, out, np.inf))
-
-
-def _violation_peak(kx: Array, kv: Array, ka: Array, tau: float, delta: float, headway: float,
-                    Om: Array, cand: Array) -> tuple[Array, Array]:
-    """max over ω of |Γ(jω)|² − 1 (:func:`excess_squared`) and where, for not-certified rows.
-
-    Searched on a logarithmic grid from 10⁻¹² Ω to Ω (a violation from Ψ3 < 0 sits near
-    ω = √(−Ψ3/(2g₂)), which can be 10⁻⁷ rad/s), at the candidates ``cand`` (the peak of
-    :func:`_peak` and the branch and bound's witness, where g < 0 was proven) and at that
-    small-ω estimate, then refined on a log scale.  Reporting only: the verdict is the
-    branch and bound's.
-    """
-    n = kx.size
-    rows = np.arange(n)
-    Om = np.maximum(Om, 1.0)
-    co = _gen.margin_coefficients(kx, kv, ka, tau, delta, headway)
-    _t2, a, b, cx, cv = (np.broadcast_to(np.asarray(c, float), (n,)) for c in co)
-    psi3, g2 = b + cx, a - cx * delta * delta / 2.0 - cv * delta
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w_small = np.where((psi3 < 0) & (g2 > 0), np.sqrt(-psi3 / (2.0 * g2)), 0.0)
-    u = np.linspace(-12.0, 0.0, 241)
-    W = np.concatenate([col(Om) * 10.0 ** u[None, :], cand, col(w_small)], axis=1)
-    E = excess_squared(W, col(kx), col(kv), col(ka), tau, delta, headway)
-    E = np.where(np.isnan(E) | (W <= 0), -np.inf, E)
-    j = np.argmax(E, axis=1)
-    best_w, best = W[rows, j], E[rows, j]
-    step = np.full(n, 0.05)  # in log10(ω)
-    v = np.linspace(-1.0, 1.0, 9)
-    for _ in range(12):
-        Wl = (best_w[:, None] * 10.0 ** (step[:, None] * v[None, :]))
-        El = excess_squared(Wl, col(kx), col(kv), col(ka), tau, delta, headway)
-        El = np.where(np.isnan(El), -np.inf, El)
-        k = np.argmax(El, axis=1)
-        better = El[rows, k] > best
-        best = np.where(better, El[rows, k], best)
-        best_w = np.where(better, Wl[rows, k], best_w)
-        step = step / 3.0
-    return best, best_w
 
 
 # ---------------------------------------------------------------------------
@@ -767,10 +684,12 @@ def _continuous_batch(
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
         e1 = e2 / (1.0 + np.sqrt(1.0 + np.maximum(e2, 0.0)))  # sup|Γ| − 1
-        take = e1 >= excess[viol]
+        # the candidates include the direct peak, so the search's value replaces the direct
+        # |Γ| − 1, whose last bits are round-off when it is tiny (2.2e-16 for a 1e-20 excess)
+        take = (e1 > 0) | (e1 >= excess[viol])
         excess[viol] = np.where(take, e1, excess[viol])
         peak_w[viol] = np.where(take, w_e, peak_w[viol])
-        sup[viol] = np.maximum(sup[viol], 1.0 + excess[viol])
+        sup[viol] = np.where(take, 1.0 + e1, sup[viol])
     excess = np.where(hz_sure, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")

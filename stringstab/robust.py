@@ -64,6 +64,7 @@ import numpy.typing as npt
 
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max
 from .criteria import hurwitz_bands
+from .excess import violation_peak as _violation_peak_continuous
 from .frequency import gain_squared, margin_g_coefficients
 from .io.results import TableColumn
 from .margin import curvature_bound, separable, tail_bound
@@ -80,6 +81,7 @@ from .sampled import (
     _peak,
     _schur_terms,
     _spread,
+    _violation_peak,
     split_delay,
 )
 from .verdicts import CERTIFIED as CERTIFIED_CODE
@@ -114,6 +116,7 @@ __all__ = [
 Array = npt.NDArray[np.float64]
 _CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
 _SLACK = ROUNDOFF_SLACK
+_EXCESS_SEARCH = 1e-4  # not-certified rows with sup gain − 1 below this get the log search
 _SCHUR_RTOL = 1e-12
 
 
@@ -250,8 +253,32 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
         sup[need], out["omega"][need] = _member_peak_continuous(
             kx[need], kv[need], ka[need], out["tau"][need], out["delta"][need],
             out["headway"][need], w[need])
+    out["sup_gain_excess"] = sup - 1.0
+    small = np.flatnonzero((v == _NOT) & sure & (sup - 1.0 < _EXCESS_SEARCH))
+    if small.size:
+        t, d, h = (out[k][small] for k in ("tau", "delta", "headway"))
+        co = margin_g_coefficients(kx[small], kv[small], ka[small], tau=t, delta=d, headway=h)
+        Om = tail_bound(*(np.broadcast_to(np.asarray(c, float), small.shape) for c in co))
+        e2, we = _violation_peak_continuous(kx[small], kv[small], ka[small], t, d, h, Om,
+                                 np.stack([out["omega"][small], w[small]], axis=1))
+        _take_excess(out, sup, small, e2, we, "omega")
     out["sup_gain"] = sup
     return out
+
+
+def _take_excess(out: dict[str, Any], sup: Array, rows: npt.NDArray[np.intp], e2: Array, at: Array,
+                 key: str) -> None:
+    """Report sup gain − 1 from |Γ|² − 1 (or |H|² − 1) searched without cancellation.
+
+    The search's candidates include the direct peak, so its value replaces the direct
+    gain − 1 (whose last bits are round-off at this size) unless it found nothing above 1.
+    """
+    e1 = e2 / (1.0 + np.sqrt(1.0 + np.maximum(e2, 0.0)))  # sup gain − 1
+    ex = out["sup_gain_excess"]
+    take = (e1 > 0) | (e1 >= ex[rows])
+    ex[rows] = np.where(take, e1, ex[rows])
+    out[key][rows] = np.where(take, at, out[key][rows])
+    sup[rows] = np.where(take, 1.0 + e1, sup[rows])
 
 
 def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array, h: Array,
@@ -538,9 +565,22 @@ def _robust_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *, hete
         ng = 65 + 8 * int(mm)
         th_grid = np.broadcast_to(np.linspace(0.0, np.pi, ng), (idx.size, ng))
         sup[idx], theta[idx] = _peak(co, int(mm), ka[idx], th_grid, theta[idx])
-    return {"verdict": status, "stable": sure, "margin": margin, "theta": theta,
-            "omega": theta / H, "tau": tau_w, "tau_prev": taup_w, "delta": d_w, "headway": h_w,
-            "n_evals": n_evals, "sup_gain": sup}
+    out = {"verdict": status, "stable": sure, "margin": margin, "theta": theta,
+           "tau": tau_w, "tau_prev": taup_w, "delta": d_w, "headway": h_w,
+           "n_evals": n_evals, "sup_gain_excess": sup - 1.0}
+    small_ = (status == _NOT) & sure & need & (sup - 1.0 < _EXCESS_SEARCH)
+    for mm in np.unique(wit["m"][small_]):
+        idx = np.flatnonzero(small_ & (wit["m"] == mm))
+        e_i = wit["e"][idx]
+        cc = kv[idx] + h_w[idx] * kx[idx]
+        co = _coefficients(kx[idx], kv[idx], ka[idx], H=H, tau=(tau_w[idx], tau_w[idx]),
+                           tau_p=(taup_w[idx], taup_w[idx]), eps=(e_i, e_i), c=(cc, cc))
+        kappa = tau_w[idx] * taup_w[idx] / H**3
+        e2, th = _violation_peak(co, int(mm), kappa, np.stack([theta[idx], wit["theta"][idx]], 1))
+        _take_excess(out, sup, idx, e2, th, "theta")
+    out["omega"] = out["theta"] / H
+    out["sup_gain"] = sup
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -577,6 +617,11 @@ class RobustCertificate(SingleResult):
         Its frequency in rad/s (and in rad/sample when sampled; NaN otherwise).
     n_evals : int
         Evaluations used.
+    sup_gain_excess : float
+        ``sup_gain`` − 1 computed without cancellation: 0 when certified, > 0 when not
+        certified and stable (also when ``sup_gain`` rounds to 1.0: the witness member's
+        violation near ω → 0, the frequency then where it is attained), ``inf`` when the
+        witness member is not internally stable.
     """
 
     k_x: float
@@ -596,6 +641,7 @@ class RobustCertificate(SingleResult):
     witness_omega: float
     witness_theta: float
     n_evals: int = 0
+    sup_gain_excess: float = float("nan")
 
 
 #: The columns of the human table of robust certificates (``stringstab certify`` with an
@@ -605,6 +651,7 @@ TABLE_COLUMNS: list[TableColumn] = [
     TableColumn("stable", "stable"),
     TableColumn("verdict", "verdict"),
     TableColumn("sup gain at witness", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("sup gain-1", "sup_gain_excess", "%.3g", missing="inf"),
     TableColumn("ω[rad/s]", "witness.omega", "%.4g"),
     TableColumn("θ[rad/sample]", "witness.theta", "%.4g"),
     TableColumn("τ", "witness.tau", "%.4g"),
@@ -639,6 +686,7 @@ class RobustCertificateBatch(BatchResult):
     witness_omega: Array
     witness_theta: Array
     n_evals: npt.NDArray[np.int64]
+    sup_gain_excess: Array
 
     def __getitem__(self, i: int) -> RobustCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]
@@ -659,7 +707,8 @@ class RobustCertificateBatch(BatchResult):
         n = len(self)
         cols: dict[str, Any] = {
             "k_x": self.k_x, "k_v": self.k_v, "k_a": self.k_a, "stable": self.stable,
-            "verdict": self.verdict, "sup_gain": self.sup_gain, "margin": self.margin,
+            "verdict": self.verdict, "sup_gain": self.sup_gain,
+            "sup_gain_excess": self.sup_gain_excess, "margin": self.margin,
             "witness": {k: getattr(self, f"witness_{k}")
                         for k in ("tau", "tau_prev", "delta", "headway", "omega", "theta")},
             "sample_time": np.full(n, np.nan if self.sample_time is None else self.sample_time),
@@ -735,7 +784,7 @@ def certify_robust_batch(
     kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
     n = kx.size
     keys = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev", "delta",
-            "headway", "n_evals", "sup_gain")
+            "headway", "n_evals", "sup_gain", "sup_gain_excess")
     acc: dict[str, list[Array]] = {k: [] for k in keys}
     for sl in chunks(n, chunk, progress=progress, desc="certify (robust)"):
         if H is None:
@@ -759,6 +808,7 @@ def certify_robust_batch(
         witness_tau_prev=cat("tau_prev"), witness_delta=cat("delta"),
         witness_headway=cat("headway"), witness_omega=cat("omega"),
         witness_theta=cat("theta"), n_evals=cat("n_evals", np.int64),
+        sup_gain_excess=cat("sup_gain_excess"),
     )
 
 

@@ -68,6 +68,19 @@ def test_psi3_just_below_zero_reports_the_violation_near_zero(kv, ka, rel):
     assert _excess_mp(w, kx, kv, ka) == pytest.approx(-psi3 * w * w / kx**2, rel=1e-3)
 
 
+@pytest.mark.parametrize("kx, kv, ka", [
+    (1.5532784944662756, -0.07701199229574218, 0.14497970227924606),
+    (1.3304562740313015, 0.5738898165441055, -0.43620484406794624),
+])
+def test_a_rounded_direct_excess_does_not_replace_the_computed_one(kx, kv, ka):
+    # |Γ| − 1 from the direct search was 2.2e-16 (round-off) at an ω where the truth is ≤ 1e-20
+    # (once even negative); the excess computed without cancellation is the one reported
+    c = ss.certify(kx, kv, ka, tau=TAU, delta=DELTA, headway=T)
+    assert c.verdict == "not_certified" and c.hurwitz and _psi3(kx, kv, ka) < 0
+    e2 = _excess_mp(c.peak_omega, kx, kv, ka)
+    assert e2 > 0 and c.sup_gain_excess * (2 + c.sup_gain_excess) == pytest.approx(e2, rel=1e-4)
+
+
 def test_a_violation_away_from_zero_matches_a_fine_sweep():
     c = ss.certify(0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T)
     W = np.linspace(1e-4, 20.0, 400_001)
