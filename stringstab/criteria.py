@@ -72,6 +72,30 @@ def psi(
     Λ is evaluated from Ψ1-Ψ3 by its definition (eq 15) rather than from its expanded
     form (~4x slower in NumPy and no more accurate).
 
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of the controller u = k_x Δp + k_v Δv + k_a a_{i-1}(t − δ) (IDL eq 4):
+        k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : array_like
+        Actuator lag τ, s.
+    delta : array_like
+        Communication delay δ, s.
+    headway : array_like
+        Desired time headway T*, s.
+    source : {"derived", "printed"}
+        Which Ψ expressions to evaluate (see above).
+
+    Returns
+    -------
+    psi1, psi2, psi3, lam : ndarray
+        Ψ1, Ψ2, Ψ3 (IDL eqs 12-14) and Λ (eq 15), all of the broadcast shape of the inputs.
+
+    Raises
+    ------
+    ValueError
+        If ``source`` is neither ``"derived"`` nor ``"printed"``.
+
     Examples
     --------
     >>> [round(float(v), 6) for v in psi(1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1)]
@@ -97,6 +121,24 @@ def hurwitz_conditions(
     Generated from :func:`stringstab.symbolic.hurwitz_conditions`: k_x and
     k_v + (T* − τ)k_x (:data:`HURWITZ_LABELS`).  Works on arrays and on floats.
 
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Position gain k_x (1/s²) and velocity gain k_v (1/s).
+    k_a : array_like
+        Acceleration-feedforward gain (dimensionless); it does not enter the
+        denominator and is accepted for a uniform call.
+    tau : float
+        Actuator lag τ, s.
+    headway : float
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    tuple of ndarray or float
+        The values of the conditions, in the order of :data:`HURWITZ_LABELS`;
+        Γ is internally stable iff all are > 0 (given τ > 0).
+
     Examples
     --------
     >>> [float(c) for c in hurwitz_conditions(1.0, 0.5, tau=0.1, headway=1.1)]
@@ -107,6 +149,18 @@ def hurwitz_conditions(
 
 def hurwitz_gradients(*, tau: float, headway: float) -> Array:
     """∇_K of each Hurwitz condition (they are linear in K): one row per condition.
+
+    Parameters
+    ----------
+    tau : float
+        Actuator lag τ, s.
+    headway : float
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    ndarray, shape (n_conditions, 3)
+        Row j is ∂c_j/∂(k_x, k_v, k_a) of condition j of :func:`hurwitz_conditions`.
 
     Examples
     --------
@@ -119,7 +173,24 @@ def hurwitz_gradients(*, tau: float, headway: float) -> Array:
 
 def hurwitz_ok(k_x: float, k_v: float, k_a: float = 0.0, *, tau: float, headway: float,
                margin: float = 0.0) -> bool:
-    """Scalar form of :func:`hurwitz` for inner loops: every condition > ``margin``."""
+    """Scalar form of :func:`hurwitz` for inner loops: every condition > ``margin``.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        Gains (k_x in 1/s², k_v in 1/s, k_a dimensionless; k_a does not enter).
+    tau : float
+        Actuator lag τ, s.
+    headway : float
+        Desired time headway T*, s.
+    margin : float
+        Absolute amount each condition must exceed (0: strict inequalities).
+
+    Returns
+    -------
+    bool
+        True iff every Hurwitz condition of :func:`hurwitz_conditions` is > ``margin``.
+    """
     return all(c > margin for c in _gen.hurwitz_conditions(k_x, k_v, k_a, tau, 0.0, headway))
 
 
@@ -175,6 +246,22 @@ def hurwitz_bands(
     The certificates' internal-stability decision (:data:`HURWITZ_RTOL`): a triple in
     neither set is left inconclusive.
 
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Position gain k_x (1/s²) and velocity gain k_v (1/s), broadcast together.
+    tau : float
+        Actuator lag τ, s.
+    headway : float
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    sure, fail : ndarray of bool
+        ``sure``: Hurwitz with relative margin :data:`HURWITZ_RTOL`; ``fail``: not
+        Hurwitz even with the margin −:data:`HURWITZ_RTOL`.  A triple in neither is
+        within the band around the boundary.
+
     Examples
     --------
     >>> [v.tolist() for v in hurwitz_bands([1.0, -1.0, 0.0], 0.5, tau=0.1, headway=1.1)]
@@ -191,6 +278,21 @@ def hurwitz_margin(
     """Decay rate −max Re(p) over the poles p of Γ (> 0 iff internally stable).
 
     Computed as the eigenvalues of the companion matrices, vectorised.
+
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Position gain k_x (1/s²) and velocity gain k_v (1/s), broadcast together.
+    tau : float
+        Actuator lag τ, s.
+    headway : float
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    ndarray
+        −max Re(p) over the three roots of τs³ + s² + (k_v + T*k_x)s + k_x, in 1/s,
+        of the broadcast shape of the gains.
 
     Examples
     --------
@@ -308,6 +410,23 @@ def proposition1(
 
     ``source="derived"``: the corrected logic Ψ1 ≥ 0 ∧ Ψ3 ≥ 0 ∧ (Ψ2 ≥ 0 ∨ Λ ≤ 0);
     ``"printed"``: the printed (Ψ1, Ψ2, Ψ3 ≥ 0) ∨ Λ ≤ 0 (module docstring).
+
+    Parameters
+    ----------
+    psi1, psi2, psi3, lam : array_like
+        Ψ1, Ψ2, Ψ3 (IDL eqs 12-14) and Λ (eq 15), broadcast together, e.g. from :func:`psi`.
+    source : {"derived", "printed"}
+        Which logic to apply (see above).
+
+    Returns
+    -------
+    ndarray of bool
+        True where the (Taylor-truncated) criterion declares string stability.
+
+    Raises
+    ------
+    ValueError
+        If ``source`` is neither ``"derived"`` nor ``"printed"``.
 
     Examples
     --------
