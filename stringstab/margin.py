@@ -81,6 +81,23 @@ def coefficients(
 ) -> MarginCoefficients:
     """The coefficients (t2, a, b, cx, cv) of g (generated from the SymPy derivation).
 
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : array_like
+        Actuator lag τ, s.
+    delta : array_like
+        Communication delay δ, s.
+    headway : array_like
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    MarginCoefficients
+        t2 = τ², a = 1 − 2τc − k_a², b = c² − 2k_x − k_v², cx = 2k_xk_a, cv = 2k_vk_a with
+        c = k_v + T*k_x (module docstring), broadcast over the inputs.
+
     Examples
     --------
     >>> c = coefficients(1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1)
@@ -95,7 +112,25 @@ def coefficient_scales(
     k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> MarginCoefficients:
-    """Σ |term| of each coefficient: the scale of its round-off (≥ its absolute value)."""
+    """Σ |term| of each coefficient: the scale of its round-off (≥ its absolute value).
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : array_like
+        Actuator lag τ, s.
+    delta : array_like
+        Communication delay δ, s.
+    headway : array_like
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    MarginCoefficients
+        For each coefficient of :func:`coefficients`, the sum of the absolute values of
+        the terms it is computed from (a round-off error is a small multiple of it).
+    """
     kx, kv, ka = (np.asarray(k, dtype=float) for k in (k_x, k_v, k_a))
     return MarginCoefficients(*_gen.margin_coefficient_scales(kx, kv, ka, tau, delta, headway))
 
@@ -108,6 +143,20 @@ def separable(
     Returns ((c, h2, h0, cx, cv), their Σ |term| scales); only c depends on the parameters
     (on T*), so the minimum of g over a box of τ, δ, T* has a closed form
     (:mod:`stringstab.robust`).  Generated from the derivation (:func:`stringstab.codegen.margin_separable`).
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    headway : array_like
+        Desired time headway T*, s (the only parameter the split depends on).
+
+    Returns
+    -------
+    values : tuple
+        (c, h2, h0, cx, cv) with c = k_v + T*k_x; broadcast arrays.
+    scales : tuple
+        The Σ |term| round-off scale of each entry of ``values``.
 
     Examples
     --------
@@ -124,7 +173,22 @@ def separable(
 
 def g_from_coefficients(omega: ArrayLike, co: _Coefficients,
                         delta: ArrayLike) -> Array:
-    """g(ω) from its coefficients (broadcasting coefficient columns against a grid of ω)."""
+    """g(ω) from its coefficients (broadcasting coefficient columns against a grid of ω).
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequencies ω ≥ 0, rad/s.
+    co : MarginCoefficients or sequence of 5 array_like
+        (t2, a, b, cx, cv) from :func:`coefficients`, broadcast against ``omega``.
+    delta : array_like
+        Communication delay δ, s.
+
+    Returns
+    -------
+    ndarray
+        g(ω) = t2ω⁴ + aω² + b + cx cos δω − cv ω sin δω, of the broadcast shape.
+    """
     t2, a, b, cx, cv = co
     return np.asarray(_gen.margin_from_coefficients(np.asarray(omega, dtype=float), t2, a, b, cx, cv,
                                                     delta))
@@ -132,7 +196,26 @@ def g_from_coefficients(omega: ArrayLike, co: _Coefficients,
 
 def g_and_scale(omega: Array, co: _Coefficients,
                 scales: _Coefficients, delta: Any) -> tuple[Array, Array]:
-    """(g(ω), S(ω)) with S(ω) ≥ Σ |terms of g(ω)|: a round-off slack is a multiple of S."""
+    """(g(ω), S(ω)) with S(ω) ≥ Σ |terms of g(ω)|: a round-off slack is a multiple of S.
+
+    Parameters
+    ----------
+    omega : ndarray
+        Angular frequencies ω ≥ 0, rad/s.
+    co : MarginCoefficients or sequence of 5 array_like
+        (t2, a, b, cx, cv) from :func:`coefficients`.
+    scales : MarginCoefficients or sequence of 5 array_like
+        Their round-off scales from :func:`coefficient_scales`.
+    delta : array_like
+        Communication delay δ, s.
+
+    Returns
+    -------
+    gv : ndarray
+        g(ω).
+    sv : ndarray
+        S(ω) ≥ Σ |terms of g(ω)|, the scale of the round-off in ``gv``.
+    """
     t2, a, b, cx, cv = co
     st2, sa, sb, scx, scv = scales
     gv, sv = _gen.margin_and_scale(omega, t2, a, b, cx, cv, st2, sa, sb, scx, scv, delta)
@@ -144,6 +227,24 @@ def g(
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> Array:
     """g(ω) = (|D(jω)|² − |N(jω)|²)/ω², continuous at ω = 0 where g(0) = Ψ3.
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequencies ω ≥ 0, rad/s.
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : array_like
+        Actuator lag τ, s.
+    delta : array_like
+        Communication delay δ, s.
+    headway : array_like
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    ndarray
+        g(ω), broadcast over all inputs; |Γ(jω)| ≤ 1 (IDL eq 10) at ω > 0 iff g(ω) ≥ 0.
 
     Examples
     --------
@@ -160,6 +261,20 @@ def curvature_bound(r: ArrayLike, co: _Coefficients,
 
     For g = t2ω⁴ + aω² + b + cx cos δω − cv ω sin δω this is
     M = 12 t2 r² + 2|a| + |cx| δ² + |cv| (2δ + δ² r).
+
+    Parameters
+    ----------
+    r : array_like
+        Right end of the frequency interval [0, r], rad/s.
+    co : MarginCoefficients or sequence of 5 array_like
+        (t2, a, b, cx, cv) from :func:`coefficients`.
+    delta : array_like
+        Communication delay δ, s.
+
+    Returns
+    -------
+    ndarray
+        M, elementwise.
     """
     t2, a, b, cx, cv = co
     return np.asarray(_gen.margin_curvature_bound(r, t2, a, b, cx, cv, delta))
@@ -203,6 +318,19 @@ def newton_terms(omega: float, k_x: float, k_v: float, k_a: float,
     tuple
         (g, ∇_K g, ∂g/∂ω, ∇_K ∂g/∂ω, ∂²g/∂ω², ∇²_KK g) at ω, the vectors as arrays of
         shape (3,) and the Hessian (3, 3).
+
+    Parameters
+    ----------
+    omega : float
+        Angular frequency ω, rad/s.
+    k_x, k_v, k_a : float
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : float
+        Actuator lag τ, s.
+    delta : float
+        Communication delay δ, s.
+    headway : float
+        Desired time headway T*, s.
     """
     (gv, g0, g1, g2, gw, gw0, gw1, gw2, gww,
      hxx, hxv, hxa, hvv, hva, haa) = _gen.margin_newton(
@@ -217,6 +345,24 @@ def casadi_g(omegas: Sequence[Any], k_x: Any, k_v: Any, k_a: Any, tau: Any, delt
 
     The generated coefficients are built once and shared by every frequency (as in
     :func:`g_from_coefficients`), with ``casadi.cos``/``casadi.sin``.
+
+    Parameters
+    ----------
+    omegas : sequence
+        Frequencies ω_j, rad/s (floats or CasADi expressions).
+    k_x, k_v, k_a : float or casadi.SX or casadi.MX
+        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), typically symbols.
+    tau : float or CasADi expression
+        Actuator lag τ, s.
+    delta : float or CasADi expression
+        Communication delay δ, s.
+    headway : float or CasADi expression
+        Desired time headway T*, s.
+
+    Returns
+    -------
+    list
+        One CasADi expression g(ω_j; K) per entry of ``omegas``.
 
     Examples
     --------
@@ -240,6 +386,16 @@ def tail_coefficients(t2: ArrayLike, a: ArrayLike, b: ArrayLike, cx: ArrayLike,
 
     Each trigonometric term is bounded by its magnitude: cx cos δω ≥ −|cx|,
     −cv ω sin δω ≥ −|cv| ω; so A = max(−a, 0)/t2, B = |cv|/t2, C = max(|cx| − b, 0)/t2.
+
+    Parameters
+    ----------
+    t2, a, b, cx, cv : array_like
+        Coefficients of g (:func:`coefficients`); t2 = τ² must be > 0.
+
+    Returns
+    -------
+    A, B, C : ndarray
+        Non-negative coefficients of the quartic minorant, broadcast together.
     """
     A = np.maximum(np.negative(a), 0.0) / t2
     B = np.abs(cv) / t2
@@ -251,6 +407,16 @@ def tail_coefficients(t2: ArrayLike, a: ArrayLike, b: ArrayLike, cx: ArrayLike,
 
 def fujiwara_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     """Fujiwara's bound 2·max(√A, ∛B, (C/2)^¼) on the roots of ω⁴ − Aω² − Bω − C.
+
+    Parameters
+    ----------
+    A, B, C : array_like
+        Non-negative coefficients of ω⁴ − Aω² − Bω − C (:func:`tail_coefficients`).
+
+    Returns
+    -------
+    ndarray
+        An upper bound on the absolute value of every root (Fujiwara 1916), elementwise.
 
     Examples
     --------
@@ -315,6 +481,30 @@ def local_minima(K: ArrayLike, *, tau: float, delta: float, headway: float, thre
     (including the end point ω = 0) are zoomed into (a 9-point grid, shrunk ×4, six
     times) and those below ``threshold`` returned.  A heuristic to pick frequencies and
     detect violations; it never certifies anything.
+
+    Parameters
+    ----------
+    K : array_like, shape (3,)
+        The gains (k_x, k_v, k_a): k_x in 1/s², k_v in 1/s, k_a dimensionless.
+    tau : float
+        Actuator lag τ, s.
+    delta : float
+        Communication delay δ, s.
+    headway : float
+        Desired time headway T*, s.
+    threshold : float
+        Only refined minimisers with g below this value are returned.
+    n : int
+        Number of points of the initial grid.
+    max_minima : int
+        How many of the lowest grid minima are refined.
+
+    Returns
+    -------
+    gmin : float
+        The smallest value of g found (grid and refined points).
+    dips : list of float
+        The refined local minimisers ω (rad/s) at which g < ``threshold``.
 
     Examples
     --------
