@@ -313,12 +313,6 @@ def newton_terms(omega: float, k_x: float, k_v: float, k_a: float,
     The ``math``-module form of the generated derivatives (NumPy's per-call overhead
     costs more than the arithmetic at one frequency).
 
-    Returns
-    -------
-    tuple
-        (g, ∇_K g, ∂g/∂ω, ∇_K ∂g/∂ω, ∂²g/∂ω², ∇²_KK g) at ω, the vectors as arrays of
-        shape (3,) and the Hessian (3, 3).
-
     Parameters
     ----------
     omega : float
@@ -331,6 +325,12 @@ def newton_terms(omega: float, k_x: float, k_v: float, k_a: float,
         Communication delay δ, s.
     headway : float
         Desired time headway T*, s.
+
+    Returns
+    -------
+    tuple
+        (g, ∇_K g, ∂g/∂ω, ∇_K ∂g/∂ω, ∂²g/∂ω², ∇²_KK g) at ω, the vectors as arrays of
+        shape (3,) and the Hessian (3, 3).
     """
     (gv, g0, g1, g2, gw, gw0, gw1, gw2, gww,
      hxx, hxv, hxa, hvv, hva, haa) = _gen.margin_newton(
