@@ -151,6 +151,25 @@ def jerk_squared(accel: ArrayLike, dt: float, *, axis: int = -1) -> Array:
 
     Returns one sample fewer than ``accel`` along ``axis``.
 
+    Parameters
+    ----------
+    accel : array_like
+        Accelerations acc_t, m/s², sampled every ``dt`` along ``axis``.
+    dt : float
+        Sample time Δt > 0, s.
+    axis : int
+        The time axis.
+
+    Returns
+    -------
+    ndarray
+        c_t, m²/s⁶, one sample shorter than ``accel`` along ``axis``.
+
+    Raises
+    ------
+    StringStabError
+        If ``dt`` is not a finite number > 0.
+
     Examples
     --------
     >>> jerk_squared([0.0, 0.1, 0.3], 0.1).round(12).tolist()
@@ -163,6 +182,20 @@ def jerk_squared(accel: ArrayLike, dt: float, *, axis: int = -1) -> Array:
 def comfort_index(accel: ArrayLike, dt: float, *, axis: int = -1) -> float:
     """M_CI, the mean squared jerk over every vehicle and moment (IDL eq 34), m²/s⁶.
 
+    Parameters
+    ----------
+    accel : array_like
+        Accelerations, m/s², time along ``axis`` (any leading axes: vehicles, platoons).
+    dt : float
+        Sample time Δt > 0, s.
+    axis : int
+        The time axis.
+
+    Returns
+    -------
+    float
+        M_CI, the mean of :func:`jerk_squared` over every entry, m²/s⁶.
+
     Examples
     --------
     >>> round(comfort_index([[0.0, 0.1, 0.3], [0.0, 0.0, 0.0]], 0.1), 12)
@@ -173,6 +206,20 @@ def comfort_index(accel: ArrayLike, dt: float, *, axis: int = -1) -> float:
 
 def time_headway(gap: ArrayLike, speed: ArrayLike, *, v_min: float = V_MIN) -> Array:
     """Time headway h = gap / v (IDL eq 22), s; NaN where v ≤ ``v_min`` (standstill).
+
+    Parameters
+    ----------
+    gap : array_like
+        Bumper-to-bumper gap to the predecessor, m.
+    speed : array_like
+        The follower's speed v, m/s, broadcast with ``gap``.
+    v_min : float
+        Speeds at or below this (m/s) count as standstill.
+
+    Returns
+    -------
+    ndarray
+        h, s, of the broadcast shape; NaN at standstill.
 
     Examples
     --------
@@ -189,6 +236,16 @@ def efficiency_index(headway: ArrayLike) -> float:
     """M_effi, the mean time headway over every vehicle and moment where it is defined (eq 35), s.
 
     Returns NaN if h is nowhere defined (every vehicle always stopped).
+
+    Parameters
+    ----------
+    headway : array_like
+        Time headways h (:func:`time_headway`), s; NaN entries are ignored.
+
+    Returns
+    -------
+    float
+        M_effi, s, or NaN if no entry is finite.
 
     Examples
     --------
@@ -207,6 +264,21 @@ def damping_ratio(accel: ArrayLike, pred_accel: ArrayLike, *, axis: int = -1) ->
     vehicle's shifted accelerations, which is a typesetting error (see the module notes).
     m_p < 1: the follower's acceleration energy is smaller than its predecessor's.
 
+    Parameters
+    ----------
+    accel : array_like
+        The follower's accelerations acc^i, m/s², time along ``axis``.
+    pred_accel : array_like
+        Its predecessor's accelerations acc^{i−1} on the same time grid, m/s².
+    axis : int
+        The time axis.
+
+    Returns
+    -------
+    ndarray
+        m_p (dimensionless), the time axis removed; NaN or inf where the predecessor
+        never accelerates.
+
     Examples
     --------
     >>> float(damping_ratio([0.0, 0.5, -0.5], [0.0, 1.0, -1.0]))
@@ -223,6 +295,21 @@ def damping_ratios_from_energy(sum_sq_accel: ArrayLike) -> Array:
 
     ``sum_sq_accel`` has shape (..., N + 1) with vehicle 0 the leader.  NaN where a
     predecessor never accelerates (0/0), ``inf`` where only the follower does.
+
+    Parameters
+    ----------
+    sum_sq_accel : array_like, shape (..., N + 1)
+        Σ_t a_t² of each vehicle, m²/s⁴, vehicle 0 the leader.
+
+    Returns
+    -------
+    ndarray, shape (..., N)
+        m_p of followers 1..N relative to their predecessors.
+
+    Raises
+    ------
+    StringStabError
+        If the last axis has fewer than two vehicles.
 
     Examples
     --------
@@ -261,6 +348,16 @@ def platoon_damping_ratios(accel: ArrayLike) -> Array:
 
 def lss_index(m_p: ArrayLike) -> Array:
     """M_lss, the mean damping ratio over the followers (IDL eq 30), along the last axis.
+
+    Parameters
+    ----------
+    m_p : array_like
+        Damping ratios of the followers (:func:`damping_ratios_from_energy`), along the last axis.
+
+    Returns
+    -------
+    ndarray
+        M_lss, the last axis removed (a 0-d array for one platoon).
 
     Examples
     --------
@@ -317,6 +414,18 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
 def collision_count(gap: ArrayLike, *, axis: int = -1) -> npt.NDArray[np.int64]:
     """Number of collisions per series: entries into gap ≤ 0 (a run starting in collision counts).
 
+    Parameters
+    ----------
+    gap : array_like
+        Bumper-to-bumper gaps, m, time along ``axis``.
+    axis : int
+        The time axis.
+
+    Returns
+    -------
+    ndarray of int64
+        Number of entries into gap ≤ 0 per series (the time axis removed).
+
     Examples
     --------
     >>> collision_count([[1.0, 0.0, -1.0, 2.0, -0.5], [1.0, 1.0, 1.0, 1.0, 1.0]]).tolist()
@@ -342,6 +451,16 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
     Followers only (the leader is prescribed).  For a batch of platoons, per-vehicle lists are
     nested per platoon and the scalar indices pool every platoon.  Only the run's arrays are
     read (``sum_sq_accel``, ``gap``, ``speed``, ``accel``, ``gains``, ``params``, ...).
+
+    Parameters
+    ----------
+    result : stringstab.traffic.PlatoonResult
+        A simulated run (one platoon or a batch).
+    ttc_star : float
+        TTC threshold TTC* of TIT (IDL eqs 31-32), s.
+    certificate : bool
+        Compute M_fss (certifies every distinct gain triple in force; skipped also when
+        the actuator lag τ differs between vehicles).
 
     Returns
     -------
