@@ -90,6 +90,22 @@ def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "")
     The one check behind every step size, lag, margin and tolerance of the
     toolkit; ``unit`` (e.g. ``" s"``) is appended to the expectation.
 
+    Parameters
+    ----------
+    name : str
+        What the value is, for the error message.
+    value : object
+        Anything ``float()`` accepts.
+    allow_zero : bool
+        Accept 0 as well.
+    unit : str
+        Unit appended to the expectation in the message (e.g. ``" s"``).
+
+    Returns
+    -------
+    float
+        ``value`` as a float.
+
     Raises
     ------
     StringStabError
@@ -116,6 +132,18 @@ def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "")
 
 def count(name: str, value: Any) -> int:
     """``value`` as an int that is >= 1 (a number of vehicles, platoons, steps).
+
+    Parameters
+    ----------
+    name : str
+        What the value is, for the error message.
+    value : object
+        An int, or a number equal to an int.
+
+    Returns
+    -------
+    int
+        ``value`` as an int ≥ 1.
 
     Raises
     ------
@@ -153,6 +181,20 @@ def _finite(name: str, value: Any) -> float:
 def check_params(tau: Any, delta: Any, headway: Any) -> tuple[float, float, float]:
     """Validate τ > 0, δ ≥ 0, T* ≥ 0 and return them as floats.
 
+    Parameters
+    ----------
+    tau : object
+        Actuator lag τ, s (IDL eq 7); must be > 0.
+    delta : object
+        Communication delay δ, s (IDL eq 4); must be ≥ 0.
+    headway : object
+        Desired time headway T*, s (IDL eq 3); must be ≥ 0.
+
+    Returns
+    -------
+    tau, delta, headway : float
+        The checked values (each also within the magnitudes of :mod:`stringstab.ranges`).
+
     Raises
     ------
     StringStabError
@@ -176,6 +218,16 @@ def as_gains(
     k_x: Any, k_v: Any, k_a: Any
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Broadcast three gain arrays to a common shape and check they are finite.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
+
+    Returns
+    -------
+    k_x, k_v, k_a : ndarray of float64
+        The gains broadcast to one shape (read-only broadcast views).
 
     Raises
     ------
@@ -206,6 +258,16 @@ def as_gains(
 
 def sample_time(value: Any) -> float:
     """The sampling period H (``sample_time``) as a float: finite and > 0 s.
+
+    Parameters
+    ----------
+    value : object
+        The sampling period H, s (anything ``float()`` accepts).
+
+    Returns
+    -------
+    float
+        H, checked finite, > 0 and within the magnitudes of :mod:`stringstab.ranges`.
 
     Raises
     ------
@@ -280,6 +342,18 @@ def parse_interval(text: str, name: str = "value") -> Interval:
 
 def as_interval(value: Any, name: str = "value") -> Interval:
     """A number, a ``(lo, hi)`` pair or a ``"LO:HI"`` string as a checked ``(lo, hi)``.
+
+    Parameters
+    ----------
+    value : float, (float, float) or str
+        A number (a point interval), a ``(lo, hi)`` pair or ``"LO:HI"``.
+    name : str
+        What the interval is, for the error message.
+
+    Returns
+    -------
+    (float, float)
+        ``(lo, hi)`` with finite ends and lo ≤ hi.
 
     Raises
     ------
@@ -367,6 +441,19 @@ class Box:
 def check_box(tau: Any, delta: Any, headway: Any) -> Box:
     """Validate three numbers, pairs or ``"LO:HI"`` strings into a :class:`Box`.
 
+    Parameters
+    ----------
+    tau : float, (float, float) or str
+        Actuator lag τ or its interval, s.
+    delta : float, (float, float) or str
+        Communication delay δ or its interval, s.
+    headway : float, (float, float) or str
+        Desired time headway T* or its interval, s.
+
+    Returns
+    -------
+    Box
+
     Raises
     ------
     StringStabError
@@ -395,6 +482,25 @@ def parameter_model(tau: Any, delta: Any, headway: Any) -> Params | Box:
 
     Numbers are checked by :func:`check_params` (so their errors are the point ones); any
     interval (``(lo, hi)`` or ``"LO:HI"``) makes the whole a box, checked by :func:`check_box`.
+
+    Parameters
+    ----------
+    tau : float, (float, float) or str
+        Actuator lag τ or its interval, s.
+    delta : float, (float, float) or str
+        Communication delay δ or its interval, s.
+    headway : float, (float, float) or str
+        Desired time headway T* or its interval, s.
+
+    Returns
+    -------
+    Params or Box
+        ``Params`` if every value is a point, else the ``Box``.
+
+    Raises
+    ------
+    StringStabError
+        If a value is malformed or out of its range.
 
     Examples
     --------
