@@ -281,6 +281,19 @@ def margin_coefficients(
 
     The ω⁰ coefficient vanishes identically (Γ(0) = 1) and odd ones are zero.
 
+    Parameters
+    ----------
+    omega_order : int
+        Highest power of ω kept (even, ≥ 2); see :func:`margin_series`.
+    delay_order : int or None
+        ``None``: exact delay; an integer: Taylor polynomial of e^{−δs} of that order
+        (see :func:`margin_series`).
+
+    Returns
+    -------
+    dict of int to sympy.Expr
+        ``{k: c_k}`` for k = 2, 4, …, ``omega_order``, in the gains and τ, δ, T*.
+
     Examples
     --------
     >>> c = margin_coefficients()
@@ -330,6 +343,11 @@ def derived_psi(delay_order: int | None = None) -> tuple[sp.Expr, sp.Expr, sp.Ex
 def gradients(delay_order: int | None = None) -> dict[str, list[sp.Expr]]:
     """∇_K Ψ2 and ∇_K Ψ3 of the derived Ψ's (IDL eqs 25-26, derived).
 
+    Parameters
+    ----------
+    delay_order : int or None
+        See :func:`margin_series`; ``None`` (exact delay) by default.
+
     Returns
     -------
     dict
@@ -348,6 +366,17 @@ def routh_hurwitz(poly: sp.Poly) -> list[sp.Expr]:
     Used only when SymPy lacks ``Poly.hurwitz_conditions`` (added after SymPy 1.14);
     it evaluates the definition (leading principal minors of the Hurwitz matrix)
     with SymPy's own determinant, rather than a hand-written Routh table.
+
+    Parameters
+    ----------
+    poly : sympy.Poly
+        The polynomial a_0 sⁿ + a_1 sⁿ⁻¹ + … + a_n (in one generator), a_0 > 0.
+
+    Returns
+    -------
+    list of sympy.Expr
+        The factored determinants Δ_1, …, Δ_n of the leading principal minors of the
+        Hurwitz matrix; the polynomial is Hurwitz iff every one is > 0.
 
     References
     ----------
@@ -470,6 +499,18 @@ def parse_substitutions(text: str | None,
 
     ``allowed`` names the substitutable symbols (default :data:`SUBSTITUTABLE`; the sampled
     derivation adds ``tau_prev``).
+
+    Parameters
+    ----------
+    text : str or None
+        Comma-separated ``NAME=VALUE`` pairs; ``None`` or ``""`` gives no substitution.
+    allowed : dict of str to sympy.Symbol, optional
+        The names that may be substituted (default :data:`SUBSTITUTABLE`).
+
+    Returns
+    -------
+    dict of sympy.Symbol to sympy.Expr
+        Each symbol mapped to the exact rational of its value.
 
     Raises
     ------
