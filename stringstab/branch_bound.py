@@ -101,6 +101,16 @@ def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
 
     The outcome codes are chosen so that CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict
     codes 0, 1, 2; only PENDING is mapped (to inconclusive).
+
+    Parameters
+    ----------
+    status : ndarray of int8
+        Item outcomes of :func:`branch_and_bound` (CERTIFIED, VIOLATED, INCONCLUSIVE, PENDING).
+
+    Returns
+    -------
+    ndarray of int8
+        A copy with PENDING replaced by INCONCLUSIVE: verdict codes 0, 1, 2.
     """
     v = np.array(status, dtype=np.int8)
     v[v == PENDING] = INCONCLUSIVE
@@ -265,6 +275,28 @@ def zoom_max(
     ``f`` maps an (n, 9) array of points (clipped to [lo, hi]) to values (NaN counts as
     +inf, a pole on the axis); ``fx`` are the values at ``x`` and ``half`` the initial
     half-widths.  Returns the best values and their points.
+
+    Parameters
+    ----------
+    f : callable
+        Maps an (n, 9) array of points to an (n, 9) array of values.
+    x : ndarray, shape (n,)
+        Starting points (e.g. the best grid points).
+    fx : ndarray, shape (n,)
+        f at ``x``.
+    half : ndarray, shape (n,)
+        Initial half-widths of the search windows.
+    lo, hi : float
+        The points are clipped to [lo, hi].
+    rounds : int
+        Number of zoom rounds.
+
+    Returns
+    -------
+    best : ndarray, shape (n,)
+        The largest value found per row (never below ``fx``).
+    bx : ndarray, shape (n,)
+        Where it was found.
 
     Examples
     --------

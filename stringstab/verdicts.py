@@ -71,6 +71,16 @@ ROW_COLUMNS: tuple[TableColumn, ...] = (
 def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:
     """Verdict codes (0, 1, 2) as their names.
 
+    Parameters
+    ----------
+    codes : array_like of int
+        Verdict codes: 0 certified, 1 not certified, 2 inconclusive.
+
+    Returns
+    -------
+    ndarray of str
+        The names from :data:`VERDICTS`, of the shape of ``codes``.
+
     Examples
     --------
     >>> names([0, 2]).tolist()
@@ -80,12 +90,33 @@ def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:
 
 
 def num(x: float) -> float | None:
-    """``x`` as a float, or None when it is not finite (a JSON row's ``null``)."""
+    """``x`` as a float, or None when it is not finite (a JSON row's ``null``).
+
+    Parameters
+    ----------
+    x : float
+        Any real number.
+
+    Returns
+    -------
+    float or None
+        ``float(x)``, or None for NaN and ±inf.
+    """
     return float(x) if math.isfinite(x) else None
 
 
 def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
     """``n``, the count of each verdict and ``m_fss`` = certified / n (IDL eq 27, a fraction).
+
+    Parameters
+    ----------
+    verdict : ndarray of str
+        Verdict names (``"certified"``, ``"not_certified"``, ``"inconclusive"``).
+
+    Returns
+    -------
+    dict
+        ``n``, one count per verdict and ``m_fss`` (NaN when ``n`` is 0).
 
     Examples
     --------
@@ -100,6 +131,15 @@ def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
 def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
     """Refuse arrays where a single-triple function takes scalars.
 
+    Parameters
+    ----------
+    fn : str
+        Name of the single-triple function, for the message.
+    batch_fn : str
+        Name of the batch function to suggest instead.
+    **gains : object
+        The gains as passed (``k_x=..., k_v=..., k_a=...``); each must be a scalar.
+
     Raises
     ------
     StringStabError
@@ -112,7 +152,24 @@ def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
 
 
 def chunks(n: int, chunk: int, *, progress: bool = False, desc: str = "certify") -> Iterable[slice]:
-    """Consecutive slices of ``chunk`` rows covering ``range(n)`` (a tqdm bar with ``progress``)."""
+    """Consecutive slices of ``chunk`` rows covering ``range(n)`` (a tqdm bar with ``progress``).
+
+    Parameters
+    ----------
+    n : int
+        Number of rows.
+    chunk : int
+        Rows per slice (the last may be shorter).
+    progress : bool
+        Show a tqdm bar over the chunks.
+    desc : str
+        Label of the bar.
+
+    Yields
+    ------
+    slice
+        ``slice(s, min(s + chunk, n))`` for s = 0, chunk, 2·chunk, …
+    """
     starts: Iterable[int] = range(0, n, chunk)
     if progress:
         from tqdm.auto import tqdm
