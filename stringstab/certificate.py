@@ -107,7 +107,18 @@ _SLACK = ROUNDOFF_SLACK
 # Step 1, the tail bound, is :func:`stringstab.margin.tail_bound` (re-exported here).
 # ---------------------------------------------------------------------------
 def col(v: Array) -> Array:
-    """A 1-D array as a column, to broadcast against a frequency grid."""
+    """A 1-D array as a column, to broadcast against a frequency grid.
+
+    Parameters
+    ----------
+    v : ndarray, shape (n,)
+        One value per row (a coefficient, a parameter).
+
+    Returns
+    -------
+    ndarray, shape (n, 1)
+        A view of ``v`` as a column.
+    """
     return v[:, None]
 
 

@@ -29,7 +29,18 @@ Array = npt.NDArray[np.float64]
 
 
 def col(v: Array) -> Array:
-    """A 1-D array as a column, to broadcast against a frequency grid."""
+    """A 1-D array as a column, to broadcast against a frequency grid.
+
+    Parameters
+    ----------
+    v : ndarray, shape (n,)
+        One value per row (a coefficient, a parameter).
+
+    Returns
+    -------
+    ndarray, shape (n, 1)
+        A view of ``v`` as a column.
+    """
     return v[:, None]
 
 

@@ -99,6 +99,20 @@ def gain_squared(
     About twice as fast as ``gain(...)**2`` (no complex exponential); used by
     the certificate's peak search.
 
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequency ω, rad/s.
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), broadcast together.
+    tau, delta, headway : array_like
+        Actuator lag τ, delay δ and desired headway T*, s.
+
+    Returns
+    -------
+    ndarray
+        |Γ(jω)|² of the derived Γ (IDL eq 11), broadcast over the inputs.
+
     Examples
     --------
     >>> round(float(gain_squared(1.0, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)), 6)
@@ -120,6 +134,13 @@ def margin_g_coefficients(
 
     g(ω) = τ² ω⁴ + a ω² + b + 2 k_x k_a cos(δω) − 2 k_v k_a ω sin(δω), with
     c = k_v + T* k_x, a = 1 − 2τc − k_a², b = c² − 2k_x − k_v².
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), broadcast together.
+    tau, delta, headway : array_like
+        Actuator lag τ, delay δ and desired headway T*, s.
 
     Returns
     -------
