@@ -55,6 +55,29 @@ def format_results(
     :func:`stringstab.io.format_results`; the table shows the certificate's columns
     (:data:`stringstab.certificate.TABLE_COLUMNS`).
 
+    Parameters
+    ----------
+    records : sequence of mapping
+        One dict per gain triple (values: numbers, strings, lists, or one level of dicts).
+    fmt : {"table", "json", "csv"}
+        Output format.
+    params : mapping, optional
+        Run parameters (τ, δ, T*, ...): a header line of the table, a ``"params"`` object
+        in JSON, constant columns in CSV (unless a record already has that column).
+    summary : mapping, optional
+        Summary (e.g. :func:`stringstab.verdicts.verdict_summary`): lines under the table and
+        a ``"summary"`` object in JSON; not written in CSV.
+
+    Returns
+    -------
+    str
+        The rendered text.
+
+    Raises
+    ------
+    StringStabError
+        If ``fmt`` is not one of :data:`FORMATS`.
+
     Examples
     --------
     >>> print(format_results([{"k_x": 1.0, "verdict": "certified"}], "csv",
@@ -75,6 +98,13 @@ def format_results(
 
 def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
     """Write text to a path atomically (temporary file + rename) or to a text stream.
+
+    Parameters
+    ----------
+    text : str
+        The text to write.
+    dest : str, path-like or text stream
+        Destination file (replaced atomically) or an open text stream.
 
     Raises
     ------
@@ -97,5 +127,22 @@ def write_results(
     params: Mapping[str, Any] | None = None,
     summary: Mapping[str, Any] | None = None,
 ) -> None:
-    """Write :func:`format_results` text to a path (atomically) or a text stream."""
+    """Write :func:`format_results` text to a path (atomically) or a text stream.
+
+    Parameters
+    ----------
+    records : sequence of mapping
+        One dict per gain triple (see :func:`format_results`).
+    dest : str, path-like or text stream
+        Destination file (replaced atomically) or an open text stream.
+    fmt : {"table", "json", "csv"}
+        Output format.
+    params, summary : mapping, optional
+        As for :func:`format_results`.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown format or when the file cannot be written.
+    """
     write_text(format_results(records, fmt, params=params, summary=summary), dest)
