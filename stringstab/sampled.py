@@ -796,6 +796,17 @@ def schur_margins(
     :mod:`stringstab.tuning` asks each to be ≥ a margin).  Each is a polynomial of degree ≤ 2
     in the gains.
 
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Position gain k_x (1/s²) and velocity gain k_v (1/s), broadcast together.
+    tau : float
+        Actuator lag τ > 0, s.
+    headway : float
+        Desired time headway T* ≥ 0, s.
+    sample_time : float
+        Sampling period H > 0, s.
+
     Returns
     -------
     ndarray, shape (5,) + the gains' shape
@@ -825,7 +836,23 @@ def spectral_radius(
 ) -> Array:
     """max |root| of Δ(z) (< 1 iff Schur), from companion-matrix eigenvalues.
 
-    Parameters and errors as for :func:`schur`; returns an array of the gains' shape.
+    Raises :class:`~stringstab.errors.StringStabError` on bad input, as :func:`schur`.
+
+    Parameters
+    ----------
+    k_x, k_v : array_like
+        Position gain k_x (1/s²) and velocity gain k_v (1/s), broadcast together.
+    tau : float
+        Actuator lag τ > 0, s.
+    headway : float
+        Desired time headway T* ≥ 0, s.
+    sample_time : float
+        Sampling period H > 0, s.
+
+    Returns
+    -------
+    ndarray
+        The spectral radius max |z| over the three roots of Δ(z), of the gains' shape.
 
     Examples
     --------
@@ -1333,6 +1360,21 @@ def certify_sampled(
     sample_time: float, tau_prev: float | None = None,
 ) -> SampledCertificate:
     """Certify one gain triple for the sampled-data loop (see :func:`certify_sampled_batch`).
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        One gain triple of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless).
+    tau : float
+        Actuator lag τ > 0, s.
+    delta : float
+        Communication delay δ ≥ 0, s.
+    headway : float
+        Desired time headway T* ≥ 0, s.
+    sample_time : float
+        Sampling period H > 0 of every vehicle, s.
+    tau_prev : float, optional
+        The predecessor's lag, s (default τ, a homogeneous platoon).
 
     Returns
     -------
