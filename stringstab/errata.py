@@ -91,6 +91,19 @@ def proposition1_conditions(
     Printed (IDL Proposition 1): (Ψ1 ≥ 0 ∧ Ψ2 ≥ 0 ∧ Ψ3 ≥ 0) ∨ Λ ≤ 0.
     Corrected: the quadratic q(x) = Ψ1x² + Ψ2x + Ψ3 is ≥ 0 for all x ≥ 0 iff
     Ψ1 ≥ 0 ∧ Ψ3 ≥ 0 ∧ (Ψ2 ≥ 0 ∨ Λ ≤ 0).
+
+    Parameters
+    ----------
+    psi1, psi2, psi3, lam : sympy.Expr
+        Ψ1, Ψ2, Ψ3 (IDL eqs 12-14) and Λ = Ψ2² − 4Ψ1Ψ3 (eq 15).
+    printed : bool
+        True: the printed logic; False: the corrected one.
+
+    Returns
+    -------
+    sympy.Basic
+        The condition as a SymPy boolean (``Or``/``And`` of relations, or a literal
+        ``true``/``false`` when the relations evaluate).
     """
     if printed:
         return sp.Or(sp.And(psi1 >= 0, psi2 >= 0, psi3 >= 0), lam <= 0)

@@ -28,6 +28,16 @@ def show(value: object) -> str:
     NumPy scalars print as plain numbers (NumPy 2's ``repr`` gives ``np.float64(0.5)``), strings
     keep their quotes, sequences and arrays print their elements the same way.
 
+    Parameters
+    ----------
+    value : object
+        The value found (a number, string, NumPy scalar or array, list or tuple).
+
+    Returns
+    -------
+    str
+        Its rendering for the message.
+
     Examples
     --------
     >>> import numpy as np

@@ -317,6 +317,16 @@ def phi_functions(x: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
     for initial acceleration a and held command u; φ1 ≈ x, ψ2 ≈ x²/2, ψ3 ≈ x³/6 for
     small x (each computed without cancellation by :mod:`stringstab.sampled`).
 
+    Parameters
+    ----------
+    x : sympy.Expr
+        The dimensionless period x = H/τ (sampling period over actuator lag).
+
+    Returns
+    -------
+    phi1, psi2, psi3 : sympy.Expr
+        φ1, ψ2 and ψ3 of ``x``.
+
     Examples
     --------
     >>> [sp.series(f, sp.Symbol("x"), 0, 4).removeO() for f in phi_functions(sp.Symbol("x"))]
