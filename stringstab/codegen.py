@@ -482,7 +482,18 @@ def generate() -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Write (or with ``--check``, compare) ``stringstab/_generated.py``; returns the exit code."""
+    """Write (or with ``--check``, compare) ``stringstab/_generated.py``; returns the exit code.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Command-line arguments (default ``sys.argv[1:]``); ``--check`` compares only.
+
+    Returns
+    -------
+    int
+        0 when written or up to date; 1 with ``--check`` when the committed file is stale.
+    """
     ap = argparse.ArgumentParser(prog="python -m stringstab.codegen", description=__doc__.splitlines()[0])
     ap.add_argument("--check", action="store_true", help="exit 1 if the committed file is stale")
     args = ap.parse_args(argv)

@@ -19,6 +19,16 @@ __all__ = ["Progress", "duration"]
 def duration(seconds: float) -> str:
     """``seconds`` for people: ``42 s``, ``3 min 05 s``, ``1 h 02 min``.
 
+    Parameters
+    ----------
+    seconds : float
+        A duration, s (negative values count as 0; rounded to whole seconds).
+
+    Returns
+    -------
+    str
+        The duration in s, min and s, or h and min.
+
     Examples
     --------
     >>> duration(42.4), duration(185), duration(3725)

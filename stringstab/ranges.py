@@ -88,6 +88,21 @@ def check_magnitude(kind: str, value: Any, *, name: str | None = None) -> float:
 def sensible_warning(kind: str, value: Any, *, name: str | None = None) -> str | None:
     """A one-sentence warning when ``value`` is beyond the sensible range of ``kind``, else None.
 
+    Parameters
+    ----------
+    kind : str
+        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``, ``sample_time``,
+        ``duration``).
+    value : float
+        The number; NaN and ±inf give no warning (they are the parsers' to refuse).
+    name : str, optional
+        How to name the value in the sentence (default: the description in :data:`RANGES`).
+
+    Returns
+    -------
+    str or None
+        The warning, or None when |value| is within the sensible bound.
+
     Examples
     --------
     >>> sensible_warning("gain", 0.5) is None
