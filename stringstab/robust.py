@@ -818,6 +818,19 @@ def certify_robust(
 ) -> RobustCertificate:
     """Certify one gain triple over a parameter box (see :func:`certify_robust_batch`).
 
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        One gain triple of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless).
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        The box of actuator lag τ, delay δ and desired headway T*, s; a plain number is a
+        point interval.  τ_lo > 0, δ_lo ≥ 0, T*_lo ≥ 0.
+    sample_time : float, optional
+        H > 0, s, for the sampled-data loop; None (default) for continuous time.
+    heterogeneous : bool
+        Sampled only: let the predecessor's lag range over the τ box independently of the
+        follower's; False ties it to τ.
+
     Returns
     -------
     RobustCertificate
@@ -849,6 +862,31 @@ def check_robust(
     The decision of :func:`certify_robust_batch`; ``hurwitz`` is stability of every member,
     and the witness member (τ, τ_prev, δ, T*) and frequency (ω, and θ when sampled) of each
     triple are those of the batch.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), broadcast together.
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        The box of actuator lag τ, delay δ and desired headway T*, s; a plain number is a
+        point interval.
+    sample_time : float, optional
+        H > 0, s, for the sampled-data loop; None (default) for continuous time.
+    heterogeneous : bool
+        Sampled only: the predecessor's lag ranges over the τ box independently of the
+        follower's; False ties it to τ.
+    n_grid, max_rounds, max_intervals : int
+        Branch-and-bound budgets, as for :func:`certify_robust_batch`.
+
+    Returns
+    -------
+    Check
+        Verdict, stability, margin and witness (member and frequency) of each triple.
+
+    Raises
+    ------
+    StringStabError
+        On a malformed box, a bad sample time or bad gains.
 
     Examples
     --------
