@@ -356,7 +356,19 @@ class TaylorCriteria:
     type: npt.NDArray[np.int8]
 
     def row(self, i: Any) -> dict[str, Any]:
-        """The JSON object ``{"psi1","psi2","psi3","lambda","verdict","type"}`` of element i."""
+        """The JSON object ``{"psi1","psi2","psi3","lambda","verdict","type"}`` of element i.
+
+        Parameters
+        ----------
+        i : int or tuple of int
+            Index into the arrays.
+
+        Returns
+        -------
+        dict
+            Ψ1, Ψ2, Ψ3, Λ as floats, the verdict (``"stable"``/``"unstable"``) and the type
+            (``"I"``-``"IV"``).
+        """
         return {
             "psi1": float(self.psi1[i]),
             "psi2": float(self.psi2[i]),

@@ -426,13 +426,35 @@ class Box:
         return {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}
 
     def columns(self, n: int) -> dict[str, npt.NDArray[np.float64]]:
-        """``tau_lo, tau_hi, delta_lo, ...``: the box repeated on ``n`` result rows."""
+        """``tau_lo, tau_hi, delta_lo, ...``: the box repeated on ``n`` result rows.
+
+        Parameters
+        ----------
+        n : int
+            Number of result rows.
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``tau_lo``, ``tau_hi``, ``delta_lo``, ``delta_hi``, ``headway_lo``, ``headway_hi``
+            (s), each of length ``n``.
+        """
         return {f"{k}_{e}": np.full(n, float(v)) for k, iv in self.as_dict().items()
                 for e, v in zip(("lo", "hi"), iv)}
 
     @classmethod
     def of(cls, p: Params | Box) -> Box:
-        """The box of a :class:`Params` (a point box), or ``p`` itself."""
+        """The box of a :class:`Params` (a point box), or ``p`` itself.
+
+        Parameters
+        ----------
+        p : Params or Box
+            Point parameters or a box.
+
+        Returns
+        -------
+        Box
+        """
         if isinstance(p, Box):
             return p
         return cls((p.tau, p.tau), (p.delta, p.delta), (p.headway, p.headway))

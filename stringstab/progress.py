@@ -105,7 +105,13 @@ class Progress:
         return self._bar
 
     def update(self, n: int = 1) -> None:
-        """``n`` more units are done."""
+        """``n`` more units are done.
+
+        Parameters
+        ----------
+        n : int
+            Units just completed.
+        """
         self.done += n
         if not self.enabled:
             return
@@ -119,7 +125,18 @@ class Progress:
 
     def timing(self, now: float | None = None) -> str:
         """``"<elapsed> elapsed, ~<left> left"`` (the time left from this call's pace; omitted
-        before the first unit and once all are done)."""
+        before the first unit and once all are done).
+
+        Parameters
+        ----------
+        now : float, optional
+            The current ``time.perf_counter()`` reading (default: read it now).
+
+        Returns
+        -------
+        str
+            Elapsed time and, while work remains, the estimated time left.
+        """
         el = (time.perf_counter() if now is None else now) - self._t0
         rate = (self.done - self.initial) / el if el > 0 else 0.0  # this call's pace
         eta = (f", ~{duration((self.total - self.done) / rate)} left"

@@ -231,7 +231,18 @@ class BatchResult:
 
     @classmethod
     def of_single(cls, row: Any) -> Any:
-        """The batch of one row (so that a single result renders through :meth:`columns`)."""
+        """The batch of one row (so that a single result renders through :meth:`columns`).
+
+        Parameters
+        ----------
+        row : SingleResult
+            One triple's result, of class ``cls.SINGLE``.
+
+        Returns
+        -------
+        BatchResult
+            A batch of length 1 (fields in ``SHARED`` kept as they are).
+        """
         values = {}
         for f in dataclasses.fields(cls):  # type: ignore[arg-type]
             v = getattr(row, f.name)
