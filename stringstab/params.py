@@ -227,7 +227,8 @@ def as_gains(
     Returns
     -------
     k_x, k_v, k_a : ndarray of float64
-        The gains broadcast to one shape (read-only broadcast views).
+        The gains broadcast to one shape: the inputs themselves or broadcast views of
+        them (copy before writing).
 
     Raises
     ------
