@@ -91,6 +91,18 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
     With ``lazy``, only ``command`` (if any) is imported and fully registered; the others are
     listed with their :data:`HELP` line, which is all ``stringstab --help`` and argparse's
     choice check need.
+
+    Parameters
+    ----------
+    command : str, optional
+        The sub-command on the command line (None: not known or not given).
+    lazy : bool, default False
+        Import and register only ``command``; list the others by their help line.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``stringstab`` parser; each sub-command's parser sets ``func`` to its ``run``.
     """
     parser = _Parser(
         prog="stringstab",
@@ -114,7 +126,21 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``stringstab`` console script; returns the exit code."""
+    """Entry point of the ``stringstab`` console script; returns the exit code.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after the program name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The sub-command's exit code (0 when it returns None); 2 after a
+        :class:`~stringstab.errors.StringStabError` or running out of memory (one line on
+        stderr); 130 when interrupted; 0 when the output pipe closes early. argparse itself
+        exits with 2 on a malformed command line.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     for stream in (sys.stdout, sys.stderr):  # a file name of undecodable bytes prints, escaped
         try:

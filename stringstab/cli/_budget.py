@@ -42,6 +42,16 @@ def available_bytes() -> int:
 def human_bytes(n: float) -> str:
     """``n`` bytes in binary units, e.g. ``74.5 GiB``.
 
+    Parameters
+    ----------
+    n : float
+        A number of bytes.
+
+    Returns
+    -------
+    str
+        Whole bytes below 1 KiB, else one decimal in KiB ... PiB.
+
     Examples
     --------
     >>> human_bytes(80e9), human_bytes(512)

@@ -58,6 +58,25 @@ NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 def integer(name: str, text: Any, minimum: int) -> int:
     """A command-line integer >= ``minimum`` (a step budget, a seed, a count).
 
+    Parameters
+    ----------
+    name : str
+        The option, for the error message (e.g. ``"--steps"``).
+    text : object
+        The value as given (its ``str`` is parsed as a base-10 integer).
+    minimum : int
+        The smallest value accepted.
+
+    Returns
+    -------
+    int
+        The value.
+
+    Raises
+    ------
+    StringStabError
+        When it is not an integer or is below ``minimum``.
+
     Examples
     --------
     >>> integer("--steps", "200", 1)
@@ -104,7 +123,13 @@ def add_vehicle_arguments(p: argparse.ArgumentParser, *, defaults: bool = True) 
 
 
 def add_model_arguments(p: argparse.ArgumentParser) -> None:
-    """``--tau --delta --headway`` (numbers or ``LO:HI`` intervals) and ``--sample-time``."""
+    """``--tau --delta --headway`` (numbers or ``LO:HI`` intervals) and ``--sample-time``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The command's parser (the values are kept as strings; :func:`loop_params` checks them).
+    """
     p.add_argument("--tau", default=str(DEFAULT_TAU), metavar="S|LO:HI",
                    help=f"actuator lag τ in s, > 0, or an interval LO:HI (default: {DEFAULT_TAU})")
     p.add_argument("--delta", default=str(DEFAULT_DELTA), metavar="S|LO:HI",
@@ -119,7 +144,29 @@ def add_model_arguments(p: argparse.ArgumentParser) -> None:
 
 def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     """The loop asked for: (τ, δ, T*) as :class:`Params` or, with any ``LO:HI``, a :class:`Box`;
-    and the sample time H (None: continuous time), each checked."""
+    and the sample time H (None: continuous time), each checked.
+
+    Warns on stderr (one line each) for values beyond their sensible range.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        With ``tau``, ``delta``, ``headway`` (s, numbers or ``LO:HI``) and ``sample_time``
+        (s or None), as added by :func:`add_model_arguments`.
+
+    Returns
+    -------
+    model : Params or Box
+        The point (τ, δ, T*) or the box of intervals.
+    H : float or None
+        The sample time (s), None for the continuous-time loop.
+
+    Raises
+    ------
+    StringStabError
+        A value that is not a number or interval, out of its domain (τ > 0, δ ≥ 0, T* ≥ 0,
+        H > 0) or beyond the physical bound.
+    """
     values = (args.tau, args.delta, args.headway)
     if any(":" in str(v) for v in values):
         model: Params | Box = parameter_model(*(str(v) for v in values))
@@ -159,6 +206,18 @@ def warn_beyond_sensible(args: Any, values: list[tuple[str, float | None, str]])
 def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
     """τ, δ, T* (a number, or [lo, hi] for an interval) and the sample time, for outputs.
 
+    Parameters
+    ----------
+    model : Params or Box
+        The loop (from :func:`loop_params`).
+    H : float or None
+        The sample time (s); None for continuous time.
+
+    Returns
+    -------
+    dict
+        ``tau``, ``delta``, ``headway`` (s; a number, or [lo, hi]) and ``sample_time``.
+
     Examples
     --------
     >>> shown_params(Box((0.1, 0.5), (0.2, 0.2), (1.1, 1.1)), 0.1)
@@ -173,6 +232,15 @@ def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
 
 def check_horizon(H: float | None, table: GainTable) -> None:
     """Refuse a sample time longer than the time span of a gain time series (its ``t`` column).
+
+    Nothing is checked for continuous time or a table without (or with an empty) ``t``.
+
+    Parameters
+    ----------
+    H : float or None
+        The sample time (s).
+    table : GainTable
+        The gains read.
 
     Raises
     ------
@@ -192,7 +260,13 @@ def check_horizon(H: float | None, table: GainTable) -> None:
 
 
 def add_gain_arguments(p: argparse.ArgumentParser) -> None:
-    """Positional ``K_X,K_V,K_A`` triples and ``--file F``."""
+    """Positional ``K_X,K_V,K_A`` triples and ``--file F``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The command's parser (:func:`gains_from_args` reads the values).
+    """
     p.add_argument("triples", nargs="*", metavar="K_X,K_V,K_A",
                    help="gain triples, e.g. 0.9,-0.5,1.1 (or use --file)")
     p.add_argument("--file", "-f", metavar="F",
@@ -202,7 +276,18 @@ def add_gain_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_output_arguments(p: argparse.ArgumentParser,
                          formats: tuple[str, ...] = RESULT_FORMATS) -> None:
-    """``--format`` (default ``table``) and ``--out FILE`` of a command that writes results."""
+    """``--format`` (default ``table``) and ``--out FILE`` of a command that writes results.
+
+    The ``--format`` default is None, resolved later from ``--out``'s extension
+    (:func:`check_output`).
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The command's parser.
+    formats : tuple of str, default RESULT_FORMATS
+        The formats ``--format`` accepts.
+    """
     p.add_argument("--format", choices=formats, default=None,
                    help="output format (default: the --out file's extension, .json .csv "
                         ".parquet .npz, else table); parquet and npz need --out")
@@ -214,6 +299,23 @@ def check_output(args: Any) -> Path | None:
 
     Returns the path, or None for standard output; a binary ``--format`` needs ``--out``.
     Resolves ``args.format`` (:func:`resolve_format`) first.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        With ``format`` and ``out`` (:func:`add_output_arguments`); ``args.format`` is set to
+        the resolved format.
+
+    Returns
+    -------
+    Path or None
+        The checked ``--out`` path, or None for standard output.
+
+    Raises
+    ------
+    StringStabError
+        A binary format without ``--out``, conflicting ``--format`` and extension, or an
+        ``--out`` that cannot be written.
     """
     args.format = resolve_format(args.format, args.out, RESULT_FORMATS)
     if args.out is None:
@@ -274,7 +376,25 @@ def resolve_format(given: str | None, out: str | None, formats: tuple[str, ...],
 
 
 def gains_from_args(args: Any) -> GainTable:
-    """The gains given as triples or ``--file`` (exactly one of the two)."""
+    """The gains given as triples or ``--file`` (exactly one of the two).
+
+    A gain beyond the physical bound is refused; one beyond the sensible range gets a warning.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        With ``triples`` and ``file`` (:func:`add_gain_arguments`).
+
+    Returns
+    -------
+    GainTable
+        The gains k_x (1/s²), k_v (1/s), k_a, one row per triple or file row.
+
+    Raises
+    ------
+    StringStabError
+        Both or neither given, a malformed triple or file, or a gain beyond the physical bound.
+    """
     if args.triples and args.file:
         raise StringStabError(
             f"expected gain triples or --file, not both; got {len(args.triples)} triple(s) "
@@ -344,6 +464,17 @@ def add_limit_arguments(p: argparse.ArgumentParser, *, speed_max: float | None =
 
 def limits_from_args(args: Any) -> Any:
     """The :class:`~stringstab.traffic.Limits` of ``--v-max --a-min --a-max``, checked.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        With ``v_max`` (m/s), ``a_min`` and ``a_max`` (m/s²) as given
+        (:func:`add_limit_arguments`).
+
+    Returns
+    -------
+    Limits
+        The followers' speed and acceleration limits.
 
     Raises
     ------

@@ -71,7 +71,14 @@ Table 2; tau from Zhou et al. 2020). See docs/certify.md.
 """
 
 def add_parser(sub: Any) -> None:
-    """Register ``certify``."""
+    """Register ``certify``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "certify",
         help="certify gain triples K = [k_x, k_v, k_a] as string stable (exact delay)",
@@ -136,7 +143,20 @@ def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input."""
+    """Run ``certify``; returns 0 (all certified), 1 (some not) or raises on bad input.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab certify``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when every gain triple (or identified follower) is certified, 1
+        when some is not; bad input raises :class:`~stringstab.errors.StringStabError`
+        (exit 2 from :func:`stringstab.cli.main`) before anything is written.
+    """
     model, H = loop_params(args)
     order = _pade_order(args.pade_order)
     if args.method == "pade" and (H is not None or isinstance(model, Box)):

@@ -13,7 +13,14 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``compare``."""
+    """Register ``compare``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "compare",
         help="compare trained runs and baselines on held-out leaders (Table 4, Figs 6, 9, 11, 12)",
@@ -38,7 +45,20 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``compare``."""
+    """Run ``compare``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab compare``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the comparison ran; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     import time
 
     from ..io import OutputDir

@@ -9,7 +9,14 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``demo``."""
+    """Register ``demo``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     from ..demo import STEPS
 
     p = sub.add_parser(
@@ -28,7 +35,20 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``demo``."""
+    """Run ``demo``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab demo``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the demo ran; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..demo import STEPS, run_demo
     from ..errors import StringStabError, show
 

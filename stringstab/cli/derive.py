@@ -19,7 +19,14 @@ from ..io import atomic_write_text, check_output_file
 __all__ = ["add_parser", "run"]
 
 def add_parser(sub: Any) -> None:
-    """Register ``derive``."""
+    """Register ``derive``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "derive",
         help="derive Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions symbolically",
@@ -70,7 +77,20 @@ def _delay_order(text: str) -> int | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``derive``; ``--out`` is checked before any derivation."""
+    """Run ``derive``; ``--out`` is checked before any derivation.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab derive``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the derivation was written; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..derivation import derivation, sampled_derivation
     from ..params import positive
 

@@ -16,7 +16,14 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``evaluate``."""
+    """Register ``evaluate``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "evaluate",
         help="evaluate a trained policy on held-out leaders; certify every executed gain",
@@ -53,7 +60,21 @@ def _sizes(text: str) -> list[int]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``evaluate``."""
+    """Run ``evaluate``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab evaluate``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when every executed gain is certified and no vehicle collided (on
+        the episodes and platoon tests), 1 otherwise (always 1 for an acceleration
+        policy); bad input raises :class:`~stringstab.errors.StringStabError` (exit 2
+        from :func:`stringstab.cli.main`).
+    """
     import time
 
     from ..io import OutputDir

@@ -15,7 +15,14 @@ __all__ = ["add_parser", "run", "run_train", "run_verify"]
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``hcfs`` (with its sub-command ``verify``)."""
+    """Register ``hcfs`` (with its sub-commands ``verify`` and ``train``).
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     from ..hcfs.constants import BETA, PAPER_JERK_LIMIT
     from ..traffic.leaders import CYCLES, SYNTHETIC
 
@@ -109,7 +116,21 @@ def add_parser(sub: Any) -> None:
 
 
 def run_verify(args: argparse.Namespace) -> int:
-    """Run ``hcfs verify``: validate everything, simulate, check, write the report."""
+    """Run ``hcfs verify``: validate everything, simulate, check, write the report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab hcfs verify``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when no frame falsifies the theorem, the bound or the jerk-safe
+        guarantee, 1 otherwise; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     import time
 
     from ..hcfs.constants import DT
@@ -183,7 +204,20 @@ def run_verify(args: argparse.Namespace) -> int:
 
 
 def run_train(args: argparse.Namespace) -> int:
-    """Run ``hcfs train``: validate everything, train, write the run folder, compare."""
+    """Run ``hcfs train``: validate everything, train, write the run folder, compare.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab hcfs train``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when training finished and the run folder was written; bad input
+        raises :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..hcfs.constants import DT
     from ..hcfs.leaders import hcfs_leader
     from ..params import positive
@@ -260,5 +294,17 @@ def _check_new_folder(out: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Dispatch ``hcfs`` sub-commands."""
+    """Dispatch ``hcfs`` sub-commands.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab hcfs``.
+
+    Returns
+    -------
+    int
+        Exit code: that of :func:`run_train` (``hcfs train``) or :func:`run_verify`
+        (``hcfs verify``).
+    """
     return run_train(args) if args.hcfs_command == "train" else run_verify(args)

@@ -39,7 +39,14 @@ See docs/identify.md.
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``identify``."""
+    """Register ``identify``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "identify",
         help="identify and certify the car-following law of recorded vehicles (OpenACC, CSV, NGSIM)",
@@ -82,7 +89,20 @@ def _seconds(name: str, text: str) -> float:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``identify``; 0 when it ran, bad input raises (exit 2)."""
+    """Run ``identify``; 0 when it ran, bad input raises (exit 2).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab identify``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when it ran (whatever the verdicts); bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     import time
 
     from ..identify.logs import read_logs

@@ -56,7 +56,14 @@ tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See d
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``region``."""
+    """Register ``region``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "region",
         help="map the string-stable gains on a 2-D slice or a 3-D grid (figures + data)",
@@ -249,6 +256,18 @@ def run(args: argparse.Namespace) -> int:
     (:class:`stringstab.io.OutputDir`): the files of an earlier ``region`` run there are
     replaced, never mixed with the new ones.  The files are written by
     :func:`stringstab.plots.save_region_outputs` (two processes share the work).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab region``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the map and its files were written; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
     """
     import time
 

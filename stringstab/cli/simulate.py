@@ -30,7 +30,14 @@ DEFAULT_GAINS = "1.2,0.5,0.6"
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``simulate``."""
+    """Register ``simulate``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     from ..traffic.cycles import CYCLES
     from ..traffic.synthetic import SYNTHETIC
 
@@ -90,6 +97,16 @@ def add_parser(sub: Any) -> None:
 
 def parse_gains(text: str) -> tuple[float, float, float]:
     """``"k_x,k_v,k_a"`` → three finite floats (:func:`stringstab.io.parse_triple`).
+
+    Parameters
+    ----------
+    text : str
+        Three comma-separated numbers: k_x (1/s²), k_v (1/s), k_a.
+
+    Returns
+    -------
+    tuple of float
+        (k_x, k_v, k_a).
 
     Raises
     ------
@@ -167,7 +184,21 @@ def _from_identified(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``simulate``."""
+    """Run ``simulate``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab simulate``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the run was written without collision, 1 when some follower
+        collided (the outputs are still written); bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     import time
 
     from ..io import OutputDir

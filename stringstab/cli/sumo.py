@@ -59,7 +59,14 @@ def _case_arguments(p: argparse.ArgumentParser, *, policy: bool) -> None:
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``sumo`` and its sub-commands ``check``, ``run`` and ``cacc``."""
+    """Register ``sumo`` and its sub-commands ``check``, ``run`` and ``cacc``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "sumo", help=HELP,
         description="Drive vehicles of Eclipse SUMO (1.28, ballistic update, speed mode 0) with "
@@ -122,7 +129,19 @@ def add_parser(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Dispatch ``sumo check|run|cacc``."""
+    """Dispatch ``sumo check|run|cacc``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab sumo``.
+
+    Returns
+    -------
+    int
+        Exit code: that of :func:`run_check`, :func:`run_platoon` or :func:`run_cacc`;
+        130 when interrupted (SUMO stopped, nothing written).
+    """
     cmd = {"check": run_check, "run": run_platoon, "cacc": run_cacc}[args.sumo_command]
     try:
         return cmd(args)
@@ -211,7 +230,20 @@ def _case(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def run_check(args: argparse.Namespace) -> int:
-    """``sumo check``: toolkit vs SUMO on one case; exit 1 above the tolerance."""
+    """``sumo check``: toolkit vs SUMO on one case; exit 1 above the tolerance.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab sumo check``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the toolkit and SUMO agree within ``--tolerance``, 1
+        otherwise; bad input raises :class:`~stringstab.errors.StringStabError` (exit 2
+        from :func:`stringstab.cli.main`).
+    """
     from ..io import atomic_write_text, check_output_file, dumps_json
     from ..sumo.agreement import agreement
 
@@ -252,7 +284,20 @@ def _fmt(v: Any, spec: str, unit: str = "") -> str:
 
 
 def run_platoon(args: argparse.Namespace) -> int:
-    """``sumo run``: a platoon (or a scenario's vehicles) in SUMO, written like ``simulate``."""
+    """``sumo run``: a platoon (or a scenario's vehicles) in SUMO, written like ``simulate``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab sumo run``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the run was written; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..io import OutputDir
     from ..traffic.output import RUN_FILES, run_document, write_run
 
@@ -381,7 +426,20 @@ def _verdict(c: dict[str, Any]) -> str:
 
 
 def run_cacc(args: argparse.Namespace) -> int:
-    """``sumo cacc``: per-mode certificates of SUMO's CACC beside the measured amplification."""
+    """``sumo cacc``: per-mode certificates of SUMO's CACC beside the measured amplification.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab sumo cacc``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when the report was written; bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..io import atomic_write_text, check_output_file, dumps_json
     from ..sumo.cacc import NO_LAG_TAU, certify_modes, measure_platoon, read_vtype
     from ..traffic.leaders import leader_by_name

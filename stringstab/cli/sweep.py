@@ -26,7 +26,14 @@ With --scheduler, --out must be on a filesystem every worker sees. See docs/swee
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``sweep``."""
+    """Register ``sweep``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "sweep",
         help="run a study (a TOML sweep spec) as Dask tasks; resumable, one record per point",
@@ -60,7 +67,22 @@ def _terminate(signum: int, frame: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``sweep``; 0 when every point is done, 1 when some failed, 130 when interrupted."""
+    """Run ``sweep``; 0 when every point is done, 1 when some failed, 130 when interrupted.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab sweep``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when every point is done (or with ``--check``, after listing the
+        points), 1 when some point failed, 130 when interrupted (finished points are
+        kept; a rerun resumes); bad input raises
+        :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..io import check_output_dir
     from ..sweep import dask_client, load_spec, read_records, run_sweep
     from ..sweep.cluster import dashboard_address

@@ -13,7 +13,14 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``train``."""
+    """Register ``train``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     from ..rl.config import ALGOS, REPAIRS
 
     p = sub.add_parser(
@@ -57,7 +64,21 @@ BYTES_PER_ENV = 2048
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``train``."""
+    """Run ``train``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab train``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when training finished and the run folder was written, 130 when
+        interrupted (the folder holds a checkpoint to ``--resume`` from); bad input
+        raises :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     from ..rl.config import config_for
     from ..rl.train import check_run_folder, train
 

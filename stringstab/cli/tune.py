@@ -62,7 +62,14 @@ defaults: tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY
 
 
 def add_parser(sub: Any) -> None:
-    """Register ``tune``."""
+    """Register ``tune``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
+        added sets ``func`` to :func:`run`.
+    """
     p = sub.add_parser(
         "tune",
         help="repair gain triples that are not string stable (region growing or projection)",
@@ -142,7 +149,20 @@ def _integer(text: str | None, option: str) -> int | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``tune``; returns 0 (every output certified), 1 (some not) or raises on bad input."""
+    """Run ``tune``; returns 0 (every output certified), 1 (some not) or raises on bad input.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line of ``stringstab tune``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when every repaired gain is certified, 1 when some is not; bad
+        input raises :class:`~stringstab.errors.StringStabError` (exit 2 from
+        :func:`stringstab.cli.main`).
+    """
     model, H = loop_params(args)
     general = H is not None or isinstance(model, Box)
     if general and args.method != "projection":

@@ -62,6 +62,20 @@ def delayed(a: Array, delta: float, dt: float) -> Array:
 
     The simulator's default reading of a delay that is not a multiple of Δt
     (:class:`stringstab.traffic.Platoon`, ``fractional_delay="linear"``).
+
+    Parameters
+    ----------
+    a : ndarray
+        Signal sampled every ``dt`` from t_0 (here an acceleration, m/s²).
+    delta : float
+        Delay δ (s), ≥ 0; need not be a multiple of ``dt``.
+    dt : float
+        Sample time Δt (s), > 0.
+
+    Returns
+    -------
+    ndarray
+        The delayed signal, same length as ``a``.
     """
     q = delta / dt
     n = math.floor(q + 1e-9)

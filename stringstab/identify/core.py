@@ -180,6 +180,24 @@ class IdentifyResult:
 def statement(point_verdict: str, boot: Sequence[str], at_bound: Sequence[str] = ()) -> str:
     """The verdict worded no more confidently than the bootstrap allows.
 
+    Parameters
+    ----------
+    point_verdict : str
+        Verdict of the point fit: ``"certified"``, ``"not_certified"`` or ``"inconclusive"``
+        (only worded when there is no bootstrap).
+    boot : sequence of str
+        Verdicts of the bootstrap refits; empty when no bootstrap was run.
+    at_bound : sequence of str, optional
+        Names of the parameters whose fit stopped at the bound of its search box; appended
+        as a caveat.
+
+    Returns
+    -------
+    str
+        "string stable in n of n bootstrap fits" / "not string stable in n of n ..." when all
+        refits agree, otherwise "inconclusive: p % of fits certified"; without a bootstrap, the
+        point verdict qualified as unmeasured.
+
     Examples
     --------
     >>> statement("not_certified", ["not_certified"] * 50)
@@ -209,7 +227,28 @@ def statement(point_verdict: str, boot: Sequence[str], at_bound: Sequence[str] =
 
 
 def block_counts(segments: Sequence[Segment], T: int, L: int, rng: np.random.Generator) -> Array:
-    """Per-sample multiplicities of one moving-block bootstrap draw (module docstring)."""
+    """Per-sample multiplicities of one moving-block bootstrap draw (module docstring).
+
+    Blocks never straddle two segments: a segment is drawn with probability proportional to
+    its number of block starts, then a start uniformly within it; blocks are drawn until as
+    many samples as the segments hold are covered (so the total may exceed it by < one block).
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+        The contiguous segments of the data (sample index ranges).
+    T : int
+        Number of samples of the whole record (length of the result).
+    L : int
+        Block length (samples); a segment shorter than ``L`` is drawn as one whole block.
+    rng : numpy.random.Generator
+        Source of the draw.
+
+    Returns
+    -------
+    ndarray
+        Length-``T`` float array: how many times each sample was drawn (0 outside segments).
+    """
     starts: list[tuple[int, int]] = []  # (first valid start, number of starts) per segment
     for s in segments:
         Ls = min(L, len(s))
@@ -482,7 +521,18 @@ def _quality(v: VehicleResult) -> list[str]:
 
 
 def simulated(v: VehicleResult) -> tuple[list[Array], list[Array]]:
-    """Simulated gap and speed of the point fit on each segment (for figures)."""
+    """Simulated gap and speed of the point fit on each segment (for figures).
+
+    Parameters
+    ----------
+    v : VehicleResult
+        An identified follower (its point fit must exist).
+
+    Returns
+    -------
+    gaps, speeds : list of ndarray
+        Per segment, the simulated gap (m) and speed (m/s) from the fitted initial states.
+    """
     f = v.fit
     assert f.theta is not None
     return simulate_segments(model_of(f.theta[:len(f.names)], f.names), v.data, f.initial)

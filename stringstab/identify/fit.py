@@ -91,7 +91,21 @@ class FollowerData:
 
 
 def model_of(theta: Array, names: tuple[str, ...]) -> FollowerModel:
-    """The :class:`FollowerModel` of a parameter vector (k_a = δ = 0 when not estimated)."""
+    """The :class:`FollowerModel` of a parameter vector (k_a = δ = 0 when not estimated).
+
+    Parameters
+    ----------
+    theta : ndarray
+        Parameter values, in the order of ``names``.
+    names : tuple of str
+        Their names, among ``k_x``, ``k_v``, ``k_a``, ``tau``, ``delta``, ``headway``,
+        ``standstill`` (all but ``k_a`` and ``delta`` required).
+
+    Returns
+    -------
+    FollowerModel
+        The follower law with those parameters.
+    """
     p = dict(zip(names, (float(x) for x in theta)))
     return FollowerModel(p["k_x"], p["k_v"], p.get("k_a", 0.0), p["tau"], p.get("delta", 0.0),
                          p["headway"], p["standstill"])
@@ -104,7 +118,20 @@ INITIAL_WINDOW = 20
 def initial_state(v: Array, dt: float) -> tuple[float, float]:
     """Initial speed and acceleration of a segment: the straight line fitted by least squares
     to its first :data:`INITIAL_WINDOW` speeds (a difference of two noisy GPS speeds would make
-    a0 err by ~σ√2/Δt, 0.7 m/s² for σ = 0.05 m/s at 10 Hz)."""
+    a0 err by ~σ√2/Δt, 0.7 m/s² for σ = 0.05 m/s at 10 Hz).
+
+    Parameters
+    ----------
+    v : ndarray
+        Measured speeds of the segment (m/s), sampled every ``dt``.
+    dt : float
+        Sample time (s).
+
+    Returns
+    -------
+    v0, a0 : float
+        The line's intercept (m/s) and slope (m/s²) at the segment's first sample.
+    """
     n = min(v.size, INITIAL_WINDOW)
     slope, icpt = np.polyfit(np.arange(n) * dt, v[:n], 1)
     return float(icpt), float(slope)
@@ -112,7 +139,18 @@ def initial_state(v: Array, dt: float) -> tuple[float, float]:
 
 def measured_initial(data: FollowerData) -> Array:
     """(s0, v0, a0) of each segment from the data: straight lines fitted to its first
-    :data:`INITIAL_WINDOW` gaps and speeds; the starting values of the fit's initial states."""
+    :data:`INITIAL_WINDOW` gaps and speeds; the starting values of the fit's initial states.
+
+    Parameters
+    ----------
+    data : FollowerData
+        The follower's measured record and its segments.
+
+    Returns
+    -------
+    ndarray
+        Shape (number of segments, 3): gap s0 (m), speed v0 (m/s), acceleration a0 (m/s²).
+    """
     out = np.empty((len(data.segments), 3))
     for i, s in enumerate(data.segments):
         n = min(len(s), INITIAL_WINDOW)
@@ -130,7 +168,22 @@ INITIAL_SLACK = (3.0, 1.0, 2.0)
 def simulate_segments(m: FollowerModel, data: FollowerData,
                       initial: Array | None = None) -> tuple[list[Array], list[Array]]:
     """Simulated gap and speed on every segment from its initial state (default the measured
-    one, :func:`measured_initial`)."""
+    one, :func:`measured_initial`).
+
+    Parameters
+    ----------
+    m : FollowerModel
+        The follower law simulated.
+    data : FollowerData
+        The record: the predecessor's speed (and acceleration, if measured) drive the follower.
+    initial : ndarray, optional
+        Initial (s0 m, v0 m/s, a0 m/s²) of each segment, any shape reshapable to (n, 3).
+
+    Returns
+    -------
+    gaps, speeds : list of ndarray
+        Per segment, the simulated gap (m) and speed (m/s).
+    """
     init = measured_initial(data) if initial is None else np.asarray(initial).reshape(-1, 3)
     gaps, speeds = [], []
     for s, (g0, v0, a0) in zip(data.segments, init):
@@ -160,7 +213,20 @@ def _residuals(x: Array, names: tuple[str, ...], data: FollowerData, sv: float, 
 
 def residual_weights(data: FollowerData, counts: Array) -> Array:
     """Per-residual weights √c_k from per-sample counts c_k (the block bootstrap's multiplicities),
-    in the order of the residual vector (speed then gap of each segment)."""
+    in the order of the residual vector (speed then gap of each segment).
+
+    Parameters
+    ----------
+    data : FollowerData
+        The record whose segments order the residuals.
+    counts : ndarray
+        Per-sample counts over the whole record (:func:`~stringstab.identify.core.block_counts`).
+
+    Returns
+    -------
+    ndarray
+        The weights, one per residual.
+    """
     parts = []
     for s in data.segments:
         c = np.sqrt(counts[s.start:s.stop])
@@ -351,7 +417,18 @@ def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
 
 
 def rms(x: Array) -> float:
-    """Root mean square."""
+    """Root mean square.
+
+    Parameters
+    ----------
+    x : ndarray
+        Values (any shape).
+
+    Returns
+    -------
+    float
+        √mean(x²); NaN for an empty array.
+    """
     return float(math.sqrt(float(np.mean(np.square(x))))) if x.size else math.nan
 
 

@@ -62,7 +62,19 @@ def _table_rows(res: IdentifyResult) -> list[dict[str, Any]]:
 
 
 def render(res: IdentifyResult) -> str:
-    """The per-follower table, its settings line, and a statement per follower below it."""
+    """The per-follower table, its settings line, and a statement per follower below it.
+
+    Parameters
+    ----------
+    res : IdentifyResult
+        The identification of one or more platoons.
+
+    Returns
+    -------
+    str
+        The text report (newline-terminated): the table, then per follower its statement and
+        notes as ``#`` lines, then the skipped inputs.
+    """
     rows = _table_rows(res)
     params = {"model": res.model, "sample_time": res.sample_time or "continuous",
               "bootstrap": res.settings["bootstrap"], "block_s": res.settings["block"]}
@@ -80,10 +92,20 @@ def render(res: IdentifyResult) -> str:
 def write_outputs(res: IdentifyResult, out: OutputDir, *, figures: bool = True) -> list[str]:
     """Write the JSON, CSV, Parquet (and figures) into a staged :class:`OutputDir`.
 
+    Parameters
+    ----------
+    res : IdentifyResult
+        The identification to write.
+    out : OutputDir
+        The staged output folder (the caller commits it).
+    figures : bool, default True
+        Also write, per follower, the fit and transfer-function figures and the platoon's
+        sup-gain figure (PNG).
+
     Returns
     -------
     list of str
-        The names written.
+        The names written into ``out`` so far (``out.written``).
     """
     out.write_json("identify.json", res.document())
     cols = columns_from_records(res.rows())

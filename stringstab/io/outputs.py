@@ -80,7 +80,15 @@ def check_output_file(path: str | os.PathLike[str], *, what: str = "output file"
     """Check that a file can be written at ``path``, before any work is done.
 
     The parent folder must exist (it is not created: a mistyped folder name should be an error,
-    not a new folder) and be writable; ``path`` itself must not be a folder.
+    not a new folder) and be writable; ``path`` itself must not be a folder. Writability is
+    probed by creating and removing a temporary file in the parent folder.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to be written later (it may or may not exist).
+    what : str, default "output file"
+        What the file is, as the first words of the error message.
 
     Returns
     -------
@@ -121,7 +129,20 @@ def check_output_file(path: str | os.PathLike[str], *, what: str = "output file"
 def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Path:
     """Check that a folder can be written (or created, with its parents) at ``path``.
 
-    Nothing is created: the nearest existing ancestor must be a writable folder.
+    Nothing is created: the nearest existing ancestor must be a writable folder (probed with a
+    temporary file, removed at once).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The folder to be written later (it may not exist yet).
+    what : str, default "output folder"
+        What the folder is, as the first words of the error message.
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`.
 
     Raises
     ------
@@ -162,6 +183,24 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
     ``safetensors``): the temporary name keeps ``path``'s suffix, so format detection works.
     If the block raises, the temporary file is removed and ``path`` is left as it was.
 
+    Parameters
+    ----------
+    path : str or path-like
+        The final file; its folder must exist (the temporary file is created there).
+    what : str, default "output file"
+        What the file is, as the first words of an error message.
+
+    Yields
+    ------
+    Path
+        The temporary path to write to; renamed onto ``path`` (with the umask's permissions)
+        when the block exits without an exception.
+
+    Raises
+    ------
+    StringStabError
+        When the temporary file cannot be created or renamed (the temporary file is removed).
+
     Examples
     --------
     >>> import tempfile, pathlib, numpy as np
@@ -191,7 +230,27 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str = "output file") -> Path:
-    """Write ``data`` to ``path`` atomically (temporary file + rename); returns the path."""
+    """Write ``data`` to ``path`` atomically (temporary file + rename); returns the path.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file written; its folder must exist.
+    data : bytes
+        The complete contents.
+    what : str, default "output file"
+        What the file is, as the first words of an error message.
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    StringStabError
+        When the file cannot be written (``path`` is then left as it was).
+    """
     with atomic_path(path, what=what) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
     return Path(path)
@@ -199,6 +258,20 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str =
 
 def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "output file") -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically (temporary file + rename); returns the path.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file written; its folder must exist.
+    text : str
+        The complete contents, encoded as UTF-8.
+    what : str, default "output file"
+        What the file is, as the first words of an error message.
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`.
 
     Examples
     --------

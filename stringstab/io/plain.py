@@ -18,6 +18,16 @@ def to_plain(x: Any) -> Any:
     Mappings keep their order (keys become strings), tuples become lists, dataclass-like objects
     with an ``as_dict()`` method are converted through it.
 
+    Parameters
+    ----------
+    x : object
+        Any value; containers are converted recursively.
+
+    Returns
+    -------
+    object
+        The JSON-ready value; objects of other types are returned unchanged.
+
     Examples
     --------
     >>> to_plain({"a": np.float64(0.5), "b": np.array([1, 2]), "c": float("nan"), 1: (True,)})
@@ -51,6 +61,18 @@ def to_plain(x: Any) -> Any:
 
 def dumps_json(doc: Any, *, indent: int | None = 2) -> str:
     """``doc`` as JSON text (UTF-8 characters kept, non-finite numbers as ``null``), newline-ended.
+
+    Parameters
+    ----------
+    doc : object
+        The document, converted by :func:`to_plain` first.
+    indent : int or None, default 2
+        Indentation of nested values; ``None`` writes one line.
+
+    Returns
+    -------
+    str
+        The JSON text, ending in a newline.
 
     Examples
     --------

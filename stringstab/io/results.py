@@ -245,6 +245,18 @@ def flatten_columns(columns: Columns, sep: str = "_") -> dict[str, npt.NDArray[A
 
     Missing values become NaN in float columns and ``""`` in string columns.
 
+    Parameters
+    ----------
+    columns : mapping
+        Ordered columns ``name → 1-D array`` (or ``name → {name → array}``), one length.
+    sep : str, default "_"
+        Joins a group's name and a column's name.
+
+    Returns
+    -------
+    dict of str to ndarray
+        The flat columns, groups expanded in place.
+
     Examples
     --------
     >>> flatten_columns({"k_x": [1.0], "taylor": {"verdict": ["stable"]}})
@@ -255,6 +267,16 @@ def flatten_columns(columns: Columns, sep: str = "_") -> dict[str, npt.NDArray[A
 
 def columns_from_records(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """Row records (dicts, one nesting level) as columns; keys missing in a record are None.
+
+    Parameters
+    ----------
+    records : sequence of mapping
+        One dict per row; a value that is a mapping is a group of columns.
+
+    Returns
+    -------
+    dict
+        Columns as lists (groups as dicts of lists), keys in order of first appearance.
 
     Examples
     --------
@@ -285,6 +307,16 @@ def records_from_columns(columns: Columns) -> list[dict[str, Any]]:
     """The rows of result columns as plain dicts (groups nested; NaN, inf and None as None).
 
     The inverse of :func:`columns_from_records`, and the rows of the ``json`` format.
+
+    Parameters
+    ----------
+    columns : mapping
+        Ordered columns ``name → 1-D array`` (or ``name → {name → array}``), one length.
+
+    Returns
+    -------
+    list of dict
+        One dict per row, values as plain Python values.
 
     Examples
     --------
@@ -679,6 +711,31 @@ def format_results(
 ) -> str:
     """The result columns as ``table``, ``json`` or ``csv`` text (see the module docstring).
 
+    Parameters
+    ----------
+    columns : mapping
+        Ordered columns ``name → 1-D array`` (or ``name → {name → array}``), one length.
+    fmt : {"table", "json", "csv"}, default "table"
+        The text format (binary formats go through :func:`write_results`).
+    params : mapping, optional
+        Settings of the run: a ``#`` header line of the table, the ``params`` object of the JSON,
+        the scalar ones repeated as trailing CSV columns.
+    summary : mapping, optional
+        Totals of the run: ``#`` footer lines of the table and the ``summary`` object of the
+        JSON (not written in CSV).
+    table : sequence of TableColumn, optional
+        The columns of the human table (with units and rounding); default all columns.
+
+    Returns
+    -------
+    str
+        The text, newline-terminated.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown format or ragged columns.
+
     Examples
     --------
     >>> print(format_results({"k_x": [1.0, 0.5], "verdict": ["certified", "not_certified"]},
@@ -707,6 +764,16 @@ def write_text(text: str, dest: str | os.PathLike[str] | IO[str], *,
     """Write text to a path atomically (temporary file + rename) or to a text stream.
 
     A stream that cannot encode a character (an ASCII terminal and ``Γ``) gets ``?`` instead.
+
+    Parameters
+    ----------
+    text : str
+        The text written.
+    dest : path or text stream
+        A path is written as UTF-8 through a temporary file and renamed; a stream is written to
+        (and not closed).
+    what : str, default "output file"
+        What the file is, as the first words of an error message.
 
     Raises
     ------

@@ -139,7 +139,20 @@ def pyplot() -> Any:
 
 
 def new_ax(ax: Any, figsize: tuple[float, float] = (6.4, 7.0)) -> Any:
-    """``ax``, or the axes of a new figure (constrained layout) when it is None."""
+    """``ax``, or the axes of a new figure (constrained layout) when it is None.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes or None
+        Axes to draw on.
+    figsize : tuple of float, default (6.4, 7.0)
+        Size (inches) of the new figure; ignored when ``ax`` is given.
+
+    Returns
+    -------
+    matplotlib Axes
+        ``ax`` itself, or the new figure's single axes.
+    """
     if ax is not None:
         return ax
     fig = pyplot().figure(figsize=figsize, layout="constrained")
@@ -147,7 +160,18 @@ def new_ax(ax: Any, figsize: tuple[float, float] = (6.4, 7.0)) -> Any:
 
 
 def categorical(colors: Sequence[str]) -> tuple[Any, Any]:
-    """A colormap and norm that map the integer codes 0, 1, ... to ``colors``."""
+    """A colormap and norm that map the integer codes 0, 1, ... to ``colors``.
+
+    Parameters
+    ----------
+    colors : sequence of str
+        Matplotlib colours, the i-th for code i.
+
+    Returns
+    -------
+    cmap, norm : ListedColormap, BoundaryNorm
+        Pass both to ``imshow``/``pcolormesh`` (boundaries at −0.5, 0.5, ...).
+    """
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
     cmap = ListedColormap(list(colors))
@@ -156,7 +180,20 @@ def categorical(colors: Sequence[str]) -> tuple[Any, Any]:
 
 
 def pct(count: int, n: int) -> str:
-    """``count`` of ``n`` as a percentage (one decimal; ``<0.1 %`` when tiny)."""
+    """``count`` of ``n`` as a percentage (one decimal; ``<0.1 %`` when tiny).
+
+    Parameters
+    ----------
+    count : int
+        The part.
+    n : int
+        The whole; 0 gives ``"nan %"``.
+
+    Returns
+    -------
+    str
+        E.g. ``"12.5 %"``.
+    """
     share = 100.0 * count / n if n else float("nan")
     if 0 < share < 0.1:
         return "<0.1 %"
@@ -164,14 +201,44 @@ def pct(count: int, n: int) -> str:
 
 
 def legend_below(ax: Any, handles: list[Any], title: str | None = None, ncol: int = 2) -> Any:
-    """A legend under the axes (below the x label), so it never covers the map."""
+    """A legend under the axes (below the x label), so it never covers the map.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+        The axes that get the legend (it replaces any legend they had).
+    handles : list
+        The legend entries (artists with labels, e.g. from :func:`patch`).
+    title : str, optional
+        The legend's title.
+    ncol : int, default 2
+        Number of columns of entries.
+
+    Returns
+    -------
+    matplotlib Legend
+        The legend drawn.
+    """
     return ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.12),
                      ncol=ncol, frameon=False, fontsize="small", title_fontsize="small",
                      columnspacing=1.2, handlelength=1.6)
 
 
 def patch(color: str, label: str) -> Any:
-    """A legend patch of ``color``."""
+    """A legend patch of ``color``.
+
+    Parameters
+    ----------
+    color : str
+        Matplotlib colour of the face (the edge is grey).
+    label : str
+        The legend text.
+
+    Returns
+    -------
+    matplotlib.patches.Patch
+        A handle for :func:`legend_below`.
+    """
     from matplotlib.patches import Patch
 
     return Patch(facecolor=color, edgecolor="#555555", linewidth=0.5, label=label)

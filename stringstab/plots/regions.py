@@ -767,6 +767,24 @@ def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
     The certificate the map's ``exact`` method is: continuous or sampled (``sample_time``),
     at the map's τ, δ, T* or over its box.
 
+    Parameters
+    ----------
+    rmap : RegionMap
+        The map whose loop (τ s, δ s, T* s, sample time, heterogeneity) the gains are
+        certified for.
+    gains : GainTable or array_like of shape (n, 3)
+        The triples k_x (1/s²), k_v (1/s), k_a (dimensionless).
+
+    Returns
+    -------
+    list of str
+        One verdict per triple (``"certified"``, ``"not_certified"``, ...).
+
+    Raises
+    ------
+    StringStabError
+        If the gains are not an n × 3 array.
+
     Examples
     --------
     >>> from stringstab.regions import region_map
@@ -880,6 +898,18 @@ def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
     2-D map: ``class_<method>`` for each method, ``compare`` (two or more methods),
     ``sup_gain`` (``exact``) and, with ``overlay``, ``overlay``.  3-D map:
     ``slices_<method>`` and ``3d_<method>`` for each method.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The computed map.
+    overlay : bool, default False
+        Include the ``overlay`` figure (2-D maps only; it needs gains to draw).
+
+    Returns
+    -------
+    list of str
+        The stems, in drawing order.
     """
     if rmap.ndim == 2:
         stems = [f"class_{m}" for m in rmap.methods]
@@ -894,7 +924,30 @@ def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
 
 
 def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = None) -> Any:
-    """Draw the standard figure ``stem`` (:func:`figure_stems`) of ``rmap``; returns its Figure."""
+    """Draw the standard figure ``stem`` (:func:`figure_stems`) of ``rmap``; returns its Figure.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The computed map.
+    stem : str
+        One of :func:`figure_stems` ``(rmap, True)``.
+    gains : GainTable or array_like of shape (n, 3), optional
+        The gain trajectory; required for ``overlay`` (drawn over the exact region projected
+        over the points' own values of the map's fixed gain).
+    verdicts : CertificateBatch or sequence of str, optional
+        The exact verdict of each gain triple (``overlay``); computed when None.
+
+    Returns
+    -------
+    matplotlib Figure
+        The new figure (the caller saves and closes it).
+
+    Raises
+    ------
+    StringStabError
+        On an unknown stem, or ``overlay`` without valid gains.
+    """
     if stem.startswith("class_"):
         return plot_class_map(rmap, stem[len("class_"):]).figure
     if stem == "compare":

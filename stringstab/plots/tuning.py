@@ -25,6 +25,28 @@ def moves_region(results: Sequence[TuneResult], *, tau: float, delta: float, hea
 
     ``k_a`` defaults to the median input k_a of ``results``; the slice is an ``n`` × ``n``
     grid over ``bounds``.
+
+    Parameters
+    ----------
+    results : sequence of TuneResult
+        The repairs (only their input k_a is used, for the default slice).
+    tau : float
+        Actuator lag τ (s).
+    delta : float
+        Communication delay δ (s).
+    headway : float
+        Time headway T* (s).
+    k_a : float, optional
+        The fixed k_a of the slice; default the median input k_a (0 without results).
+    bounds : tuple of float, default GAIN_BOUNDS
+        Range (lo, hi) of both k_x (1/s²) and k_v (1/s).
+    n : int, default 121
+        Grid points per axis.
+
+    Returns
+    -------
+    RegionMap
+        The continuous-time exact map (``methods="exact"``), computed serially.
     """
     from ..regions import region_map
     from ..tuning.inputs import as_bounds

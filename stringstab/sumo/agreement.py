@@ -29,6 +29,12 @@ TOLERANCE = 1e-3
 def differences(a: PlatoonResult, b: PlatoonResult) -> dict[str, float]:
     """Largest absolute differences between two runs of one platoon, over followers and time.
 
+    Parameters
+    ----------
+    a, b : PlatoonResult
+        Two recorded runs of the same platoon (same shape; e.g. SUMO and the toolkit's
+        simulator), with accelerations and speeds recorded.
+
     Returns
     -------
     dict

@@ -106,6 +106,17 @@ def read_vtype(spec: str) -> CACCType:
     The model is named by ``carFollowModel="CACC"`` or a ``<carFollowing-CACC .../>`` child
     (whose attributes then count too).
 
+    Parameters
+    ----------
+    spec : str
+        ``FILE:TYPE``: a SUMO route or additional file (XML) and the id of a vType in it.
+
+    Returns
+    -------
+    CACCType
+        The vType's id, file, CACC parameters (SUMO's defaults where absent; tau = T* in s,
+        minGap in m, length in m) and its XML element.
+
     Raises
     ------
     StringStabError
@@ -185,6 +196,18 @@ class ModeLaw:
 def mode_laws(vt: CACCType, dt: float) -> list[ModeLaw]:
     """The three gap-control modes of ``vt`` at step ``dt`` as linear laws.
 
+    Parameters
+    ----------
+    vt : CACCType
+        The CACC vType (from :func:`read_vtype`).
+    dt : float
+        SUMO's step (s); the per-step gains are divided by max(dt, 0.1 s).
+
+    Returns
+    -------
+    list of ModeLaw
+        One law per mode, in the order of ``MODES``.
+
     Raises
     ------
     StringStabError
@@ -215,11 +238,21 @@ def discrete_sweep(law: ModeLaw, dt: float, n: int = 20001) -> dict[str, Any]:
     i.e. N(z)/D(z) with N = k_p Δt² z(z + 1) + 2 k_d Δt z(z − 1) and
     D = 2z(z − 1)² + N + 2 k_p T Δt z(z − 1) + 2 k_d T (z − 1)².
 
+    Parameters
+    ----------
+    law : ModeLaw
+        One mode's law (from :func:`mode_laws`).
+    dt : float
+        SUMO's step Δt (s).
+    n : int, default 20001
+        Number of grid points θ = π/n, ..., π.
+
     Returns
     -------
     dict
         ``schur`` (all roots of D inside the unit circle), ``spectral_radius``, ``sup_gain``
-        (max over the grid θ ∈ (0, π]; None when not Schur), ``peak_omega`` (rad/s).
+        (max over the grid θ ∈ (0, π]; None when not Schur), ``peak_omega`` (rad/s, θ/Δt at
+        the grid maximum, reported even when not Schur), ``grid`` (``n``).
     """
     kp, kd, T, h = law.k_p, law.k_d, law.headway, float(dt)
     Np = np.polynomial.Polynomial
@@ -248,7 +281,27 @@ def _no_lag_closed_form(law: ModeLaw) -> dict[str, Any]:
 
 def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
     """Each mode's law with its certificates: continuous and sampled at ``dt`` (τ = 1 ms,
-    δ = 0), the closed-form no-lag condition, and the exact discrete sweep."""
+    δ = 0), the closed-form no-lag condition, and the exact discrete sweep.
+
+    Parameters
+    ----------
+    vt : CACCType
+        The CACC vType (from :func:`read_vtype`).
+    dt : float
+        SUMO's step (s).
+
+    Returns
+    -------
+    list of dict
+        Per mode: the :class:`ModeLaw` fields, ``continuous`` and ``sampled`` (verdict and sup
+        gain of :func:`stringstab.certificate.certify`), ``no_lag_closed_form`` (Hurwitz,
+        k_x T*² + 2 k_v T* ≥ 2) and ``sumo_discrete_sweep`` (:func:`discrete_sweep`).
+
+    Raises
+    ------
+    StringStabError
+        When a mode is ill-posed (:func:`mode_laws`).
+    """
     from ..certificate import certify
 
     rows = []
@@ -270,11 +323,23 @@ def law_residual(records: dict[str, Array], vt: CACCType, dt: float) -> dict[str
     ``records`` holds per step and follower: ``gap`` (bumper to bumper), ``v``, ``v_pred``,
     ``a`` (SUMO's acceleration before the step), ``v_next`` and ``mode`` (SUMO's name).
 
+    Parameters
+    ----------
+    records : dict of str to ndarray
+        The recorded steps, flat arrays of one length: ``gap`` (m), ``v``, ``v_pred``,
+        ``v_next`` (m/s), ``a`` (m/s²), ``mode`` (str).
+    vt : CACCType
+        The CACC vType the followers use.
+    dt : float
+        SUMO's step (s).
+
     Returns
     -------
     dict
-        Per mode: steps and the largest |v_next − (v + g_s e + g_d ė)| (m/s); a step where
-        SUMO's safe speed or a bound overrode the mode shows as a large residual.
+        Per mode: ``steps``, ``max_residual`` and ``median_residual`` of
+        |v_next − max(v + (g_s e + g_d ė) Δt/h, 0)| (m/s, h = max(Δt, 0.1 s); None for a mode
+        never used); a step where SUMO's safe speed or a bound overrode the mode shows as a
+        large residual.
     """
     laws = {law.sumo_name: law for law in mode_laws(vt, dt)}
     h = max(dt, TUNED_STEP)
@@ -301,6 +366,17 @@ def measure_platoon(vt: CACCType, leader: Trajectory, n_followers: int, *,
     CACC vehicles, inserted at the law's equilibrium gap s_0 + T v.  Their accelerations are
     SUMO's finite differences of speed, which for these lag-free vehicles are the held
     accelerations themselves.
+
+    Parameters
+    ----------
+    vt : CACCType
+        The vType of the leader and the followers.
+    leader : Trajectory
+        The leader's speed profile; its ``dt`` is SUMO's step (s).
+    n_followers : int
+        Number of CACC followers.
+    api : {"libsumo", "traci"}, default "libsumo"
+        How SUMO is driven.
 
     Returns
     -------

@@ -51,6 +51,20 @@ DEFAULT_LENGTH = 5.0
 def vehicle_state(session: SumoSession, ids: list[str], t: float) -> tuple[Array, Array]:
     """Lane positions and speeds of ``ids`` from their subscriptions (after a step).
 
+    Parameters
+    ----------
+    session : SumoSession
+        The running SUMO, with position and speed subscribed for each of ``ids``.
+    ids : list of str
+        The vehicles, in the order of the result.
+    t : float
+        Simulation time (s), for the error message only.
+
+    Returns
+    -------
+    x, v : ndarray
+        Lane positions (m) and speeds (m/s), one per id.
+
     Raises
     ------
     StringStabError
@@ -78,6 +92,11 @@ def ballistic_leader(leader: Trajectory) -> tuple[Trajectory, float]:
     ballistic update); a trajectory whose positions are another integral of its speeds (the
     synthetic profiles' closed-form positions) is driven in SUMO as this one.  Accelerations are
     kept (they are what the followers receive over the delayed link).
+
+    Parameters
+    ----------
+    leader : Trajectory
+        The leader's profile (``dt`` s, positions m, speeds m/s, accelerations m/s²).
 
     Returns
     -------
@@ -328,7 +347,30 @@ def run_loop(plat: Any, controller: Controller, T: int, *, progress: bool = Fals
              on_step: Any = None, desc: str = "sumo") -> PlatoonResult:
     """Step a platoon with the observe/advance contract ``T`` times, recording like
     :func:`~stringstab.traffic.simulate` (``record=True``); returns the result without
-    ``params`` beyond ``dt``."""
+    ``params`` beyond ``dt``.
+
+    Parameters
+    ----------
+    plat : platoon
+        The SUMO-backed platoon of this module (its ``N``, ``dt`` in s, ``observe()``,
+        ``advance(u)``, state arrays, ``limits``, ``inner`` and ``session`` are used).
+    controller : Controller
+        Maps each observation to the followers' commanded accelerations (m/s²).
+    T : int
+        Number of recorded samples (SUMO is advanced T − 1 times; the last command is only
+        clipped and recorded).
+    progress : bool, default False
+        Show a progress bar (or periodic lines when not on a terminal).
+    on_step : callable, optional
+        Called as ``on_step(k, plat.session)`` after each step.
+    desc : str, default "sumo"
+        Label of the progress bar.
+
+    Returns
+    -------
+    PlatoonResult
+        Positions, speeds, accelerations, commands and smallest gaps over the ``T`` steps.
+    """
     N, dt = plat.N, plat.dt
     pos = np.empty((T, N + 1))
     spd = np.empty((T, N + 1))

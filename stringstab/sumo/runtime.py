@@ -52,6 +52,16 @@ def import_api(api: str) -> Any:
     only for SUMO's Parquet outputs, which the toolkit never asks for; the warning is printed
     to Python's stdout and is kept out of the user's output here.
 
+    Parameters
+    ----------
+    api : {"libsumo", "traci"}
+        Which SUMO Python interface to import (sumolib is imported too).
+
+    Returns
+    -------
+    module
+        The ``libsumo`` or ``traci`` module.
+
     Raises
     ------
     StringStabError
@@ -75,7 +85,23 @@ def import_api(api: str) -> Any:
 
 
 def binary(name: str) -> str:
-    """Path of a SUMO program (``sumo``, ``netconvert``) from the ``eclipse-sumo`` wheel."""
+    """Path of a SUMO program (``sumo``, ``netconvert``) from the ``eclipse-sumo`` wheel.
+
+    Parameters
+    ----------
+    name : str
+        The program's name.
+
+    Returns
+    -------
+    str
+        Its path (as found by ``sumolib.checkBinary``).
+
+    Raises
+    ------
+    StringStabError
+        If the SUMO extra is not installed or the program is not there.
+    """
     import_api("traci")
     import sumolib
 
@@ -131,6 +157,13 @@ def check_config(sumocfg: str | os.PathLike[str], dt: float) -> None:
     must say ``<step-length value="dt"/>`` and ``<step-method.ballistic value="true"/>``
     (Euler is off from the ballistic update by ~2e-2 m/s² in acceleration for the same
     commanded speeds).
+
+    Parameters
+    ----------
+    sumocfg : str or path-like
+        The SUMO configuration file.
+    dt : float
+        The step (s) it must declare.
 
     Raises
     ------
@@ -357,6 +390,11 @@ def _one_line(e: BaseException) -> str:
 
 def check_running(session: SumoSession) -> None:
     """Ask the running SUMO for its step and position update; refuse a mismatch.
+
+    Parameters
+    ----------
+    session : SumoSession
+        The open session (its ``dt`` is the expected step, s).
 
     Raises
     ------

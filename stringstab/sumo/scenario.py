@@ -35,6 +35,16 @@ MARGIN = 50.0
 def follower_ids(n: int) -> list[str]:
     """SUMO ids of the followers: ``F1`` (behind the leader) .. ``FN``.
 
+    Parameters
+    ----------
+    n : int
+        Number of followers.
+
+    Returns
+    -------
+    list of str
+        The ids, front to back.
+
     Examples
     --------
     >>> follower_ids(3)

@@ -16,7 +16,20 @@ POINT_FORMAT = "stringstab-sweep-point/1"
 
 
 def record_path(out: str | os.PathLike[str], pid: str) -> Path:
-    """Where the record of point ``pid`` lives in the sweep folder ``out``."""
+    """Where the record of point ``pid`` lives in the sweep folder ``out``.
+
+    Parameters
+    ----------
+    out : path
+        The sweep folder.
+    pid : str
+        The point's id.
+
+    Returns
+    -------
+    Path
+        ``out/points/<pid>.json`` (it need not exist).
+    """
     return Path(out) / "points" / f"{pid}.json"
 
 

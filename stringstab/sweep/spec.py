@@ -337,6 +337,18 @@ _SWEEP_KEYS = ("name", "kind", "study", "seeds")
 def parse_spec(text: str, *, source: str = "spec") -> SweepSpec:
     """Parse and check the TOML text of a sweep spec (see the module docstring).
 
+    Parameters
+    ----------
+    text : str
+        The TOML document: ``[sweep]`` (required), ``[base]``, ``[axes]``, ``[zip]``.
+    source : str, default "spec"
+        Where the text came from (e.g. the file name), as the first words of an error.
+
+    Returns
+    -------
+    SweepSpec
+        The checked spec with its expanded points.
+
     Raises
     ------
     StringStabError
