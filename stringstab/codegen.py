@@ -197,6 +197,11 @@ def _margin_expr() -> sp.Expr:
 def margin_basis() -> dict[str, sp.Expr]:
     """The coefficient of each term of :data:`MARGIN_BASIS` in the derived g(ω).
 
+    Returns
+    -------
+    dict of str to sympy.Expr
+        Each basis term's name mapped to its coefficient in g(ω).
+
     Raises
     ------
     AssertionError
@@ -227,6 +232,11 @@ def margin_separable() -> dict[str, sp.Expr]:
     c = k_v + T*k_x) and only the trigonometric terms on δ.  Everything is derived from
     :func:`margin_basis`: t2 = τ², c = −½ ∂a/∂τ (a is affine in τ), h2 = a + 2τc,
     h0 = b − c².
+
+    Returns
+    -------
+    dict of str to sympy.Expr
+        ``t2``, ``c``, ``h2``, ``h0``, ``c_x``, ``c_v``: the pieces of the split.
 
     Raises
     ------
@@ -477,7 +487,13 @@ def _source() -> str:
 
 
 def generate() -> str:
-    """The source text of ``stringstab/_generated.py`` (LF line endings)."""
+    """The source text of ``stringstab/_generated.py`` (LF line endings).
+
+    Returns
+    -------
+    str
+        The module's full source text.
+    """
     return _source()
 
 

@@ -80,6 +80,12 @@ def derivation(
     with_errata : bool
         Add the comparison with the IDL paper's printed formulas (:func:`stringstab.errata.errata`).
 
+    Returns
+    -------
+    Derivation
+        The derived expressions, their rendered document and, with ``with_errata``,
+        the comparison with the printed formulas.
+
     Examples
     --------
     >>> d = derivation(substitute="tau=0.1,delta=0.2,headway=1.1")

@@ -290,6 +290,8 @@ def gradient(omega: ArrayLike, K: ArrayLike, *, tau: float, delta: float,
         Frequencies, rad/s.
     K : array_like, shape (3,)
         The gains (k_x, k_v, k_a).
+    tau, delta, headway : float
+        Lag τ, delay δ and time headway T*, s.
 
     Returns
     -------

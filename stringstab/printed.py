@@ -83,6 +83,11 @@ PRINTED: dict[str, PrintedEquation] = {
 def printed_psi() -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
     """(Ψ1, Ψ2, Ψ3, Λ) exactly as printed in IDL eqs 12-15.
 
+    Returns
+    -------
+    tuple of sympy.Expr
+        (Ψ1, Ψ2, Ψ3, Λ) as printed.
+
     Examples
     --------
     >>> printed_psi()[0]
@@ -92,7 +97,13 @@ def printed_psi() -> tuple[sp.Expr, sp.Expr, sp.Expr, sp.Expr]:
 
 
 def printed_gradients() -> dict[str, list[sp.Expr]]:
-    """∇_K Ψ2 and ∇_K Ψ3 exactly as printed in IDL eqs 25-26."""
+    """∇_K Ψ2 and ∇_K Ψ3 exactly as printed in IDL eqs 25-26.
+
+    Returns
+    -------
+    dict of str to list of sympy.Expr
+        ``grad_psi2`` and ``grad_psi3``: ∂/∂k_x, ∂/∂k_v, ∂/∂k_a as printed.
+    """
     return {
         "grad_psi2": list(PRINTED["grad_psi2"].expr),
         "grad_psi3": list(PRINTED["grad_psi3"].expr),

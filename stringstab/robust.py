@@ -185,6 +185,11 @@ def robust_margin(
     tau, delta, headway : float, (lo, hi) or "LO:HI"
         The box (module docstring).
 
+    Returns
+    -------
+    ndarray
+        min over the box of g(ω), of the broadcast shape of ``omega`` and the gains.
+
     Examples
     --------
     >>> from stringstab.frequency import margin_g

@@ -224,6 +224,11 @@ def characteristic_polynomial() -> sp.Expr:
     A cubic in z; it does not depend on δ or τ_p, and T* enters only through
     c = k_v + T* k_x, as in the continuous denominator (IDL eq 11, derived).
 
+    Returns
+    -------
+    sympy.Expr
+        Δ(z), a monic cubic in ``z``.
+
     Examples
     --------
     >>> sp.Poly(characteristic_polynomial(), z).degree()
@@ -292,6 +297,11 @@ def dc_margin() -> sp.Expr:
     φ1 = 1 − e^{−H/τ}, φ1p = 1 − e^{−H/τ_p}.  It does not depend on δ; in a homogeneous
     platoon (τ_p = τ) it is H² φ1⁴ times Ψ3 of the continuous loop (IDL eq 14, derived),
     so the low-frequency condition is the same for every sampling period.
+
+    Returns
+    -------
+    sympy.Expr
+        c₂, the θ² coefficient (in τ, τ_p, H and the gains).
 
     Examples
     --------
@@ -393,6 +403,11 @@ def derive_sampled_all(substitute: dict[sp.Symbol, sp.Expr] | None = None) -> di
     ----------
     substitute : dict, optional
         Symbol → value substitutions applied to every expression (e.g. τ, δ, H, ε, m).
+
+    Returns
+    -------
+    dict of str to object
+        The expressions under the keys listed above.
 
     Examples
     --------

@@ -403,6 +403,11 @@ def hurwitz_conditions() -> list[sp.Expr]:
     identically (such as τ > 0) are dropped, and each determinant is reduced to
     its factors that can change sign.
 
+    Returns
+    -------
+    list of sympy.Expr
+        The conditions, each of which must be > 0.
+
     Examples
     --------
     >>> hurwitz_conditions()
@@ -570,6 +575,11 @@ def derive_all(
         Taylor order of e^{−δs} for Ψ (None: exact delay); see :func:`margin_series`.
     substitute : dict, optional
         Symbol → value substitutions applied to every expression.
+
+    Returns
+    -------
+    dict of str to object
+        The expressions under the keys listed above.
     """
     sub = substitute or {}
     g = gamma()

@@ -349,6 +349,12 @@ def resolve_format(given: str | None, out: str | None, formats: tuple[str, ...],
     default : str
         Without either.
 
+    Returns
+    -------
+    str
+        The format to write: ``given`` when set, else the one ``out``'s extension names,
+        else ``default``.
+
     Raises
     ------
     StringStabError

@@ -49,7 +49,13 @@ def _libraries() -> list[tuple[Any, Any]]:
 
 @contextlib.contextmanager
 def single_threaded_blas() -> Iterator[None]:
-    """Run the block with one OpenBLAS thread; the previous counts are restored after it."""
+    """Run the block with one OpenBLAS thread; the previous counts are restored after it.
+
+    Yields
+    ------
+    None
+        Control returns to the block with one BLAS thread.
+    """
     libs = _libraries()
     saved = []
     for g, s in libs:

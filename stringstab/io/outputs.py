@@ -299,6 +299,11 @@ def invocation(doc: Any) -> Iterator[None]:
         JSON-serialisable entries, e.g. ``{"argv": [...], "inputs": {...}}``, or a callable
         returning them (called when a manifest is written: hashing inputs only when needed).
 
+    Yields
+    ------
+    None
+        Control returns to the block; the record is dropped when it ends.
+
     Examples
     --------
     >>> with invocation({"argv": ["stringstab", "demo"]}):
@@ -319,6 +324,11 @@ def deferred_interrupt() -> Iterator[None]:
     For the few milliseconds that move finished files into place: an interrupt there would
     leave a mix of two runs.  Outside the main thread (where signals cannot be handled) the
     block runs unprotected.
+
+    Yields
+    ------
+    None
+        Control returns to the block; a held Ctrl-C is raised when it ends.
 
     Examples
     --------

@@ -643,6 +643,11 @@ def render_table(
     params, summary : mapping, optional
         A ``# k = v, ...`` header line, and footer lines (a nested mapping gets its own line).
 
+    Returns
+    -------
+    str
+        The table's text, one line per row, ending in a newline.
+
     Examples
     --------
     >>> print(render_table({"k_x": [0.9, 1.3], "ok": [False, True]},
@@ -815,6 +820,8 @@ def write_results(
         Settings of the run and its totals.
     table : sequence of TableColumn, optional
         The columns of the human table.
+    what : str
+        How error messages name the destination (e.g. ``"--out"``).
 
     Raises
     ------

@@ -132,7 +132,13 @@ GAIN_LABELS: dict[str, str] = {
 
 
 def pyplot() -> Any:
-    """matplotlib.pyplot, imported on first use."""
+    """matplotlib.pyplot, imported on first use.
+
+    Returns
+    -------
+    module
+        The ``matplotlib.pyplot`` module.
+    """
     import matplotlib.pyplot as plt
 
     return plt

@@ -70,6 +70,8 @@ def agreement(leader: Trajectory, controller: Controller, n_followers: int, *,
         How SUMO runs.
     tolerance : float
         The largest accepted difference.
+    progress : bool
+        Show SUMO's run with a progress bar (or periodic lines off a terminal).
 
     Returns
     -------
