@@ -60,6 +60,14 @@ def quadratic_form(f: Callable[[Array, Array, Array], Array]) -> Array:
     ``f(k_x, k_v, k_a)`` evaluates q on arrays.  With q(0) = c, q(±e_i) = c ± b_i + A_ii and
     q(e_i + e_j) = c + b_i + b_j + A_ii + A_jj + 2A_ij, the identities are exact for a quadratic.
 
+    Parameters
+    ----------
+    f : callable
+        ``f(k_x, k_v, k_a) -> ndarray``: the quadratic q evaluated elementwise on three arrays of
+        gains (k_x in 1/s², k_v in 1/s, k_a dimensionless; IDL eq 4), for instance a margin
+        g(ω; K) at one member and frequency.  It is called once, on the 10 polarisation points
+        0, ±e_i, e_i + e_j.  A q of degree > 2 is not detected: its form is then wrong.
+
     Returns
     -------
     ndarray, shape (10,)
@@ -84,6 +92,19 @@ def quadratic_form(f: Callable[[Array, Array, Array], Array]) -> Array:
 
 def evaluate_forms(forms: Array, K: Array) -> Array:
     """q(K) for each row of ``forms`` (shape (n, 10)) at K (shape (3,), or (m, 3): (n, m)).
+
+    Parameters
+    ----------
+    forms : ndarray, shape (n, 10)
+        Quadratic forms as returned by :func:`quadratic_form`, one per row: (c, b_x, b_v, b_a,
+        A_xx, A_xv, A_xa, A_vv, A_va, A_aa).
+    K : ndarray, shape (3,) or (m, 3)
+        Gains (k_x [1/s²], k_v [1/s], k_a [-]) of IDL eq 4: one triple or m triples.
+
+    Returns
+    -------
+    ndarray, shape (n,) or (n, m)
+        q(K) = c + bᵀK + KᵀAK of each form at each triple.
 
     Examples
     --------
