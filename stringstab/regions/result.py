@@ -470,6 +470,17 @@ class RegionMap:
 def load_npz(path: str | os.PathLike[str]) -> RegionMap:
     """Read a map written by :meth:`RegionMap.save_npz`.
 
+    Parameters
+    ----------
+    path : str or path-like
+        The NPZ file.
+
+    Returns
+    -------
+    RegionMap
+        The map, with its axes, fixed gains, parameters (a :class:`~stringstab.params.Params`
+        or a :class:`~stringstab.params.Box`), methods and per-point fields.
+
     Raises
     ------
     StringStabError
@@ -496,6 +507,17 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
 
 def describe_params(p: Params | Box) -> str:
     """``τ = 0.1 s, δ = 0.2 s, T* = 1.1 s``, intervals as ``τ ∈ [0.1, 0.3] s``.
+
+    Parameters
+    ----------
+    p : Params or Box
+        Actuator lag τ (IDL eq 7), communication delay δ (eq 4) and time headway T* (eq 3), in
+        s, each a value or an interval.
+
+    Returns
+    -------
+    str
+        One line; a degenerate interval is written as a value.
 
     Examples
     --------
