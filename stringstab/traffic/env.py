@@ -87,6 +87,24 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
 
     s = [(gap − T* v − l_0)/α_p, (v_{i−1} − v)/α_v, a_{i−1}(t − δ)/α_acc].  Usable as the input
     of a gain policy inside :class:`~stringstab.traffic.controllers.TimeVaryingLinearController`.
+
+    Parameters
+    ----------
+    obs : Observation
+        What the followers know at one step: gap Δx (m), own speed v (m/s), relative speed
+        Δv = v_{i−1} − v (m/s) and the delayed predecessor acceleration a_{i−1}(t − δ) (m/s²).
+    headway : float
+        Desired time headway T* (IDL eq 3), s.
+    standstill : float
+        Standstill distance l_0 (eq 3), m.
+    scales : (float, float, float)
+        α_p (m), α_v (m/s), α_acc (m/s²) of eq 16 (Table 2: 25, 2.5, 4.5).
+
+    Returns
+    -------
+    ndarray, shape ``(*obs.gap.shape, 3)``
+        The normalised state [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc], Δp the spacing error of
+        eq 3.
     """
     dp = obs.gap - headway * obs.speed - standstill
     return np.stack([dp / scales[0], obs.rel_speed / scales[1],
@@ -96,6 +114,21 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
 def state_dim(observe: Sequence[str] = ()) -> int:
     """Length of the state with the ``observe`` extras: 3 (eq 16), 1 more for ``"accel"``, 3
     more for ``"gains"`` (:func:`extend_state`).
+
+    Parameters
+    ----------
+    observe : sequence of str
+        Extras appended to the eq-16 state, some of :data:`OBSERVE` (``"accel"``, ``"gains"``).
+
+    Returns
+    -------
+    int
+        3, 4, 6 or 7.
+
+    Raises
+    ------
+    StringStabError
+        If ``observe`` names something other than ``"accel"`` or ``"gains"``.
 
     Examples
     --------
@@ -115,6 +148,30 @@ def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
 
     ``"accel"`` appends the follower's own acceleration a_i/α_acc (``accel``, shape ``(...)``),
     ``"gains"`` the gains executed at the previous step K_{t−1}/2 (``prev_gains``, (..., 3)).
+
+    Parameters
+    ----------
+    state : array_like, shape (..., 3)
+        The normalised IDL state of eq 16 (:func:`state_vector`).
+    observe : sequence of str
+        Extras to append, some of :data:`OBSERVE`, always in the order accel, then gains.
+    accel : array_like, shape (...), optional
+        The follower's own acceleration a_i, m/s²; needed for ``"accel"``.
+    prev_gains : array_like, shape (..., 3), optional
+        The gains (k_x [1/s²], k_v [1/s], k_a [-]) executed at the previous step; needed for
+        ``"gains"`` (zeros at an episode's first step).
+    scales : (float, float, float)
+        α_p, α_v, α_acc of eq 16; only α_acc is used here.
+
+    Returns
+    -------
+    ndarray, shape (..., :func:`state_dim` (observe))
+        The extended state (``state`` itself, as floats, when ``observe`` is empty).
+
+    Raises
+    ------
+    StringStabError
+        If ``observe`` names an unknown extra, or an extra's input is missing.
 
     Examples
     --------
@@ -143,6 +200,22 @@ def limit_rate(gains: npt.ArrayLike, prev_gains: npt.ArrayLike, rate: float, *,
     Rows where ``fresh`` is true (an episode's first step: no previous gains) are left as
     they are.  The result still needs the repair: the rate limit keeps the gains near a
     certified triple, it does not certify them.
+
+    Parameters
+    ----------
+    gains : array_like, shape (..., 3)
+        The proposed gains (k_x, k_v, k_a) of IDL eq 4 (the policy's action, eq 17).
+    prev_gains : array_like, shape (..., 3)
+        The gains executed at the previous step.
+    rate : float
+        The largest change r of each gain per step (in the gain's unit per step).
+    fresh : array_like of bool, shape (...), or bool
+        True where there are no previous gains (the proposed gains pass unchanged).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        clip(gains, prev_gains − r, prev_gains + r), or ``gains`` where ``fresh``.
 
     Examples
     --------
