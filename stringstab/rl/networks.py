@@ -19,7 +19,22 @@ __all__ = ["Actor", "QNetwork", "mlp"]
 
 
 def mlp(n_in: int, hidden: Sequence[int], n_out: int) -> nn.Sequential:
-    """Linear–ReLU layers of widths ``hidden``, then a linear output; Glorot-uniform weights."""
+    """Linear–ReLU layers of widths ``hidden``, then a linear output; Glorot-uniform weights.
+
+    Parameters
+    ----------
+    n_in : int
+        Input width (the state's length, or state + action for a critic).
+    hidden : sequence of int
+        Hidden layer widths (Table 1: 128, 128).
+    n_out : int
+        Output width.
+
+    Returns
+    -------
+    torch.nn.Sequential
+        The network, weights Glorot-uniform and biases zero (Table 1, as in Keras).
+    """
     layers: list[nn.Module] = []
     width = n_in
     for h in hidden:

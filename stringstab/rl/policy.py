@@ -152,6 +152,18 @@ def _need(doc: dict[str, Any], key: str, kind: type | tuple[type, ...], where: s
 def load_policy(directory: str | os.PathLike[str]) -> Policy:
     """Load a policy saved by :meth:`Policy.save` (or a training run folder holding one).
 
+    Parameters
+    ----------
+    directory : str or path-like
+        A folder holding ``policy.json`` and ``policy.safetensors`` (a training run folder
+        does).
+
+    Returns
+    -------
+    Policy
+        The actor with its description (``algo``, ``action``, τ, δ, T*, ``dt``, ``observe``,
+        ``gain_rate``, the repair).
+
     Raises
     ------
     StringStabError
