@@ -65,7 +65,18 @@ Obs = npt.NDArray[np.float32]
 
 def default_training_leaders(*, dt: float = DT) -> list[Trajectory]:
     """The paper's training leader as far as the bundled data allows: UDDS at half speed from
-    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``."""
+    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``.
+
+    Parameters
+    ----------
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    list of Trajectory
+        One leader.
+    """
     return [training_leader(dt=dt)]
 
 
