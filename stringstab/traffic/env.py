@@ -469,7 +469,27 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """Start an episode on the next leader (``options={"index": i}`` chooses it)."""
+        """Start an episode on the next leader (``options={"index": i}`` chooses it).
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds the environment's RNG (leader order ``"random"``, start spread).
+        options : dict, optional
+            ``{"index": i}`` runs leader i; otherwise the next leader in ``order``.
+
+        Returns
+        -------
+        state : ndarray (float32)
+            The first state: eq 16, with the ``observe`` extras.
+        info : dict
+            ``{"leader_index": i}``.
+
+        Raises
+        ------
+        StringStabError
+            If ``options["index"]`` is out of range.
+        """
         super().reset(seed=seed)
         m = self.n_leaders
         if options and "index" in options:
@@ -486,7 +506,33 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
         return self._core.state()[0], {"leader_index": j}
 
     def step(self, action: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]:
-        """Apply one action; returns (state, reward, terminated, truncated, info)."""
+        """Apply one action; returns (state, reward, terminated, truncated, info).
+
+        Parameters
+        ----------
+        action : array_like
+            Gains K = (k_x, k_v, k_a) (eq 17; rate limited and filtered as configured) or the
+            desired acceleration u, m/s², by the action mode.
+
+        Returns
+        -------
+        state : ndarray (float32)
+            The next state (eq 16, with the ``observe`` extras).
+        reward : float
+            r of eq 18 (eqs 19-24).
+        terminated : bool
+            A collision ended the episode (with ``terminate_on_collision``).
+        truncated : bool
+            The leader's last sample was reached.
+        info : dict
+            Scalars describing the step (``gap``, ``speed``, ``accel``, ``r_f``, ``r_j``, ``r_e``,
+            ``collision``, ``gains``, ...).
+
+        Raises
+        ------
+        StringStabError
+            If :meth:`reset` was not called first.
+        """
         if self._core.obs is None:
             raise StringStabError("call reset() before step()")
         r, term, trunc, info = self._core.step(np.asarray(action)[None])
@@ -562,7 +608,25 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``."""
+        """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``.
+
+        Each sub-environment draws its leader at random (seeded by ``seed``).  With
+        ``observe`` extras the states have :func:`state_dim` columns instead of 3.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds the episode-drawing RNG.
+        options : dict, optional
+            Ignored.
+
+        Returns
+        -------
+        states : ndarray (num_envs, state_dim), float32
+            The first states.
+        info : dict
+            ``{"leader_index": array (num_envs,)}``.
+        """
         super().reset(seed=seed)
         rows = np.arange(self.num_envs)
         self._core.reset_rows(rows, self._draw(self.num_envs), self.np_random)
@@ -587,7 +651,21 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         return meta, {k: np.array(v, copy=True) for k, v in arrays.items()}
 
     def load_state_dict(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
-        """Restore :meth:`state_dict` output (same leaders and ``num_envs``; checked)."""
+        """Restore :meth:`state_dict` output (same leaders and ``num_envs``; checked).
+
+        Parameters
+        ----------
+        meta : dict
+            The JSON-ready part of :meth:`state_dict`.
+        arrays : dict of str to ndarray
+            The arrays of :meth:`state_dict`.
+
+        Raises
+        ------
+        StringStabError
+            If the number of environments or leaders differs, an array is missing or has another
+            shape.
+        """
         c, p = self._core, self._core.platoon
         if meta.get("num_envs") != self.num_envs or meta.get("n_leaders") != len(c.items):
             raise StringStabError(
@@ -617,7 +695,30 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
     def step(self, actions: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], Array,
                                                    npt.NDArray[np.bool_], npt.NDArray[np.bool_],
                                                    dict[str, Any]]:
-        """Step every sub-environment (see the class docstring)."""
+        """Step every sub-environment (see the class docstring).
+
+        Parameters
+        ----------
+        actions : array_like (num_envs, 3) or (num_envs, 1)
+            Gains (eq 17) or desired accelerations (m/s²), one row per sub-environment.
+
+        Returns
+        -------
+        states : ndarray (num_envs, state_dim), float32
+            The next states; a finished episode's row is the first state of its new episode.
+        rewards : ndarray (num_envs,)
+            r of eq 18.
+        terminated, truncated : bool ndarray (num_envs,)
+            Collision ends and ends at the leader's last sample.
+        info : dict
+            ``final_obs``/``_final_obs`` and ``episode_return`` of the finished episodes (NaN
+            elsewhere), and arrays (num_envs,) describing the step.
+
+        Raises
+        ------
+        StringStabError
+            If :meth:`reset` was not called first.
+        """
         if self._core.obs is None:
             raise StringStabError("call reset() before step()")
         r, term, trunc, info = self._core.step(actions)
