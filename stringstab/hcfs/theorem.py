@@ -265,6 +265,19 @@ class TheoremCheck:
 
         ``index`` selects part of the leading axes (e.g. one vehicle); default all frames.
 
+        Parameters
+        ----------
+        index : index expression, optional
+            Applied to every per-frame array before counting (default ``...``: everything).
+
+        Returns
+        -------
+        dict of str to int
+            ``frames``, ``P1_holds``/``P1_fails``, ``P2_holds``/``P2_fails``,
+            ``P3_holds``/``P3_fails``, ``premises_hold``, ``conclusion_fails``, ``violations``
+            (premises hold, conclusion fails), ``counterexamples`` (P1, P2 hold, P3 and the
+            conclusion fail), ``bound_violations`` and ``switches``.
+
         Examples
         --------
         >>> c = check_theorem([0.0, 1.0], [0.0, 1.0], [False, True], jerk_limit=5.0, dt=0.2)
