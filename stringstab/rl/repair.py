@@ -284,6 +284,17 @@ class GainRepair:
         others are replaced by their nearest certified lattice point, without the exact check
         or the refinement.  Used by the actor's proposal penalty
         (``TD3Config.proposal_penalty``); never executed.
+
+        Parameters
+        ----------
+        K : array_like (..., 3)
+            Proposed gains (k_x, k_v, k_a); clipped to the bounds first.
+
+        Returns
+        -------
+        ndarray (n, 3)
+            The approximate repaired gains (not certified); the clipped input if the repair is
+            ``"off"``.
         """
         K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
         if self.method == "off":
