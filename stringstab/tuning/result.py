@@ -204,7 +204,22 @@ class TuneResults:
     @classmethod
     def collect(cls, results: Sequence[TuneResult], meta: Mapping[str, Any] | None = None,
                 methods: Sequence[str] = ()) -> TuneResults:
-        """Results (and per-result ``meta`` columns) as a :class:`TuneResults`."""
+        """Results (and per-result ``meta`` columns) as a :class:`TuneResults`.
+
+        Parameters
+        ----------
+        results : sequence of TuneResult
+            One result per input triple.
+        meta : mapping of str to array_like, optional
+            Extra columns, one value per result (e.g. the input's row or τ, δ, T*).
+        methods : sequence of str
+            The repair methods that were run.
+
+        Returns
+        -------
+        TuneResults
+            The collection.
+        """
         return cls(tuple(results), {k: np.asarray(v) for k, v in (meta or {}).items()},
                    tuple(methods))
 
@@ -267,6 +282,18 @@ class Verdict:
 
     @classmethod
     def of(cls, cert: Certificate) -> Verdict:
+        """The verdict and sup |Γ| of a full certificate.
+
+        Parameters
+        ----------
+        cert : Certificate
+            The exact certificate of one triple.
+
+        Returns
+        -------
+        Verdict
+            ``cert.verdict`` and ``float(cert.sup_gain)``.
+        """
         return cls(cert.verdict, float(cert.sup_gain))
 
 
