@@ -706,16 +706,16 @@ class FunctionController(Controller):
 class MixedController(Controller):
     """Different controllers at different platoon positions (e.g. IDM humans among CAVs).
 
+    Every candidate is evaluated on the whole batch and the results are selected per position,
+    so the cost is the sum of the candidates'.  :meth:`gains` returns K only if every candidate
+    is of the eq-4 form with one headway.
+
     Parameters
     ----------
     controllers : sequence of Controller
         The candidates.
     assignment : sequence of int
         For each follower position (1..N), the index of its controller.
-
-    Every candidate is evaluated on the whole batch and the results are selected per position,
-    so the cost is the sum of the candidates'.  :meth:`gains` returns K only if every candidate
-    is of the eq-4 form with one headway.
     """
 
     def __init__(self, controllers: Sequence[Controller], assignment: Sequence[int]) -> None:
