@@ -101,6 +101,28 @@ def cacc_printed(state: npt.ArrayLike, gains: Sequence[float] = CACC_GAINS) -> A
 
     Its value is a speed (m/s), the speed reference of the PATH CACC, not an acceleration.
 
+    Parameters
+    ----------
+    state : array_like (..., 6)
+        The eq-3 state [e_x(k,k−1), e_v(k,k−1), e_x(k,0), e_v(k,0), v_k, a_k]
+        (:func:`stringstab.hcfs.mdp.state`); v_k (m/s) is read as v_k_last.
+    gains : (k1, k2, k3, k4)
+        Gains of eq 11 (k1, k3 in 1/s; k2, k4 dimensionless).
+
+    Returns
+    -------
+    array (...)
+        The printed right-hand side of eq 11, m/s (with the printed signs).
+
+    Raises
+    ------
+    StringStabError
+        If the state does not have 6 components or the gains are not four finite numbers.
+
+    References
+    ----------
+    HCFS paper, eq 11.
+
     Examples
     --------
     >>> float(cacc_printed([1.0, 0.0, 0.0, 0.0, 10.0, 0.0], (0.1, 0.4, 0.05, 0.2)))
@@ -121,10 +143,26 @@ def closed_loop_matrix(n_followers: int, gains: Sequence[float] = CACC_GAINS, *,
     limits.  ``sign=-1`` is the printed sign convention (positive gains on the ego-minus-
     predecessor deviations of eqs 1-2).
 
+    Parameters
+    ----------
+    n_followers : int
+        N ≥ 1.
+    gains : (k1, k2, k3, k4)
+        Gains of eq 11 (k1, k3 in 1/s; k2, k4 dimensionless).
+    dt : float
+        Frame length T, s.
+    sign : float
+        1 for the derived law (:func:`cacc_acceleration`), −1 for the printed signs.
+
     Returns
     -------
     array (2N, 2N)
         The linear map; the loop is internally stable iff its spectral radius is < 1.
+
+    Raises
+    ------
+    StringStabError
+        If N < 1 or the gains are not four finite numbers.
 
     Examples
     --------

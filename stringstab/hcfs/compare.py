@@ -99,6 +99,19 @@ def compare_controllers(cases: Sequence[tuple[Trajectory, int]], policy: Acceler
 def comparison_markdown(rows: Sequence[Mapping[str, Any]]) -> str:
     """The rows of :func:`compare_controllers` as a Markdown table.
 
+    Parameters
+    ----------
+    rows : sequence of mapping
+        Rows of :func:`compare_controllers`: ``case``, ``n_followers``, ``controller``,
+        ``sum_abs_speed_error`` (Σ|e_v|, m/s), ``sum_abs_jerk`` (Σ|jerk|, m/s³), ``sum_reward``
+        (Σr of eq 6), ``max_jerk`` (m/s³), ``collisions``, ``min_gap`` (m) and ``ddpg_share``
+        (share of frames on a1, shown for the HCFS rows only).
+
+    Returns
+    -------
+    str
+        The table (header, separator, one line per row), ending in a newline.
+
     Examples
     --------
     >>> print(comparison_markdown([{"case": "c", "n_followers": 4, "controller": "CACC",

@@ -98,6 +98,15 @@ def reward_weights_from_table_iv(*, speed_max: float = SPEED_MAX, accel_max: flo
     Solves (ω1/v_max)·Σ|e_v| + (ω2·T/(2a_max))·Σ|jerk| = −Σr for the two rows, then predicts
     the HCFS row as a consistency check.
 
+    Parameters
+    ----------
+    speed_max : float
+        v_max of eq 4's normalisation, m/s.
+    accel_max : float
+        a_max of eq 5's jerk normalisation 2a_max/T, m/s².
+    dt : float
+        Frame length T, s.
+
     Returns
     -------
     dict

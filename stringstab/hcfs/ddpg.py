@@ -190,7 +190,20 @@ def train_ddpg(*, total_steps: int = 100_000, seed: int = 0, env: HCFSVectorEnv 
                **config: Any) -> ScaledPolicy:
     """Train the HCFS DDPG and return it as an acceleration policy on SI eq-3 states.
 
-    :func:`train_hcfs_ddpg` without a run folder; see there for the parameters.
+    :func:`train_hcfs_ddpg` without a run folder.
+
+    Parameters
+    ----------
+    total_steps : int
+        Environment steps (summed over sub-environments).
+    seed : int
+        Seed of the trainer and of the environment.
+    env : HCFSVectorEnv, optional
+        The training environment (default: 4 platoons of 6 followers behind
+        :func:`~stringstab.hcfs.leaders.training_leader`).
+    **config
+        Further ``DDPGConfig`` fields, and ``progress``/``on_checkpoint`` of
+        :func:`train_hcfs_ddpg`.
 
     Returns
     -------
@@ -213,7 +226,26 @@ def _write_sidecar(d: Path, policy: ScaledPolicy, training: dict[str, Any] | Non
 
 
 def save_ddpg(policy: ScaledPolicy, directory: str | Path) -> Path:
-    """Save a trained policy (``policy.policy.save``) with its scales and label beside it."""
+    """Save a trained policy (``policy.policy.save``) with its scales and label beside it.
+
+    Parameters
+    ----------
+    policy : ScaledPolicy
+        A policy trained by :mod:`stringstab.rl` (:func:`train_ddpg`), with its eq-3 state
+        scales and label.
+    directory : str or Path
+        The folder to write (``policy.json``, ``policy.safetensors`` and the HCFS sidecar).
+
+    Returns
+    -------
+    Path
+        ``directory``.
+
+    Raises
+    ------
+    StringStabError
+        If the wrapped policy was not trained by :mod:`stringstab.rl` (it cannot be saved).
+    """
     d = Path(directory)
     if not hasattr(policy.policy, "save"):
         raise StringStabError(f"only a policy trained by stringstab.rl can be saved; got {type(policy.policy).__name__}")
@@ -224,6 +256,16 @@ def save_ddpg(policy: ScaledPolicy, directory: str | Path) -> Path:
 
 def load_ddpg(directory: str | Path) -> ScaledPolicy:
     """Load a policy saved by :func:`save_ddpg` or :func:`train_hcfs_ddpg` (``stringstab.rl.load_policy`` + scales).
+
+    Parameters
+    ----------
+    directory : str or Path
+        A folder written by :func:`save_ddpg` or ``stringstab hcfs train``.
+
+    Returns
+    -------
+    ScaledPolicy
+        The acceleration policy on SI eq-3 states, with its label.
 
     Raises
     ------
@@ -271,6 +313,18 @@ def candidate(spec: str, *, what: str = "--policy") -> AccelerationPolicy:
     """The learned candidate a1 named by ``spec``: ``"bundled"`` (:func:`load_bundled_ddpg`),
     ``"stand-in"`` (:class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`) or a folder written by
     ``stringstab hcfs train`` / :func:`save_ddpg`.
+
+    Parameters
+    ----------
+    spec : str
+        ``"stand-in"``, ``"bundled"`` or a folder path.
+    what : str
+        The option that gave ``spec``, for the error message.
+
+    Returns
+    -------
+    AccelerationPolicy
+        The candidate a1 of the switch (HCFS eqs 12-14).
 
     Raises
     ------

@@ -65,7 +65,18 @@ Obs = npt.NDArray[np.float32]
 
 def default_training_leaders(*, dt: float = DT) -> list[Trajectory]:
     """The paper's training leader as far as the bundled data allows: UDDS at half speed from
-    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``."""
+    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``.
+
+    Parameters
+    ----------
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    list of Trajectory
+        One leader.
+    """
     return [training_leader(dt=dt)]
 
 
@@ -187,7 +198,22 @@ class HCFSVectorEnv(VectorEnv[Obs, Obs, npt.NDArray[Any]]):
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[Obs, dict[str, Any]]:
-        """Start every platoon on a new window; returns observations ``(num_envs, 6)``."""
+        """Start every platoon on a new window; returns observations ``(num_envs, 6)``.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds the RNG that draws leaders and windows.
+        options : dict, optional
+            Ignored.
+
+        Returns
+        -------
+        obs : ndarray (num_envs, 6), float32
+            The scaled eq-3 state of every follower (divided by :data:`STATE_SCALES`).
+        info : dict
+            ``{"leader_index": array (num_envs,)}``: each row's leader.
+        """
         super().reset(seed=seed)
         self._reset_rows(np.arange(self.P))
         self._started = True
@@ -196,7 +222,35 @@ class HCFSVectorEnv(VectorEnv[Obs, Obs, npt.NDArray[Any]]):
 
     def step(self, actions: npt.ArrayLike) -> tuple[Obs, Array, npt.NDArray[np.bool_],
                                                    npt.NDArray[np.bool_], dict[str, Any]]:
-        """Apply one acceleration per row; see the module docstring for the returns."""
+        """Apply one acceleration per row; see the module docstring for the returns.
+
+        Parameters
+        ----------
+        actions : array_like, ``num_envs`` values
+            Target accelerations a_k, m/s²; clipped to [a_min, a_max] (then to the previous
+            action ± J T when a step limit is set).
+
+        Returns
+        -------
+        obs : ndarray (num_envs, 6), float32
+            The next scaled eq-3 states (a finished platoon's rows: the first state of its next
+            window).
+        reward : ndarray (num_envs,)
+            r = r_v + r_jerk (HCFS eqs 4-6).
+        terminated : bool ndarray (num_envs,)
+            Always False (episodes never terminate).
+        truncated : bool ndarray (num_envs,)
+            True for every row of a platoon whose window ended.
+        info : dict
+            ``r_v``, ``r_jerk``, ``speed_error`` (e_v(k,0), m/s), ``gap`` (m), ``collision``,
+            ``action`` (applied, m/s²), ``final_obs``/``_final_obs`` and ``episode_return``.
+
+        Raises
+        ------
+        StringStabError
+            If :meth:`reset` was not called first, or ``actions`` does not have ``num_envs``
+            values.
+        """
         if not self._started:
             raise StringStabError("call reset() before step()")
         a = np.asarray(actions, dtype=np.float64)

@@ -72,6 +72,25 @@ def half_speed(tr: Trajectory, *, factor: float = HALF_SPEED, name: str | None =
     Scaling a piecewise-linear speed keeps the trajectory exact on its grid (x_{k+1} = x_k +
     v_k T + ½ a_k T² still holds).
 
+    Parameters
+    ----------
+    tr : Trajectory
+        The leader.
+    factor : float
+        Speed factor (> 0); HCFS §IV drives "twice as slow", 0.5.
+    name : str, optional
+        The new name (default ``"<name> x<factor>"``).
+
+    Returns
+    -------
+    Trajectory
+        The scaled leader; ``meta["speed_factor"]`` records the factor.
+
+    Raises
+    ------
+    StringStabError
+        If ``factor`` is not a finite number > 0.
+
     Examples
     --------
     >>> from stringstab.traffic.leaders import from_speed
@@ -98,6 +117,16 @@ def _window(tr: Trajectory, start: float, stop: float | None, name: str) -> Traj
 def training_leader(*, dt: float = DT) -> Trajectory:
     """The DDPG's training leader: UDDS at half speed from 600 s to the end (HCFS §IV).
 
+    Parameters
+    ----------
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    Trajectory
+        The leader, re-timed to start at t = 0.
+
     Examples
     --------
     >>> tr = training_leader()
@@ -111,6 +140,25 @@ def training_leader(*, dt: float = DT) -> Trajectory:
 
 def case_leader(name: str, *, dt: float = DT) -> tuple[Trajectory, int]:
     """A test case (see the module docstring): its leader and number of followers.
+
+    Parameters
+    ----------
+    name : {"hcfs-case1", "hcfs-case2", "hcfs-case3"}
+        The case (:data:`CASES`): a 20 s window of half-speed UDDS before 600 s.
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    leader : Trajectory
+        The window, re-timed to start at t = 0.
+    n_followers : int
+        The followers of the case (8, 6, 4).
+
+    Raises
+    ------
+    StringStabError
+        On an unknown case name.
 
     Examples
     --------
@@ -126,6 +174,16 @@ def case_leader(name: str, *, dt: float = DT) -> tuple[Trajectory, int]:
 
 def paper_cases(*, dt: float = DT) -> list[tuple[Trajectory, int]]:
     """The three test cases, in order: ``[(leader, followers), …]`` (see :data:`CASES`).
+
+    Parameters
+    ----------
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    list of (Trajectory, int)
+        :func:`case_leader` of each case.
 
     Examples
     --------

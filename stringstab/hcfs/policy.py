@@ -46,6 +46,16 @@ class AccelerationPolicy(Protocol):
 def policy_label(policy: AccelerationPolicy) -> str:
     """The policy's ``label`` attribute, or its class name.
 
+    Parameters
+    ----------
+    policy : AccelerationPolicy
+        Any acceleration policy.
+
+    Returns
+    -------
+    str
+        Its non-empty ``label``, else its class name.
+
     Examples
     --------
     >>> policy_label(LeaderSpeedMatcher()).startswith("stand-in")
@@ -57,10 +67,23 @@ def policy_label(policy: AccelerationPolicy) -> str:
 def accelerations(policy: AccelerationPolicy, state: npt.ArrayLike) -> Array:
     """Call a policy on states of any batch shape ``(..., 6)``; returns accelerations ``(...)``.
 
+    Parameters
+    ----------
+    policy : AccelerationPolicy
+        ``policy(states (n, 6)) -> (n,) or (n, 1)`` accelerations, m/s².
+    state : array_like (..., 6)
+        Eq-3 states (:func:`stringstab.hcfs.mdp.state`), flattened to (n, 6) for the call.
+
+    Returns
+    -------
+    array (...)
+        The accelerations, m/s², in the batch shape of ``state``.
+
     Raises
     ------
     StringStabError
-        If the policy returns the wrong number of values or a NaN/inf.
+        If the state does not have 6 components, the policy raises a TypeError or
+        ValueError, returns the wrong number of values or a NaN/inf.
 
     Examples
     --------
@@ -92,6 +115,23 @@ def rate_limit(raw: npt.ArrayLike, previous: npt.ArrayLike, step_limit: npt.Arra
     ``previous`` is the candidate's own (limited) value of the last frame and lies in
     [a_min, a_max], so the result lies between it and the clipped raw value: it satisfies both
     the acceleration bounds and |a_k − a_{k−1}| ≤ J T.
+
+    Parameters
+    ----------
+    raw : array_like
+        The candidate's unlimited acceleration a_k, m/s².
+    previous : array_like
+        Its limited value a_{k−1} of the last frame, m/s² (assumed in [a_min, a_max]; the
+        bounds are not guaranteed otherwise).
+    step_limit : float or array_like
+        J T, m/s² (premises P1/P2 of the HCFS theorem, §III-C).
+    accel_min, accel_max : float
+        a_min, a_max, m/s².
+
+    Returns
+    -------
+    array
+        The limited acceleration, m/s².
 
     Examples
     --------

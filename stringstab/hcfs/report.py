@@ -58,7 +58,24 @@ def _figure_names(ver: Verification) -> list[tuple[int, float, dict[str, str]]]:
 
 
 def report_dict(ver: Verification, *, command: str | None = None) -> dict[str, Any]:
-    """Everything the report states, JSON-ready: the theorem, the set-up, the results."""
+    """Everything the report states, JSON-ready: the theorem, the set-up, the results.
+
+    Parameters
+    ----------
+    ver : Verification
+        The verification (:func:`stringstab.hcfs.verify.verify`); the set-up is read from its
+        first run.
+    command : str, optional
+        The command that reproduces the run, recorded as ``command``.
+
+    Returns
+    -------
+    dict
+        ``theorem`` (:data:`THEOREM`: HCFS §III-C, eqs 13-21), ``setup`` (leaders, N, T, β,
+        jerk limits, 2a_max/T, δ, L, h, limits, ω1, ω2, CACC gains, policy label),
+        :meth:`Verification.to_dict`'s entries, and ``exit_code`` (0 if the verification
+        passed, else 1).
+    """
     run = ver.runs[0]
     p = run.params
     doc: dict[str, Any] = {
@@ -90,7 +107,23 @@ def _frame_row(f: Frame) -> str:
 
 def report_markdown(ver: Verification, *, command: str | None = None,
                     figures: list[tuple[int, float, dict[str, str]]] | None = None) -> str:
-    """The report as Markdown (see :func:`write_report`)."""
+    """The report as Markdown (see :func:`write_report`).
+
+    Parameters
+    ----------
+    ver : Verification
+        The verification; the set-up is read from its first run.
+    command : str, optional
+        The command that reproduces the run (a "Reproduce" section).
+    figures : list of (int, float, dict), optional
+        ``(run index, J, {kind: file name})`` of the figures to link (a "Figures" section);
+        None for none.
+
+    Returns
+    -------
+    str
+        The Markdown text, ending in a newline.
+    """
     run = ver.runs[0]
     p = run.params
     T = run.dt

@@ -155,7 +155,25 @@ class HCFSRun:
         return int(self.output.shape[1])
 
     def index(self, mode: str, jerk_limit: float) -> int:
-        """Position of configuration (mode, J) in :attr:`configs`."""
+        """Position of configuration (mode, J) in :attr:`configs`.
+
+        Parameters
+        ----------
+        mode : str
+            The strategy (``"cacc"``, ``"policy"``, ``"paper"``, ``"safe"``).
+        jerk_limit : float
+            J, m/s³ (matched to a relative 1e-12).
+
+        Returns
+        -------
+        int
+            The index into :attr:`configs` and the per-configuration arrays.
+
+        Raises
+        ------
+        StringStabError
+            If the run has no such configuration.
+        """
         for i, c in enumerate(self.configs):
             if c.mode == mode and np.isclose(c.jerk_limit, jerk_limit, rtol=1e-12, atol=0.0):
                 return i
@@ -172,6 +190,17 @@ class HCFSRun:
         −1 → 0, …, K − 2 → K − 1 are checked.  The checker recomputes the eq-13 output from the
         applied choices (the same arithmetic as the run, so the same numbers); for ``"safe"``
         it takes the applied, clipped output.
+
+        Parameters
+        ----------
+        i : int
+            Index of the configuration (:meth:`index`).
+
+        Returns
+        -------
+        TheoremCheck
+            Premises P1-P3, the conclusion and the bound (HCFS §III-C) at every follower and frame
+            (:func:`stringstab.hcfs.theorem.check_theorem`).
         """
         a0 = self.params["initial_accel"]
         c0 = self.configs[i].mode == "policy"

@@ -61,6 +61,16 @@ RULES = ("paper", "safe")
 def check_beta(beta: object) -> float:
     """β as a float in [0, 1] (eq 13).
 
+    Parameters
+    ----------
+    beta : object
+        β of eqs 13-14, the weight of the losing candidate at a switch (the paper: 0.5).
+
+    Returns
+    -------
+    float
+        β.
+
     Raises
     ------
     StringStabError
@@ -86,6 +96,16 @@ def check_beta(beta: object) -> float:
 
 def choose(r_ddpg: npt.ArrayLike, r_cacc: npt.ArrayLike) -> BoolArray:
     """Eq 12: True where the DDPG action wins (r_DDPG > r_CACC; a tie goes to CACC).
+
+    Parameters
+    ----------
+    r_ddpg, r_cacc : array_like
+        The eq-6 rewards the two candidates would earn (:func:`predicted_rewards`).
+
+    Returns
+    -------
+    bool array
+        c_k: True where a1 (DDPG) wins.
 
     Examples
     --------
@@ -182,6 +202,22 @@ def predicted_lead_speed(lead_speed_rx: npt.ArrayLike, prev_lead_speed_rx: npt.A
 
     The received speeds are those of t_k − δ and t_{k−1} − δ; at constant acceleration
     â = (ṽ_k − ṽ_{k−1}) / T the speed at t_{k+1} is ṽ_k + â (T + δ).
+
+    Parameters
+    ----------
+    lead_speed_rx : array_like
+        ṽ_k, the leader's speed received at frame k (that of t_k − δ), m/s.
+    prev_lead_speed_rx : array_like
+        ṽ_{k−1}, the one received at frame k − 1, m/s.
+    delay : float
+        V2V delay δ, s.
+    dt : float
+        Frame length T, s.
+
+    Returns
+    -------
+    array
+        The predicted leader speed at t_{k+1}, m/s (for the reward of eq 12's choice).
 
     Examples
     --------

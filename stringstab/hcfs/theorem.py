@@ -71,6 +71,21 @@ Case = Literal["switch", "after-switch", "double-switch"]
 def check_jerk_limit(jerk_limit: Any) -> float:
     """J as a float: a finite number > 0 (m/s³).
 
+    Parameters
+    ----------
+    jerk_limit : object
+        The jerk limit J of the HCFS theorem (§III-C), m/s³.
+
+    Returns
+    -------
+    float
+        J.
+
+    Raises
+    ------
+    StringStabError
+        Unless J is a finite number > 0.
+
     Examples
     --------
     >>> check_jerk_limit(0)
@@ -92,6 +107,25 @@ def weight_change(prev_switch: npt.ArrayLike, switch: npt.ArrayLike, beta: float
     no                       yes          1 − β
     yes                      yes          |1 − 2β|
     ======================  ==========  ============
+
+    Parameters
+    ----------
+    prev_switch : bool array_like
+        α_{k−1}: a switch at frame k − 1.
+    switch : bool array_like
+        α_k: a switch at frame k.
+    beta : float
+        β of eqs 13-14, in [0, 1].
+
+    Returns
+    -------
+    array
+        |λ_k − λ_{k−1}|, the factor of |a1_{k−1} − a2_{k−1}| in the jerk bound.
+
+    Raises
+    ------
+    StringStabError
+        If β is not in [0, 1].
 
     Examples
     --------
@@ -230,6 +264,19 @@ class TheoremCheck:
         """Numbers of frames where each premise holds or fails, and of failures.
 
         ``index`` selects part of the leading axes (e.g. one vehicle); default all frames.
+
+        Parameters
+        ----------
+        index : index expression, optional
+            Applied to every per-frame array before counting (default ``...``: everything).
+
+        Returns
+        -------
+        dict of str to int
+            ``frames``, ``P1_holds``/``P1_fails``, ``P2_holds``/``P2_fails``,
+            ``P3_holds``/``P3_fails``, ``premises_hold``, ``conclusion_fails``, ``violations``
+            (premises hold, conclusion fails), ``counterexamples`` (P1, P2 hold, P3 and the
+            conclusion fail), ``bound_violations`` and ``switches``.
 
         Examples
         --------
@@ -448,6 +495,24 @@ def lattice_search(q: int, *, beta: float = BETA) -> LatticeSearch:
     them, and checks the theorem.  The proposition of ``docs/hcfs.md`` predicts the smallest
     counterexample gap to be one lattice unit, 1/q, with a step of 1 + max|Δλ|/q at that gap.
     The number of sequences is 8 (2q + 1)⁴: keep q ≤ 12 or so (3·10⁶ sequences).
+
+    Parameters
+    ----------
+    q : int
+        Lattice points per J T (≥ 1).
+    beta : float
+        β of eqs 13-14.
+
+    Returns
+    -------
+    LatticeSearch
+        The sequences (in units of J T) and the theorem checked on each
+        (:func:`check_theorem` with J = 1, T = 1).
+
+    Raises
+    ------
+    StringStabError
+        If q < 1 or β is not in [0, 1].
 
     Examples
     --------

@@ -35,7 +35,29 @@ FORMAT = "stringstab-region-map/1"
 
 def write_npz(path: str | os.PathLike[str], axes: Mapping[str, npt.NDArray[Any]],
               fields: Mapping[str, npt.NDArray[Any]], metadata: Mapping[str, Any]) -> Path:
-    """Write ``axis_<gain>`` coordinates, the fields and the metadata (JSON) to ``path``."""
+    """Write ``axis_<gain>`` coordinates, the fields and the metadata (JSON) to ``path``.
+
+    The archive is a zip of ``.npy`` members (what :func:`numpy.load` reads) compressed at
+    zlib level 1, written atomically (a temporary file renamed into place).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The NPZ file to write.
+    axes : mapping of str to ndarray
+        The grid coordinates of each swept gain (``"k_x"``, ``"k_v"``, ``"k_a"``; 1/s², 1/s,
+        dimensionless), stored as ``axis_<gain>``.
+    fields : mapping of str to ndarray
+        The per-point arrays (verdicts, types, sup |Γ|, margin, ...), stored under their names.
+    metadata : mapping
+        JSON-serialisable description of the map; its ``format`` should be :data:`FORMAT`
+        (:func:`read_npz` refuses any other).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     arrays: dict[str, npt.NDArray[Any]] = {f"axis_{n}": a for n, a in axes.items()}
     arrays.update(fields)
     arrays["metadata"] = np.array(json.dumps(metadata))
@@ -50,6 +72,18 @@ def write_npz(path: str | os.PathLike[str], axes: Mapping[str, npt.NDArray[Any]]
 
 def read_npz(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
     """(metadata, arrays) of a file written by :func:`write_npz`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A region-map NPZ file.
+
+    Returns
+    -------
+    metadata : dict
+        The decoded ``metadata`` entry (its ``format`` is :data:`FORMAT`).
+    arrays : dict of str to ndarray
+        Every entry of the archive, ``metadata`` included, by name.
 
     Raises
     ------
@@ -76,6 +110,19 @@ def csv_text(columns: Mapping[str, npt.NDArray[Any]], comments: Sequence[str] | 
     numbers, ``True``/``False``, a non-finite number as an empty field).  With
     ``comments=None``, the rows alone (no header): the texts of consecutive row ranges
     concatenate to the text of the whole.
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray
+        The table, column by column; every column has one element per row.
+    comments : sequence of str or None
+        Lines written first, each as ``# <line>``, before the header; None to leave out both
+        the comment lines and the header.
+
+    Returns
+    -------
+    str
+        The CSV text, ending in a newline.
     """
     text = format_results(columns, "csv")
     if comments is None:

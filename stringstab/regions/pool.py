@@ -45,6 +45,26 @@ def run_blocks(
     With ``executor`` (any :class:`concurrent.futures.Executor`, e.g. a Dask client's
     ``get_executor()``) they go there instead, ``2 × workers`` in flight (``evaluate`` and
     ``spec`` are pickled; no warm-up).
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(spec, i0, i1, j0, j1) -> dict``: the results of one block of the grid.
+    spec : object
+        Everything ``evaluate`` needs besides the block (passed to it unchanged).
+    blocks : sequence of Block
+        The blocks ``(i0, i1, j0, j1)`` of the internal 3-D grid to evaluate.
+    workers : int
+        Worker processes; ≤ 1 evaluates the blocks here, in order.
+    warm : callable, optional
+        ``warm(spec)``: a warm-up (imports, caches) run here and in each forked worker.
+    executor : concurrent.futures.Executor, optional
+        Run the blocks there instead of a local pool.
+
+    Yields
+    ------
+    (Block, dict)
+        Each block with its result, in completion order (in block order when ``workers`` ≤ 1).
     """
     if executor is not None:
         yield from _submit_all(executor, evaluate, spec, blocks, max(int(workers), 1))
@@ -94,6 +114,18 @@ def in_background(fn: Callable[..., Any], *args: Any) -> Callable[[], None]:
     error (one line) if it failed.  Where processes cannot be forked (no ``fork`` start
     method, or this process is a daemon), ``fn(*args)`` runs here, now, and ``join()`` does
     nothing.  Used to draw a map's figures while its data files are written.
+
+    Parameters
+    ----------
+    fn : callable
+        The work to run; its return value is discarded.
+    *args
+        Its arguments (inherited by the forked child, not pickled).
+
+    Returns
+    -------
+    callable
+        ``join()``: waits for the child; raises :class:`StringStabError` if it failed.
     """
     if "fork" not in multiprocessing.get_all_start_methods() or in_daemon():
         fn(*args)

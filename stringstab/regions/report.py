@@ -11,12 +11,36 @@ __all__ = ["percent", "render_report"]
 
 
 def percent(x: float) -> str:
-    """A share as a percentage with one decimal (``<0.1 %`` for a tiny non-zero share)."""
+    """A share as a percentage with one decimal (``<0.1 %`` for a tiny non-zero share).
+
+    Parameters
+    ----------
+    x : float
+        A share in [0, 1].
+
+    Returns
+    -------
+    str
+        For instance ``"20.0 %"``; ``"<0.1 %"`` for 0 < x < 0.001.
+    """
     return "<0.1 %" if 0 < x < 1e-3 else f"{100 * x:.1f} %"
 
 
 def render_report(rmap: RegionMap) -> str:
     """The grid, the class shares per method and the disagreements, one line each.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The map to describe.
+
+    Returns
+    -------
+    str
+        The report, lines joined by newlines (no final newline): the grid and τ, δ, T*; the
+        class shares of each method (Taylor types I-IV of IDL §3.3, exact verdicts); the
+        points where methods disagree; for a sampled map, the points certified in one of
+        continuous and sampled time only.
 
     Examples
     --------

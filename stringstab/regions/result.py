@@ -183,12 +183,46 @@ class RegionMap:
             )
 
     def stable(self, method: str) -> npt.NDArray[np.bool_]:
-        """Where ``method`` says string stable (certified, or Hurwitz ∧ Proposition 1)."""
+        """Where ``method`` says string stable (certified, or Hurwitz ∧ Proposition 1).
+
+        Parameters
+        ----------
+        method : str
+            One of the map's :attr:`methods` (``"exact"``, ``"continuous"``, ``"taylor"``,
+            ``"printed"``).
+
+        Returns
+        -------
+        bool ndarray, shape :attr:`shape`
+            True where the method's verdict is string stable.
+
+        Raises
+        ------
+        StringStabError
+            If ``method`` was not evaluated in this map.
+        """
         self._check_method(method)
         return np.asarray(self.verdict[method] == STABLE)
 
     def class_names(self, method: str) -> tuple[str, ...]:
-        """Names of the class codes of :meth:`classes` for ``method``."""
+        """Names of the class codes of :meth:`classes` for ``method``.
+
+        Parameters
+        ----------
+        method : str
+            One of the map's :attr:`methods`.
+
+        Returns
+        -------
+        tuple of str
+            :data:`EXACT_CLASSES` for a certificate, :data:`TYPE_CLASSES` for a Taylor method;
+            entry i names code i.
+
+        Raises
+        ------
+        StringStabError
+            If ``method`` was not evaluated in this map.
+        """
         self._check_method(method)
         return EXACT_CLASSES if method in _CERTIFICATES else TYPE_CLASSES
 
@@ -198,7 +232,22 @@ class RegionMap:
         ``exact`` (and ``continuous``): 0 not internally stable, 1 not certified,
         2 inconclusive, 3 certified (:data:`EXACT_CLASSES`).  ``taylor`` / ``printed``: 0 not
         internally stable, then 1 type III, 2 type IV, 3 type I, 4 type II of
-        that method's Ψ (:data:`TYPE_CLASSES`).
+        that method's Ψ (:data:`TYPE_CLASSES`; IDL §3.3).
+
+        Parameters
+        ----------
+        method : str
+            One of the map's :attr:`methods`.
+
+        Returns
+        -------
+        int8 ndarray, shape :attr:`shape`
+            The class codes.
+
+        Raises
+        ------
+        StringStabError
+            If ``method`` was not evaluated in this map.
         """
         self._check_method(method)
         if method in _CERTIFICATES:
@@ -293,6 +342,18 @@ class RegionMap:
     # ---------------------------------------------------------------- slicing
     def slice(self, gain: str, value: float) -> RegionMap:
         """The 2-D slice of a 3-D map at the grid coordinate of ``gain`` nearest ``value``.
+
+        Parameters
+        ----------
+        gain : {"k_x", "k_v", "k_a"}
+            The axis to fix.
+        value : float
+            The gain value; the nearest grid coordinate is taken (and recorded in ``fixed``).
+
+        Returns
+        -------
+        RegionMap
+            The 2-D map over the two other gains, with the same parameters and methods.
 
         Raises
         ------
@@ -431,6 +492,16 @@ class RegionMap:
         (``hurwitz``, ``type``, ``verdict_<method>``, ...) and ``metadata``, a
         JSON string with the parameters and the tool version.  Read it back with
         :func:`load_npz`.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (atomically).
+
+        Returns
+        -------
+        Path
+            ``path``.
         """
         return write_npz(path, self.axes, self.fields(), self.metadata())
 
@@ -442,6 +513,16 @@ class RegionMap:
         and the rows, written column by column (:mod:`stringstab.io`'s writer: numbers
         in their shortest round-trip form, booleans ``True``/``False``, a non-finite
         number, such as ``sup_gain`` where Γ is not internally stable, as an empty field).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (atomically).
+
+        Returns
+        -------
+        Path
+            The file written.
         """
         return atomic_write_text(path, self.csv_text(), what="region map CSV")
 
@@ -450,6 +531,18 @@ class RegionMap:
 
         ``head=False`` leaves out the ``#`` lines and the header, so that the texts of
         consecutive row ranges concatenate to the whole file (two processes can write one).
+
+        Parameters
+        ----------
+        rows : slice, optional
+            The grid points (flattened in C order) to write; None for all.
+        head : bool
+            Start with the ``#`` lines and the header.
+
+        Returns
+        -------
+        str
+            The CSV text.
 
         Examples
         --------
@@ -469,6 +562,17 @@ class RegionMap:
 
 def load_npz(path: str | os.PathLike[str]) -> RegionMap:
     """Read a map written by :meth:`RegionMap.save_npz`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The NPZ file.
+
+    Returns
+    -------
+    RegionMap
+        The map, with its axes, fixed gains, parameters (a :class:`~stringstab.params.Params`
+        or a :class:`~stringstab.params.Box`), methods and per-point fields.
 
     Raises
     ------
@@ -496,6 +600,17 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
 
 def describe_params(p: Params | Box) -> str:
     """``τ = 0.1 s, δ = 0.2 s, T* = 1.1 s``, intervals as ``τ ∈ [0.1, 0.3] s``.
+
+    Parameters
+    ----------
+    p : Params or Box
+        Actuator lag τ (IDL eq 7), communication delay δ (eq 4) and time headway T* (eq 3), in
+        s, each a value or an interval.
+
+    Returns
+    -------
+    str
+        One line; a degenerate interval is written as a value.
 
     Examples
     --------

@@ -71,13 +71,42 @@ class Agent:
     # -- acting -----------------------------------------------------------------------------
     @torch.no_grad()
     def act(self, obs: npt.ArrayLike) -> npt.NDArray[np.float32]:
-        """μ(s) for a batch of states, in environment units (no exploration noise)."""
+        """μ(s) for a batch of states, in environment units (no exploration noise).
+
+        Parameters
+        ----------
+        obs : array_like (n, obs_dim)
+            States (the eq-16 state of the IDL paper, with any ``observe`` extras).
+
+        Returns
+        -------
+        ndarray (n, act_dim), float32
+            The actor's actions: gains (eq 17) or accelerations (m/s²), within the action bounds.
+        """
         x = torch.as_tensor(np.asarray(obs, dtype=np.float32))
         return np.asarray(self.actor(x).numpy(), dtype=np.float32)
 
     # -- learning ---------------------------------------------------------------------------
     def update(self, batch: dict[str, npt.NDArray[np.float32]]) -> dict[str, float]:
-        """One critic step (and, every ``policy_delay`` steps, one actor and target step)."""
+        """One critic step (and, every ``policy_delay`` steps, one actor and target step).
+
+        The critic target is y = r + γ ((1 − d) min_j Q'_j(s', μ'(s') + ε) + d V_term), with
+        target policy smoothing ε (TD3) when enabled, the minimum over twin critics (TD3; one
+        critic for DDPG), and V_term = ``terminal_value`` for a terminated next state.  The actor
+        maximises Q_1(s, μ(s)) (minus the proposal penalty, if set); targets are updated softly
+        with rate ``soft_update``.
+
+        Parameters
+        ----------
+        batch : dict of str to ndarray (float32)
+            ``obs``, ``actions``, ``rewards`` (n, 1), ``next_obs``, ``dones`` (n, 1)
+            (:meth:`ReplayBuffer.sample`).
+
+        Returns
+        -------
+        dict of str to float
+            ``critic_loss``, and ``actor_loss`` on the steps where the actor was updated.
+        """
         c = self.config
         obs, act = torch.as_tensor(batch["obs"]), torch.as_tensor(batch["actions"])
         rew, nxt = torch.as_tensor(batch["rewards"]), torch.as_tensor(batch["next_obs"])
@@ -148,7 +177,20 @@ class Agent:
         return meta, tensors
 
     def load_state(self, meta: dict[str, Any], tensors: dict[str, torch.Tensor]) -> None:
-        """Restore :meth:`state` output; refuses missing or mis-shaped tensors."""
+        """Restore :meth:`state` output; refuses missing or mis-shaped tensors.
+
+        Parameters
+        ----------
+        meta : dict
+            The JSON-ready part of :meth:`state` (``n_updates``, the optimisers' parameter groups).
+        tensors : dict of str to torch.Tensor
+            Networks, targets and Adam moments, by name.
+
+        Raises
+        ------
+        StringStabError
+            If a tensor is missing or does not fit this agent's networks.
+        """
         try:
             for name, m in self._modules().items():
                 want = m.state_dict()

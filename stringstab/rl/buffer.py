@@ -52,7 +52,21 @@ class ReplayBuffer:
 
     def add(self, obs: npt.ArrayLike, actions: npt.ArrayLike, rewards: npt.ArrayLike,
             next_obs: npt.ArrayLike, dones: npt.ArrayLike) -> None:
-        """Append a batch of transitions (leading axis: environments)."""
+        """Append a batch of transitions (leading axis: environments).
+
+        Parameters
+        ----------
+        obs : array_like (n, obs_dim)
+            States s.
+        actions : array_like (n, act_dim)
+            Actions a (environment units).
+        rewards : array_like (n,)
+            Rewards r.
+        next_obs : array_like (n, obs_dim)
+            Next states s' (for an episode that ended, its final state).
+        dones : array_like (n,)
+            1 where s' is terminal (the target then uses ``terminal_value``), else 0.
+        """
         o = np.asarray(obs, dtype=np.float32)
         n = o.shape[0]
         idx = (self.pos + np.arange(n)) % self.capacity
@@ -65,7 +79,24 @@ class ReplayBuffer:
         self.size = int(min(self.size + n, self.capacity))
 
     def sample(self, batch_size: int) -> dict[str, F32]:
-        """A uniform minibatch (with replacement), as float32 arrays."""
+        """A uniform minibatch (with replacement), as float32 arrays.
+
+        Parameters
+        ----------
+        batch_size : int
+            Transitions to draw.
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``obs``, ``actions``, ``rewards`` (batch_size, 1), ``next_obs``, ``dones``
+            (batch_size, 1).
+
+        Raises
+        ------
+        StringStabError
+            If the buffer is empty.
+        """
         if self.size == 0:
             raise StringStabError("cannot sample from an empty replay buffer")
         idx = self.rng.integers(0, self.size, size=batch_size)
@@ -82,7 +113,20 @@ class ReplayBuffer:
                 "rng": self.rng.bit_generator.state}
 
     def load_state(self, state: dict[str, Any], arrays: dict[str, Any]) -> None:
-        """Restore from :meth:`state` and :meth:`arrays` (shapes are checked)."""
+        """Restore from :meth:`state` and :meth:`arrays` (shapes are checked).
+
+        Parameters
+        ----------
+        state : dict
+            :meth:`state` output: ``capacity``, ``pos``, ``size``, ``rng``.
+        arrays : dict of str to ndarray
+            :meth:`arrays` output: the stored transitions.
+
+        Raises
+        ------
+        StringStabError
+            If the capacity differs or an array has another shape.
+        """
         size = int(state["size"])
         if int(state["capacity"]) != self.capacity or not 0 <= size <= self.capacity:
             raise StringStabError(

@@ -47,7 +47,18 @@ LATEST_FORMAT = "stringstab-rl-latest/1"
 
 
 def sha256(path: str | os.PathLike[str]) -> str:
-    """Hex SHA-256 of a file."""
+    """Hex SHA-256 of a file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file, read in 1 MiB blocks.
+
+    Returns
+    -------
+    str
+        64 lower-case hex digits.
+    """
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -56,7 +67,20 @@ def sha256(path: str | os.PathLike[str]) -> str:
 
 
 def write_tensors(path: str | os.PathLike[str], arrays: dict[str, npt.NDArray[Any]]) -> str:
-    """Write NumPy arrays to a safetensors file atomically; returns its SHA-256."""
+    """Write NumPy arrays to a safetensors file atomically; returns its SHA-256.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.safetensors`` file to write (complete or absent).
+    arrays : dict of str to ndarray
+        The tensors by name (made C-contiguous before writing).
+
+    Returns
+    -------
+    str
+        The hex SHA-256 of the file written (:func:`sha256`), to record in the JSON naming it.
+    """
     from safetensors.numpy import save_file
 
     clean = {k: np.ascontiguousarray(v) for k, v in arrays.items()}
@@ -68,6 +92,20 @@ def write_tensors(path: str | os.PathLike[str], arrays: dict[str, npt.NDArray[An
 def read_tensors(path: str | os.PathLike[str], *, expected_sha256: str | None,
                  what: str = "checkpoint") -> dict[str, npt.NDArray[Any]]:
     """Arrays of a safetensors file, after checking its SHA-256 (no code is ever run).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.safetensors`` file.
+    expected_sha256 : str or None
+        The hex digest recorded when it was written; None skips the check.
+    what : str
+        What the file is, for the error messages (``"checkpoint"``, ``"policy"``).
+
+    Returns
+    -------
+    dict of str to ndarray
+        The tensors by name.
 
     Raises
     ------
@@ -96,6 +134,20 @@ def read_tensors(path: str | os.PathLike[str], *, expected_sha256: str | None,
 
 def read_json(path: str | os.PathLike[str], *, fmt: str, what: str) -> dict[str, Any]:
     """A JSON object whose ``format`` tag is ``fmt``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The JSON file (UTF-8).
+    fmt : str
+        The ``format`` tag expected (e.g. :data:`CHECKPOINT_FORMAT`).
+    what : str
+        What the file is, for the error messages.
+
+    Returns
+    -------
+    dict
+        The decoded object, ``format`` included.
 
     Raises
     ------
@@ -169,6 +221,20 @@ def write_checkpoint(folder: str | os.PathLike[str], step: int, state: dict[str,
 def latest_checkpoint(folder: str | os.PathLike[str]) -> tuple[dict[str, Any],
                                                              dict[str, dict[str, npt.NDArray[Any]]]]:
     """Read the newest checkpoint under ``folder``: (state, {file stem: arrays}), verified.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        A run's ``checkpoint`` folder, holding ``latest.json`` and ``ckpt-<step>/`` folders
+        (:func:`write_checkpoint`).
+
+    Returns
+    -------
+    state : dict
+        The checkpoint's ``state.json`` (config, counters, RNG states, episode log, ``files``).
+    tensors : dict of str to dict of str to ndarray
+        The arrays of each tensor file, by file stem (``"agent"``, ``"buffer"``), each file's
+        SHA-256 checked against ``state.json`` before it is parsed.
 
     Raises
     ------

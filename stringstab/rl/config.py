@@ -321,6 +321,26 @@ def config_for(algo: str, *, paper: bool = False, **overrides: Any) -> TD3Config
     :class:`TD3Config` with acceleration actions and exploration noise 0.25 (the best for pure
     TD3 in the paper's §5.1(2)); ``ddpg`` is :class:`DDPGConfig`.
 
+    Parameters
+    ----------
+    algo : {"idl", "td3", "ddpg"}
+        The agent: IDL (TD3 choosing the gains of eq 4, eq 17), pure TD3 or DDPG choosing the
+        acceleration.
+    paper : bool, default False
+        For ``"idl"``, leave out :data:`IDL_OPTIONS` (the paper's set-up); ignored otherwise.
+    **overrides
+        Config fields to set, applied last (they win over the defaults above).
+
+    Returns
+    -------
+    TD3Config
+        A :class:`TD3Config` (or :class:`DDPGConfig`, a subclass), every field checked.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown ``algo`` or an invalid field.
+
     Examples
     --------
     >>> config_for("td3").action, config_for("td3").exploration_noise
@@ -345,6 +365,22 @@ def config_for(algo: str, *, paper: bool = False, **overrides: Any) -> TD3Config
 
 def config_from_dict(doc: Any, *, source: str = "config") -> TD3Config:
     """Rebuild a config from :meth:`TD3Config.as_dict` output, checking every field.
+
+    JSON lists are turned back into the tuples the fields hold (``hidden``, ``weights``,
+    ``observe``, ``start_spread``).
+
+    Parameters
+    ----------
+    doc : object
+        The decoded JSON: a mapping with ``class`` (``"TD3Config"`` or ``"DDPGConfig"``) and
+        config fields.
+    source : str
+        What ``doc`` was read from, for the error messages.
+
+    Returns
+    -------
+    TD3Config
+        The config (a :class:`DDPGConfig` for ``class: "DDPGConfig"``).
 
     Raises
     ------

@@ -53,6 +53,26 @@ MIN_TOP_SPEED = 1.0
 def cut(tr: Trajectory, seconds: float) -> list[Trajectory]:
     """Non-overlapping windows of ``seconds`` (the tail shorter than a window is dropped).
 
+    Each window has round(seconds/dt) steps (one more sample), is re-timed to start at
+    t = 0 and named ``<name>@<start>s``.
+
+    Parameters
+    ----------
+    tr : Trajectory
+        The leader to cut.
+    seconds : float
+        Window length, s.
+
+    Returns
+    -------
+    list of Trajectory
+        The windows in order (empty if ``tr`` is shorter than one window).
+
+    Raises
+    ------
+    StringStabError
+        If ``seconds`` is shorter than one step.
+
     Examples
     --------
     >>> from stringstab.traffic import cycle
@@ -92,6 +112,27 @@ def _synthetic(split: Split, dt: float) -> list[Trajectory]:
 
 def default_leaders(split: Split, *, seconds: float = 30.0, dt: float = 0.1) -> list[Trajectory]:
     """The bundled training or test episodes (see the module docstring).
+
+    Parameters
+    ----------
+    split : {"train", "test"}
+        Which split: 70 % or 30 % of the driving-cycle windows (fixed seed), plus that split's
+        synthetic disturbances.
+    seconds : float
+        Episode length, s.
+    dt : float
+        Sample step, s.
+
+    Returns
+    -------
+    list of Trajectory
+        The cycle windows, then the synthetic ones; leaders that never exceed 1 m/s are
+        dropped.
+
+    Raises
+    ------
+    StringStabError
+        If ``split`` is neither ``"train"`` nor ``"test"``.
 
     Examples
     --------

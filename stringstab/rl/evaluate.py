@@ -57,12 +57,37 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         dt: float) -> dict[str, Any]:
     """M_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
 
-    Returns ``{"M_fss": % of triples certified by the exact continuous-time certificate
-    (:func:`stringstab.metrics.fss_ratio`), "M_fss_sampled": % certified by the sampled-data
-    certificate of the zero-order-hold loop at the control step ``dt``
-    (:func:`stringstab.sampled.check_sampled`), "n": triples}``.  The continuous certificate is
-    what the repair guarantees (and what the exit code of ``stringstab evaluate`` requires); the
-    sampled one is the loop the simulator actually runs (u held over each step of ``dt``).
+    The continuous certificate is what the repair guarantees (and what the exit code of
+    ``stringstab evaluate`` requires); the sampled one is the loop the simulator actually runs
+    (u held over each step of ``dt``).
+
+    Parameters
+    ----------
+    gains : array_like, shape (..., 3)
+        Executed gains (k_x [1/s²], k_v [1/s], k_a [-]; IDL eq 4), one triple per (vehicle,
+        moment).
+    tau : float
+        Actuator lag τ (IDL eq 7), s.
+    delta : float
+        Communication delay δ (eq 4), s.
+    headway : float
+        Time headway T* (eq 3), s.
+    dt : float
+        Control step, s: the sampling period H of the sampled-data certificate.
+
+    Returns
+    -------
+    dict
+        ``"M_fss"``: % of triples certified by the exact continuous-time certificate (IDL eqs
+        27-28, :func:`stringstab.metrics.fss_ratio`); ``"M_fss_sampled"``: % certified by the
+        sampled-data certificate of the zero-order-hold loop at ``dt``
+        (:func:`stringstab.sampled.check_sampled`); ``"n"``: the number of triples;
+        ``"certificate"``, ``"dt"``: what was checked.
+
+    Raises
+    ------
+    StringStabError
+        If there is no gain triple.
     """
     from ..sampled import check_sampled
 
@@ -87,6 +112,28 @@ def controller_for(strategy: Policy | str, *, headway: float,
     (:meth:`Policy.gains`); an acceleration policy commands its output; ``"cacc"`` is van Arem
     et al.'s CACC with T* as time gap, ``"idm"`` the IDM (the paper's HDV row replays recorded
     NGSIM followers; without NGSIM the IDM stands in for the human driver).
+
+    Parameters
+    ----------
+    strategy : Policy or {"cacc", "idm"}
+        A trained policy or a baseline's name.
+    headway : float
+        Time headway T* (eq 3), s: of the eq-16 state and the eq-4 law (the CACC's time gap).
+    standstill : float
+        Standstill distance l_0 (eq 3), m (the IDM's minimum gap).
+
+    Returns
+    -------
+    controller
+        A ``TimeVaryingLinearController`` (gain policy; it remembers the previous step's
+        executed gains for the policy's rate limit and extended state, reset at step 0), a
+        ``FunctionController`` (acceleration policy), a ``CACCController`` or an
+        ``IDMController``.
+
+    Raises
+    ------
+    StringStabError
+        On an unknown baseline name.
     """
     from ..traffic.controllers import (
         CACCController,
@@ -173,16 +220,47 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
              ttc_star: float = TTC_STAR, limits: Any = None, progress: Any = None) -> Evaluation:
     """Run ``strategy`` (a policy, ``"cacc"`` or ``"idm"``) on every leader; see the module.
 
-    ``limits`` (a :class:`~stringstab.traffic.Limits`; default IDL Table 2) bound the
-    followers; ``progress``, a callable, receives the number of leaders done after each
-    group of equally long leaders (for a progress line).
+    Leaders of equal length and step are simulated together, one follower each.
+
+    Parameters
+    ----------
+    strategy : Policy or {"cacc", "idm"}
+        What the follower runs (:func:`controller_for`).
+    leaders : sequence of Trajectory or FollowingPair
+        The held-out leaders; a pair starts from the recorded follower's gap and speed, a
+        trajectory from the equilibrium gap l_0 + T* v.
+    tau : float
+        Actuator lag τ of the follower (IDL eq 7), s.
+    delta : float
+        Communication delay δ (eq 4), s.
+    headway : float
+        Time headway T* (eq 3), s.
+    name : str, optional
+        Label of the strategy (default the baseline's name or the policy's ``algo``).
+    standstill : float
+        Standstill distance l_0 (eq 3), m.
+    ttc_star : float
+        TTC* of the time-integrated TTC (eqs 31-32), s.
+    limits : Limits, optional
+        Bounds on the followers (default IDL Table 2).
+    progress : callable, optional
+        Receives the number of leaders done after each group of equally long leaders (for a
+        progress line).
 
     Returns
     -------
     Evaluation
-        ``summary``: ``episodes``, ``M_lss``, ``share_m_p_below_1``, ``TIT`` (mean per
-        episode), ``TIT_total``, ``M_CI``, ``M_effi``, ``collisions``, ``collided_episodes``,
-        ``min_gap``, and for gain policies ``M_fss`` (with ``n_gains``).
+        ``episodes``: one dict per leader (``m_p`` of eq 29, ``TIT``, ``collisions``,
+        ``min_gap``, ``M_fss``); ``summary``: ``episodes``, ``M_lss`` (eq 30),
+        ``share_m_p_below_1``, ``TIT`` (mean per episode), ``TIT_total``, ``M_CI`` (eq 34),
+        ``M_effi`` (eq 35), ``median_headway``, ``collisions``, ``collided_episodes``,
+        ``min_gap``, and for gain policies ``M_fss`` (eq 27, with ``n_gains``) and
+        ``M_fss_sampled``; ``gains``: the executed gains, rows (t, episode, k_x, k_v, k_a).
+
+    Raises
+    ------
+    StringStabError
+        If ``leaders`` is empty or ``strategy`` an unknown baseline.
     """
     from ..traffic.platoon import simulate
 
@@ -267,8 +345,35 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
                  standstill: float = STANDSTILL, limits: Any = None) -> dict[str, Any]:
     """``n_vehicles`` running ``strategy`` behind the §5.1-style leader: m_p per vehicle and more.
 
-    Returns ``{"n", "m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_fss"}`` (M_fss for gain
-    policies: every vehicle's executed gains at every step).
+    Parameters
+    ----------
+    strategy : Policy or {"cacc", "idm"}
+        What every follower runs (:func:`controller_for`).
+    n_vehicles : int
+        Followers in the platoon (the paper: 10 and 100).
+    tau : float
+        Actuator lag τ (IDL eq 7), s.
+    delta : float
+        Communication delay δ (eq 4), s.
+    headway : float
+        Time headway T* (eq 3), s.
+    dt : float
+        Simulation step, s (also the sampled certificate's period).
+    hold : float
+        Seconds the leader (:func:`stringstab.traffic.paper_mix`) is held at its final speed,
+        so the disturbance reaches the tail.
+    standstill : float
+        Standstill distance l_0 (eq 3), m; the platoon starts in equilibrium l_0 + T* v.
+    limits : Limits, optional
+        Bounds on the followers (default IDL Table 2).
+
+    Returns
+    -------
+    dict
+        ``"n"``, ``"leader"``, ``"m_p"`` (per vehicle, eq 29), ``"max_m_p"``, ``"M_lss"``
+        (eq 30), ``"collisions"``, ``"TIT"``, and for gain policies ``"M_fss"`` and
+        ``"M_fss_sampled"`` (:func:`fss` of every vehicle's executed gains at every step;
+        None otherwise).
     """
     from ..metrics import platoon_metrics
     from ..traffic.leaders import paper_mix

@@ -19,7 +19,22 @@ __all__ = ["Actor", "QNetwork", "mlp"]
 
 
 def mlp(n_in: int, hidden: Sequence[int], n_out: int) -> nn.Sequential:
-    """Linear–ReLU layers of widths ``hidden``, then a linear output; Glorot-uniform weights."""
+    """Linear–ReLU layers of widths ``hidden``, then a linear output; Glorot-uniform weights.
+
+    Parameters
+    ----------
+    n_in : int
+        Input width (the state's length, or state + action for a critic).
+    hidden : sequence of int
+        Hidden layer widths (Table 1: 128, 128).
+    n_out : int
+        Output width.
+
+    Returns
+    -------
+    torch.nn.Sequential
+        The network, weights Glorot-uniform and biases zero (Table 1, as in Keras).
+    """
     layers: list[nn.Module] = []
     width = n_in
     for h in hidden:
@@ -59,6 +74,18 @@ class Actor(nn.Module):
         self.register_buffer("action_bias", torch.as_tensor((hi + lo) / 2.0))
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        """μ(s) = tanh(net(s)) · scale + bias: the action within [low, high].
+
+        Parameters
+        ----------
+        obs : torch.Tensor (n, obs_dim)
+            States.
+
+        Returns
+        -------
+        torch.Tensor (n, act_dim)
+            Actions in environment units.
+        """
         return torch.tanh(self.net(obs)) * self.action_scale + self.action_bias
 
 
@@ -70,4 +97,18 @@ class QNetwork(nn.Module):
         self.net = mlp(obs_dim + act_dim, hidden, 1)
 
     def forward(self, obs: torch.Tensor, act: torch.Tensor) -> torch.Tensor:
+        """Q(s, a) of each state-action pair.
+
+        Parameters
+        ----------
+        obs : torch.Tensor (n, obs_dim)
+            States.
+        act : torch.Tensor (n, act_dim)
+            Actions, environment units.
+
+        Returns
+        -------
+        torch.Tensor (n, 1)
+            The Q-values.
+        """
         return self.net(torch.cat([obs, act], dim=1))

@@ -102,6 +102,20 @@ class Policy:
         None at an episode's first step: zeros, and no rate limit), the proposal is rate
         limited (``gain_rate``) and repaired, so each returned triple is certified (unless the
         repair is off).
+
+        Parameters
+        ----------
+        state : array_like (n, 3)
+            The IDL state of eq 16 (:func:`stringstab.traffic.state_vector`).
+        accel : array_like (n,), optional
+            The follower's own acceleration, m/s² (zeros if None; used with ``observe`` "accel").
+        prev_gains : array_like (n, 3), optional
+            The gains executed at the previous step; None at an episode's first step.
+
+        Returns
+        -------
+        ndarray (n, 3)
+            The executed gains (k_x, k_v, k_a) of eq 4.
         """
         from ..traffic.env import extend_state, limit_rate
 
@@ -121,6 +135,21 @@ class Policy:
 
         Stateless: for a policy trained with a ``gain_rate`` or ``observe`` extras, use
         :meth:`step_gains`, which is how it runs in training and evaluation.
+
+        Parameters
+        ----------
+        obs : array_like (..., obs_dim)
+            Full policy inputs (eq-16 state plus any ``observe`` extras).
+
+        Returns
+        -------
+        ndarray (..., 3)
+            The repaired gains (k_x, k_v, k_a).
+
+        Raises
+        ------
+        StringStabError
+            If the policy outputs accelerations.
         """
         if self.action != "gains":
             raise StringStabError(f"policy of {self.algo!r} outputs accelerations, not gains")
@@ -131,7 +160,18 @@ class Policy:
         return self.repair(K2).reshape(shape)
 
     def save(self, directory: str | os.PathLike[str]) -> Path:
-        """Write ``policy.safetensors`` and ``policy.json`` into ``directory`` (created)."""
+        """Write ``policy.safetensors`` and ``policy.json`` into ``directory`` (created).
+
+        Parameters
+        ----------
+        directory : str or path-like
+            The folder (checked as an output folder, created if absent).
+
+        Returns
+        -------
+        Path
+            The folder.
+        """
         d = check_output_dir(directory, what="policy folder")
         d.mkdir(parents=True, exist_ok=True)
         arrays = {k: v.detach().cpu().numpy() for k, v in self.actor.state_dict().items()}
@@ -151,6 +191,18 @@ def _need(doc: dict[str, Any], key: str, kind: type | tuple[type, ...], where: s
 
 def load_policy(directory: str | os.PathLike[str]) -> Policy:
     """Load a policy saved by :meth:`Policy.save` (or a training run folder holding one).
+
+    Parameters
+    ----------
+    directory : str or path-like
+        A folder holding ``policy.json`` and ``policy.safetensors`` (a training run folder
+        does).
+
+    Returns
+    -------
+    Policy
+        The actor with its description (``algo``, ``action``, τ, δ, T*, ``dt``, ``observe``,
+        ``gain_rate``, the repair).
 
     Raises
     ------

@@ -106,10 +106,36 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
     (and, with ``sample_time``, by the sampled-data certificate at that step).
 
+    A point is kept when it is internally stable (Hurwitz), passes a cheap screen g(ω) ≥ 0 at
+    :data:`SCREEN_OMEGA` and the exact certificate (:func:`stringstab.certificate.check`)
+    certifies it.  The grid has round((hi − lo)/resolution) + 1 points per axis, so its
+    spacing is ``resolution`` only when that divides hi − lo.  Cached (8 entries).
+
+    Parameters
+    ----------
+    tau : float
+        Actuator lag τ (IDL eq 7), s.
+    delta : float
+        Communication delay δ (eq 4), s.
+    headway : float
+        Time headway T* (eq 3), s.
+    lo, hi : float
+        The gain box [lo, hi] of every gain (Table 2: [−2, 2]).
+    resolution : float
+        Grid spacing.
+    sample_time : float, optional
+        Also require the sampled-data certificate of the zero-order-hold loop at this
+        period H, s.
+
     Returns
     -------
     ndarray (m, 3)
         Read-only; columns k_x, k_v, k_a.
+
+    Raises
+    ------
+    StringStabError
+        If no point of the lattice is certified.
 
     Examples
     --------
@@ -258,6 +284,17 @@ class GainRepair:
         others are replaced by their nearest certified lattice point, without the exact check
         or the refinement.  Used by the actor's proposal penalty
         (``TD3Config.proposal_penalty``); never executed.
+
+        Parameters
+        ----------
+        K : array_like (..., 3)
+            Proposed gains (k_x, k_v, k_a); clipped to the bounds first.
+
+        Returns
+        -------
+        ndarray (n, 3)
+            The approximate repaired gains (not certified); the clipped input if the repair is
+            ``"off"``.
         """
         K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
         if self.method == "off":

@@ -16,11 +16,23 @@ __all__ = ["open_run", "test_leaders"]
 def open_run(folder: str | os.PathLike[str]) -> tuple[dict[str, Any], Policy]:
     """``run.json`` and the policy of a folder written by ``stringstab train``.
 
+    Parameters
+    ----------
+    folder : str or path-like
+        The training run folder.
+
+    Returns
+    -------
+    run : dict
+        ``run.json``, with ``"folder"`` added.
+    policy : Policy
+        The run's policy (:func:`~stringstab.rl.policy.load_policy`).
+
     Raises
     ------
     StringStabError
-        For a missing folder, a folder not written by ``stringstab train``, or a missing,
-        altered or foreign policy file.
+        For a missing folder, a folder not written by ``stringstab train``, a missing, altered
+        or foreign policy file, or a policy of another ``algo`` than the run's.
     """
     from .train import RUN_FORMAT
 
@@ -43,7 +55,27 @@ def open_run(folder: str | os.PathLike[str]) -> tuple[dict[str, Any], Policy]:
 def test_leaders(specs: list[str] | None, *, dt: float, seconds: float = 30.0) -> tuple[list[Any], str]:
     """The held-out leaders: ``None`` or ``["test"]`` → the bundled test episodes; else files.
 
-    Returns (leaders, description).
+    Parameters
+    ----------
+    specs : list of str or None
+        ``None``/``["test"]`` for the bundled test split, else paths of ``t, v[, a]`` CSV or
+        NGSIM files (:func:`~stringstab.rl.episodes.leaders_from_files`, test part).
+    dt : float
+        Sample step, s.
+    seconds : float
+        Episode length of the bundled split, s.
+
+    Returns
+    -------
+    leaders : list
+        Trajectories or following pairs.
+    description : str
+        Where they come from, for reports.
+
+    Raises
+    ------
+    StringStabError
+        If ``"test"`` is mixed with file paths, or a file cannot be read.
     """
     from .episodes import default_leaders, leaders_from_files
 

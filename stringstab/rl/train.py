@@ -90,6 +90,20 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> Any:
 
     Leaders: ``leaders`` or the bundled training episodes
     (:func:`~stringstab.rl.episodes.default_leaders`); gains go through the config's repair.
+
+    Parameters
+    ----------
+    config : TD3Config
+        Supplies the number of environments, action mode, τ, δ, T*, gain bounds, reward
+        weights (eq 18) and TTC* (eq 20), the repair, gain rate, ``observe`` and start spread.
+    leaders : list, optional
+        The training leaders (trajectories or following pairs).
+
+    Returns
+    -------
+    BatchedCarFollowingEnv
+        The environment, with the :class:`~stringstab.rl.repair.GainRepair` it applies (None
+        for acceleration actions) as its ``repair`` attribute.
     """
     from ..traffic.env import BatchedCarFollowingEnv
     from .episodes import default_leaders
@@ -158,7 +172,23 @@ def _write_log(rows: list[dict[str, Any]]) -> str:
 
 
 def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
-    """Before any work: a new run needs an empty or absent folder; a resumed one its own run."""
+    """Before any work: a new run needs an empty or absent folder; a resumed one its own run.
+
+    Parameters
+    ----------
+    out : Path
+        The run folder (``--out``).
+    resume : bool
+        Whether the run continues the one in ``out``.
+    config : TD3Config
+        The run's config; a resumed run must be of the same ``algo``.
+
+    Raises
+    ------
+    StringStabError
+        If ``out`` cannot be an output folder, a new run's folder has visible files in it, or a
+        resumed folder holds no run or a run of another ``algo``.
+    """
     check_output_dir(out, what="--out")
     if resume:
         from .checkpoint import read_json

@@ -102,17 +102,52 @@ class Controller:
     time_varying: bool = False
 
     def command(self, obs: Observation) -> Array:
-        """Desired accelerations u (m/s²), shaped like ``obs.gap``."""
+        """Desired accelerations u (m/s²), shaped like ``obs.gap``.
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step.
+
+        Returns
+        -------
+        array
+            u per follower, m/s², before the platoon's limits and actuator lag.
+        """
         raise NotImplementedError
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
         """The gap (m) at which a follower cruising at ``speed`` behind an equal-speed leader
-        has u = 0 (used to start a platoon in equilibrium)."""
+        has u = 0 (used to start a platoon in equilibrium).
+
+        The base class returns the IDL spacing policy l_0 + T* v (eq 3) with the defaults.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s.
+
+        Returns
+        -------
+        array
+            The equilibrium gap, m, shaped like ``speed``.
+        """
         return DEFAULT_STANDSTILL + DEFAULT_HEADWAY * np.asarray(speed, dtype=np.float64)
 
     def gains(self, obs: Observation) -> Array | None:
         """The eq-4 gain vector K = (k_x, k_v, k_a) in force, shape ``(..., 3)``, or None if
-        the controller is not of the eq-4 form (then M_fss, eq 27, is undefined)."""
+        the controller is not of the eq-4 form (then M_fss, eq 27, is undefined).
+
+        Parameters
+        ----------
+        obs : Observation
+            The current step (time-varying controllers read ``obs.step`` or the state).
+
+        Returns
+        -------
+        array (..., 3) or None
+            None in the base class.
+        """
         return None
 
     @property
@@ -161,6 +196,18 @@ class LinearController(Controller):
         return self._headway
 
     def command(self, obs: Observation) -> Array:
+        """The eq-4 law u = k_x (gap − T* v − l_0) + k_v Δv + k_a a_{i−1}(t − δ) (IDL eqs 3-4).
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step.
+
+        Returns
+        -------
+        array
+            u, m/s², shaped like ``obs.gap`` (broadcast with the gains).
+        """
         u = self.k_x * obs.gap
         u -= self._kxT * obs.speed
         u -= self._kxl
@@ -169,9 +216,33 @@ class LinearController(Controller):
         return u
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """l_0 + T* v, the eq-3 spacing at which u = 0 behind an equal-speed leader.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s.
+
+        Returns
+        -------
+        array
+            The equilibrium gap, m.
+        """
         return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
 
     def gains(self, obs: Observation) -> Array:
+        """The fixed gains.
+
+        Parameters
+        ----------
+        obs : Observation
+            Ignored.
+
+        Returns
+        -------
+        array (..., 3)
+            K = (k_x, k_v, k_a) as given at construction.
+        """
         return self._K
 
     def describe(self) -> dict[str, Any]:
@@ -232,6 +303,20 @@ class TimeVaryingLinearController(Controller):
         ``vehicle`` column, vehicle ``i`` (an integer, 1 = first follower) gets its own series
         and the platoon must have exactly those followers (see :meth:`from_table`).
 
+        Parameters
+        ----------
+        path : str or Path
+            The gain time series file.
+        headway : float
+            T* of the eq-3 spacing policy, s.
+        standstill : float
+            l_0, m.
+
+        Returns
+        -------
+        TimeVaryingLinearController
+            The controller; ``followers`` is the number of per-vehicle series, or None.
+
         Raises
         ------
         StringStabError
@@ -247,6 +332,26 @@ class TimeVaryingLinearController(Controller):
         """Gains from a :class:`~stringstab.io.GainTable` time series (see :meth:`from_csv`).
 
         Before the first ``t`` of a series its first gains apply, after the last its last.
+
+        Parameters
+        ----------
+        table : GainTable
+            Gains with times ``t`` (s) and optionally ``vehicle`` ids 1..N.
+        headway : float
+            T* of the eq-3 spacing policy, s.
+        standstill : float
+            l_0, m.
+
+        Returns
+        -------
+        TimeVaryingLinearController
+            The controller; at time t it runs the gains of the last row with ``t`` ≤ t (+1e-9 s).
+
+        Raises
+        ------
+        StringStabError
+            If there is no ``t`` column, vehicle ids are not 1..N, or a series' times are not
+            strictly increasing; at run time, if the platoon does not have N followers.
 
         Examples
         --------
@@ -313,6 +418,24 @@ class TimeVaryingLinearController(Controller):
         return self._headway
 
     def gains(self, obs: Observation) -> Array:
+        """The gains in force at ``obs.step`` (computed once per step and cached).
+
+        Parameters
+        ----------
+        obs : Observation
+            The current step.
+
+        Returns
+        -------
+        array (..., 3)
+            The schedule's row for the step (the last row after the end), or the callable's
+            output.
+
+        Raises
+        ------
+        StringStabError
+            If the callable does not return an array with a last axis of 3.
+        """
         if self._last is not None and self._last[0] == obs.step:
             return self._last[1]
         if self._fn is not None:
@@ -326,6 +449,18 @@ class TimeVaryingLinearController(Controller):
         return K
 
     def command(self, obs: Observation) -> Array:
+        """The eq-4 law with the gains in force (:meth:`gains`).
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step.
+
+        Returns
+        -------
+        array
+            u = k_x (gap − T* v − l_0) + k_v Δv + k_a a_{i−1}(t − δ), m/s².
+        """
         K = self.gains(obs)
         k_x, k_v, k_a = K[..., 0], K[..., 1], K[..., 2]
         return np.asarray(
@@ -334,6 +469,18 @@ class TimeVaryingLinearController(Controller):
         )
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """l_0 + T* v (eq 3), whatever the gains.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s.
+
+        Returns
+        -------
+        array
+            The equilibrium gap, m.
+        """
         return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
 
     def describe(self) -> dict[str, Any]:
@@ -387,15 +534,52 @@ class CACCController(Controller):
         return self.t_system
 
     def command(self, obs: Observation) -> Array:
+        """u = min(a_v, a_d) of van Arem et al. (2006) (see the class docstring).
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step.
+
+        Returns
+        -------
+        array
+            u, m/s²: the smaller of the speed-control and the gap-control accelerations.
+        """
         r_ref = np.maximum(self.r_min, self.t_system * obs.speed)
         a_d = (self.k_a * obs.pred_accel_delayed + self.k_v * obs.rel_speed
                + self.k_d * (obs.gap - r_ref))
         return np.minimum(self.k * (self.speed_intended - obs.speed), a_d)
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """r_ref = max(r_min, t_system v), the gap where a_d = 0 behind an equal-speed leader.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s.
+
+        Returns
+        -------
+        array
+            The equilibrium gap, m.
+        """
         return np.maximum(self.r_min, self.t_system * np.asarray(speed, dtype=np.float64))
 
     def gains(self, obs: Observation | None) -> Array:
+        """(k_d, k_v, k_a): the eq-4 gains of the gap-control mode (with T* = t_system).
+
+        Parameters
+        ----------
+        obs : Observation or None
+            Ignored.
+
+        Returns
+        -------
+        array (3,)
+            K = (k_x, k_v, k_a) = (k_d, k_v, k_a).  It holds only in car following
+            (a_d < a_v and t_system v > r_min), which is not checked.
+        """
         return self._K
 
     def describe(self) -> dict[str, Any]:
@@ -432,12 +616,37 @@ class IDMController(Controller):
         self._ab2 = 2.0 * math.sqrt(self.a * self.b)
 
     def command(self, obs: Observation) -> Array:
+        """The IDM acceleration u = a [1 − (v/v_0)^exponent − (s*/s)²] (Treiber et al. 2000).
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step (the delayed predecessor acceleration is not
+            used).
+
+        Returns
+        -------
+        array
+            u, m/s² (the gap s floored at 1 cm).
+        """
         v = obs.speed
         s_star = self.s0 + np.maximum(0.0, v * self.T - v * obs.rel_speed / self._ab2)
         s = np.maximum(obs.gap, 0.01)
         return self.a * (1.0 - (v / self.v0) ** self.exponent - (s_star / s) ** 2)
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """s_e = (s_0 + v T) / sqrt(1 − (v/v_0)^exponent), where u = 0 behind an equal-speed leader.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s (capped at 0.999 v_0, where the gap is still finite).
+
+        Returns
+        -------
+        array
+            The equilibrium gap, m.
+        """
         v = np.minimum(np.asarray(speed, dtype=np.float64), 0.999 * self.v0)
         return (self.s0 + v * self.T) / np.sqrt(1.0 - (v / self.v0) ** self.exponent)
 
@@ -464,14 +673,42 @@ class FunctionController(Controller):
         self._headway, self.standstill = float(headway), float(standstill)
 
     def command(self, obs: Observation) -> Array:
+        """``fn(obs)``, broadcast to the shape of ``obs.gap``.
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step.
+
+        Returns
+        -------
+        array
+            u, m/s² (a copy).
+        """
         return np.broadcast_to(np.asarray(self.fn(obs), dtype=np.float64), obs.gap.shape).copy()
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """l_0 + T* v with the ``headway`` and ``standstill`` given.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s.
+
+        Returns
+        -------
+        array
+            The gap a platoon starts with, m.
+        """
         return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
 
 
 class MixedController(Controller):
     """Different controllers at different platoon positions (e.g. IDM humans among CAVs).
+
+    Every candidate is evaluated on the whole batch and the results are selected per position,
+    so the cost is the sum of the candidates'.  :meth:`gains` returns K only if every candidate
+    is of the eq-4 form with one headway.
 
     Parameters
     ----------
@@ -479,10 +716,6 @@ class MixedController(Controller):
         The candidates.
     assignment : sequence of int
         For each follower position (1..N), the index of its controller.
-
-    Every candidate is evaluated on the whole batch and the results are selected per position,
-    so the cost is the sum of the candidates'.  :meth:`gains` returns K only if every candidate
-    is of the eq-4 form with one headway.
     """
 
     def __init__(self, controllers: Sequence[Controller], assignment: Sequence[int]) -> None:
@@ -497,9 +730,33 @@ class MixedController(Controller):
         self.time_varying = any(c.time_varying for c in self.controllers)
 
     def command(self, obs: Observation) -> Array:
+        """Each follower position's own controller's command.
+
+        Parameters
+        ----------
+        obs : Observation
+            What every follower knows at this step (last axis: the N follower positions).
+
+        Returns
+        -------
+        array
+            u, m/s², shaped like ``obs.gap``.
+        """
         return np.asarray(np.choose(self.assignment, [c.command(obs) for c in self.controllers]))
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
+        """Each follower position's own controller's equilibrium gap.
+
+        Parameters
+        ----------
+        speed : array_like
+            Cruise speed v, m/s (broadcast against the N positions).
+
+        Returns
+        -------
+        array (..., N)
+            The equilibrium gaps, m.
+        """
         v = np.asarray(speed, dtype=np.float64)
         shape = np.broadcast_shapes(v.shape, (self.assignment.size,))
         gaps = [np.broadcast_to(c.equilibrium_gap(v), shape) for c in self.controllers]
@@ -511,6 +768,18 @@ class MixedController(Controller):
         return hs.pop() if len(hs) == 1 else None
 
     def gains(self, obs: Observation) -> Array | None:
+        """Each position's eq-4 gains, if every candidate is of the eq-4 form with one headway.
+
+        Parameters
+        ----------
+        obs : Observation
+            The current step.
+
+        Returns
+        -------
+        array (..., N, 3) or None
+            The gains per follower, or None if a candidate has none or the headways differ.
+        """
         gs = [c.gains(obs) for c in self.controllers]
         if any(g is None for g in gs) or self.headway is None:
             return None

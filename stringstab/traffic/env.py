@@ -87,6 +87,24 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
 
     s = [(gap − T* v − l_0)/α_p, (v_{i−1} − v)/α_v, a_{i−1}(t − δ)/α_acc].  Usable as the input
     of a gain policy inside :class:`~stringstab.traffic.controllers.TimeVaryingLinearController`.
+
+    Parameters
+    ----------
+    obs : Observation
+        What the followers know at one step: gap Δx (m), own speed v (m/s), relative speed
+        Δv = v_{i−1} − v (m/s) and the delayed predecessor acceleration a_{i−1}(t − δ) (m/s²).
+    headway : float
+        Desired time headway T* (IDL eq 3), s.
+    standstill : float
+        Standstill distance l_0 (eq 3), m.
+    scales : (float, float, float)
+        α_p (m), α_v (m/s), α_acc (m/s²) of eq 16 (Table 2: 25, 2.5, 4.5).
+
+    Returns
+    -------
+    ndarray, shape ``(*obs.gap.shape, 3)``
+        The normalised state [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc], Δp the spacing error of
+        eq 3.
     """
     dp = obs.gap - headway * obs.speed - standstill
     return np.stack([dp / scales[0], obs.rel_speed / scales[1],
@@ -96,6 +114,21 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
 def state_dim(observe: Sequence[str] = ()) -> int:
     """Length of the state with the ``observe`` extras: 3 (eq 16), 1 more for ``"accel"``, 3
     more for ``"gains"`` (:func:`extend_state`).
+
+    Parameters
+    ----------
+    observe : sequence of str
+        Extras appended to the eq-16 state, some of :data:`OBSERVE` (``"accel"``, ``"gains"``).
+
+    Returns
+    -------
+    int
+        3, 4, 6 or 7.
+
+    Raises
+    ------
+    StringStabError
+        If ``observe`` names something other than ``"accel"`` or ``"gains"``.
 
     Examples
     --------
@@ -115,6 +148,30 @@ def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
 
     ``"accel"`` appends the follower's own acceleration a_i/α_acc (``accel``, shape ``(...)``),
     ``"gains"`` the gains executed at the previous step K_{t−1}/2 (``prev_gains``, (..., 3)).
+
+    Parameters
+    ----------
+    state : array_like, shape (..., 3)
+        The normalised IDL state of eq 16 (:func:`state_vector`).
+    observe : sequence of str
+        Extras to append, some of :data:`OBSERVE`, always in the order accel, then gains.
+    accel : array_like, shape (...), optional
+        The follower's own acceleration a_i, m/s²; needed for ``"accel"``.
+    prev_gains : array_like, shape (..., 3), optional
+        The gains (k_x [1/s²], k_v [1/s], k_a [-]) executed at the previous step; needed for
+        ``"gains"`` (zeros at an episode's first step).
+    scales : (float, float, float)
+        α_p, α_v, α_acc of eq 16; only α_acc is used here.
+
+    Returns
+    -------
+    ndarray, shape (..., :func:`state_dim` (observe))
+        The extended state (``state`` itself, as floats, when ``observe`` is empty).
+
+    Raises
+    ------
+    StringStabError
+        If ``observe`` names an unknown extra, or an extra's input is missing.
 
     Examples
     --------
@@ -143,6 +200,22 @@ def limit_rate(gains: npt.ArrayLike, prev_gains: npt.ArrayLike, rate: float, *,
     Rows where ``fresh`` is true (an episode's first step: no previous gains) are left as
     they are.  The result still needs the repair: the rate limit keeps the gains near a
     certified triple, it does not certify them.
+
+    Parameters
+    ----------
+    gains : array_like, shape (..., 3)
+        The proposed gains (k_x, k_v, k_a) of IDL eq 4 (the policy's action, eq 17).
+    prev_gains : array_like, shape (..., 3)
+        The gains executed at the previous step.
+    rate : float
+        The largest change r of each gain per step (in the gain's unit per step).
+    fresh : array_like of bool, shape (...), or bool
+        True where there are no previous gains (the proposed gains pass unchanged).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        clip(gains, prev_gains − r, prev_gains + r), or ``gains`` where ``fresh``.
 
     Examples
     --------
@@ -396,7 +469,27 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """Start an episode on the next leader (``options={"index": i}`` chooses it)."""
+        """Start an episode on the next leader (``options={"index": i}`` chooses it).
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds the environment's RNG (leader order ``"random"``, start spread).
+        options : dict, optional
+            ``{"index": i}`` runs leader i; otherwise the next leader in ``order``.
+
+        Returns
+        -------
+        state : ndarray (float32)
+            The first state: eq 16, with the ``observe`` extras.
+        info : dict
+            ``{"leader_index": i}``.
+
+        Raises
+        ------
+        StringStabError
+            If ``options["index"]`` is out of range.
+        """
         super().reset(seed=seed)
         m = self.n_leaders
         if options and "index" in options:
@@ -413,7 +506,33 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
         return self._core.state()[0], {"leader_index": j}
 
     def step(self, action: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]:
-        """Apply one action; returns (state, reward, terminated, truncated, info)."""
+        """Apply one action; returns (state, reward, terminated, truncated, info).
+
+        Parameters
+        ----------
+        action : array_like
+            Gains K = (k_x, k_v, k_a) (eq 17; rate limited and filtered as configured) or the
+            desired acceleration u, m/s², by the action mode.
+
+        Returns
+        -------
+        state : ndarray (float32)
+            The next state (eq 16, with the ``observe`` extras).
+        reward : float
+            r of eq 18 (eqs 19-24).
+        terminated : bool
+            A collision ended the episode (with ``terminate_on_collision``).
+        truncated : bool
+            The leader's last sample was reached.
+        info : dict
+            Scalars describing the step (``gap``, ``speed``, ``accel``, ``r_f``, ``r_j``, ``r_e``,
+            ``collision``, ``gains``, ...).
+
+        Raises
+        ------
+        StringStabError
+            If :meth:`reset` was not called first.
+        """
         if self._core.obs is None:
             raise StringStabError("call reset() before step()")
         r, term, trunc, info = self._core.step(np.asarray(action)[None])
@@ -489,7 +608,25 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
 
     def reset(self, *, seed: int | None = None,
               options: dict[str, Any] | None = None) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``."""
+        """Reset every sub-environment; returns states ``(num_envs, 3)`` and ``{"leader_index"}``.
+
+        Each sub-environment draws its leader at random (seeded by ``seed``).  With
+        ``observe`` extras the states have :func:`state_dim` columns instead of 3.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds the episode-drawing RNG.
+        options : dict, optional
+            Ignored.
+
+        Returns
+        -------
+        states : ndarray (num_envs, state_dim), float32
+            The first states.
+        info : dict
+            ``{"leader_index": array (num_envs,)}``.
+        """
         super().reset(seed=seed)
         rows = np.arange(self.num_envs)
         self._core.reset_rows(rows, self._draw(self.num_envs), self.np_random)
@@ -514,7 +651,21 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         return meta, {k: np.array(v, copy=True) for k, v in arrays.items()}
 
     def load_state_dict(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
-        """Restore :meth:`state_dict` output (same leaders and ``num_envs``; checked)."""
+        """Restore :meth:`state_dict` output (same leaders and ``num_envs``; checked).
+
+        Parameters
+        ----------
+        meta : dict
+            The JSON-ready part of :meth:`state_dict`.
+        arrays : dict of str to ndarray
+            The arrays of :meth:`state_dict`.
+
+        Raises
+        ------
+        StringStabError
+            If the number of environments or leaders differs, an array is missing or has another
+            shape.
+        """
         c, p = self._core, self._core.platoon
         if meta.get("num_envs") != self.num_envs or meta.get("n_leaders") != len(c.items):
             raise StringStabError(
@@ -544,7 +695,30 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
     def step(self, actions: npt.ArrayLike) -> tuple[npt.NDArray[np.float32], Array,
                                                    npt.NDArray[np.bool_], npt.NDArray[np.bool_],
                                                    dict[str, Any]]:
-        """Step every sub-environment (see the class docstring)."""
+        """Step every sub-environment (see the class docstring).
+
+        Parameters
+        ----------
+        actions : array_like (num_envs, 3) or (num_envs, 1)
+            Gains (eq 17) or desired accelerations (m/s²), one row per sub-environment.
+
+        Returns
+        -------
+        states : ndarray (num_envs, state_dim), float32
+            The next states; a finished episode's row is the first state of its new episode.
+        rewards : ndarray (num_envs,)
+            r of eq 18.
+        terminated, truncated : bool ndarray (num_envs,)
+            Collision ends and ends at the leader's last sample.
+        info : dict
+            ``final_obs``/``_final_obs`` and ``episode_return`` of the finished episodes (NaN
+            elsewhere), and arrays (num_envs,) describing the step.
+
+        Raises
+        ------
+        StringStabError
+            If :meth:`reset` was not called first.
+        """
         if self._core.obs is None:
             raise StringStabError("call reset() before step()")
         r, term, trunc, info = self._core.step(actions)

@@ -124,10 +124,24 @@ def save_trajectories(result: PlatoonResult, path: str | Path, *, fmt: Format = 
     columns at full precision (the leader's empty cells are NaN), the run's parameters as
     JSON in the file metadata.
 
+    Parameters
+    ----------
+    result : PlatoonResult
+        One platoon's run, recorded with ``record=True`` (not a batch).
+    path : str or Path
+        The file to write.
+    fmt : {"npz", "csv", "parquet"}
+        The file format.
+
     Returns
     -------
     Path
         The file written.
+
+    Raises
+    ------
+    StringStabError
+        If the run was not recorded, is a batch, or ``fmt`` is unknown.
     """
     if result.speed is None or result.position is None or result.accel is None:
         raise StringStabError("save_trajectories needs a run recorded with record=True")

@@ -367,6 +367,23 @@ class Platoon:
 
         Also records collisions (gap ≤ 0) and stores accelerations for the delayed link.  The
         observation's arrays may be views of the state: they are valid until :meth:`advance`.
+        A delay δ that is not a multiple of the step is interpolated between the two samples
+        around t − δ.
+
+        Parameters
+        ----------
+        leader_position : array_like (P,)
+            Position of each platoon's leader at this step, m.
+        leader_speed : array_like (P,)
+            Its speed, m/s.
+        leader_accel : array_like (P,)
+            Its acceleration, m/s².
+
+        Returns
+        -------
+        Observation
+            Arrays (P, N): gap Δx (m), speed, acceleration, the predecessor's speed, Δv,
+            the predecessor's acceleration and a_{i−1}(t − δ) (IDL eq 4).
         """
         X, V, A = self.position, self.speed, self.accel
         X[:, 0] = leader_position
@@ -402,7 +419,22 @@ class Platoon:
                            A[:, :-1], ad)
 
     def advance(self, command: npt.ArrayLike) -> Array:
-        """Apply desired accelerations u (P, N) over one step; returns the limited u."""
+        """Apply desired accelerations u (P, N) over one step; returns the limited u.
+
+        u is clipped to [acc_min, acc_max]; with ``model="lag"`` the acceleration follows
+        τ ȧ + a = u (IDL eq 7) exactly over the step (u held), with ``"kinematic"`` a = u.  Speeds are kept
+        within the limits (the position then follows the clipped speed).
+
+        Parameters
+        ----------
+        command : array_like, broadcastable to (P, N)
+            Desired accelerations u of the followers, m/s².
+
+        Returns
+        -------
+        ndarray (P, N)
+            The commands applied after the acceleration limits, m/s².
+        """
         lim = self.limits
         u = np.clip(np.asarray(command, dtype=np.float64), lim.accel_min, lim.accel_max)
         if u.shape != (self.P, self.N):
@@ -527,7 +559,21 @@ class PlatoonResult:
         return damping_ratios_from_energy(self.sum_sq_accel)
 
     def metrics(self, *, ttc_star: float = TTC_STAR, certificate: bool = True) -> dict[str, Any]:
-        """The IDL paper's evaluation metrics of this run (see :func:`stringstab.metrics.platoon_metrics`)."""
+        """The IDL paper's evaluation metrics of this run (see :func:`stringstab.metrics.platoon_metrics`).
+
+        Parameters
+        ----------
+        ttc_star : float
+            TTC* of the time-integrated TTC (eqs 31-32), s.
+        certificate : bool
+            Also compute M_fss (eq 27) of the executed gains with the exact certificate.
+
+        Returns
+        -------
+        dict
+            ``m_p`` (eq 29), ``M_lss`` (eq 30), ``TIT``, ``M_CI`` (eq 34), ``M_effi`` (eq 35),
+            ``collisions``, ``m_fss``/``M_fss`` (eq 27; None without ``certificate``), ...
+        """
         return platoon_metrics(self, ttc_star=ttc_star, certificate=certificate)
 
 

@@ -71,6 +71,20 @@ def comfort_reward(accel: npt.ArrayLike, prev_accel: npt.ArrayLike, *,
                    accel_max: float = ACCEL_MAX, accel_min: float = ACCEL_MIN) -> Array:
     """r_j (IDL eq 21) = −(acc_t − acc_{t−1})² / (acc_max − acc_min)².
 
+    Parameters
+    ----------
+    accel : array_like
+        The follower's acceleration acc_t at this step, m/s².
+    prev_accel : array_like
+        Its acceleration acc_{t−1} at the previous step, m/s².
+    accel_max, accel_min : float
+        acc_max and acc_min, m/s² (Table 2: 3 and −7.6).
+
+    Returns
+    -------
+    ndarray
+        r_j, dimensionless, in [−1, 0] while both accelerations are within the limits.
+
     Examples
     --------
     >>> float(comfort_reward(3.0, -7.6))
@@ -83,6 +97,18 @@ def comfort_reward(accel: npt.ArrayLike, prev_accel: npt.ArrayLike, *,
 def headway_density(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
                     sigma: float = HEADWAY_SIGMA) -> Array:
     """F(h), the log-normal time-headway density (IDL eq 23, with the 1/h of the log-normal).
+
+    Parameters
+    ----------
+    h : array_like
+        Time headway h (eq 22: gap over the follower's speed), s.
+    mu, sigma : float
+        μ and σ of ln h (Zhu et al. 2020: 0.4226, 0.4365).
+
+    Returns
+    -------
+    ndarray
+        F(h) = exp(−(ln h − μ)²/(2σ²)) / (h σ √(2π)), in 1/s; 0 where h ≤ 0 or is not finite.
 
     Examples
     --------
@@ -99,6 +125,20 @@ def headway_density(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
 def efficiency_reward(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
                       sigma: float = HEADWAY_SIGMA) -> Array:
     """r_e (IDL eq 24) = F(h)/F(h*) − 1 for h ∈ (0, ∞), −1 otherwise (NaN h counts as −1).
+
+    h* = e^{μ − σ²} is the mode of :func:`headway_density` (1.26 s for the defaults).
+
+    Parameters
+    ----------
+    h : array_like
+        Time headway (eq 22), s.
+    mu, sigma : float
+        μ and σ of the log-normal headway density (eq 23).
+
+    Returns
+    -------
+    ndarray
+        r_e, dimensionless, in [−1, 0]; 0 at h = h*.
 
     Examples
     --------

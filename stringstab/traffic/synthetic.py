@@ -87,6 +87,30 @@ def hard_braking(
 ) -> Trajectory:
     """Cruise, brake at ``decel`` (default the IDL acc_min −7.6 m/s²) to ``to_speed``, cruise.
 
+    Parameters
+    ----------
+    speed : float
+        Initial cruise speed, m/s.
+    to_speed : float
+        Speed after braking, m/s (< ``speed``).
+    decel : float
+        Braking acceleration, m/s² (< 0).
+    cruise_before, cruise_after : float
+        Cruise durations before and after the braking, s.
+    dt : float
+        Sample step, s.
+
+    Returns
+    -------
+    Trajectory
+        The leader, integrated exactly from its piecewise-constant acceleration
+        (:func:`~stringstab.traffic.trajectory.from_accel_segments`).
+
+    Raises
+    ------
+    StringStabError
+        If ``decel`` ≥ 0 or ``to_speed`` ≥ ``speed``.
+
     Examples
     --------
     >>> tr = hard_braking(speed=25.0, to_speed=0.0, dt=0.1)
@@ -114,6 +138,29 @@ def hard_acceleration(
     dt: float = DT,
 ) -> Trajectory:
     """Cruise, accelerate at ``accel`` (default the IDL acc_max 3 m/s²) to ``to_speed``, cruise.
+
+    Parameters
+    ----------
+    speed : float
+        Initial cruise speed, m/s.
+    to_speed : float
+        Speed after the acceleration, m/s (> ``speed``).
+    accel : float
+        Acceleration, m/s² (> 0).
+    cruise_before, cruise_after : float
+        Cruise durations before and after the acceleration, s.
+    dt : float
+        Sample step, s.
+
+    Returns
+    -------
+    Trajectory
+        The leader (:func:`~stringstab.traffic.trajectory.from_accel_segments`).
+
+    Raises
+    ------
+    StringStabError
+        If ``accel`` ≤ 0 or ``to_speed`` ≤ ``speed``.
 
     Examples
     --------
@@ -143,6 +190,35 @@ def stop_and_go(
     dt: float = DT,
 ) -> Trajectory:
     """Stop-and-go waves: ``waves`` trapezoidal dips from ``speed_high`` to ``speed_low`` and back.
+
+    Each wave: brake at ``decel`` to ``speed_low``, dwell ``dwell_low``, accelerate at
+    ``accel`` back to ``speed_high``, dwell ``dwell_high``; the trajectory starts with a
+    ``dwell_high`` cruise.
+
+    Parameters
+    ----------
+    speed_high, speed_low : float
+        Cruise and trough speeds, m/s (speed_high > speed_low ≥ 0).
+    waves : int
+        Number of dips (≥ 1).
+    accel : float
+        Acceleration out of a dip, m/s² (> 0).
+    decel : float
+        Braking into a dip, m/s² (< 0).
+    dwell_high, dwell_low : float
+        Time spent at ``speed_high`` and at ``speed_low`` per wave, s.
+    dt : float
+        Sample step, s.
+
+    Returns
+    -------
+    Trajectory
+        The leader (:func:`~stringstab.traffic.trajectory.from_accel_segments`).
+
+    Raises
+    ------
+    StringStabError
+        If the speeds, accelerations or ``waves`` are out of range.
 
     Examples
     --------
@@ -178,6 +254,16 @@ def paper_mix(*, dt: float = DT) -> Trajectory:
     with abrupt braking down to −7.6 m/s² and sudden accelerations up to 3 m/s², but does not
     publish it.  This one (125 s from 20 m/s, :data:`PAPER_MIX_SEGMENTS`) brakes at −3, −7.6,
     −5 and −7.6 m/s² (the last to a full stop) and accelerates at 3, 3, 2 and 3 m/s².
+
+    Parameters
+    ----------
+    dt : float
+        Sample step, s.
+
+    Returns
+    -------
+    Trajectory
+        The 125 s leader (a reconstruction, not the paper's data).
 
     Examples
     --------

@@ -94,6 +94,22 @@ class Trajectory:
         Lets a long platoon settle before its damping ratios are measured (eq 29 sums over the
         whole run).
 
+        Parameters
+        ----------
+        seconds : float
+            Duration of the hold, s (rounded to whole steps; ≥ 0).
+
+        Returns
+        -------
+        Trajectory
+            The extended trajectory; the last original sample's acceleration is set to 0 when
+            ``seconds`` adds a step.
+
+        Raises
+        ------
+        StringStabError
+            If ``seconds`` < 0.
+
         Examples
         --------
         >>> tr = from_speed([0, 1], [10.0, 12.0], dt=0.5).hold(1.0)
@@ -112,13 +128,36 @@ class Trajectory:
                           np.r_[accel, np.zeros(n)], self.name, dict(self.meta))
 
     def window(self, start: int, stop: int | None = None) -> Trajectory:
-        """Samples ``start:stop``, re-timed to start at t = 0."""
+        """Samples ``start:stop``, re-timed to start at t = 0.
+
+        Parameters
+        ----------
+        start : int
+            First sample index.
+        stop : int, optional
+            One past the last sample index (None: to the end).
+
+        Returns
+        -------
+        Trajectory
+            The samples, same name and metadata (the position is not shifted).
+        """
         sl = slice(start, stop)
         return Trajectory(self.dt, self.position[sl], self.speed[sl], self.accel[sl], self.name,
                           dict(self.meta))
 
     def head(self, duration: float) -> Trajectory:
         """The first ``duration`` seconds (at least two samples, at most the whole trajectory).
+
+        Parameters
+        ----------
+        duration : float
+            Seconds to keep (> 0).
+
+        Returns
+        -------
+        Trajectory
+            Samples 0 … floor(duration/dt), at least two.
 
         Raises
         ------

@@ -60,6 +60,14 @@ def quadratic_form(f: Callable[[Array, Array, Array], Array]) -> Array:
     ``f(k_x, k_v, k_a)`` evaluates q on arrays.  With q(0) = c, q(±e_i) = c ± b_i + A_ii and
     q(e_i + e_j) = c + b_i + b_j + A_ii + A_jj + 2A_ij, the identities are exact for a quadratic.
 
+    Parameters
+    ----------
+    f : callable
+        ``f(k_x, k_v, k_a) -> ndarray``: the quadratic q evaluated elementwise on three arrays of
+        gains (k_x in 1/s², k_v in 1/s, k_a dimensionless; IDL eq 4), for instance a margin
+        g(ω; K) at one member and frequency.  It is called once, on the 10 polarisation points
+        0, ±e_i, e_i + e_j.  A q of degree > 2 is not detected: its form is then wrong.
+
     Returns
     -------
     ndarray, shape (10,)
@@ -84,6 +92,19 @@ def quadratic_form(f: Callable[[Array, Array, Array], Array]) -> Array:
 
 def evaluate_forms(forms: Array, K: Array) -> Array:
     """q(K) for each row of ``forms`` (shape (n, 10)) at K (shape (3,), or (m, 3): (n, m)).
+
+    Parameters
+    ----------
+    forms : ndarray, shape (n, 10)
+        Quadratic forms as returned by :func:`quadratic_form`, one per row: (c, b_x, b_v, b_a,
+        A_xx, A_xv, A_xa, A_vv, A_va, A_aa).
+    K : ndarray, shape (3,) or (m, 3)
+        Gains (k_x [1/s²], k_v [1/s], k_a [-]) of IDL eq 4: one triple or m triples.
+
+    Returns
+    -------
+    ndarray, shape (n,) or (n, m)
+        q(K) = c + bᵀK + KᵀAK of each form at each triple.
 
     Examples
     --------
@@ -187,7 +208,23 @@ class Loop:
     # ------------------------------------------------------------------ the one homes
     def margin(self, member: Member, freq: Array, K: Array) -> Array:
         """g (or g_H) at ``member`` on frequencies ``freq`` for the gains K (3,): from the one
-        home of each margin (:func:`stringstab.margin.g`, :func:`stringstab.sampled.sampled_margin`)."""
+        home of each margin (:func:`stringstab.margin.g`, :func:`stringstab.sampled.sampled_margin`).
+
+        Parameters
+        ----------
+        member : Member
+            τ, τ_p, δ, T* (s); τ_p is used by the sampled margin only.
+        freq : ndarray
+            ω in rad/s (continuous) or θ = ωH in rad/sample (sampled).
+        K : ndarray, shape (3,)
+            Gains (k_x, k_v, k_a) of IDL eq 4.
+
+        Returns
+        -------
+        ndarray
+            g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (≥ 0 iff |Γ(jω)| ≤ 1), or the normalised sampled
+            margin g_H(θ), at each frequency.
+        """
         if not self.sampled:
             return _margin.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                              headway=member.headway)
@@ -198,7 +235,20 @@ class Loop:
                               tau_prev=member.tau_prev)
 
     def margin_slot(self, member: Member, freq: float) -> Slot:
-        """The constraint g(freq; K) ≥ ε at ``member``, as a quadratic form in K."""
+        """The constraint g(freq; K) ≥ ε at ``member``, as a quadratic form in K.
+
+        Parameters
+        ----------
+        member : Member
+            The member of the box the margin is taken at.
+        freq : float
+            ω (rad/s) or, sampled, θ (rad/sample).
+
+        Returns
+        -------
+        Slot
+            Kind ``"margin"``, with the form (c, b, A) of g (:func:`quadratic_form`).
+        """
         if not self.sampled:
             form = quadratic_form(lambda x, v, a: _margin.g(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway))
@@ -212,7 +262,19 @@ class Loop:
 
     def stability_slots(self, member: Member) -> list[Slot]:
         """Internal stability at ``member``: the Hurwitz conditions (continuous) or the
-        normalised Schur conditions (sampled), each a quadratic form in K."""
+        normalised Schur conditions (sampled), each a quadratic form in K.
+
+        Parameters
+        ----------
+        member : Member
+            The member of the box.
+
+        Returns
+        -------
+        list of Slot
+            Kind ``"stability"``: two Hurwitz conditions (:func:`stringstab.criteria.hurwitz_conditions`)
+            or five Schur conditions (:func:`stringstab.sampled.schur_margins`), ``index`` 0, 1, ….
+        """
         def conditions(x: Array, v: Array, a: Array) -> Array:
             if not self.sampled:
                 return np.asarray(hurwitz_conditions(x, v, a, tau=member.tau,
@@ -240,7 +302,25 @@ class Loop:
 
     def dips(self, K: Array, member: Member, threshold: float, n: int = 384) -> list[float]:
         """Local minima of the margin at ``member`` below ``threshold`` (a scan, zoomed): a
-        heuristic to pick frequencies, never a proof."""
+        heuristic to pick frequencies, never a proof.
+
+        Parameters
+        ----------
+        K : ndarray, shape (3,)
+            Gains (k_x, k_v, k_a).
+        member : Member
+            The member of the box.
+        threshold : float
+            Only minima with a margin below it are returned.
+        n : int
+            Grid points of the sampled scan on [0, π] (the continuous scan is
+            :func:`stringstab.margin.local_minima`'s).
+
+        Returns
+        -------
+        list of float
+            The minimisers: ω (rad/s) or θ (rad/sample), at most 12.
+        """
         if not self.sampled:
             return _margin.local_minima(K, tau=member.tau, delta=member.delta,
                                         headway=member.headway, threshold=threshold)[1]
@@ -266,6 +346,22 @@ class Loop:
 
         A witness is a member and a frequency (ω, or θ when sampled) where the margin was
         found smallest: |Γ| > 1 (|H| > 1) there when K is internally stable and not certified.
+
+        Parameters
+        ----------
+        K : ndarray, shape (3,)
+            Gains (k_x, k_v, k_a).
+
+        Returns
+        -------
+        verdict : str
+            ``"certified"``, ``"not_certified"`` or ``"inconclusive"``
+            (:func:`stringstab.certificate.check`).
+        stable : bool
+            Internally stable (every member of the box, for a box).
+        witnesses : list of (Member, float)
+            The witness, if its frequency is finite; the box's centre stands in for a member the
+            certificate does not report.
         """
         from ..certificate import check
 
@@ -288,7 +384,19 @@ class Loop:
         return verdict, stable, ([(member, f)] if math.isfinite(f) else [])
 
     def certify(self, K: Array) -> Any:
-        """The full certificate of K (for a result that failed: its verdict and sup gain)."""
+        """The full certificate of K (for a result that failed: its verdict and sup gain).
+
+        Parameters
+        ----------
+        K : ndarray, shape (3,)
+            Gains (k_x, k_v, k_a).
+
+        Returns
+        -------
+        Certificate
+            :func:`stringstab.certificate.certify` on this loop (point or box, continuous or
+            sampled).
+        """
         from ..certificate import certify
 
         b = self.box
@@ -300,6 +408,16 @@ class Loop:
 
         For a box, the point certificate at the box's centre screens first (a gain certified
         for the box is certified at its centre), then the robust one decides.
+
+        Parameters
+        ----------
+        K : ndarray, shape (n, 3)
+            Gain triples (k_x, k_v, k_a).
+
+        Returns
+        -------
+        bool ndarray, shape (n,)
+            True where certified.
         """
         from ..certificate import certify_batch
 

@@ -36,6 +36,31 @@ def tune(
     growing's candidate test is the Taylor Proposition 1 of the continuous loop at one
     τ, δ, T*, so it takes neither.
 
+    Parameters
+    ----------
+    K0 : sequence of 3 floats or ndarray
+        The gains to repair, (k_x [1/s²], k_v [1/s], k_a [-]) of IDL eq 4.
+    method : {"projection", "region-growing"}
+        :func:`stringstab.tuning.project` (nearest certified gains, any loop) or
+        :func:`stringstab.tuning.region_growing` (the IDL paper's §3.3 search).
+    tau : float or (lo, hi)
+        Actuator lag τ of the follower (IDL eq 7), in s; an interval only for the projection.
+    delta : float or (lo, hi)
+        Communication delay δ on a_{i−1} (IDL eq 4), in s; an interval only for the projection.
+    headway : float or (lo, hi)
+        Desired time headway T* (IDL eq 3), in s; an interval only for the projection.
+    sample_time : float, optional
+        Sampling period H of the sampled-data loop, in s (projection only); None for the
+        continuous loop.
+    **options
+        Passed on to the method (for instance ``weights``, ``bounds``; ``r0``, ``grid`` for
+        region growing; ``eps``, ``hurwitz_margin`` for the projection).
+
+    Returns
+    -------
+    TuneResult
+        The repaired gains, the exact certificate's verdict on them and the distance moved.
+
     Raises
     ------
     StringStabError

@@ -28,7 +28,25 @@ Array = npt.NDArray[np.float64]
 
 
 def violating_dips(K: Array, p: Params, threshold: float) -> tuple[float, list[float]]:
-    """The violating dips of g(·; K) (:func:`stringstab.margin.local_minima`)."""
+    """The violating dips of g(·; K) (:func:`stringstab.margin.local_minima`).
+
+    Parameters
+    ----------
+    K : ndarray, shape (3,)
+        Gains (k_x [1/s²], k_v [1/s], k_a [-]) of IDL eq 4.
+    p : Params
+        τ, δ, T* of the continuous loop (s).
+    threshold : float
+        A local minimiser of the margin g(ω) = (|D(jω)|² − |N(jω)|²)/ω² is returned when g is
+        below it (the projection passes its ε).
+
+    Returns
+    -------
+    gmin : float
+        The smallest g found by the scan (a heuristic: never a certificate).
+    dips : list of float
+        Local minimisers ω (rad/s) of g(·; K) with g < ``threshold``.
+    """
     return _margin.local_minima(K, tau=p.tau, delta=p.delta, headway=p.headway, threshold=threshold)
 
 
@@ -48,6 +66,27 @@ def predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
     (the dip moves down in frequency as the gains are repaired, by up to
     ~20 % in the benchmark); twice.  The frequencies returned only seed the
     NLP's frequency set; the exact certificate decides.
+
+    Parameters
+    ----------
+    K0 : ndarray, shape (3,)
+        The gains to repair (k_x [1/s²], k_v [1/s], k_a [-]; IDL eq 4).
+    dips : list of float
+        Violating local minimisers ω of g(·; K0), in rad/s (:func:`violating_dips`).
+    p : Params
+        τ, δ, T* of the continuous loop (s).
+    w : ndarray, shape (3,)
+        Weights of the distance ‖K − K0‖_W the repair minimises.
+    eps : float
+        The margin the repair asks for: g(ω; K) ≥ ε.
+    rounds : int, default 2
+        Gauss-Newton step and dip-following rounds per dip.
+
+    Returns
+    -------
+    list of float
+        The predicted dip frequencies (rad/s, > 0), at most one per input dip; a dip whose
+        prediction reaches ω = 0 is dropped.
     """
     out: list[float] = []
     v = np.linspace(0.7, 1.05, 36)
@@ -162,8 +201,36 @@ def predict(k0: Array, pred: list[float], omegas: list[float], *, params: Params
     is added, at most three in all.  The point is returned only when every
     multiplier is positive, nothing is violated (by more than 1e-10 in g)
     and the exact certificate certifies it, with the names of the active
-    constraints; otherwise None (IPOPT decides).  ``check(K)`` is the exact certificate's
-    (verdict, internally stable, witness frequency) of K.
+    constraints; otherwise None (IPOPT decides).
+
+    Parameters
+    ----------
+    k0 : ndarray, shape (3,)
+        The gains to repair (k_x [1/s²], k_v [1/s], k_a [-]; IDL eq 4).
+    pred : list of float
+        Predicted dips of the repaired gains, rad/s (:func:`predict_dips`).
+    omegas : list of float
+        The first NLP's frequency set, rad/s; the frequencies > 0 are checked for violations.
+    params : Params
+        τ, δ, T* of the continuous loop (s).
+    weights : ndarray, shape (3,)
+        Weights of the distance ‖K − K0‖_W.
+    eps : float
+        The margin asked for: g(ω; K) ≥ ε, including Ψ3 = g(0) ≥ ε.
+    bounds : (float, float)
+        Lower and upper bound on every gain.
+    hurwitz_margin : float
+        m of the internal-stability constraints: each Hurwitz condition (linear in K,
+        :func:`stringstab.criteria.hurwitz_gradients`) ≥ m.
+    check : callable
+        ``check(K) -> (verdict, internally stable, witness frequency)``: the exact certificate
+        of K (:func:`stringstab.certificate.check`).
+
+    Returns
+    -------
+    (ndarray, list of str) or None
+        The certified gains and the names of the active constraints, or None when the
+        predictor fails (IPOPT then solves the NLP).
     """
     p, w = params, weights
     lo, hi = bounds

@@ -727,6 +727,14 @@ def project(
     frequency set) and the exact certificate certifies it; otherwise the
     IPOPT path above runs unchanged (and the map fallback applies to both).
 
+    For the sampled-data loop and for a parameter box there is no predictor; the exchange
+    runs on an NLP whose constraints are quadratic forms in K
+    (:mod:`stringstab.tuning.constraints`): the Schur (or worst-corner Hurwitz) conditions,
+    the margin at 0 at the box's corners and on the ladder at its centre, and then, after
+    each solve, the margin at the certificate's witness member and frequency (θ when
+    sampled) and at the dips of that member's margin; the certificate of that loop decides
+    every output, and the fallback is the nearest point of that loop's certified map.
+
     Parameters
     ----------
     K0 : sequence of 3 floats
@@ -754,14 +762,6 @@ def project(
         Maximum number of solves.
     predictor : bool
         Try the Newton predictor before IPOPT (default); False: IPOPT only.
-
-    For the sampled-data loop and for a parameter box there is no predictor; the exchange
-    runs on an NLP whose constraints are quadratic forms in K
-    (:mod:`stringstab.tuning.constraints`): the Schur (or worst-corner Hurwitz) conditions,
-    the margin at 0 at the box's corners and on the ladder at its centre, and then, after
-    each solve, the margin at the certificate's witness member and frequency (θ when
-    sampled) and at the dips of that member's margin; the certificate of that loop decides
-    every output, and the fallback is the nearest point of that loop's certified map.
 
     Returns
     -------

@@ -204,19 +204,60 @@ class TuneResults:
     @classmethod
     def collect(cls, results: Sequence[TuneResult], meta: Mapping[str, Any] | None = None,
                 methods: Sequence[str] = ()) -> TuneResults:
-        """Results (and per-result ``meta`` columns) as a :class:`TuneResults`."""
+        """Results (and per-result ``meta`` columns) as a :class:`TuneResults`.
+
+        Parameters
+        ----------
+        results : sequence of TuneResult
+            One result per input triple.
+        meta : mapping of str to array_like, optional
+            Extra columns, one value per result (e.g. the input's row or τ, δ, T*).
+        methods : sequence of str
+            The repair methods that were run.
+
+        Returns
+        -------
+        TuneResults
+            The collection.
+        """
         return cls(tuple(results), {k: np.asarray(v) for k, v in (meta or {}).items()},
                    tuple(methods))
 
 
 def wdist(K: Array, K0: Array, w: Array) -> Array:
-    """Weighted Euclidean distance(s) of the row(s) of K from K0."""
+    """Weighted Euclidean distance(s) of the row(s) of K from K0.
+
+    Parameters
+    ----------
+    K : ndarray, shape (3,) or (n, 3)
+        Gain triple(s) (k_x, k_v, k_a).
+    K0 : ndarray, shape (3,)
+        The reference gains.
+    w : ndarray, shape (3,)
+        Weights (w_x, w_v, w_a).
+
+    Returns
+    -------
+    ndarray, shape () or (n,)
+        ‖K − K0‖_W = sqrt(Σ_i w_i (K_i − K0_i)²) of each triple.
+    """
     d = np.asarray(K, dtype=float) - K0
     return np.asarray(np.sqrt(np.sum(w * d * d, axis=-1)))
 
 
 def triple(k: Array) -> tuple[float, float, float]:
-    """The three gains as Python floats."""
+    """The three gains as Python floats.
+
+    Parameters
+    ----------
+    k : ndarray, shape (3,)
+        Gains (k_x, k_v, k_a).
+
+    Returns
+    -------
+    tuple of float
+        ``(k_x, k_v, k_a)``.
+    """
     return float(k[0]), float(k[1]), float(k[2])
 
 
@@ -241,6 +282,18 @@ class Verdict:
 
     @classmethod
     def of(cls, cert: Certificate) -> Verdict:
+        """The verdict and sup |Γ| of a full certificate.
+
+        Parameters
+        ----------
+        cert : Certificate
+            The exact certificate of one triple.
+
+        Returns
+        -------
+        Verdict
+            ``cert.verdict`` and ``float(cert.sup_gain)``.
+        """
         return cls(cert.verdict, float(cert.sup_gain))
 
 
@@ -250,7 +303,36 @@ CERTIFIED = Verdict("certified", 1.0)
 
 def make_result(method: str, K0: Array, K: Array, cert: Certificate | Verdict, status: str,
                 w: Array, iterations: int, t0: float, message: str, **details: Any) -> TuneResult:
-    """A :class:`TuneResult` of ``method`` that moved ``K0`` to ``K``, timed from ``t0``."""
+    """A :class:`TuneResult` of ``method`` that moved ``K0`` to ``K``, timed from ``t0``.
+
+    Parameters
+    ----------
+    method : str
+        The repair method's name (``"projection"``, ``"region-growing"``).
+    K0 : ndarray, shape (3,)
+        The input gains (k_x [1/s²], k_v [1/s], k_a [-]; IDL eq 4).
+    K : ndarray, shape (3,)
+        The output gains.
+    cert : Certificate or Verdict
+        The exact certificate of K (or the verdict and sup |Γ| taken from it).
+    status : str
+        The method's exit status (recorded as is).
+    w : ndarray, shape (3,)
+        Weights of the reported distance ‖K − K0‖_W (:func:`wdist`).
+    iterations : int
+        Iterations the method ran.
+    t0 : float
+        ``time.perf_counter()`` at the start; ``seconds`` is measured from it.
+    message : str
+        Human-readable outcome.
+    **details
+        Method-specific extras, stored in ``TuneResult.details``.
+
+    Returns
+    -------
+    TuneResult
+        ``certified`` and ``verdict`` come from ``cert``, never from ``status``.
+    """
     v = cert if isinstance(cert, Verdict) else Verdict.of(cert)
     return TuneResult(
         method=method, k_in=triple(K0), k=triple(K), certified=v.certified,
