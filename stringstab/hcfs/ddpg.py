@@ -294,12 +294,23 @@ def load_ddpg(directory: str | Path) -> ScaledPolicy:
 
 
 def bundled_policy_dir() -> Path:
-    """The folder of the DDPG shipped with the package."""
+    """The folder of the DDPG shipped with the package.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder inside the installed package.
+    """
     return Path(str(resources.files("stringstab").joinpath(BUNDLED_POLICY)))
 
 
 def load_bundled_ddpg() -> ScaledPolicy:
     """The DDPG shipped with the package, trained by ``stringstab hcfs train`` (see its README).
+
+    Returns
+    -------
+    ScaledPolicy
+        The bundled trained actor.
 
     Raises
     ------

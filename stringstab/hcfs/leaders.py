@@ -206,6 +206,11 @@ def hcfs_leader(spec: str, *, dt: float = DT, duration: float | None = None) -> 
     duration : float, optional
         Keep only the first ``duration`` seconds.
 
+    Returns
+    -------
+    Trajectory
+        The leader's speed profile.
+
     Raises
     ------
     StringStabError

@@ -186,6 +186,11 @@ def limit_step(target: npt.ArrayLike, previous: npt.ArrayLike, step_limit: npt.A
     step_limit : float or array_like
         J T, m/s² (broadcast against ``target``).
 
+    Returns
+    -------
+    ndarray
+        The clipped accelerations, m/s².
+
     Examples
     --------
     >>> limit_step([1.0, -1.0, 0.1], 0.0, 0.5).tolist()
@@ -247,6 +252,11 @@ def predicted_rewards(candidates: npt.ArrayLike, speed: npt.ArrayLike, lead_spee
         T, s.
     **weights : float
         ``omega_1, omega_2, speed_max, accel_max`` passed to :func:`~stringstab.hcfs.mdp.reward`.
+
+    Returns
+    -------
+    ndarray
+        The predicted eq-6 reward of each candidate.
 
     Examples
     --------

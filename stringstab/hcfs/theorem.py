@@ -156,6 +156,11 @@ def jerk_bound(jerk_limit: float, gap: npt.ArrayLike, prev_switch: npt.ArrayLike
     beta, dt : float
         β (eq 13) and T.
 
+    Returns
+    -------
+    ndarray
+        The bound on |a_k − a_{k−1}|, m/s² per step.
+
     Examples
     --------
     >>> float(jerk_bound(5.0, 0.4, False, True, beta=0.5, dt=0.2))

@@ -22,7 +22,13 @@ Block = tuple[int, int, int, int]
 
 
 def cpu_count() -> int:
-    """The cores this process may run on."""
+    """The cores this process may run on.
+
+    Returns
+    -------
+    int
+        The number of usable cores (at least 1).
+    """
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
@@ -30,7 +36,13 @@ def cpu_count() -> int:
 
 
 def in_daemon() -> bool:
-    """Whether this process is a daemon (e.g. a multiprocessing.Pool worker: no children)."""
+    """Whether this process is a daemon (e.g. a multiprocessing.Pool worker: no children).
+
+    Returns
+    -------
+    bool
+        True in a daemon process, which may not start children.
+    """
     return bool(multiprocessing.current_process().daemon)
 
 

@@ -174,6 +174,12 @@ def leaders_from_files(paths: Sequence[str | Path], split: Split, *, seconds: fl
     seconds, dt : float
         Episode length and step, s.
 
+    Returns
+    -------
+    list of Leader
+        The episodes: CSV leaders (cut into ``seconds``-long episodes for training) and
+        NGSIM pairs.
+
     Raises
     ------
     StringStabError

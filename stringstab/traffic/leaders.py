@@ -89,6 +89,11 @@ def leader_by_name(spec: str, *, dt: float = DT, duration: float | None = None) 
     duration : float, optional
         Keep only the first ``duration`` seconds.
 
+    Returns
+    -------
+    Trajectory
+        The leader's speed profile.
+
     Raises
     ------
     StringStabError

@@ -39,6 +39,11 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
     speed_max : float, optional
         Cap the speed, m/s.
 
+    Returns
+    -------
+    Trajectory
+        The leader read from the file.
+
     Raises
     ------
     StringStabError

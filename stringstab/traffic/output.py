@@ -58,6 +58,11 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
         TTC* of the safety metrics, s.
     warnings : sequence of str
         Warnings about the run (e.g. from :func:`~stringstab.traffic.platoon.check_leader`).
+
+    Returns
+    -------
+    dict
+        The JSON-serialisable document written as ``metrics.json``.
     """
     metrics = result.metrics(ttc_star=ttc_star)
     return {
@@ -205,10 +210,20 @@ def write_run(result: PlatoonResult, out: str | Path | OutputDir, *, metrics: di
 
     Parameters
     ----------
+    result : PlatoonResult
+        The simulated run (:func:`~stringstab.traffic.simulate`).
     out : path or OutputDir
         The folder: written all-or-nothing, replacing the files of an earlier run (see
         :data:`RUN_FILES`); or an open :class:`~stringstab.io.OutputDir` (e.g. checked by a
         command before it simulated) that the caller commits.
+    metrics : dict
+        The ``metrics.json`` document (:func:`run_document`).
+    fmt : {"npz", "csv"}
+        The trajectories' format.
+    figures : bool
+        Also draw ``platoon.png`` and ``damping.png``.
+    title : str, optional
+        The figures' title.
 
     Returns
     -------

@@ -55,6 +55,11 @@ def safety_reward(ttc: npt.ArrayLike, *, ttc_star: float = TTC_STAR,
     gap : array_like, optional
         Bumper-to-bumper gap; where gap ≤ 0 the reward is −1 (collision).
 
+    Returns
+    -------
+    ndarray
+        r_f, in [−1, 0], of the shape of the TTC.
+
     Examples
     --------
     >>> safety_reward([np.inf, 1.5, 0.0]).tolist()

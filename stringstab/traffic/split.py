@@ -33,6 +33,11 @@ def train_test_split(
     shuffle : bool
         If False, the last items are the test set (a chronological split).
 
+    Returns
+    -------
+    (list, list)
+        The train items and the test items.
+
     Examples
     --------
     >>> train_test_split(list(range(10)), test_fraction=0.3, shuffle=False)

@@ -53,6 +53,11 @@ def sinusoid(
     dt : float
         Step, s.
 
+    Returns
+    -------
+    Trajectory
+        The leader's speed profile.
+
     Examples
     --------
     >>> tr = sinusoid(omega=1.0, amplitude=2.0, speed=20.0, duration=100.0)

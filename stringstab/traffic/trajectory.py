@@ -302,6 +302,11 @@ def from_accel_segments(
     name : str
         Label.
 
+    Returns
+    -------
+    Trajectory
+        The integrated trajectory.
+
     Examples
     --------
     >>> tr = from_accel_segments([(0.0, 1.0), (-2.0, 1.0)], speed0=10.0, dt=0.5)
