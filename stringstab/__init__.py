@@ -8,10 +8,9 @@ maps, gain repair, a platoon simulator and a compact policy trainer.
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
-
 from typing import Any
 
+from ._version import __version__
 from .certificate import Certificate, CertificateBatch, certify, certify_batch, certify_pade, check
 from .criteria import hurwitz, stability_type, taylor_criteria
 from .errors import StringStabError

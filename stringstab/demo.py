@@ -173,7 +173,8 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from .io import atomic_path, columns_from_records, parse_triple, write_results
-    from .tuning import plot_moves, project, region_growing
+    from .plots import plot_moves
+    from .tuning import project, region_growing
 
     results = []
     for t in TUNE_TRIPLES:

@@ -61,6 +61,7 @@ def test_derive_writes_its_file(tmp_path, capsys):
     assert _files(tmp_path) == ["d.json"]  # no temporary file left
 
 
+@pytest.mark.slow  # ~9.8 s with -n 2 on 2 shared cores (CI runs it)
 def test_region_rerun_replaces_its_own_files(tmp_path, capsys):
     out = tmp_path / "maps"
     assert main([*REGION, "--format", "png,pdf", "--out", str(out)]) == 0

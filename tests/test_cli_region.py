@@ -14,6 +14,7 @@ from stringstab.regions import load_npz, region_map
 ROLLOUT = Path(stringstab.__file__).parent / "data" / "examples" / "gain_rollout.csv"
 
 
+@pytest.mark.slow  # ~11.1 s with -n 2 on 2 shared cores (CI runs it)
 def test_slice_writes_data_and_figures(tmp_path, capsys):
     out = tmp_path / "maps"
     rc = main(["region", "--x", "k_x", "--y", "k_v", "--fix", "k_a=0.5", "--range", "-2,2", "--n", "15",

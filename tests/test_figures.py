@@ -89,6 +89,7 @@ def _check(saved, expected):
     return names
 
 
+@pytest.mark.slow  # ~9.9 s with -n 2 on 2 shared cores (CI runs it)
 def test_region_figures(tmp_path, captured):
     # the writer the region command uses, in this process (the command shares it with a fork)
     from stringstab.io import read_gains

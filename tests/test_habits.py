@@ -13,7 +13,7 @@ def test_version_has_one_source():
     pyproject = (ROOT / "pyproject.toml").read_text()
     assert 'dynamic = ["version"]' in pyproject
     assert not re.search(r'^version\s*=\s*"', pyproject, re.M)  # no second copy
-    assert 'attr = "stringstab.__version__"' in pyproject
+    assert 'attr = "stringstab._version.__version__"' in pyproject
     assert metadata.version("stringstab") == stringstab.__version__
     assert not re.search(r"^version:", (ROOT / "CITATION.cff").read_text(), re.M)
 

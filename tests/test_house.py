@@ -3,13 +3,13 @@
 The import graph is read from the source (``ast``), so it includes the imports made inside
 functions (lazy imports), which Python would otherwise only reveal at run time.  An edge
 A → B means module A names module B in an ``import`` statement run at run time (imports for
-type hints only, under ``if TYPE_CHECKING:``, are not edges); importing a submodule also
-runs its parents' ``__init__``, but that implicit step is not an edge (as in pylint's
-``cyclic-import`` and import-linter).  *Upward* means a module importing a package that
-contains it (the façade at the top re-exports the layers below, so a layer importing it
-reaches over its own head).  The one exception is ``from .. import __version__``: the
-package's single version string lives in its ``__init__`` (``pyproject.toml`` reads it
-there), and reading a constant is not an edge.
+type hints only, under ``if TYPE_CHECKING:``, are not edges).  Importing a submodule also
+runs its parents' ``__init__`` (``import a.b.c`` imports ``a`` and ``a.b`` first), so an
+edge A → ``a.b.c`` brings the edges A → ``a.b`` and A → ``a``, except to the packages that
+contain A (already being imported when A runs).  *Upward* means a module importing a
+package that contains it (the façade at the top re-exports the layers below, so a layer
+importing it reaches over its own head); the package's version string therefore lives in
+``stringstab/_version.py``, below every layer, and the ``__init__`` re-exports it.
 """
 
 from __future__ import annotations
@@ -94,16 +94,28 @@ def import_graph() -> dict[str, set[str]]:
                 if not (base == ROOT or base.startswith(ROOT + ".")):
                     continue
                 for alias in node.names:
-                    if alias.name == "__version__":
-                        continue  # the version constant (module docstring)
                     sub = f"{base}.{alias.name}"
                     # "from .pkg import submodule" imports the submodule; a name from pkg
                     # imports pkg itself
                     graph[mod].add(sub if sub in MODULES else base)
     for mod in graph:
-        graph[mod].discard(mod)
         graph[mod] &= set(MODULES)
+        graph[mod] |= {p for t in graph[mod] for p in _implicit_parents(mod, t)}
+        graph[mod].discard(mod)
     return graph
+
+
+def _implicit_parents(mod: str, target: str) -> set[str]:
+    """The packages that importing ``target`` from ``mod`` also imports: its parents.
+
+    Importing ``a.b.c`` runs ``a/__init__`` and ``a/b/__init__`` first.  The parents that
+    contain ``mod`` itself are left out: they are already being imported when ``mod`` runs
+    (``stringstab.regions.grid`` importing ``stringstab.io`` does not run ``stringstab``
+    again), so they add no step.
+    """
+    parts = target.split(".")
+    parents = {".".join(parts[:i]) for i in range(1, len(parts))}
+    return {p for p in parents if p in MODULES and not mod.startswith(p + ".")}
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -154,8 +166,14 @@ def test_the_graph_sees_lazy_and_relative_imports():
     assert "stringstab.criteria" in g["stringstab.certificate"]  # top-level relative import
     assert "stringstab.criteria" in g["stringstab.symbolic"]  # inside lambdify_psi
     assert "stringstab.symbolic" in g["stringstab.codegen"]  # "from . import symbolic as S"
-    assert "stringstab.regions.report" in g["stringstab.regions.result"]  # lazy, in a method
-    assert "stringstab.regions.result" not in g["stringstab.regions.report"]  # TYPE_CHECKING
+    assert "stringstab.regions.report" in g["stringstab.regions.result"]
+    assert "stringstab.tuning.projection" in g["stringstab.tuning"]  # from .projection import
+    # implicit parents: "from .io.gains import ..." in the façade also runs io/__init__ ...
+    assert {"stringstab.io.gains", "stringstab.io"} <= g["stringstab"]
+    # ... but not the packages containing the importer, already being imported
+    assert _implicit_parents("stringstab.regions.grid", "stringstab.io.outputs") == {"stringstab.io"}
+    assert _implicit_parents("stringstab.cli.tune", "stringstab.plots.tuning") == {"stringstab.plots"}
+    assert _implicit_parents("stringstab.plots.tuning", "stringstab.plots._common") == set()
     # the checks below can fail: a made-up cycle and upward import are found
     fake = {**g, "stringstab.margin": g["stringstab.margin"] | {"stringstab.certificate"}}
     assert any("stringstab.margin" in c for c in cycles(fake))

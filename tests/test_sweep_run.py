@@ -152,6 +152,7 @@ def test_worker_killed_mid_task_is_retried(client: Any, tmp_path: Path) -> None:
     assert rec["status"] == "done" and rec["pid"] != killed["pid"]  # finished by another process
 
 
+@pytest.mark.slow  # ~12.2 s with -n 2 on 2 shared cores (CI runs it)
 def test_interrupted_cli_sweep_resumes(tmp_path: Path) -> None:
     spec_file = tmp_path / "probes.toml"
     spec_file.write_text('[sweep]\nkind = "probe"\nseeds = [0, 1, 2, 3, 4, 5]\n[base]\nseconds = 1.0\n')

@@ -19,7 +19,8 @@ from numpy.testing import assert_allclose
 from stringstab.certificate import certify, certify_batch
 from stringstab.errors import StringStabError
 from stringstab.frequency import gain
-from stringstab.tuning import Projector, TuneResult, plot_moves, project, region_growing, tune
+from stringstab.plots import plot_moves
+from stringstab.tuning import Projector, TuneResult, project, region_growing, tune
 
 P = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
 # delay-free model of the hand-worked region-growing cases

@@ -21,7 +21,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 from ..errors import StringStabError
 
 __all__ = ["COMMANDS", "HELP", "build_parser", "main"]

@@ -27,7 +27,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
 from .env import HCFSVectorEnv

@@ -540,7 +540,7 @@ class OutputDir:
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.chmod(staging / name, mode)
                 os.replace(staging / name, dest)
-            from .. import __version__
+            from .._version import __version__
 
             inv = _INVOCATION.get()
             manifest = {"command": self.command, "version": __version__, "files": new,

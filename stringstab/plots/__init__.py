@@ -28,8 +28,8 @@ module / function              shows
 :func:`plot_damping_ratios`    m_p of each follower (IDL eq 29)
 =============================  ===============================================================
 
-matplotlib is imported on first use.  ``stringstab.tuning.plot_moves`` and
-``stringstab.traffic.plots`` re-export their functions from here.
+matplotlib is imported on first use.  ``stringstab.traffic.plots`` re-exports its functions
+from here.
 """
 
 from __future__ import annotations

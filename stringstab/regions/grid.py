@@ -327,7 +327,7 @@ def region_map(
     >>> m.disagreements()["exact vs printed"]
     2
     """
-    from .. import __version__  # the package's one version (a constant, not a layer)
+    from .._version import __version__  # the package's one version (a constant, not a layer)
 
     p = parameter_model(tau, delta, headway)
     H = None if sample_time is None else _sample_time(sample_time)

@@ -2,12 +2,42 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from .result import RegionMap
+import numpy as np
 
-__all__ = ["percent", "render_report"]
+__all__ = ["ReportedMap", "percent", "render_report"]
+
+
+class ReportedMap(Protocol):
+    """What the report reads from a map: :class:`~stringstab.regions.result.RegionMap` has it.
+
+    Written as a protocol so that this module sits below ``result.py`` (``RegionMap.report``
+    calls :func:`render_report`) and imports nothing from it.
+    """
+
+    @property
+    def axes(self) -> Mapping[str, Any]: ...
+
+    @property
+    def methods(self) -> tuple[str, ...]: ...
+
+    @property
+    def shape(self) -> tuple[int, ...]: ...
+
+    @property
+    def size(self) -> int: ...
+
+    def title(self) -> str: ...
+
+    def class_shares(self) -> dict[str, dict[str, float]]: ...
+
+    def verdict_shares(self) -> dict[str, dict[str, float]]: ...
+
+    def disagreements(self) -> dict[str, int]: ...
+
+    def stable(self, method: str) -> np.ndarray: ...
 
 
 def percent(x: float) -> str:
@@ -26,13 +56,13 @@ def percent(x: float) -> str:
     return "<0.1 %" if 0 < x < 1e-3 else f"{100 * x:.1f} %"
 
 
-def render_report(rmap: RegionMap) -> str:
+def render_report(rmap: ReportedMap) -> str:
     """The grid, the class shares per method and the disagreements, one line each.
 
     Parameters
     ----------
     rmap : RegionMap
-        The map to describe.
+        The map to describe (anything with the attributes of :class:`ReportedMap`).
 
     Returns
     -------

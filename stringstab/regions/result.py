@@ -23,6 +23,7 @@ from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
 from ..params import Box, Params
 from .files import FORMAT, csv_text, read_npz, write_npz
+from .report import render_report
 
 __all__ = [
     "CONTINUOUS",
@@ -327,8 +328,6 @@ class RegionMap:
 
         See :func:`stringstab.regions.report.render_report`.
         """
-        from .report import render_report
-
         return render_report(self)
 
     def title(self) -> str:

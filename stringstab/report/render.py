@@ -322,7 +322,7 @@ class Report:
     def __init__(self, title: str, *, command: str, params: Mapping[str, Any] | None = None,
                  version: str | None = None, intro: str = "", started: float | None = None) -> None:
         if version is None:
-            from .. import __version__ as version
+            from .._version import __version__ as version
         self.title = title
         self.command = command
         self.params = dict(params or {})

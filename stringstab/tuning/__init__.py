@@ -31,7 +31,8 @@ Modules: :mod:`~stringstab.tuning.result` (the result types),
 :mod:`~stringstab.tuning.region_growing`, :mod:`~stringstab.tuning.projection` (the NLP,
 the exchange and the :class:`Projector`), :mod:`~stringstab.tuning.predictor` (the Newton
 predictor) and :mod:`~stringstab.tuning.methods` (:func:`tune`); the figure
-:func:`plot_moves` lives in :mod:`stringstab.plots.tuning`.
+:func:`~stringstab.plots.plot_moves` lives in :mod:`stringstab.plots.tuning` (the
+plots import the tuning, never the reverse).
 
 References
 ----------
@@ -43,7 +44,6 @@ applications", SIAM Review 35 (1993) 380-429 (the exchange method).
 
 from __future__ import annotations
 
-from ..plots.tuning import plot_moves
 from .methods import METHODS, tune
 from .predictor import _g_and_grad as _g_and_grad  # for tests: the predictor's derivatives
 from .predictor import _g_full as _g_full
@@ -56,7 +56,6 @@ __all__ = [
     "Projector",
     "TuneResult",
     "TuneResults",
-    "plot_moves",
     "project",
     "region_growing",
     "tune",
