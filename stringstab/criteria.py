@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _generated as _gen
+from .errors import StringStabError
 from .params import as_gains, check_params
 
 __all__ = [
@@ -93,8 +94,8 @@ def psi(
 
     Raises
     ------
-    ValueError
-        If ``source`` is neither ``"derived"`` nor ``"printed"``.
+    StringStabError
+        If ``source`` is neither ``"derived"`` nor ``"printed"`` (a ValueError).
 
     Examples
     --------
@@ -104,7 +105,7 @@ def psi(
     try:
         fn = _PSI[source]
     except KeyError:
-        raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}") from None
+        raise StringStabError(f"source must be 'derived' or 'printed'; got {source!r}") from None
     args = (k_x, k_v, k_a, tau, delta, headway)
     shape = np.broadcast_shapes(*(np.shape(v) for v in args))
     p1, p2, p3 = (np.broadcast_to(np.asarray(o, dtype=float), shape)
@@ -437,8 +438,8 @@ def proposition1(
 
     Raises
     ------
-    ValueError
-        If ``source`` is neither ``"derived"`` nor ``"printed"``.
+    StringStabError
+        If ``source`` is neither ``"derived"`` nor ``"printed"`` (a ValueError).
 
     Examples
     --------
@@ -450,4 +451,4 @@ def proposition1(
         return np.asarray((p1 >= 0) & (p3 >= 0) & ((p2 >= 0) | (lm <= 0)))
     if source == "printed":
         return np.asarray(((p1 >= 0) & (p2 >= 0) & (p3 >= 0)) | (lm <= 0))
-    raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}")
+    raise StringStabError(f"source must be 'derived' or 'printed'; got {source!r}")

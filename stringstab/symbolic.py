@@ -26,6 +26,8 @@ from functools import cache, lru_cache
 import numpy as np
 import sympy as sp
 
+from .errors import StringStabError
+
 __all__ = [
     "GAINS",
     "PARAMS",
@@ -253,13 +255,13 @@ def margin_series(omega_order: int = 6, delay_order: int | None = None) -> sp.Ex
         Polynomial in ω (even powers only).
     """
     if omega_order < 2 or omega_order % 2:
-        raise ValueError(f"omega_order must be an even integer >= 2; got {omega_order!r}")
+        raise StringStabError(f"omega_order must be an even integer >= 2; got {omega_order!r}")
     if delay_order is None:
         F = margin_exact()
         ser = sp.series(F, omega, 0, omega_order + 1).removeO()
         return sp.expand(ser)
     if delay_order < 0:
-        raise ValueError(f"delay_order must be >= 0 or None; got {delay_order!r}")
+        raise StringStabError(f"delay_order must be >= 0 or None; got {delay_order!r}")
     g = gamma()
     n0, n1 = _split_delay(g.numerator)
     taylor = sum((-delta * s) ** k / sp.factorial(k) for k in range(delay_order + 1))
@@ -464,7 +466,7 @@ def lambdify_psi(
     [0.010293, 0.592, 0.71, 0.321231]
     """
     if source not in ("derived", "printed"):
-        raise ValueError(f"source must be 'derived' or 'printed'; got {source!r}")
+        raise StringStabError(f"source must be 'derived' or 'printed'; got {source!r}")
     if source == "printed" or delay_order is None:
         # the generated code of these two (stringstab._generated, tested against SymPy)
         from functools import partial

@@ -25,3 +25,17 @@ def test_numpy_values_print_plainly(call, text):
     msg = str(e.value)
     assert "np." not in msg and "array(" not in msg, msg
     assert text in msg, msg
+
+
+def test_library_refusals_are_the_toolkits_error():
+    """Bad arguments deep in the library are StringStabError (one line at the CLI), not bare errors."""
+    import math
+
+    from stringstab.criteria import psi
+
+    tr = from_speed([0, 1], [10.0, 12.0], dt=0.5)
+    for bad in (math.nan, math.inf, -1.0):
+        with pytest.raises(StringStabError, match="hold needs a finite seconds"):
+            tr.hold(bad)
+    with pytest.raises(StringStabError, match="source must be 'derived' or 'printed'"):
+        psi(1.0, 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1, source="neither")

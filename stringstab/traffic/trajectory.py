@@ -108,7 +108,7 @@ class Trajectory:
         Raises
         ------
         StringStabError
-            If ``seconds`` < 0.
+            If ``seconds`` is negative or not finite.
 
         Examples
         --------
@@ -116,9 +116,9 @@ class Trajectory:
         >>> tr.speed.tolist(), tr.accel.tolist()
         ([10.0, 11.0, 12.0, 12.0, 12.0], [2.0, 2.0, 0.0, 0.0, 0.0])
         """
+        if not math.isfinite(float(seconds)) or seconds < 0:
+            raise StringStabError(f"hold needs a finite seconds >= 0; got {show(seconds)}")
         n = round(float(seconds) / self.dt)
-        if n < 0:
-            raise StringStabError(f"hold needs seconds >= 0; got {show(seconds)}")
         v_end = self.speed[-1]
         x_tail = self.position[-1] + v_end * self.dt * np.arange(1, n + 1)
         accel = self.accel.copy()
