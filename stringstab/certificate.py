@@ -57,6 +57,7 @@ from . import margin as _margin
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
 from .errors import StringStabError
+from .excess import EXCESS_SEARCH, col
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
 from .io.results import TableColumn, columns_from_records
@@ -106,22 +107,6 @@ _SLACK = ROUNDOFF_SLACK
 # ---------------------------------------------------------------------------
 # Step 1, the tail bound, is :func:`stringstab.margin.tail_bound` (re-exported here).
 # ---------------------------------------------------------------------------
-def col(v: Array) -> Array:
-    """A 1-D array as a column, to broadcast against a frequency grid.
-
-    Parameters
-    ----------
-    v : ndarray, shape (n,)
-        One value per row (a coefficient, a parameter).
-
-    Returns
-    -------
-    ndarray, shape (n, 1)
-        A view of ``v`` as a column.
-    """
-    return v[:, None]
-
-
 def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
     """g on the grid ``w`` and its round-off slack (step 3).
 
@@ -688,9 +673,10 @@ def _continuous_batch(
     cert = verdict == _CERT
     sup[cert] = np.maximum(sup[cert], 1.0)
     # not certified and stable ⇒ |Γ| > 1 somewhere: sup|Γ| − 1 without cancellation, so a
-    # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0
+    # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0;
+    # searched only where the direct excess is below EXCESS_SEARCH (above it, it is exact enough)
     excess = np.where(cert, 0.0, sup - 1.0)
-    viol = np.flatnonzero((verdict == _NOT) & hz_sure)
+    viol = np.flatnonzero((verdict == _NOT) & hz_sure & (excess < EXCESS_SEARCH))
     if viol.size:
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))

@@ -64,6 +64,7 @@ import numpy.typing as npt
 
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max
 from .criteria import hurwitz_bands
+from .excess import EXCESS_SEARCH
 from .excess import violation_peak as _violation_peak_continuous
 from .frequency import gain_squared, margin_g_coefficients
 from .io.results import TableColumn
@@ -116,7 +117,6 @@ __all__ = [
 Array = npt.NDArray[np.float64]
 _CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
 _SLACK = ROUNDOFF_SLACK
-_EXCESS_SEARCH = 1e-4  # not-certified rows with sup gain − 1 below this get the log search
 _SCHUR_RTOL = 1e-12
 
 
@@ -259,7 +259,7 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
             kx[need], kv[need], ka[need], out["tau"][need], out["delta"][need],
             out["headway"][need], w[need])
     out["sup_gain_excess"] = sup - 1.0
-    small = np.flatnonzero((v == _NOT) & sure & (sup - 1.0 < _EXCESS_SEARCH))
+    small = np.flatnonzero((v == _NOT) & sure & (sup - 1.0 < EXCESS_SEARCH))
     if small.size:
         t, d, h = (out[k][small] for k in ("tau", "delta", "headway"))
         co = margin_g_coefficients(kx[small], kv[small], ka[small], tau=t, delta=d, headway=h)
@@ -573,7 +573,7 @@ def _robust_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *, hete
     out = {"verdict": status, "stable": sure, "margin": margin, "theta": theta,
            "tau": tau_w, "tau_prev": taup_w, "delta": d_w, "headway": h_w,
            "n_evals": n_evals, "sup_gain_excess": sup - 1.0}
-    small_ = (status == _NOT) & sure & need & (sup - 1.0 < _EXCESS_SEARCH)
+    small_ = (status == _NOT) & sure & need & (sup - 1.0 < EXCESS_SEARCH)
     for mm in np.unique(wit["m"][small_]):
         idx = np.flatnonzero(small_ & (wit["m"] == mm))
         e_i = wit["e"][idx]

@@ -70,6 +70,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes, zoom_max
+from .excess import EXCESS_SEARCH
 from .io.results import TableColumn
 from .params import Box, Params, as_gains, check_params, positive
 from .params import sample_time as _sample_time
@@ -111,7 +112,6 @@ _CERT, _NOT, _INC = CERTIFIED_CODE, NOT_CERTIFIED, INCONCLUSIVE
 
 _SLACK = ROUNDOFF_SLACK  # on g_H, per unit of the magnitude companion
 _SCHUR_RTOL = 1e-12  # relative band around the Schur boundary left inconclusive
-_EXCESS_SEARCH = 1e-4  # not-certified rows with sup|H| − 1 below this get the log-θ search
 
 
 # ---------------------------------------------------------------------------
@@ -1333,7 +1333,7 @@ def certify_sampled_batch(
             # so a violation of 1e-20 near θ = 0 is reported as such, where it is attained
             # (rows whose |H| − 1 from the direct search keeps ≥ 12 digits are left as they are)
             excess[sl][idx] = sp_ - 1.0
-            viol = np.flatnonzero((v == _NOT) & s_sure & (excess[sl] < _EXCESS_SEARCH))
+            viol = np.flatnonzero((v == _NOT) & s_sure & (excess[sl] < EXCESS_SEARCH))
             if viol.size:
                 kappa = np.full(viol.size, p.tau * tp / H**3)
                 e2, th = _violation_peak(_take(co, viol), m, kappa,
