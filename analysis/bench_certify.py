@@ -2,7 +2,7 @@
 
 The same ``--n`` random gain triples K uniform in [-2, 2]³ (``--seed``) are certified
 
-(a) by :func:`stringstab.certificate.certify_batch` (exact delay, sound), in one call;
+(a) by :func:`stringstab.certify.continuous.certify_batch` (exact delay, sound), in one call;
 (b) the python-control way, one triple at a time: the delay replaced by
     ``control.pade(delta, 5)``, our own stability check of the poles
     (``control.poles``), then ``control.norm(sys, "inf")`` (which alone returns
@@ -12,7 +12,7 @@ The same ``--n`` random gain triples K uniform in [-2, 2]³ (``--seed``) are cer
     back as 1 + O(1e-6)).  ``--pade-subset`` times (b) on a random subset when
     the full set is too slow;
 (c) by an independent check: Hurwitz by ``numpy.roots`` and, for stable Γ, a
-    ``--points`` (10⁶) point sweep of |Γ(jω)| with :func:`stringstab.frequency.gain`
+    ``--points`` (10⁶) point sweep of |Γ(jω)| with :func:`stringstab.certify.frequency.gain`
     on [0, Ω], where Ω is the largest root of the cubic
     ½τω³ − |k_a|ω² − (½|c| + |k_v|)ω − |k_x| (c = k_v + T*k_x), beyond which
     |Γ(jω)| ≤ (|k_x| + |k_v|ω + |k_a|ω²) / (ω(τω² − |c|)) ≤ ½.
@@ -24,7 +24,7 @@ satisfies |m| ≤ 1e-6 (m → Ψ3/k_x² as ω → 0, where |Γ| → 1; the plain
 |Γ(0)| = 1).  Otherwise the sweep decides: certified iff Hurwitz and m > 0.
 
 (d) the other loops, in the same run, on the same triples, through the same entry points
-    (:func:`stringstab.certificate.certify_batch` and :func:`~stringstab.certificate.check`
+    (:func:`stringstab.certify.continuous.certify_batch` and :func:`~stringstab.certify.continuous.check`
     with ``sample_time`` and intervals): the sampled-data certificate at Δt = 0.1 s (δ on a
     multiple of Δt) and at Δt = 0.08 s (δ/Δt = 2.5), the robust certificate over
     τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25], T* ∈ [1.0, 1.2] in continuous time and, on the first
@@ -50,8 +50,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from stringstab.certificate import certify_batch, check
-from stringstab.frequency import gain
+from stringstab.certify.continuous import certify_batch, check
+from stringstab.certify.frequency import gain
 from stringstab.params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 
 PADE_TOL = 1e-5

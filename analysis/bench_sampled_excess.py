@@ -1,6 +1,6 @@
 """Cost of the sampled certificate's ``sup_gain_excess`` (issue 21, item 5).
 
-Times :func:`stringstab.sampled.certify_sampled_batch` on 20,000 random triples in [−2, 2]³
+Times :func:`stringstab.certify.sampled.certify_sampled_batch` on 20,000 random triples in [−2, 2]³
 (τ = 0.1, δ = 0.2, T* = 1.1, H = 0.1) with the violation-peak search of not-certified Schur
 rows, and in the same run with that search replaced by a no-op (the code before it), and
 prints the ratio and the machine load; then, on rows whose Ψ3 is just below 0, how many
@@ -15,7 +15,7 @@ from unittest import mock
 
 import numpy as np
 
-from stringstab import sampled
+from stringstab.certify import sampled
 
 
 def _no_search(co, m, kappa, cand):  # type: ignore[no-untyped-def]
@@ -53,7 +53,7 @@ def near_zero(n: int = 86, H: float = 0.1) -> None:
     how many report sup|H| = 1.0 at θ = 0, and how many have sup_gain_excess > 0 and θ > 0."""
     from scipy.optimize import brentq
 
-    from stringstab.margin import coefficients
+    from stringstab.certify.margin import coefficients
 
     def psi3(kx: float, kv: float, ka: float) -> float:
         c = coefficients(kx, kv, ka, tau=0.1, delta=0.2, headway=1.1)

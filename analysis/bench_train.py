@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from stringstab import sampled
+from stringstab.certify import sampled
 from stringstab.rl import config_for, train
 from stringstab.rl.repair import GainRepair
 from stringstab.tuning import project

@@ -71,7 +71,7 @@ def figures() -> dict[str, object]:
     pkg = H.PKG
     root = sorted(p.name for p in pkg.glob("*.py"))
     sizes = {str(p.relative_to(pkg.parent)): len(p.read_text(encoding="utf-8").splitlines())
-             for p in pkg.rglob("*.py") if p.name != "_generated.py"}
+             for p in pkg.rglob("*.py") if p.name != "generated.py"}
     largest = max(sizes, key=sizes.__getitem__)
     over = sorted((n for n, s in sizes.items() if s > 500), key=lambda n: -sizes[n])
     g = H.import_graph()

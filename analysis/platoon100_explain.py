@@ -26,14 +26,14 @@ import time
 
 import numpy as np
 
-from stringstab.certificate import check
+from stringstab.certify.continuous import check
+from stringstab.certify.sampled import check_sampled
 from stringstab.constants import DELTA, HEADWAY, STANDSTILL, TAU
-from stringstab.metrics import platoon_metrics
 from stringstab.rl import load_policy
 from stringstab.rl.evaluate import controller_for
-from stringstab.sampled import check_sampled
 from stringstab.traffic.controllers import LinearController
 from stringstab.traffic.leaders import paper_mix
+from stringstab.traffic.metrics import platoon_metrics
 from stringstab.traffic.platoon import Limits, simulate
 
 N = 100

@@ -11,7 +11,7 @@ The three parameters of the IDL paper's vehicle model (eqs 3-9):
 
 Each may also be uncertain: an interval ``(lo, hi)`` (or ``"LO:HI"`` on the command line),
 and the three intervals form a :class:`Box` (the robust certificate,
-:mod:`stringstab.robust`, holds for every member).  :func:`parameter_model` turns what a
+:mod:`stringstab.certify.robust`, holds for every member).  :func:`parameter_model` turns what a
 caller gives into :class:`Params` (every value a point) or a :class:`Box`.
 
 Defaults follow the IDL paper's Table 2 (δ = 0.2 s, T* = 1.1 s); the paper does

@@ -1,8 +1,8 @@
 """Independent truth for the sampled-data tests: H(e^{jθ}) of two consecutive vehicles.
 
 Built here from the continuous state equations with ``scipy.linalg.expm`` (Van Loan's
-block exponential for the held inputs), *not* from stringstab.sampled or
-stringstab.sampled_symbolic, and with the predecessor's held command u_p as the input:
+block exponential for the held inputs), *not* from stringstab.certify.sampled or
+stringstab.derive.sampled_symbolic, and with the predecessor's held command u_p as the input:
 the predecessor is a lag vehicle, a_p = Φ_p a_p + Γ_p u_p, and the follower's delayed
 sample a_p(kH − δ) is its exact value inside the step (another ``expm`` over the
 fraction of the step) — or, with ``delay="linear"``, the simulator's linear

@@ -1,7 +1,7 @@
 """The exact certificate against independent truth: a fine frequency sweep and numpy.roots.
 
 The sweep below evaluates Γ(jω) directly from the model with complex NumPy
-(not through stringstab.frequency), on a dense grid up to 400 rad/s plus a
+(not through stringstab.certify.frequency), on a dense grid up to 400 rad/s plus a
 logarithmic grid near 0.
 """
 
@@ -13,9 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certificate import certify, certify_batch, certify_pade, tail_bound
+from stringstab.certify.continuous import certify, certify_batch, certify_pade, tail_bound
+from stringstab.certify.frequency import margin_g, margin_g_coefficients
 from stringstab.errors import StringStabError
-from stringstab.frequency import margin_g, margin_g_coefficients
 
 W_SWEEP = np.unique(np.concatenate([
     np.geomspace(1e-4, 1.0, 3000),
@@ -223,7 +223,7 @@ def test_witness_of_a_tiny_violation_is_reported():
 
 
 def test_check_gives_the_same_verdicts_as_certify_batch():
-    from stringstab.certificate import check
+    from stringstab.certify.continuous import check
 
     rng = np.random.default_rng(11)
     K = rng.uniform(-2, 2, (500, 3))

@@ -14,27 +14,37 @@ from _sampled_truth import THETA, pair_response, pair_roots
 from numpy.testing import assert_allclose
 
 import stringstab
-from stringstab.certificate import Certificate, CertificateBatch, certify, certify_batch, check
-from stringstab.criteria import psi
-from stringstab.errors import StringStabError
-from stringstab.params import Box, Params, parameter_model
-from stringstab.robust import RobustCertificate, RobustCertificateBatch, certify_robust_batch
-from stringstab.sampled import (
+from stringstab.certify.continuous import (
+    Certificate,
+    CertificateBatch,
+    certify,
+    certify_batch,
+    check,
+)
+from stringstab.certify.criteria import psi
+from stringstab.certify.robust import (
+    RobustCertificate,
+    RobustCertificateBatch,
+    certify_robust_batch,
+)
+from stringstab.certify.sampled import (
     SampledCertificate,
     SampledCertificateBatch,
     SampledCheck,
     certify_sampled_batch,
     check_sampled,
 )
-from stringstab.verdicts import VERDICTS
+from stringstab.certify.verdicts import VERDICTS
+from stringstab.errors import StringStabError
+from stringstab.params import Box, Params, parameter_model
 
 P = dict(tau=0.1, delta=0.2, headway=1.1)
 K = np.random.default_rng(11).uniform(-2, 2, (300, 3))
 
 
 def test_one_vocabulary():
-    import stringstab.certificate as C
-    import stringstab.sampled as S
+    from stringstab.certify import continuous as C
+    from stringstab.certify import sampled as S
 
     assert C.VERDICTS is VERDICTS and S.VERDICTS is VERDICTS and stringstab.VERDICTS is VERDICTS
 

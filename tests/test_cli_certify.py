@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 from stringstab.cli import certify as cli_certify
 from stringstab.cli import main
-from stringstab.gainio import read_gains
+from stringstab.io.gains import read_gains
 
 TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
 #: Certified: internally stable and sup|Γ| = |Γ(0)| = 1 (checked against the sweep below).
@@ -175,7 +175,7 @@ def test_json_schema(capsys):
 
 
 def test_cli_matches_library(capsys):
-    from stringstab.certificate import certify
+    from stringstab.certify.continuous import certify
 
     _, doc, _ = _json(capsys, BAD, "--delta", "0.25")
     ref = certify(0.9, -0.5, 1.1, tau=TAU, delta=0.25, headway=HEADWAY).as_dict()

@@ -5,8 +5,8 @@ import json
 import pytest
 import sympy as sp
 
-from stringstab import symbolic as S
 from stringstab.cli import main
+from stringstab.derive import symbolic as S
 
 KEYS = ["gamma", "gamma_numerator", "gamma_denominator", "psi1", "psi2", "psi3", "lambda",
         "grad_psi2", "grad_psi3", "hurwitz"]

@@ -119,12 +119,12 @@ def test_ctrl_c_while_writing_keeps_the_old_run_whole(capsys, tmp_path, monkeypa
 
 
 def test_memory_error_is_one_line(capsys, monkeypatch):
-    import stringstab.certificate
+    from stringstab.certify import continuous
 
     def oom(*a, **k):
         raise MemoryError("Unable to allocate 74.5 GiB for an array")
 
-    monkeypatch.setattr(stringstab.certificate, "certify_batch", oom)
+    monkeypatch.setattr(continuous, "certify_batch", oom)
     _one_line(capsys, ["certify", "1,1,1"], 2, "stringstab certify: error: out of memory (Unable "
               "to allocate 74.5 GiB for an array); expected a smaller request")
 
@@ -159,6 +159,7 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
         return env
 
     monkeypatch.setattr(rl_train, "make_env", make_env)
+    handler = signal.getsignal(signal.SIGINT)  # SIG_IGN when pytest runs in a background job
     out = tmp_path / "run"
     argv = ["train", "--algo", "ddpg", "--steps", "64", "--num-envs", "4", "--out", str(out),
             "--no-progress"]
@@ -170,7 +171,7 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     assert err.rstrip().endswith("--resume") and "--num-envs 4" in err
     for name in ("train_log.csv", "summary.json", "policy.json", "checkpoint"):
         assert (out / name).exists(), name
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handler restored
+    assert signal.getsignal(signal.SIGINT) is handler  # handler restored
     monkeypatch.setattr(rl_train, "make_env", real)
     assert main([*argv, "--resume"]) == 0
     assert "trained ddpg: 64 steps" in capsys.readouterr().out

@@ -6,7 +6,7 @@ import pytest
 
 import stringstab.cli
 import stringstab.tuning
-from stringstab import demo
+from stringstab.cli import demo_steps as demo
 from stringstab.cli import main
 from stringstab.io import MANIFEST
 

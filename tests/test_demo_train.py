@@ -15,8 +15,8 @@ pytestmark = pytest.mark.torch
 
 @pytest.mark.slow  # ~13.5 s with -n 2 on 2 shared cores (CI runs it)
 def test_demo_train_step(tmp_path):
-    from stringstab import demo
-    from stringstab.certificate import check
+    from stringstab.certify.continuous import check
+    from stringstab.cli import demo_steps as demo
 
     lines: list[str] = []
     out = tmp_path / "train"

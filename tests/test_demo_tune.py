@@ -2,7 +2,7 @@
 
 import json
 
-from stringstab.certificate import certify
+from stringstab.certify.continuous import certify
 from stringstab.cli import main
 
 

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
-from stringstab import errata
 from stringstab.cli import main
+from stringstab.derive.errata import errata
 
 DOC = (Path(__file__).resolve().parents[1] / "docs" / "theory.md").read_text()
 
@@ -53,7 +53,7 @@ def test_errata_shares_in_doc_match_tool():
 def test_margin_block_equals_margin_exact():
     import sympy as sp
 
-    from stringstab import symbolic as S
+    from stringstab.derive import symbolic as S
 
     block = next(b for b in re.findall(r"```text\n(.*?)```", DOC, re.S) if b.startswith("F(ω) ="))
     expr = " ".join(block.split("=", 1)[1].split())

@@ -39,7 +39,7 @@ def documented_names(body: str) -> set[str]:
 def public_functions() -> list[tuple[str, ast.FunctionDef]]:
     out = []
     for path in sorted(PKG.rglob("*.py")):
-        if path.name == "_generated.py":
+        if path.name == "generated.py" and path.parent.name == "derive":
             continue
         rel = path.relative_to(PKG.parent).as_posix()
         for node in ast.parse(path.read_text(encoding="utf-8")).body:
@@ -69,7 +69,7 @@ FUNCTIONS = public_functions()
 
 def test_the_scan_sees_the_package():
     names = {k for k, _ in FUNCTIONS}
-    assert "stringstab/certificate.py:certify" in names
+    assert "stringstab/certify/continuous.py:certify" in names
     assert len(FUNCTIONS) > 300
 
 

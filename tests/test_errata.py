@@ -2,8 +2,8 @@
 
 import sympy as sp
 
-from stringstab import errata
-from stringstab import symbolic as S
+from stringstab.derive import symbolic as S
+from stringstab.derive.errata import errata
 
 
 def _rows():

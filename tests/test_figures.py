@@ -111,7 +111,7 @@ def test_region_figures(tmp_path, captured):
 def test_simulate_and_tune_figures(tmp_path, captured, capsys):
     assert main(["simulate", "--leader", "us06", "--duration", "30", "--followers", "3",
                  "--out", str(tmp_path / "sim")]) == 0
-    from stringstab import demo
+    from stringstab.cli import demo_steps as demo
 
     (tmp_path / "tune").mkdir()
     demo._step_tune(tmp_path / "tune", lambda _: None)
@@ -133,7 +133,7 @@ def test_hcfs_figures(tmp_path, captured, capsys):
 def test_training_and_comparison_figures(tmp_path, captured):
     pytest.importorskip("torch")
     pytest.importorskip("safetensors")
-    from stringstab import demo
+    from stringstab.cli import demo_steps as demo
 
     (tmp_path / "t").mkdir()
     demo._step_train(tmp_path / "t", lambda _: None, steps=300, episodes=3, platoon=0)

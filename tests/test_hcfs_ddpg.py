@@ -192,7 +192,7 @@ def test_train_names_the_missing_trainer(tmp_path, monkeypatch, capsys):
 @pytest.mark.torch
 def test_demo_hcfs_step(tmp_path):
     _torch()
-    from stringstab.demo import run_demo
+    from stringstab.cli.demo_steps import run_demo
 
     lines = []
     summary = run_demo(tmp_path / "demo", log=lines.append, only=["hcfs"])["hcfs"]

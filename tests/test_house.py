@@ -163,9 +163,9 @@ def upward(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
 
 def test_the_graph_sees_lazy_and_relative_imports():
     g = import_graph()
-    assert "stringstab.criteria" in g["stringstab.certificate"]  # top-level relative import
-    assert "stringstab.criteria" in g["stringstab.symbolic"]  # inside lambdify_psi
-    assert "stringstab.symbolic" in g["stringstab.codegen"]  # "from . import symbolic as S"
+    assert "stringstab.certify.criteria" in g["stringstab.certify.continuous"]  # top-level relative import
+    assert "stringstab.certify.criteria" in g["stringstab.derive.symbolic"]  # inside lambdify_psi
+    assert "stringstab.derive.symbolic" in g["stringstab.derive.codegen"]  # "from . import symbolic as S"
     assert "stringstab.regions.report" in g["stringstab.regions.result"]
     assert "stringstab.tuning.projection" in g["stringstab.tuning"]  # from .projection import
     # implicit parents: "from .io.gains import ..." in the façade also runs io/__init__ ...
@@ -175,10 +175,10 @@ def test_the_graph_sees_lazy_and_relative_imports():
     assert _implicit_parents("stringstab.cli.tune", "stringstab.plots.tuning") == {"stringstab.plots"}
     assert _implicit_parents("stringstab.plots.tuning", "stringstab.plots._common") == set()
     # the checks below can fail: a made-up cycle and upward import are found
-    fake = {**g, "stringstab.margin": g["stringstab.margin"] | {"stringstab.certificate"}}
-    assert any("stringstab.margin" in c for c in cycles(fake))
-    fake = {**g, "stringstab.margin": g["stringstab.margin"] | {"stringstab"}}
-    assert ("stringstab.margin", "stringstab") in upward(fake)
+    fake = {**g, "stringstab.certify.margin": g["stringstab.certify.margin"] | {"stringstab.certify.continuous"}}
+    assert any("stringstab.certify.margin" in c for c in cycles(fake))
+    fake = {**g, "stringstab.certify.margin": g["stringstab.certify.margin"] | {"stringstab"}}
+    assert ("stringstab.certify.margin", "stringstab") in upward(fake)
 
 
 def test_no_import_cycle():
@@ -196,7 +196,7 @@ def test_no_library_module_imports_the_cli_or_the_demo():
     for mod, targets in import_graph().items():
         if mod.startswith(("stringstab.cli", "stringstab.__main__")):
             continue
-        if any(t.startswith("stringstab.cli") or t == "stringstab.demo" for t in targets):
+        if any(t.startswith("stringstab.cli") or t == "stringstab.cli.demo_steps" for t in targets):
             users.add(mod)
     assert users - KNOWN_CLI_USERS == set(), "library modules importing the CLI"
     assert KNOWN_CLI_USERS - users == set(), "fixed: remove them from KNOWN_CLI_USERS"
@@ -220,7 +220,7 @@ def test_certify_loads_no_heavy_module():
         "assert c.verdict == 'certified'") == []
 
 
-@pytest.mark.parametrize("module", ["stringstab.margin", "stringstab.regions", "stringstab.tuning",
+@pytest.mark.parametrize("module", ["stringstab.certify.margin", "stringstab.regions", "stringstab.tuning",
                                     "stringstab.plots"])
 def test_numeric_modules_load_no_heavy_module(module):
     assert _heavy_after(f"import {module}") == []
@@ -235,7 +235,7 @@ def test_cli_certify_loads_no_heavy_module():
 
 
 #: The certificates of other loops, imported only when a caller asks for them.
-OTHER_LOOPS = ("stringstab.sampled", "stringstab.robust", "stringstab.sampled_symbolic")
+OTHER_LOOPS = ("stringstab.certify.sampled", "stringstab.certify.robust", "stringstab.derive.sampled_symbolic")
 
 
 def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one():
@@ -249,7 +249,88 @@ def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one
     assert _heavy_after(code, OTHER_LOOPS) == []
     # the check above can fail: asking for the sampled loop loads it (and no heavy module)
     sampled = code + "stringstab.certify(1, 0.5, 0.5, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)\n"
-    assert _heavy_after(sampled, OTHER_LOOPS) == ["stringstab.sampled"]
+    assert _heavy_after(sampled, OTHER_LOOPS) == ["stringstab.certify.sampled"]
     robust = code + "stringstab.certify(1, 0.5, 0.5, tau=(0.1, 0.2), delta=0.2, headway=1.1)\n"
-    assert _heavy_after(robust, OTHER_LOOPS) == ["stringstab.sampled", "stringstab.robust"]
+    assert _heavy_after(robust, OTHER_LOOPS) == ["stringstab.certify.sampled", "stringstab.certify.robust"]
     assert _heavy_after(robust) == []
+
+
+#: The package root: the façade and the shared basics; every other module lives in a
+#: subpackage whose ``__init__`` says what is there.
+ROOT_MODULES = {"__init__.py", "__main__.py", "_version.py", "params.py", "ranges.py",
+                "constants.py", "errors.py", "progress.py"}
+
+
+def test_the_root_holds_the_facade_and_the_shared_basics_only():
+    assert {p.name for p in PKG.glob("*.py")} == ROOT_MODULES
+
+
+def test_every_subpackage_says_what_lives_there():
+    for init in PKG.rglob("__init__.py"):
+        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8")))
+        assert doc and len(doc) > 80, f"{init.relative_to(PKG.parent)} has no docstring saying what lives there"
+
+
+def _private_imports() -> set[tuple[str, str]]:
+    """(importer, "module.name") for every underscored name imported from another module."""
+    out = set()
+    for mod, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                base = _resolve(mod, node.level, node.module)
+                if base.startswith(ROOT) and base != mod:
+                    out |= {(mod, f"{base}.{a.name}") for a in node.names
+                            if a.name.startswith("_") and not a.name.startswith("__")}
+    return out
+
+
+#: Underscored names still imported across modules (the test fails when one is gone).
+KNOWN_PRIVATE_IMPORTS: set[tuple[str, str]] = {
+    ("stringstab.certify.robust", "stringstab.certify.sampled._Ad"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._Coeffs"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._cell_coefficients"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._coefficients"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._curvature"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._eval_cells"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._part"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._peak"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._schur_terms"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._spread"),
+    ("stringstab.certify.robust", "stringstab.certify.sampled._violation_peak"),
+    ("stringstab.regions", "stringstab.regions.grid._blocks"),
+    ("stringstab.traffic.synthetic", "stringstab.traffic.trajectory._grid"),
+    ("stringstab.tuning", "stringstab.tuning.predictor._g_and_grad"),
+    ("stringstab.tuning", "stringstab.tuning.predictor._g_full"),
+}
+
+
+def test_no_underscored_name_is_imported_from_another_module():
+    found = _private_imports()
+    assert found - KNOWN_PRIVATE_IMPORTS == set(), "private names imported across modules"
+    assert KNOWN_PRIVATE_IMPORTS - found == set(), "fixed: remove them from KNOWN_PRIVATE_IMPORTS"
+
+
+def test_stringstab_certify_stays_the_function():
+    # the façade binds the name to the function of the subpackage of the same name; importing
+    # every module of that subpackage must not rebind it to the subpackage
+    code = ("import importlib, pkgutil, inspect, sys, stringstab\n"
+            "pkg = sys.modules['stringstab.certify']\n"
+            "for m in pkgutil.iter_modules(pkg.__path__):\n"
+            "    importlib.import_module('stringstab.certify.' + m.name)\n"
+            "import stringstab.derive.errata\n"
+            "assert inspect.isfunction(stringstab.certify), stringstab.certify\n"
+            "assert stringstab.certify(1, 0.5, 0.5, tau=0.1, delta=0.2, headway=1.1).verdict\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_no_source_reaches_certify_modules_through_the_function():
+    # "import stringstab.certify.x as m" and "stringstab.certify.x.f" look up the attribute
+    # ``certify`` of the package, which is the function: both fail at run time
+    import re
+
+    bad = re.compile(r"^\s*import stringstab\.certify\.\w+ as |(?<![\w.`:])stringstab\.certify\.\w+\.\w+\(")
+    roots = [PKG, PKG.parent / "tests", PKG.parent / "analysis"]
+    hits = [f"{p}:{i}" for r in roots if r.exists() for p in r.rglob("*.py")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+            if bad.search(line) and p.name != "test_house.py"]
+    assert hits == []

@@ -1,7 +1,7 @@
 """The generated numeric code against the SymPy derivation: the one place each form is checked.
 
-Every formula the numeric library evaluates lives in ``stringstab/_generated.py``, written by
-``python -m stringstab.codegen`` from :mod:`stringstab.symbolic` (and :mod:`stringstab.printed`).
+Every formula the numeric library evaluates lives in ``stringstab/derive/generated.py``, written by
+``python -m stringstab.derive.codegen`` from :mod:`stringstab.derive.symbolic` (and :mod:`stringstab.derive.printed`).
 Here each generated form is compared with SymPy's own evaluation of the derived expression (or
 of its derivatives), in each back-end it is used with (NumPy arrays, Python floats with the
 ``math`` module, CasADi symbols), and the committed file with a fresh generation.
@@ -18,10 +18,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab import _generated as gen
-from stringstab import codegen, margin
-from stringstab import symbolic as S
-from stringstab.printed import printed_psi
+from stringstab.certify import margin
+from stringstab.derive import codegen
+from stringstab.derive import generated as gen
+from stringstab.derive import symbolic as S
+from stringstab.derive.printed import printed_psi
 
 G, P, W = S.GAINS, S.PARAMS, S.omega
 ARGS = [*G, *P]
@@ -50,7 +51,7 @@ def close(ours, theirs, rtol=1e-10):
 
 def test_committed_file_equals_a_fresh_generation():
     assert codegen.TARGET.read_text(encoding="utf-8") == codegen.generate(), (
-        "stringstab/_generated.py is stale: run `python -m stringstab.codegen`")
+        "stringstab/derive/generated.py is stale: run `python -m stringstab.derive.codegen`")
 
 
 def test_the_check_flag_reports_a_stale_file(tmp_path, monkeypatch, capsys):

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from stringstab.errors import StringStabError
-from stringstab.metrics import (
+from stringstab.traffic.metrics import (
     collision_count,
     comfort_index,
     damping_ratio,

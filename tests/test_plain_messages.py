@@ -31,7 +31,7 @@ def test_library_refusals_are_the_toolkits_error():
     """Bad arguments deep in the library are StringStabError (one line at the CLI), not bare errors."""
     import math
 
-    from stringstab.criteria import psi
+    from stringstab.certify.criteria import psi
 
     tr = from_speed([0, 1], [10.0, 12.0], dt=0.5)
     for bad in (math.nan, math.inf, -1.0):

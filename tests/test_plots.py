@@ -16,9 +16,9 @@ from matplotlib.legend import Legend
 from numpy.testing import assert_array_equal
 
 from stringstab import plots
-from stringstab.certificate import certify_batch
+from stringstab.certify.continuous import certify_batch
 from stringstab.errors import StringStabError
-from stringstab.gainio import GainTable
+from stringstab.io.gains import GainTable
 from stringstab.regions import EXACT_CLASSES, TYPE_CLASSES, region_map
 
 P = dict(tau=0.1, delta=0.2, headway=1.1)

@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import pytest
 
-from stringstab import demo
+from stringstab.cli import demo_steps as demo
 from stringstab.cli import main
 from stringstab.report import Report, caption_for
 

@@ -90,7 +90,7 @@ def test_repair_executes_only_certified_gains(props):
 @settings(max_examples=15, deadline=None)
 @given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 3), min_size=1, max_size=6))
 def test_repair_with_sample_time_certifies_the_sampled_loop_too(props):
-    from stringstab.sampled import check_sampled
+    from stringstab.certify.sampled import check_sampled
 
     rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
                      sample_time=0.1)
@@ -313,7 +313,7 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
     doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
     assert doc["summary"]["M_fss"] == 100.0  # the repair is on: every executed gain certified
     assert code == (0 if doc["summary"]["collisions"] == 0 else 1)
-    from stringstab.gainio import read_gains
+    from stringstab.io.gains import read_gains
 
     g = read_gains(run / "evaluation" / "gains.csv")
     assert len(g) == doc["summary"]["n_gains"] == tr.n_steps
@@ -349,9 +349,9 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
 
 
 def test_platoon_test_reports_m_p_per_vehicle():
-    from stringstab.metrics import platoon_damping_ratios
     from stringstab.rl.evaluate import platoon_test
     from stringstab.traffic import CACCController, paper_mix, simulate
+    from stringstab.traffic.metrics import platoon_damping_ratios
 
     p = platoon_test("cacc", 3, tau=TAU, delta=DELTA, headway=HEADWAY, hold=0.0)
     res = simulate(paper_mix(), CACCController(), 3, tau=TAU, delta=DELTA,

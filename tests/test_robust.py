@@ -15,10 +15,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certificate import certify, certify_batch
-from stringstab.errors import StringStabError
-from stringstab.frequency import margin_g
-from stringstab.robust import (
+from stringstab.certify.continuous import certify, certify_batch
+from stringstab.certify.frequency import margin_g
+from stringstab.certify.robust import (
     Box,
     _robust_g,
     as_interval,
@@ -28,7 +27,8 @@ from stringstab.robust import (
     parse_interval,
     robust_margin,
 )
-from stringstab.sampled import certify_sampled, check_sampled
+from stringstab.certify.sampled import certify_sampled, check_sampled
+from stringstab.errors import StringStabError
 
 gain = st.floats(-2, 2, allow_nan=False)
 

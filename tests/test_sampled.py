@@ -17,12 +17,11 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-import stringstab.sampled as sampled_module
-from stringstab.certificate import VERDICTS as CONTINUOUS_VERDICTS
-from stringstab.certificate import certify_batch
-from stringstab.errors import StringStabError
-from stringstab.frequency import gain, margin_g
-from stringstab.sampled import (
+from stringstab.certify import sampled as sampled_module
+from stringstab.certify.continuous import VERDICTS as CONTINUOUS_VERDICTS
+from stringstab.certify.continuous import certify_batch
+from stringstab.certify.frequency import gain, margin_g
+from stringstab.certify.sampled import (
     VERDICTS,
     certify_sampled,
     certify_sampled_batch,
@@ -33,6 +32,7 @@ from stringstab.sampled import (
     spectral_radius,
     split_delay,
 )
+from stringstab.errors import StringStabError
 
 # (tau, delta, headway, sample_time, tau_prev): δ on and between multiples of H, δ < H,
 # δ = 0, H > τ, and a heterogeneous pair
@@ -197,7 +197,7 @@ def test_margin_tends_to_the_continuous_margin():
 
 # ---------------------------------------------------------------------------
 # (e) the Ψ3 boundary: in a homogeneous platoon the sampled θ² coefficient is H²φ1⁴Ψ3
-#     (stringstab.sampled_symbolic.dc_margin), so Ψ3 < 0 means |H| > 1 near θ = 0
+#     (stringstab.derive.sampled_symbolic.dc_margin), so Ψ3 < 0 means |H| > 1 near θ = 0
 # ---------------------------------------------------------------------------
 @pytest.mark.parametrize("tau, delta, headway, H", [(0.1, 0.2, 1.1, 0.1), (0.3, 0.25, 0.8, 0.2),
                                                     (0.05, 0.4, 1.5, 0.05)])

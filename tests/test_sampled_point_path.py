@@ -1,7 +1,7 @@
 """The sampled certificate's point path: point parameters give point coefficients.
 
 ``check_sampled`` (the repair's inner loop in :mod:`stringstab.rl.repair`) builds its
-coefficients with the interval type of :mod:`stringstab.sampled`; with point parameters every
+coefficients with the interval type of :mod:`stringstab.certify.sampled`; with point parameters every
 coefficient must be a point, or each operation pays for interval arithmetic (four products and
 a min/max) on intervals of zero width.  The verdicts of both paths are equal (the interval
 operations on equal end points return those end points), which the second test checks against
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from stringstab import sampled
+from stringstab.certify import sampled
 from stringstab.params import Params
 
 

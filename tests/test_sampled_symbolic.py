@@ -16,9 +16,9 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
 
-from stringstab import sampled as S
-from stringstab import sampled_symbolic as SS
-from stringstab import symbolic as C
+from stringstab.certify import sampled as S
+from stringstab.derive import sampled_symbolic as SS
+from stringstab.derive import symbolic as C
 
 gain = st.floats(-2, 2, allow_nan=False)
 lag = st.floats(0.05, 0.6)
@@ -65,7 +65,7 @@ def test_symbolic_H_equals_direct_construction(kx, kv, ka, tau, tp, H, d, h):
 
 @given(kx=gain, kv=gain, ka=gain, tau=lag, tp=lag, H=period, d=delay, h=hw)
 def test_numeric_w_coefficients_equal_the_derivation(kx, kv, ka, tau, tp, H, d, h):
-    """The closed forms evaluated by stringstab.sampled are the SymPy coefficients."""
+    """The closed forms evaluated by stringstab.certify.sampled are the SymPy coefficients."""
     _, eps = S.split_delay(d, H)
     want = _w_coefficients()(kx, kv, ka, tau, d, h, H, tp, eps)
     one = np.ones(1)

@@ -8,8 +8,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab import symbolic as S
-from stringstab.printed import printed_psi
+from stringstab.derive import symbolic as S
+from stringstab.derive.printed import printed_psi
 
 gain = st.floats(-2, 2, allow_nan=False)
 lag = st.floats(0.05, 1.0)
@@ -150,8 +150,8 @@ def test_parse_substitutions_errors():
 
 @given(kx=gain, kv=gain, ka=gain, tau=lag, delta=delay, headway=hw, w=st.floats(0.01, 50))
 def test_numeric_frequency_module_matches_sympy(kx, kv, ka, tau, delta, headway, w):
-    """stringstab.frequency (hand-vectorised) equals the SymPy derivation."""
-    from stringstab.frequency import gain_squared, gamma_jw, margin_g
+    """stringstab.certify.frequency (hand-vectorised) equals the SymPy derivation."""
+    from stringstab.certify.frequency import gain_squared, gamma_jw, margin_g
 
     g = S.gamma()
     f = sp.lambdify([*S.GAINS, *S.PARAMS, S.s], g.expr, "numpy")

@@ -2,7 +2,7 @@
 
 The decisive test: a platoon driven by a sinusoidal leader at ω reaches a steady state in which
 the ratio of follower to predecessor acceleration amplitudes is |Γ(jω)| — the frequency
-response computed by :mod:`stringstab.frequency` — for certified and uncertified gains.
+response computed by :mod:`stringstab.certify.frequency` — for certified and uncertified gains.
 """
 
 import math
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from stringstab.certify.frequency import gain
 from stringstab.errors import StringStabError
-from stringstab.frequency import gain
 from stringstab.traffic import (
     CACCController,
     FunctionController,

@@ -1,7 +1,7 @@
 """Gain repair (stringstab.tuning): region growing (IDL §3.3) and the nearest-point projection.
 
 Independent truth: every output reported certified is re-checked by a dense
-frequency sweep of |Γ(jω)| (:func:`stringstab.frequency.gain`) and by the
+frequency sweep of |Γ(jω)| (:func:`stringstab.certify.frequency.gain`) and by the
 poles of Γ's denominator from ``numpy.roots`` — neither is used by the code
 under test.  The region-growing cases are worked by hand from the closed-form
 Ψ of a delay-free model (δ = 0, where Ψ1 = τ², Ψ2 = 1 − 2τ(k_v + T*k_x) − k_a²,
@@ -16,9 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certificate import certify, certify_batch
+from stringstab.certify.continuous import certify, certify_batch
+from stringstab.certify.frequency import gain
 from stringstab.errors import StringStabError
-from stringstab.frequency import gain
 from stringstab.plots import plot_moves
 from stringstab.tuning import Projector, TuneResult, project, region_growing, tune
 
@@ -382,10 +382,10 @@ def test_plot_moves():
 
 def test_hand_derivatives_of_g_match_sympy():
     """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g equal SymPy's derivatives
-    of the derived margin (|D|² − |N|²)/ω² (stringstab.symbolic)."""
+    of the derived margin (|D|² − |N|²)/ω² (stringstab.derive.symbolic)."""
     import sympy as sp
 
-    from stringstab import symbolic as S
+    from stringstab.derive import symbolic as S
     from stringstab.params import Params
     from stringstab.tuning import _g_and_grad, _g_full
 

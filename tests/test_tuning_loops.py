@@ -15,11 +15,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certificate import certify_batch
+from stringstab.certify.continuous import certify_batch
+from stringstab.certify.frequency import margin_g
+from stringstab.certify.sampled import sampled_margin, schur_margins
 from stringstab.cli import main
 from stringstab.errors import StringStabError
-from stringstab.frequency import margin_g
-from stringstab.sampled import sampled_margin, schur_margins
 from stringstab.tuning import Projector, project, tune
 from stringstab.tuning.constraints import evaluate_forms, quadratic_form
 

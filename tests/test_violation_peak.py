@@ -12,8 +12,9 @@ import pytest
 from scipy.optimize import brentq
 
 import stringstab as ss
-from stringstab.margin import coefficients
-from stringstab.sampled import split_delay
+from stringstab.certify.frequency import gain_squared
+from stringstab.certify.margin import coefficients
+from stringstab.certify.sampled import split_delay
 
 TAU, DELTA, T = 0.1, 0.2, 1.1
 mpmath.mp.dps = 60
@@ -84,7 +85,7 @@ def test_a_rounded_direct_excess_does_not_replace_the_computed_one(kx, kv, ka):
 def test_a_violation_away_from_zero_matches_a_fine_sweep():
     c = ss.certify(0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T)
     W = np.linspace(1e-4, 20.0, 400_001)
-    direct = np.sqrt(ss.frequency.gain_squared(W, 0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T))
+    direct = np.sqrt(gain_squared(W, 0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T))
     assert c.sup_gain == pytest.approx(float(direct.max()), abs=1e-8)
     assert c.sup_gain_excess == pytest.approx(c.sup_gain - 1, rel=1e-9)
     assert c.peak_omega == pytest.approx(float(W[np.argmax(direct)]), abs=1e-3)

@@ -3,7 +3,7 @@ sup|H| − 1 > 0 (``sup_gain_excess``, without cancellation) and the θ where it
 when the DC margin (H²φ1⁴ Ψ3 in a homogeneous platoon) is just below 0 and the violation sits
 near θ → 0, as small as 1e-20.
 
-The truth is independent of stringstab.sampled: H(e^{jθ}) of two consecutive vehicles from the
+The truth is independent of stringstab.certify.sampled: H(e^{jθ}) of two consecutive vehicles from the
 continuous state equations discretised exactly (Van Loan's block exponential, as in
 tests/_sampled_truth.py) in 60-digit arithmetic (mpmath), with the predecessor's held command as
 the input.
@@ -17,8 +17,8 @@ import pytest
 from scipy.optimize import brentq
 
 import stringstab as ss
-from stringstab import sampled
-from stringstab.margin import coefficients
+from stringstab.certify import sampled
+from stringstab.certify.margin import coefficients
 
 TAU, DELTA, T = 0.1, 0.2, 1.1
 DPS = 60

@@ -1,10 +1,10 @@
 """``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
 
 Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
-certifies them with :func:`stringstab.certificate.certify_batch` — the continuous-time loop,
+certifies them with :func:`stringstab.certify.continuous.certify_batch` — the continuous-time loop,
 the sampled-data loop (``--sample-time``) or every member of a box of parameters (``--tau``,
 ``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
-(:meth:`~stringstab.certificate.CertificateBatch.columns`) as a table, JSON, CSV, Parquet or
+(:meth:`~stringstab.certify.continuous.CertificateBatch.columns`) as a table, JSON, CSV, Parquet or
 NPZ (:func:`stringstab.io.write_results`).  Exit code 0
 when every triple is certified, 1 when any is not (``not_certified`` or
 ``inconclusive``), 2 on bad input (nothing printed, no file written).
@@ -176,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
                       f"expected at most about {int(max(_available() - BYTES_BASE, 0) // BYTES_PER_ROW)} "
                       "rows at once on this machine: split the file")
 
-    from ..certificate import certify_batch
+    from ..certify.continuous import certify_batch
     from ..io import write_results
 
     n = len(table)
@@ -190,15 +190,15 @@ def run(args: argparse.Namespace) -> int:
             progress=progress,
         )
     if H is None and not isinstance(model, Box):  # the continuous loop at one τ, δ, T*
-        from ..certificate import TABLE_COLUMNS as columns
+        from ..certify.continuous import TABLE_COLUMNS as columns
 
         params: dict[str, Any] = {"tau": model.tau, "delta": model.delta,
                                   "headway": model.headway, "method": args.method}
     else:
         if isinstance(model, Box):
-            from ..robust import TABLE_COLUMNS as columns
+            from ..certify.robust import TABLE_COLUMNS as columns
         else:
-            from ..sampled import TABLE_COLUMNS as columns
+            from ..certify.sampled import TABLE_COLUMNS as columns
         params = {**shown_params(model, H), "method": args.method}
     if args.method == "pade":
         params["pade_order"] = order
@@ -224,7 +224,7 @@ def _for_table(params: dict[str, Any]) -> dict[str, Any]:
 
 def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
-    from ..certificate import certify_batch
+    from ..certify.continuous import certify_batch
     from ..identify.report import read_identified
     from ..io import columns_from_records, write_results
     from ..io.results import TableColumn

@@ -17,7 +17,7 @@ def add_parser(sub: Any) -> None:
         The ``stringstab`` sub-command set (:func:`stringstab.cli.build_parser`); the parser
         added sets ``func`` to :func:`run`.
     """
-    from ..demo import STEPS
+    from .demo_steps import STEPS
 
     p = sub.add_parser(
         "demo",
@@ -49,8 +49,8 @@ def run(args: argparse.Namespace) -> int:
         :class:`~stringstab.errors.StringStabError` (exit 2 from
         :func:`stringstab.cli.main`).
     """
-    from ..demo import STEPS, run_demo
     from ..errors import StringStabError, show
+    from .demo_steps import STEPS, run_demo
 
     names = [n for n, _ in STEPS]
     for o in args.only or []:

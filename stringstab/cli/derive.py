@@ -1,7 +1,7 @@
 """``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions.
 
 With ``--sample-time H``: the sampled-data loop instead (H(z), the characteristic polynomial
-Δ(z) and its Schur conditions; :func:`stringstab.derivation.sampled_derivation`).
+Δ(z) and its Schur conditions; :func:`stringstab.derive.derivation.sampled_derivation`).
 
 SymPy is imported when the command runs, not when it is registered.  ``--out`` is checked
 before anything is derived and written atomically; a bad path is one line and exit code 2.
@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         :class:`~stringstab.errors.StringStabError` (exit 2 from
         :func:`stringstab.cli.main`).
     """
-    from ..derivation import derivation, sampled_derivation
+    from ..derive.derivation import derivation, sampled_derivation
     from ..params import positive
 
     delay_order = _delay_order(args.delay_order)

@@ -297,7 +297,7 @@ def run(args: argparse.Namespace) -> int:
     if args.overlay is not None:
         if args.three_d:
             raise StringStabError("--overlay draws on a 2-D map; got --3d")
-        from ..gainio import read_gains
+        from ..io.gains import read_gains
 
         gains = read_gains(args.overlay)
     if Path(args.out).is_file():

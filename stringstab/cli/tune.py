@@ -1,6 +1,6 @@
 """``stringstab tune``: repair gain triples that are not string stable.
 
-Reads triples from the command line or a file (:mod:`stringstab.gainio`, the
+Reads triples from the command line or a file (:mod:`stringstab.io.gains`, the
 same inputs as ``certify``), repairs each with the IDL paper's region-growing
 search and/or the nearest-point projection (:mod:`stringstab.tuning`), and
 writes a table, JSON or CSV.  Exit code 0 when every output is certified by the

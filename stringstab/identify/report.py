@@ -153,7 +153,7 @@ def _fig_fit(v: VehicleResult) -> Any:
 
 
 def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
-    from ..frequency import gain
+    from ..certify.frequency import gain
 
     fig = _figure(7, 5.5)
     ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))

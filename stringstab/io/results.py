@@ -26,7 +26,7 @@ double (``0.1``, ``1.0``); every cell is converted column by column in C (pyarro
 is not slower than computing.  pyarrow is imported only when one of these formats is written.
 
 Every result type owns its columns (e.g.
-:meth:`stringstab.certificate.CertificateBatch.columns`); this module knows none of them.
+:meth:`stringstab.certify.continuous.CertificateBatch.columns`); this module knows none of them.
 """
 
 from __future__ import annotations

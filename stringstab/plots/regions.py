@@ -753,7 +753,7 @@ def plot_boundaries(
 def _gain_rows(gains: Any) -> tuple[npt.NDArray[np.float64], Any]:
     """(K of shape (n, 3), vehicle ids or None) of a gain table or an (n, 3) array."""
     table_K = getattr(gains, "K", None)
-    if table_K is not None:  # a gain table (stringstab.gainio.GainTable)
+    if table_K is not None:  # a gain table (stringstab.io.gains.GainTable)
         return np.asarray(table_K, dtype=float), getattr(gains, "vehicle", None)
     K = np.asarray(gains, dtype=float)
     if K.ndim != 2 or K.shape[1] != 3 or K.shape[0] == 0:
@@ -793,7 +793,7 @@ def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
     >>> trajectory_verdicts(m, [[1.5, 0.3, -0.1], [0.9, -0.5, 1.1]])
     ['certified', 'not_certified']
     """
-    from ..certificate import certify_batch
+    from ..certify.continuous import certify_batch
 
     K, _ = _gain_rows(gains)
     p = rmap.params
@@ -814,9 +814,9 @@ def plot_trajectory(
     vehicle are joined in order; the first point of each is labelled.
 
     Compute, then draw: pass the verdicts computed beforehand
-    (:func:`stringstab.certificate.certify_batch` of the triples, or its ``.verdict``).
+    (:func:`stringstab.certify.continuous.certify_batch` of the triples, or its ``.verdict``).
     Without them, as python-control's ``bode_plot(sys)`` computes the response it draws,
-    they are computed here first (one :func:`~stringstab.certificate.certify_batch`
+    they are computed here first (one :func:`~stringstab.certify.continuous.certify_batch`
     call); the toolkit's own callers always pass them.
 
     Parameters
@@ -825,7 +825,7 @@ def plot_trajectory(
         The 2-D map it is drawn over (gives the axes and the parameters).
     gains : GainTable or array_like of shape (n, 3)
         The triples k_x, k_v, k_a in time order (a gain table, e.g. from
-        :func:`stringstab.gainio.read_gains`, adds ``t`` and ``vehicle``).
+        :func:`stringstab.io.read_gains`, adds ``t`` and ``vehicle``).
     ax : matplotlib Axes, optional
         Usually the axes of a class map; a new figure when None.
     verdicts : CertificateBatch or sequence of str, optional

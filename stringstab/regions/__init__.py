@@ -4,15 +4,15 @@
 all three, and returns a :class:`RegionMap` holding, per grid point,
 
 * ``hurwitz``: internal stability of Γ (k_x > 0 and k_v + (T* − τ)k_x > 0,
-  :func:`stringstab.criteria.hurwitz`);
+  :func:`stringstab.certify.criteria.hurwitz`);
 * ``type``: the stability type I-IV of IDL §3.3 from the *derived* Ψ2, Ψ3, Λ
-  (:func:`stringstab.criteria.stability_type`), and ``type_printed`` from the
+  (:func:`stringstab.certify.criteria.stability_type`), and ``type_printed`` from the
   Ψ as printed (IDL eqs 13-15) when the ``printed`` method is requested;
 * ``verdict[method]`` for each requested method:
 
   ``exact``
       the sound certificate with the exact delay
-      (:func:`stringstab.certificate.certify_batch`): ``certified``,
+      (:func:`stringstab.certify.continuous.certify_batch`): ``certified``,
       ``not_certified`` or ``inconclusive``;
   ``taylor``
       Proposition 1 (IDL eqs 12-15) with the *derived* Ψ and the corrected
@@ -28,7 +28,7 @@ all three, and returns a :class:`RegionMap` holding, per grid point,
   stable) and ``margin`` (min_ω g(ω) found) when ``exact`` is requested.
 
 With ``sample_time`` or an interval for τ, δ or T*, ``exact`` is the sampled-data
-(:mod:`stringstab.sampled`) or robust (:mod:`stringstab.robust`) certificate, ``hurwitz`` the
+(:mod:`stringstab.certify.sampled`) or robust (:mod:`stringstab.certify.robust`) certificate, ``hurwitz`` the
 stability of that loop (Schur; every member of the box), and the one other method is
 ``continuous`` (sampled maps only): the continuous-time certificate at the same parameters,
 so that :func:`stringstab.plots.plot_comparison` draws the band of gains certified in
@@ -57,8 +57,8 @@ Evaluation is chunked in blocks of grid points (memory bounded by the block
 size, not the grid) and spread over worker processes.  The Taylor quantities
 are evaluated as polynomials in one gain with coefficients on the plane of the
 other two (Horner's rule, coefficients generated from the SymPy expressions of
-:func:`stringstab.symbolic.derived_psi` and :func:`stringstab.printed.printed_psi`);
-this agrees with :func:`stringstab.criteria.taylor_criteria` to round-off
+:func:`stringstab.derive.symbolic.derived_psi` and :func:`stringstab.derive.printed.printed_psi`);
+this agrees with :func:`stringstab.certify.criteria.taylor_criteria` to round-off
 (~1e-15 relative), so only grid points lying exactly on a boundary Ψ = 0 or
 Λ = 0 can fall on the other side of it.
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..criteria import TYPE_NAMES
+from ..certify.criteria import TYPE_NAMES
 from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
 from ..params import Box, Params

@@ -1,7 +1,7 @@
 """The demo's report: the front page of the toolkit, read top to bottom as the story of the two
 papers checked (IDL: derive, certify, map, repair, simulate, train; HCFS: the jerk theorem).
 
-Built from the summaries the demo steps return (:func:`stringstab.demo.run_demo`), never from
+Built from the summaries the demo steps return (:func:`stringstab.cli.demo_steps.run_demo`), never from
 re-reading their files; the figures are the files the steps wrote, found in the output folder.
 """
 
@@ -237,7 +237,7 @@ def demo_report(summary: Mapping[str, Any], root: str | Path, *, command: str,
     Parameters
     ----------
     summary : mapping
-        ``{step: summary}`` as returned by :func:`stringstab.demo.run_demo` (steps not run are
+        ``{step: summary}`` as returned by :func:`stringstab.cli.demo_steps.run_demo` (steps not run are
         left out of the report).
     root : path-like
         The folder holding the steps' outputs (the demo's staging folder while it runs).

@@ -111,7 +111,7 @@ class TD3Config:
     #: Bisection steps from the lattice point towards the proposed gains (each one exact check).
     repair_refine: int = 4
     #: Certify executed gains also for the sampled-data loop at the control step ``dt`` (zero-order
-    #: hold; :mod:`stringstab.sampled`), which is the loop the simulator runs.
+    #: hold; :mod:`stringstab.certify.sampled`), which is the loop the simulator runs.
     repair_sampled: bool = True
     #: Which action the replay buffer stores: "proposed" (the actor's, before the repair; the
     #: repair is then part of the environment) or "executed" (after the repair).

@@ -6,12 +6,12 @@ Each test episode is one follower behind one leader (a test episode of
 the episode (§4.1.2).  Every strategy starts from the same state: the recorded follower's gap
 and speed for an NGSIM pair, else the IDL equilibrium gap l_0 + T* v at the leader's speed.
 
-Metrics (:mod:`stringstab.metrics`): m_p of each episode (eq 29, follower over leader) and their
+Metrics (:mod:`stringstab.traffic.metrics`): m_p of each episode (eq 29, follower over leader) and their
 mean M_lss (eq 30), TIT per episode (eqs 31-32) and its mean, M_CI (eq 34, pooled), M_effi
 (eq 35, pooled), collisions, and for gain policies M_fss (eq 27): the share of executed
 (vehicle, moment) gains certified by the exact certificate, and beside it M_fss_sampled, the
 share certified by the sampled-data certificate of the zero-order-hold loop at the control step
-``dt`` (:mod:`stringstab.sampled`).  Both are computed in one place, :func:`fss`.
+``dt`` (:mod:`stringstab.certify.sampled`).  Both are computed in one place, :func:`fss`.
 
 A platoon test (§5.1): 10 and 100 vehicles running the strategy behind
 :func:`stringstab.traffic.paper_mix` (held 100 s at its final speed so the disturbance reaches
@@ -33,7 +33,7 @@ import numpy.typing as npt
 
 from ..constants import STANDSTILL, TTC_STAR
 from ..errors import StringStabError
-from ..metrics import (
+from ..traffic.metrics import (
     efficiency_index,
     fss_ratio,
     jerk_squared,
@@ -79,9 +79,9 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     -------
     dict
         ``"M_fss"``: % of triples certified by the exact continuous-time certificate (IDL eqs
-        27-28, :func:`stringstab.metrics.fss_ratio`); ``"M_fss_sampled"``: % certified by the
+        27-28, :func:`stringstab.traffic.metrics.fss_ratio`); ``"M_fss_sampled"``: % certified by the
         sampled-data certificate of the zero-order-hold loop at ``dt``
-        (:func:`stringstab.sampled.check_sampled`); ``"n"``: the number of triples;
+        (:func:`stringstab.certify.sampled.check_sampled`); ``"n"``: the number of triples;
         ``"certificate"``, ``"dt"``: what was checked.
 
     Raises
@@ -89,7 +89,7 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     StringStabError
         If there is no gain triple.
     """
-    from ..sampled import check_sampled
+    from ..certify.sampled import check_sampled
 
     K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
     if not K.shape[0]:
@@ -375,8 +375,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
         ``"M_fss_sampled"`` (:func:`fss` of every vehicle's executed gains at every step;
         None otherwise).
     """
-    from ..metrics import platoon_metrics
     from ..traffic.leaders import paper_mix
+    from ..traffic.metrics import platoon_metrics
     from ..traffic.platoon import simulate
 
     leader = paper_mix(dt=dt).hold(hold)

@@ -2,7 +2,7 @@
 
 The agent proposes K = (k_x, k_v, k_a) for every environment at every step; before the eq-4 law
 acts, :class:`GainRepair` replaces each K that the exact certificate
-(:func:`stringstab.certificate.check`) does not certify by a nearby certified triple.  The
+(:func:`stringstab.certify.continuous.check`) does not certify by a nearby certified triple.  The
 library's repairs (:func:`stringstab.tuning.project`, :func:`stringstab.tuning.region_growing`)
 take milliseconds per triple, and at the start of training about 90 % of the gain box is not
 certified (at τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, 9 % of a 0.05-spaced lattice over [−2, 2]³ is),
@@ -12,7 +12,7 @@ so calling them per environment step would dominate training.  The default metho
 ``"projection"`` (default)
     1. a cheap screen drops triples that surely fail (not internally stable, k_x ≤ 0 or
        k_v + (T* − τ)k_x ≤ 0, or g(ω) < 0 at one of 48 fixed frequencies, where g is the
-       margin of :func:`stringstab.frequency.margin_g`: |Γ(jω)| > 1 there);
+       margin of :func:`stringstab.certify.frequency.margin_g`: |Γ(jω)| > 1 there);
     2. the rest are checked by the exact certificate in one vectorised call; certified triples
        are executed unchanged;
     3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
@@ -35,9 +35,9 @@ so calling them per environment step would dominate training.  The default metho
 ``"off"``
     no repair: the ablation (executed gains may be uncertified).
 
-Whatever the method, a triple is executed only if :func:`~stringstab.certificate.check` returned
+Whatever the method, a triple is executed only if :func:`~stringstab.certify.continuous.check` returned
 ``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
-:func:`stringstab.sampled.check_sampled` at H: the loop the simulator runs holds u over each
+:func:`stringstab.certify.sampled.check_sampled` at H: the loop the simulator runs holds u over each
 control step, and gains on the continuous certificate's boundary need not be string stable in
 that sampled loop.
 """
@@ -51,11 +51,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certificate import check
+from ..certify.continuous import check
+from ..certify.criteria import hurwitz
+from ..certify.frequency import margin_g
 from ..constants import GAIN_BOUNDS
-from ..criteria import hurwitz
 from ..errors import StringStabError
-from ..frequency import margin_g
 from ..params import Params, positive
 from .config import REPAIRS
 
@@ -71,7 +71,7 @@ def _certified(K: Array, p: Params, sample_time: float | None = None) -> npt.NDA
     """Exact-certificate verdict (``check``) for the rows of K that pass the screen.
 
     With ``sample_time`` H, a row counts only if the sampled-data certificate of the
-    zero-order-hold loop at H (:func:`stringstab.sampled.check_sampled`) certifies it too.
+    zero-order-hold loop at H (:func:`stringstab.certify.sampled.check_sampled`) certifies it too.
     """
     out = np.zeros(K.shape[0], dtype=bool)
     if not K.shape[0]:
@@ -93,7 +93,7 @@ def _certified(K: Array, p: Params, sample_time: float | None = None) -> npt.NDA
 
 def _sampled_ok(K: Array, p: Params, sample_time: float) -> npt.NDArray[np.bool_]:
     """Sampled-data certificate (zero-order hold at ``sample_time``) of every row of K."""
-    from ..sampled import check_sampled
+    from ..certify.sampled import check_sampled
 
     c = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta, headway=p.headway,
                       sample_time=sample_time)
@@ -107,7 +107,7 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     (and, with ``sample_time``, by the sampled-data certificate at that step).
 
     A point is kept when it is internally stable (Hurwitz), passes a cheap screen g(ω) ≥ 0 at
-    :data:`SCREEN_OMEGA` and the exact certificate (:func:`stringstab.certificate.check`)
+    :data:`SCREEN_OMEGA` and the exact certificate (:func:`stringstab.certify.continuous.check`)
     certifies it.  The grid has round((hi − lo)/resolution) + 1 points per axis, so its
     spacing is ``resolution`` only when that divides hi − lo.  Cached (8 entries).
 
@@ -173,7 +173,7 @@ class GainRepair:
         Bisection steps after the lookup.
     sample_time : float, optional
         Also require the sampled-data certificate of the zero-order-hold loop at this step
-        (:func:`stringstab.sampled.check_sampled`) for every executed triple.
+        (:func:`stringstab.certify.sampled.check_sampled`) for every executed triple.
 
     Attributes
     ----------
@@ -187,7 +187,7 @@ class GainRepair:
     >>> K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])
     >>> K[0].tolist(), bool((K[1] != [0.9, -0.5, 1.1]).any())
     ([1.2, 0.5, 0.6], True)
-    >>> from stringstab.certificate import check
+    >>> from stringstab.certify.continuous import check
     >>> check(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
     ['certified', 'certified']
     """

@@ -294,7 +294,7 @@ def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
     -------
     list of dict
         Per mode: the :class:`ModeLaw` fields, ``continuous`` and ``sampled`` (verdict and sup
-        gain of :func:`stringstab.certificate.certify`), ``no_lag_closed_form`` (Hurwitz,
+        gain of :func:`stringstab.certify.continuous.certify`), ``no_lag_closed_form`` (Hurwitz,
         k_x T*² + 2 k_v T* ≥ 2) and ``sumo_discrete_sweep`` (:func:`discrete_sweep`).
 
     Raises
@@ -302,7 +302,7 @@ def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
     StringStabError
         When a mode is ill-posed (:func:`mode_laws`).
     """
-    from ..certificate import certify
+    from ..certify.continuous import certify
 
     rows = []
     for law in mode_laws(vt, dt):
@@ -386,7 +386,7 @@ def measure_platoon(vt: CACCType, leader: Trajectory, n_followers: int, *,
         ``mode_share`` (fraction of follower-steps in each mode), ``law_residual``
         (:func:`law_residual`), ``collisions``-free ``min_gap`` (m).
     """
-    from ..metrics import damping_ratios_from_energy
+    from ..traffic.metrics import damping_ratios_from_energy
 
     dt = float(leader.dt)
     T, s0, L = vt.headway, vt.min_gap, vt.length

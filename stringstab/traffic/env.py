@@ -53,11 +53,11 @@ from gymnasium.vector.utils import batch_space
 
 from ..constants import DT, GAIN_BOUNDS, STATE_SCALES, TTC_STAR
 from ..errors import StringStabError, show
-from ..metrics import time_headway, time_to_collision
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from .controllers import DEFAULT_STANDSTILL, Observation
 from .cycles import cycle
 from .loaders import FollowingPair
+from .metrics import time_headway, time_to_collision
 from .platoon import DEFAULT_LENGTH, Limits, Model, Platoon
 from .reward import reward
 from .trajectory import Trajectory

@@ -29,7 +29,7 @@ Communication delay δ
     ``fractional_delay="exact"`` it is the predecessor's acceleration at t_k − δ itself, as its
     model evolves inside the step: u + (a − u) e^{−(1−f)Δt/τ_p} from the sample and the held
     command of step k − n − 1 (``model="lag"``; the held command u itself with
-    ``model="kinematic"``), which is the sampled-data loop :mod:`stringstab.sampled` certifies.
+    ``model="kinematic"``), which is the sampled-data loop :mod:`stringstab.certify.sampled` certifies.
     The leader's acceleration between samples is not modelled, so its followers receive the
     interpolation either way.  Before t = 0 the history is the initial acceleration.
 
@@ -69,9 +69,9 @@ import numpy.typing as npt
 
 from ..constants import ACCEL_MAX, ACCEL_MIN, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
-from ..metrics import damping_ratios_from_energy, platoon_metrics, time_headway
 from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from .controllers import Controller, Observation
+from .metrics import damping_ratios_from_energy, platoon_metrics, time_headway
 from .trajectory import Trajectory
 
 __all__ = ["DEFAULT_LENGTH", "Limits", "Platoon", "PlatoonResult", "check_leader", "simulate"]
@@ -559,7 +559,7 @@ class PlatoonResult:
         return damping_ratios_from_energy(self.sum_sq_accel)
 
     def metrics(self, *, ttc_star: float = TTC_STAR, certificate: bool = True) -> dict[str, Any]:
-        """The IDL paper's evaluation metrics of this run (see :func:`stringstab.metrics.platoon_metrics`).
+        """The IDL paper's evaluation metrics of this run (see :func:`stringstab.traffic.metrics.platoon_metrics`).
 
         Parameters
         ----------

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..constants import ACCEL_MAX, ACCEL_MIN, HEADWAY_MU, HEADWAY_SIGMA, TTC_STAR
-from ..metrics import time_headway, time_to_collision
+from .metrics import time_headway, time_to_collision
 
 __all__ = [
     "ACCEL_MAX",

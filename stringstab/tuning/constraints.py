@@ -2,25 +2,25 @@
 
 The gain repair (:mod:`stringstab.tuning.projection`) asks for gains certified for the loop a
 controller runs: the continuous loop at one τ, δ, T* (its own NLP, built on
-:func:`stringstab.margin.casadi_g`), the sampled-data loop (``sample_time``) or every member of
+:func:`stringstab.certify.margin.casadi_g`), the sampled-data loop (``sample_time``) or every member of
 a box of τ, δ, T* (the robust certificate), sampled or not.  For the last three, every
 constraint of the NLP is a *quadratic form in the gains*:
 
-* the continuous margin g(ω; K) (:func:`stringstab.margin.g`) at one member (τ, δ, T*) and one
+* the continuous margin g(ω; K) (:func:`stringstab.certify.margin.g`) at one member (τ, δ, T*) and one
   frequency ω is a polynomial of degree 2 in K = (k_x, k_v, k_a): t2 does not depend on K,
   a is affine, b, c_x, c_v are quadratic;
-* the sampled margin g_H(θ; K) (:func:`stringstab.sampled.sampled_margin`) is one too: every
+* the sampled margin g_H(θ; K) (:func:`stringstab.certify.sampled.sampled_margin`) is one too: every
   w-coefficient of Δ(w) and n(w) is affine in K, and g_H is a sum of products of two of them;
 * so are the internal-stability conditions: the Hurwitz conditions (linear,
-  :func:`stringstab.criteria.hurwitz_conditions`) and the normalised Schur conditions of the
-  sampled loop (:func:`stringstab.sampled.schur_margins`).
+  :func:`stringstab.certify.criteria.hurwitz_conditions`) and the normalised Schur conditions of the
+  sampled loop (:func:`stringstab.certify.sampled.schur_margins`).
 
 A quadratic q(K) = c + bᵀK + KᵀAK is recovered *exactly* (up to round-off) from ten evaluations
 by polarisation (:func:`quadratic_form`), so each constraint is evaluated by the same code as
 the certificate it serves, and the NLP sees only the numbers (c, b, A) of each slot: one NLP for
 every loop.  :class:`Loop` says which member and frequency each constraint is taken at: a few
 fixed ones to start, then the certificate's witnesses (the exchange method), and decides every
-output with the certificate of that loop (:func:`stringstab.certificate.check`).
+output with the certificate of that loop (:func:`stringstab.certify.continuous.check`).
 
 References
 ----------
@@ -39,8 +39,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .. import margin as _margin
-from ..criteria import hurwitz_conditions
+from ..certify import margin as _margin
+from ..certify.criteria import hurwitz_conditions
 from ..params import Box, Params
 
 __all__ = ["FORM_SIZE", "Loop", "Member", "Slot", "quadratic_form"]
@@ -208,7 +208,7 @@ class Loop:
     # ------------------------------------------------------------------ the one homes
     def margin(self, member: Member, freq: Array, K: Array) -> Array:
         """g (or g_H) at ``member`` on frequencies ``freq`` for the gains K (3,): from the one
-        home of each margin (:func:`stringstab.margin.g`, :func:`stringstab.sampled.sampled_margin`).
+        home of each margin (:func:`stringstab.certify.margin.g`, :func:`stringstab.certify.sampled.sampled_margin`).
 
         Parameters
         ----------
@@ -228,7 +228,7 @@ class Loop:
         if not self.sampled:
             return _margin.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                              headway=member.headway)
-        from ..sampled import sampled_margin
+        from ..certify.sampled import sampled_margin
 
         return sampled_margin(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                               headway=member.headway, sample_time=self.H,
@@ -253,7 +253,7 @@ class Loop:
             form = quadratic_form(lambda x, v, a: _margin.g(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway))
         else:
-            from ..sampled import sampled_margin
+            from ..certify.sampled import sampled_margin
 
             form = quadratic_form(lambda x, v, a: sampled_margin(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway,
@@ -272,14 +272,14 @@ class Loop:
         Returns
         -------
         list of Slot
-            Kind ``"stability"``: two Hurwitz conditions (:func:`stringstab.criteria.hurwitz_conditions`)
-            or five Schur conditions (:func:`stringstab.sampled.schur_margins`), ``index`` 0, 1, ….
+            Kind ``"stability"``: two Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
+            or five Schur conditions (:func:`stringstab.certify.sampled.schur_margins`), ``index`` 0, 1, ….
         """
         def conditions(x: Array, v: Array, a: Array) -> Array:
             if not self.sampled:
                 return np.asarray(hurwitz_conditions(x, v, a, tau=member.tau,
                                                      headway=member.headway))
-            from ..sampled import schur_margins
+            from ..certify.sampled import schur_margins
 
             return schur_margins(x, v, tau=member.tau, headway=member.headway, sample_time=self.H)
 
@@ -314,7 +314,7 @@ class Loop:
             Only minima with a margin below it are returned.
         n : int
             Grid points of the sampled scan on [0, π] (the continuous scan is
-            :func:`stringstab.margin.local_minima`'s).
+            :func:`stringstab.certify.margin.local_minima`'s).
 
         Returns
         -------
@@ -356,14 +356,14 @@ class Loop:
         -------
         verdict : str
             ``"certified"``, ``"not_certified"`` or ``"inconclusive"``
-            (:func:`stringstab.certificate.check`).
+            (:func:`stringstab.certify.continuous.check`).
         stable : bool
             Internally stable (every member of the box, for a box).
         witnesses : list of (Member, float)
             The witness, if its frequency is finite; the box's centre stands in for a member the
             certificate does not report.
         """
-        from ..certificate import check
+        from ..certify.continuous import check
 
         b = self.box
         c = check(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
@@ -394,10 +394,10 @@ class Loop:
         Returns
         -------
         Certificate
-            :func:`stringstab.certificate.certify` on this loop (point or box, continuous or
+            :func:`stringstab.certify.continuous.certify` on this loop (point or box, continuous or
             sampled).
         """
-        from ..certificate import certify
+        from ..certify.continuous import certify
 
         b = self.box
         return certify(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
@@ -419,7 +419,7 @@ class Loop:
         bool ndarray, shape (n,)
             True where certified.
         """
-        from ..certificate import certify_batch
+        from ..certify.continuous import certify_batch
 
         b, c = self.box, self.centre()
         ok = np.zeros(len(K), dtype=bool)

@@ -5,7 +5,7 @@ Before any IPOPT solve, :func:`predict` solves the projection problem of
 internal-stability margin, a bound, Ψ3 = g(0) ≥ ε, or g ≥ ε at a dip whose frequency is a
 variable), and hands its point back only when every multiplier is positive, nothing is
 violated and the exact certificate certifies it.  The derivatives of g come from
-:mod:`stringstab.margin` (generated from the SymPy derivation; the scalar form, for latency).
+:mod:`stringstab.certify.margin` (generated from the SymPy derivation; the scalar form, for latency).
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .. import margin as _margin
-from ..criteria import HURWITZ_LABELS, hurwitz_gradients
+from ..certify import margin as _margin
+from ..certify.criteria import HURWITZ_LABELS, hurwitz_gradients
 from ..params import Params
 from .inputs import GAIN_NAMES
 
@@ -28,7 +28,7 @@ Array = npt.NDArray[np.float64]
 
 
 def violating_dips(K: Array, p: Params, threshold: float) -> tuple[float, list[float]]:
-    """The violating dips of g(·; K) (:func:`stringstab.margin.local_minima`).
+    """The violating dips of g(·; K) (:func:`stringstab.certify.margin.local_minima`).
 
     Parameters
     ----------
@@ -52,7 +52,7 @@ def violating_dips(K: Array, p: Params, threshold: float) -> tuple[float, list[f
 
 
 def _g_and_grad(om: Array, K: Array, p: Params) -> tuple[Array, Array]:
-    """g(ω; K) and ∇_K g (rows: frequencies): :func:`stringstab.margin.gradient`."""
+    """g(ω; K) and ∇_K g (rows: frequencies): :func:`stringstab.certify.margin.gradient`."""
     return _margin.gradient(om, K, tau=p.tau, delta=p.delta, headway=p.headway)
 
 
@@ -113,7 +113,7 @@ def predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
 def _g_full(om: float, K: Array, p: Params) -> tuple[float, Array, float, Array, float, Array]:
     """g(ω; K) with the derivatives the KKT Newton step needs, in scalar arithmetic.
 
-    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g): :func:`stringstab.margin.newton_terms`
+    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g): :func:`stringstab.certify.margin.newton_terms`
     (the generated derivatives in ``math``-module arithmetic; the vectorised form costs
     ~0.5 ms of median repair latency).
     """
@@ -221,10 +221,10 @@ def predict(k0: Array, pred: list[float], omegas: list[float], *, params: Params
         Lower and upper bound on every gain.
     hurwitz_margin : float
         m of the internal-stability constraints: each Hurwitz condition (linear in K,
-        :func:`stringstab.criteria.hurwitz_gradients`) ≥ m.
+        :func:`stringstab.certify.criteria.hurwitz_gradients`) ≥ m.
     check : callable
         ``check(K) -> (verdict, internally stable, witness frequency)``: the exact certificate
-        of K (:func:`stringstab.certificate.check`).
+        of K (:func:`stringstab.certify.continuous.check`).
 
     Returns
     -------

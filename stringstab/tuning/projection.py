@@ -3,10 +3,10 @@
 :func:`project` (and the stateful :class:`Projector`, for a control loop) solves
 min ‖K − K0‖_W subject to the internal-stability conditions with a margin and the exact
 frequency condition g(ω_j; K) ≥ ε on a finite set of frequencies, refined by exchange until
-the exact certificate (:func:`stringstab.certificate.check`) certifies; first, the Newton
+the exact certificate (:func:`stringstab.certify.continuous.check`) certifies; first, the Newton
 predictor of :mod:`stringstab.tuning.predictor` answers without IPOPT when it can.  The NLP's
-constraints are the generated Hurwitz conditions (:func:`stringstab.criteria.hurwitz_conditions`)
-and g (:func:`stringstab.margin.casadi_g`).
+constraints are the generated Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
+and g (:func:`stringstab.certify.margin.casadi_g`).
 
 For the sampled-data loop (``sample_time``) and for a box of parameters (intervals: every
 member certified) the same exchange runs on the NLP of :func:`_quad_nlp`, whose constraints
@@ -33,10 +33,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .. import margin as _margin
-from ..certificate import certify, certify_batch, check
+from ..certify import margin as _margin
+from ..certify.continuous import certify, certify_batch, check
+from ..certify.criteria import hurwitz_conditions, hurwitz_ok
 from ..constants import GAIN_BOUNDS
-from ..criteria import hurwitz_conditions, hurwitz_ok
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model, positive
 from ..params import sample_time as _sample_time
@@ -196,8 +196,8 @@ class Projector:
       over: along a trajectory that set grows and slows every later solve).
 
     Every output reported certified has been certified by the exact
-    certificate, :func:`stringstab.certificate.check` (the verdicts of
-    :func:`~stringstab.certificate.certify` without its reporting extras; a
+    certificate, :func:`stringstab.certify.continuous.check` (the verdicts of
+    :func:`~stringstab.certify.continuous.certify` without its reporting extras; a
     cache hit returns gains that were).
 
     Parameters
@@ -314,7 +314,7 @@ class Projector:
         return np.asarray(sol["x"], dtype=float).ravel(), str(st["return_status"]), int(st["iter_count"])
 
     def _check(self, K: Array) -> tuple[str, bool, float]:
-        """The exact certificate's verdict on K (:func:`stringstab.certificate.check`).
+        """The exact certificate's verdict on K (:func:`stringstab.certify.continuous.check`).
 
         Returns (verdict, internally stable, witness frequency: where the
         smallest g(ω) was found; |Γ(jω)| > 1 there when K is internally stable
@@ -688,7 +688,7 @@ def project(
         k_x \\ge m,\\; k_v + (T^* - τ)k_x \\ge m,\\;
         g(ω_j; K) \\ge ε \\;(j = 1..n),\\; K \\in [\\text{lo}, \\text{hi}]^3,
 
-    where g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.frequency.margin_g`;
+    where g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.certify.frequency.margin_g`;
     g(0) = Ψ3), so g(ω_j) ≥ ε is |D(jω_j)|² − |N(jω_j)|² ≥ ε ω_j².  The frequency
     set starts as {0}, a fixed ladder of 16 frequencies (0.2 to 5 rad/s,
     geometric), the violating local minima of g(·; K0) (each also at 0.95
@@ -696,7 +696,7 @@ def project(
     repaired gains (the dip of g at the nearest point of the linearised
     constraint, followed twice; each also at 0.98 and 1.02 times itself).  It
     is refined by *exchange*: after each solve the exact certificate
-    (:func:`stringstab.certificate.check`) is asked; if it does not certify
+    (:func:`stringstab.certify.continuous.check`) is asked; if it does not certify
     K, its witness frequency (where |Γ(jω)| > 1) and the local minima of
     g(·; K) below 0 found by a dense scan are added, each with neighbours at
     ±5 %.  The loop ends when the certificate certifies K, when nothing new
@@ -741,9 +741,9 @@ def project(
         The gains to repair.
     tau, delta, headway : float, (lo, hi) or "LO:HI"
         Model parameters (s); an interval asks for gains certified for every member of the
-        box (the robust certificate, :mod:`stringstab.robust`).
+        box (the robust certificate, :mod:`stringstab.certify.robust`).
     sample_time : float, optional
-        H (s): gains certified for the sampled-data loop (:mod:`stringstab.sampled`).
+        H (s): gains certified for the sampled-data loop (:mod:`stringstab.certify.sampled`).
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently.
     weights : sequence of 3 floats
@@ -753,7 +753,7 @@ def project(
     hurwitz_margin : float
         m in k_x ≥ m and k_v + (T* − τ)k_x ≥ m (internal stability with a margin); sampled,
         m in each Schur condition normalised to these as H → 0
-        (:func:`stringstab.sampled.schur_margins`).
+        (:func:`stringstab.certify.sampled.schur_margins`).
     eps : float
         ε > 0 of the frequency constraints.
     warm_start : sequence of 3 floats, optional

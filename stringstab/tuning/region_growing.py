@@ -19,9 +19,9 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from ..certificate import certify
+from ..certify.continuous import certify
+from ..certify.criteria import TYPE_NAMES, hurwitz, taylor_criteria
 from ..constants import GAIN_BOUNDS
-from ..criteria import TYPE_NAMES, hurwitz, taylor_criteria
 from ..errors import StringStabError
 from ..params import Params, positive
 from .inputs import as_bounds, as_k0, as_weights
@@ -137,7 +137,7 @@ def region_growing(
         Maximum number of regions R_1 ... R_max_iter; None: until R_k covers the bounds.
     criterion : {"derived", "printed"}
         Which Ψ formulas and Proposition-1 logic the Taylor test uses
-        (:func:`stringstab.criteria.taylor_criteria`).
+        (:func:`stringstab.certify.criteria.taylor_criteria`).
     weights : sequence of 3 floats
         Weights w of the distance sqrt(Σ w_i (K_i − K0_i)²) used to pick the
         nearest accepted point and reported in the result.

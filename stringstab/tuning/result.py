@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certificate import Certificate
+from ..certify.continuous import Certificate
 from ..io import TableColumn
 
 __all__ = [
@@ -265,11 +265,11 @@ def triple(k: Array) -> tuple[float, float, float]:
 class Verdict:
     """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
 
-    Built from a full :class:`~stringstab.certificate.Certificate` or, in the
-    projection's fast path, from :func:`stringstab.certificate.check` (the same
+    Built from a full :class:`~stringstab.certify.continuous.Certificate` or, in the
+    projection's fast path, from :func:`stringstab.certify.continuous.check` (the same
     sound decision without the reporting extras).  A certified triple has
     ‖Γ‖_{H∞} = 1 exactly (Γ(0) = 1 and |Γ(jω)| ≤ 1), which is what
-    :func:`~stringstab.certificate.certify` reports for it too, so no peak
+    :func:`~stringstab.certify.continuous.certify` reports for it too, so no peak
     search is needed; for any other verdict the full certificate is computed.
     """
 
@@ -297,7 +297,7 @@ class Verdict:
         return cls(cert.verdict, float(cert.sup_gain))
 
 
-#: The verdict of a triple that :func:`stringstab.certificate.check` certified.
+#: The verdict of a triple that :func:`stringstab.certify.continuous.check` certified.
 CERTIFIED = Verdict("certified", 1.0)
 
 

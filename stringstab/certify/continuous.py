@@ -13,7 +13,7 @@ delay, Γ is internally stable iff that cubic is Hurwitz; then
     g(ω) = \\frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
          = τ^2ω^4 + aω^2 + b + 2k_xk_a\\cos δω - 2k_vk_a ω\\sin δω \\ge 0 ,
 
-(:func:`stringstab.frequency.margin_g`).  The method is a branch and bound on g
+(:func:`stringstab.certify.frequency.margin_g`).  The method is a branch and bound on g
 that is sound by construction:
 
 1. **Tail.**  For ω ≥ 0, g(ω) ≥ L(ω) = τ²ω⁴ − Aω² − Bω − C with A = max(−a, 0),
@@ -38,7 +38,7 @@ certified triple has sup |Γ| = 1, attained at ω = 0.
 References
 ----------
 IDL paper, Definition 1 (eq 10) and eq 11 (derived form, see
-:func:`stringstab.symbolic.gamma`).
+:func:`stringstab.derive.symbolic.gamma`).
 M. Fujiwara, "Über die obere Schranke des absoluten Betrages der Wurzeln einer
 algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
 """
@@ -52,18 +52,18 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
-from . import _generated as _gen
+from ..derive import generated as _gen
+from ..errors import StringStabError
+from ..io.results import TableColumn, columns_from_records
+from ..params import Box, Params, as_gains, parameter_model
+from ..params import sample_time as _sample_time
 from . import margin as _margin
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
 from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
-from .errors import StringStabError
 from .excess import EXCESS_SEARCH, col
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
-from .io.results import TableColumn, columns_from_records
 from .margin import tail_bound
-from .params import Box, Params, as_gains, parameter_model
-from .params import sample_time as _sample_time
 from .verdicts import (
     CERTIFIED,
     INCONCLUSIVE,
@@ -105,7 +105,7 @@ _SLACK = ROUNDOFF_SLACK
 
 
 # ---------------------------------------------------------------------------
-# Step 1, the tail bound, is :func:`stringstab.margin.tail_bound` (re-exported here).
+# Step 1, the tail bound, is :func:`stringstab.certify.margin.tail_bound` (re-exported here).
 # ---------------------------------------------------------------------------
 def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
     """g on the grid ``w`` and its round-off slack (step 3).
@@ -118,7 +118,7 @@ def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
 
 
 # ---------------------------------------------------------------------------
-# Step 2: branch and bound on g over [0, Omega] (stringstab.branch_bound, the one engine)
+# Step 2: branch and bound on g over [0, Omega] (stringstab.certify.branch_bound, the one engine)
 # ---------------------------------------------------------------------------
 @dataclass
 class _Exact:
@@ -238,7 +238,7 @@ class Certificate(SingleResult):
         bound on the true minimum.
     taylor_derived, taylor_printed : dict
         Ψ1, Ψ2, Ψ3, Λ, Proposition-1 verdict and type from the derived and
-        the printed formulas (:func:`stringstab.criteria.taylor_criteria`).
+        the printed formulas (:func:`stringstab.certify.criteria.taylor_criteria`).
     method : str
         ``"exact"``.
     omega_max : float
@@ -411,10 +411,10 @@ _LOOP_DOC = """tau, delta, headway : float, (lo, hi) or "LO:HI"
         Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
         point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
         :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.robust`).
+        box of every such member (:mod:`stringstab.certify.robust`).
     sample_time : float, optional
         H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
     tau_prev : float, optional
         Sampled, point parameters only: the predecessor's lag (default τ).
     heterogeneous : bool
@@ -477,10 +477,10 @@ def check(
         Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
         point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
         :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.robust`).
+        box of every such member (:mod:`stringstab.certify.robust`).
     sample_time : float, optional
         H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
     tau_prev : float, optional
         Sampled, point parameters only: the predecessor's lag (default τ).
     heterogeneous : bool
@@ -493,7 +493,7 @@ def check(
     -------
     Check
         With ``sample_time`` and ``witness_theta`` when sampled
-        (:class:`stringstab.sampled.SampledCheck`), and the witness member
+        (:class:`stringstab.certify.sampled.SampledCheck`), and the witness member
         (``witness_tau``, ``witness_delta``, ...) over a box.
 
     Examples
@@ -554,8 +554,8 @@ def certify_batch(
 
     With point parameters and no sample time this is the continuous-time certificate of
     this module; ``sample_time`` certifies the sampled-data loop
-    (:func:`stringstab.sampled.certify_sampled_batch`) and any interval the whole box
-    (:func:`stringstab.robust.certify_robust_batch`), with the same three verdicts.
+    (:func:`stringstab.certify.sampled.certify_sampled_batch`) and any interval the whole box
+    (:func:`stringstab.certify.robust.certify_robust_batch`), with the same three verdicts.
 
     Parameters
     ----------
@@ -565,10 +565,10 @@ def certify_batch(
         Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
         point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
         :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.robust`).
+        box of every such member (:mod:`stringstab.certify.robust`).
     sample_time : float, optional
         H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
     tau_prev : float, optional
         Sampled, point parameters only: the predecessor's lag (default τ).
     heterogeneous : bool
@@ -754,10 +754,10 @@ def certify(
         Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
         point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
         :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.robust`).
+        box of every such member (:mod:`stringstab.certify.robust`).
     sample_time : float, optional
         H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.sampled`) instead of the continuous-time one.
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
     tau_prev : float, optional
         Sampled, point parameters only: the predecessor's lag (default τ).
     heterogeneous : bool

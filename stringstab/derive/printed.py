@@ -2,8 +2,8 @@
 
 These are transcriptions of eqs 11-15 and 25-26 of the IDL paper (text
 extracted from the PDF; the garbled ``T^e`` of eqs 25-26 is read as T*).  The
-toolkit never uses them for a verdict of its own; :mod:`stringstab.errata`
-compares them with the forms derived in :mod:`stringstab.symbolic`, and the
+toolkit never uses them for a verdict of its own; :mod:`stringstab.derive.errata`
+compares them with the forms derived in :mod:`stringstab.derive.symbolic`, and the
 ``printed`` method of the criteria reproduces the paper's Proposition 1 as a
 user of the paper would apply it.
 

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .constants import DELTA, HEADWAY, TAU
+from ..constants import DELTA, HEADWAY, TAU
 
 __all__ = ["DEMO_TRIPLES", "STEPS", "TRAIN_STEPS", "TUNE_TRIPLES", "run_demo"]
 
@@ -25,13 +25,13 @@ Log = Callable[[str], None]
 Step = Callable[..., dict[str, Any]]  # (out, log) plus limits= for LIMITED_STEPS
 
 PARAMS = {"tau": TAU, "delta": DELTA, "headway": HEADWAY}
-ROLLOUT = Path(__file__).parent / "data" / "examples" / "gain_rollout.csv"
+ROLLOUT = Path(__file__).parents[1] / "data" / "examples" / "gain_rollout.csv"
 
 
 def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     """Derive Γ(s), Ψ1-Ψ3, Λ and compare with the printed formulas."""
-    from .derivation import derivation
-    from .io import atomic_write_text
+    from ..derive.derivation import derivation
+    from ..io import atomic_write_text
 
     d = derivation(None, None, with_errata=True)
     doc = d.document
@@ -56,8 +56,8 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     """Certify a few triples and a bundled gain time series (exact delay)."""
     import numpy as np
 
-    from .certificate import TABLE_COLUMNS, certify_batch
-    from .io import GainTable, parse_triple, read_gains, write_results
+    from ..certify.continuous import TABLE_COLUMNS, certify_batch
+    from ..io import GainTable, parse_triple, read_gains, write_results
 
     params = {**PARAMS, "method": "exact"}
     files = []
@@ -101,10 +101,10 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
 
 def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
     """A 10-vehicle platoon behind the §5.1-style leader: certified gains vs the CACC baseline."""
-    from .traffic.controllers import CACCController, LinearController
-    from .traffic.leaders import leader_by_name
-    from .traffic.output import run_document, write_run
-    from .traffic.platoon import check_leader, simulate
+    from ..traffic.controllers import CACCController, LinearController
+    from ..traffic.leaders import leader_by_name
+    from ..traffic.output import run_document, write_run
+    from ..traffic.platoon import check_leader, simulate
 
     leader = leader_by_name("mix")
     warnings = check_leader(leader, limits)
@@ -139,9 +139,9 @@ def _step_region(out: Path, log: Log) -> dict[str, Any]:
     matplotlib.use("Agg")
     import numpy as np
 
-    from .io import read_gains
-    from .plots import save_figures
-    from .regions import region_map
+    from ..io import read_gains
+    from ..plots import save_figures
+    from ..regions import region_map
 
     g = np.linspace(-2.0, 2.0, 121)
     rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
@@ -172,9 +172,9 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from .io import atomic_path, columns_from_records, parse_triple, write_results
-    from .plots import plot_moves
-    from .tuning import project, region_growing
+    from ..io import atomic_path, columns_from_records, parse_triple, write_results
+    from ..plots import plot_moves
+    from ..tuning import project, region_growing
 
     results = []
     for t in TUNE_TRIPLES:
@@ -215,7 +215,7 @@ def _step_hcfs(out: Path, log: Log, *, final: Path | None = None) -> dict[str, A
     import matplotlib
 
     matplotlib.use("Agg")
-    from .hcfs import case_leader, load_bundled_ddpg, verify, write_report
+    from ..hcfs import case_leader, load_bundled_ddpg, verify, write_report
 
     leader, n = case_leader("hcfs-case1")
     ver = verify([leader], load_bundled_ddpg(), jerk_limits=[2.5], n_followers=n)
@@ -266,11 +266,11 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
     import matplotlib
 
     matplotlib.use("Agg")
-    from .io import OutputDir
-    from .rl import config_for, train
-    from .rl.episodes import default_leaders
-    from .rl.evaluate import evaluate, platoon_test
-    from .rl.report import verdict, write_comparison, write_evaluation
+    from ..io import OutputDir
+    from ..rl import config_for, train
+    from ..rl.episodes import default_leaders
+    from ..rl.evaluate import evaluate, platoon_test
+    from ..rl.report import verdict, write_comparison, write_evaluation
 
     cfg = config_for("idl", total_steps=steps, seed=0, learning_starts=min(2_000, steps // 4),
                      checkpoint_every=max(steps, 1))
@@ -356,15 +356,15 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
     StringStabError
         If ``out`` cannot be used or a step name is unknown (before any work).
     """
-    from .errors import StringStabError
-    from .io import OutputDir
+    from ..errors import StringStabError
+    from ..io import OutputDir
 
     names = [n for n, _ in STEPS]
     for o in only or []:
         if o not in names:
             raise StringStabError(f"unknown demo step {o!r}; expected one of {names}")
     summary: dict[str, Any] = {}
-    from .progress import duration
+    from ..progress import duration
 
     todo = sum(1 for n in names if not only or n in only)
     done, started = 0, time.perf_counter()
@@ -384,7 +384,7 @@ def run_demo(out: str | Path, *, log: Log = print, only: list[str] | None = None
             summary[name] = result
             log(f"   ({result['seconds']} s, outputs in {d.final(name)})")
         d.write_json("summary.json", summary)
-        from .report.demo import demo_report
+        from ..report.demo import demo_report
 
         demo_report(summary, d.staging, command=command, params=PARAMS, started=started).write(d)
     return summary

@@ -4,7 +4,7 @@ Nothing here is typed in from the paper: the transfer function Γ(s), the
 frequency-domain margin |D(jω)|² − |N(jω)|², the coefficients Ψ1, Ψ2, Ψ3, the
 discriminant Λ, their gradients and the Hurwitz conditions are all *computed*
 by SymPy from the state-space model of the IDL paper (eqs 3-9).  The printed
-forms live in :mod:`stringstab.printed`; :mod:`stringstab.errata` compares.
+forms live in :mod:`stringstab.derive.printed`; :mod:`stringstab.derive.errata` compares.
 
 Symbols (shared by every module): ``k_x k_v k_a`` (gains), ``tau`` (actuator lag
 τ), ``delta`` (communication delay δ), ``headway`` (desired time headway T*),
@@ -26,7 +26,7 @@ from functools import cache, lru_cache
 import numpy as np
 import sympy as sp
 
-from .errors import StringStabError
+from ..errors import StringStabError
 
 __all__ = [
     "GAINS",
@@ -447,11 +447,11 @@ def lambdify_psi(
     ----------
     source : {"derived", "printed"}
         ``"derived"``: :func:`derived_psi` (exact-delay series); ``"printed"``:
-        the IDL paper's eqs 12-15 as printed (:mod:`stringstab.printed`).
+        the IDL paper's eqs 12-15 as printed (:mod:`stringstab.derive.printed`).
     delay_order : int or None
         Only for ``"derived"``; see :func:`margin_series`.  ``None`` and the
         printed forms use the code generated from these expressions
-        (:func:`stringstab.criteria.psi`); other orders are lambdified here.
+        (:func:`stringstab.certify.criteria.psi`); other orders are lambdified here.
 
     Returns
     -------
@@ -468,10 +468,10 @@ def lambdify_psi(
     if source not in ("derived", "printed"):
         raise StringStabError(f"source must be 'derived' or 'printed'; got {source!r}")
     if source == "printed" or delay_order is None:
-        # the generated code of these two (stringstab._generated, tested against SymPy)
+        # the generated code of these two (stringstab.derive.generated, tested against SymPy)
         from functools import partial
 
-        from .criteria import psi as _psi
+        from ..certify.criteria import psi as _psi
 
         fn = partial(_psi, source=source)
 
@@ -530,7 +530,7 @@ def parse_substitutions(text: str | None,
     >>> parse_substitutions("tau=0.1,delta=0.2")
     {tau: 1/10, delta: 1/5}
     """
-    from .errors import StringStabError
+    from ..errors import StringStabError
 
     out: dict[sp.Symbol, sp.Expr] = {}
     names = SUBSTITUTABLE if allowed is None else allowed

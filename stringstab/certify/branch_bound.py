@@ -1,7 +1,7 @@
 """A vectorised one-dimensional branch and bound: is f ≥ 0 on [0, Ω_i] for every item i?
 
-The one engine behind every certificate: continuous time (:mod:`stringstab.certificate`),
-sampled data (:mod:`stringstab.sampled`) and robust (:mod:`stringstab.robust`).  Each item i (a gain triple, or a gain triple and a cell of
+The one engine behind every certificate: continuous time (:mod:`stringstab.certify.continuous`),
+sampled data (:mod:`stringstab.certify.sampled`) and robust (:mod:`stringstab.certify.robust`).  Each item i (a gain triple, or a gain triple and a cell of
 uncertain parameters) has a function f_i on [0, Ω_i] that the caller can evaluate at any
 points, returning for each point
 
@@ -96,7 +96,7 @@ _NO_POINTS.setflags(write=False)
 
 
 def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
-    """Item outcomes as verdict codes (:data:`stringstab.verdicts.VERDICTS`): certified 0,
+    """Item outcomes as verdict codes (:data:`stringstab.certify.verdicts.VERDICTS`): certified 0,
     violated 1 (not certified), anything else 2 (inconclusive).
 
     The outcome codes are chosen so that CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict

@@ -13,7 +13,7 @@ a_{i−1}(kH − δ) for any δ ≥ 0 (δ = mH + εH, m integer, 0 ≤ ε < 1), 
 
 Nothing below is typed in from a paper.  The derivation is:
 
-1. **State equations** of the follower (IDL eqs 5-9; :func:`stringstab.symbolic.vehicle_model`)
+1. **State equations** of the follower (IDL eqs 5-9; :func:`stringstab.derive.symbolic.vehicle_model`)
    augmented with the predecessor's acceleration a_p (lag τ_p, its own held command u_p)
    and the two held commands: a linear ODE with constant inputs over a period.
 2. **Exact discretisation**: Φ = exp(A_aug H), the SymPy matrix exponential
@@ -36,9 +36,9 @@ z = 0; internal stability is Schur stability of Δ (:func:`schur_conditions`).
 
 In the variable w = z − 1 (the delta operator) every coefficient is a sum of terms of one
 order in H (:func:`w_coefficients`), which is what the numeric certificate
-(:mod:`stringstab.sampled`) evaluates.
+(:mod:`stringstab.certify.sampled`) evaluates.
 
-Symbols: the gains and ``tau``, ``delta``, ``headway`` of :mod:`stringstab.symbolic`,
+Symbols: the gains and ``tau``, ``delta``, ``headway`` of :mod:`stringstab.derive.symbolic`,
 plus ``sample_time`` (H), ``tau_prev`` (τ_p, the predecessor's lag; τ_p = τ in a
 homogeneous platoon), ``epsilon`` (ε, the fractional part of δ/H), ``m`` (its integer
 part), ``z`` and ``w``.
@@ -115,7 +115,7 @@ def sampled_model() -> SampledModel:
     """Augment the follower's state equations and discretise them exactly.
 
     The follower's rows are the IDL model (M1, M2, M3 of
-    :func:`stringstab.symbolic.vehicle_model`); the predecessor's acceleration obeys
+    :func:`stringstab.derive.symbolic.vehicle_model`); the predecessor's acceleration obeys
     τ_p ȧ_p = u_p − a_p; both commands are constant over a period (zero-order hold).
 
     Returns
@@ -305,7 +305,7 @@ def dc_margin() -> sp.Expr:
 
     Examples
     --------
-    >>> from stringstab.symbolic import derived_psi
+    >>> from stringstab.derive.symbolic import derived_psi
     >>> phi1 = 1 - sp.exp(-sample_time / tau)
     >>> c2 = dc_margin().subs(tau_prev, tau)
     >>> sp.simplify(c2 - sample_time**2 * phi1**4 * derived_psi()[2])
@@ -325,7 +325,7 @@ def phi_functions(x: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
 
     Over one period of a lag with x = H/τ: ∫a = τ(ψ2 u + φ1 a), ∫∫a = τ²(ψ3 u + ψ2 a)
     for initial acceleration a and held command u; φ1 ≈ x, ψ2 ≈ x²/2, ψ3 ≈ x³/6 for
-    small x (each computed without cancellation by :mod:`stringstab.sampled`).
+    small x (each computed without cancellation by :mod:`stringstab.certify.sampled`).
 
     Parameters
     ----------
@@ -354,7 +354,7 @@ def schur_conditions() -> list[sp.Expr]:
 
     The bilinear map z = (1 + s)/(1 − s) sends the open unit disc onto the open left
     half-plane, so Δ is Schur iff (1 − s)³ Δ((1 + s)/(1 − s)) is Hurwitz; its Hurwitz
-    determinants (SymPy, :func:`stringstab.symbolic.routh_hurwitz`) together with its
+    determinants (SymPy, :func:`stringstab.derive.symbolic.routh_hurwitz`) together with its
     leading coefficient give the conditions.  With w = 2s/(1 − s) the transformed cubic
     is 8s³ + 4δ2 s²(1 − s) + 2δ1 s(1 − s)² + δ0 (1 − s)³.
 
@@ -385,7 +385,7 @@ def schur_conditions() -> list[sp.Expr]:
 
 
 #: Symbols of the sampled derivation a caller may substitute (with those of
-#: :data:`stringstab.symbolic.SUBSTITUTABLE`).
+#: :data:`stringstab.derive.symbolic.SUBSTITUTABLE`).
 SAMPLED_SUBSTITUTABLE: dict[str, sp.Symbol] = {
     str(x): x for x in (sample_time, tau_prev, epsilon, m)
 }

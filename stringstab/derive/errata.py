@@ -1,8 +1,8 @@
 """Errata: where the IDL paper's printed formulas differ from the derived ones.
 
-For each printed expression of eqs 11-15 and 25-26 (:mod:`stringstab.printed`)
+For each printed expression of eqs 11-15 and 25-26 (:mod:`stringstab.derive.printed`)
 the report says whether it equals the form derived from the model
-(:mod:`stringstab.symbolic`), and if not gives the simplified difference
+(:mod:`stringstab.derive.symbolic`), and if not gives the simplified difference
 (printed − derived), the terms that differ, an explanation, and how much it
 matters in practice: the share of a gain grid over [-2, 2]³ on which the sign
 (hence the verdict) of the printed expression differs from the derived one.
@@ -234,7 +234,7 @@ def _proposition1_row(params: dict[str, float]) -> Erratum:
     derived_c = proposition1_conditions(p1, p2, p3, lam, printed=False)
     # impact: verdict disagreement between printed logic on printed Ψ and
     # corrected logic on derived Ψ (criteria.taylor_criteria), on the grid
-    from .criteria import proposition1, taylor_criteria
+    from ..certify.criteria import proposition1, taylor_criteria
 
     kx, kv, ka = _grid()
     kw = {"tau": params["tau"], "delta": params["delta"], "headway": params["headway"]}

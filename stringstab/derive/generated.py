@@ -1,12 +1,12 @@
 """Numeric code generated from the symbolic derivation: DO NOT EDIT.
 
-Written by ``python -m stringstab.codegen`` from :mod:`stringstab.symbolic` (and the
-printed Ψ of :mod:`stringstab.printed`); ``tests/test_margin.py`` checks that this file
+Written by ``python -m stringstab.derive.codegen`` from :mod:`stringstab.derive.symbolic` (and the
+printed Ψ of :mod:`stringstab.derive.printed`); ``tests/test_margin.py`` checks that this file
 equals a fresh generation and agrees with SymPy.  Only arithmetic, ``abs`` and the
 ``cos``/``sin`` passed in are used, so every function evaluates NumPy arrays (the
 default), Python floats (``cos=math.cos, sin=math.sin``) and CasADi symbols
 (``cos=casadi.cos, sin=casadi.sin``) alike.  The public interface is
-:mod:`stringstab.margin` and :mod:`stringstab.criteria`.
+:mod:`stringstab.certify.margin` and :mod:`stringstab.certify.criteria`.
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
-"""Generate :mod:`stringstab._generated`, the numeric code of every derived formula.
+"""Generate :mod:`stringstab.derive.generated`, the numeric code of every derived formula.
 
 The numeric library never imports SymPy: each formula it evaluates (the margin g(ω)
 and its derivatives, Ψ1-Ψ3, the Hurwitz conditions, the parts of Γ(jω)) is derived
-once by :mod:`stringstab.symbolic` (and, for the printed Ψ, :mod:`stringstab.printed`),
+once by :mod:`stringstab.derive.symbolic` (and, for the printed Ψ, :mod:`stringstab.derive.printed`),
 printed as plain Python arithmetic by this module, and committed as
-``stringstab/_generated.py``.  Rerun after changing the model::
+``stringstab/derive/generated.py``.  Rerun after changing the model::
 
-    python -m stringstab.codegen            # rewrite stringstab/_generated.py
-    python -m stringstab.codegen --check    # exit 1 if the committed file is stale
+    python -m stringstab.derive.codegen            # rewrite stringstab/derive/generated.py
+    python -m stringstab.derive.codegen --check    # exit 1 if the committed file is stale
 
 The generated functions use only ``+ - * /``, ``abs`` and the ``cos``/``sin`` they
 are handed (NumPy's by default), so the *same* code evaluates NumPy arrays
@@ -18,7 +18,7 @@ generation and that every generated form agrees with the SymPy derivation.
 
 References
 ----------
-IDL paper, eqs 11-15 (derived forms, :mod:`stringstab.symbolic`).
+IDL paper, eqs 11-15 (derived forms, :mod:`stringstab.derive.symbolic`).
 """
 
 from __future__ import annotations
@@ -39,12 +39,12 @@ from .printed import printed_psi
 __all__ = ["MARGIN_BASIS", "TARGET", "generate", "main", "margin_basis", "margin_separable"]
 
 #: The committed file this module writes.
-TARGET = Path(__file__).with_name("_generated.py")
+TARGET = Path(__file__).with_name("generated.py")
 
 #: The terms of g(ω) = (|D(jω)|² − |N(jω)|²)/ω², as (name, sign, trigonometric factor, power
 #: of ω): g = τ²ω⁴ + aω² + b + c_x cos(δω) − c_v ω sin(δω).  :func:`margin_basis` checks the
 #: derivation has exactly these terms; the tail and curvature bounds of
-#: :mod:`stringstab.margin` rely on it.
+#: :mod:`stringstab.certify.margin` rely on it.
 MARGIN_BASIS: tuple[tuple[str, int, str, int], ...] = (
     ("t2", 1, "1", 4),
     ("a", 1, "1", 2),
@@ -56,13 +56,13 @@ MARGIN_BASIS: tuple[tuple[str, int, str, int], ...] = (
 _HEADER = '''\
 """Numeric code generated from the symbolic derivation: DO NOT EDIT.
 
-Written by ``python -m stringstab.codegen`` from :mod:`stringstab.symbolic` (and the
-printed Ψ of :mod:`stringstab.printed`); ``tests/test_margin.py`` checks that this file
+Written by ``python -m stringstab.derive.codegen`` from :mod:`stringstab.derive.symbolic` (and the
+printed Ψ of :mod:`stringstab.derive.printed`); ``tests/test_margin.py`` checks that this file
 equals a fresh generation and agrees with SymPy.  Only arithmetic, ``abs`` and the
 ``cos``/``sin`` passed in are used, so every function evaluates NumPy arrays (the
 default), Python floats (``cos=math.cos, sin=math.sin``) and CasADi symbols
 (``cos=casadi.cos, sin=casadi.sin``) alike.  The public interface is
-:mod:`stringstab.margin` and :mod:`stringstab.criteria`.
+:mod:`stringstab.certify.margin` and :mod:`stringstab.certify.criteria`.
 """
 
 from __future__ import annotations
@@ -206,7 +206,7 @@ def margin_basis() -> dict[str, sp.Expr]:
     ------
     AssertionError
         When the derived g has other terms (a changed model needs a new basis and new
-        bounds in :mod:`stringstab.margin`).
+        bounds in :mod:`stringstab.certify.margin`).
     """
     w, d = S.omega, S.delta
     trig = {"1": sp.Integer(1), "cos": sp.cos(d * w), "sin": sp.sin(d * w)}
@@ -227,7 +227,7 @@ def margin_basis() -> dict[str, sp.Expr]:
 def margin_separable() -> dict[str, sp.Expr]:
     """g(ω) split as (τω² − c)² + h2 ω² + h0 + c_x cos(δω) − c_v ω sin(δω).
 
-    The robust certificate (:mod:`stringstab.robust`) minimises g over a box of τ, δ, T*
+    The robust certificate (:mod:`stringstab.certify.robust`) minimises g over a box of τ, δ, T*
     in closed form because only the square depends on τ and T* (through τ and
     c = k_v + T*k_x) and only the trigonometric terms on δ.  Everything is derived from
     :func:`margin_basis`: t2 = τ², c = −½ ∂a/∂τ (a is affine in τ), h2 = a + 2τc,
@@ -487,7 +487,7 @@ def _source() -> str:
 
 
 def generate() -> str:
-    """The source text of ``stringstab/_generated.py`` (LF line endings).
+    """The source text of ``stringstab/derive/generated.py`` (LF line endings).
 
     Returns
     -------
@@ -498,7 +498,7 @@ def generate() -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Write (or with ``--check``, compare) ``stringstab/_generated.py``; returns the exit code.
+    """Write (or with ``--check``, compare) ``stringstab/derive/generated.py``; returns the exit code.
 
     Parameters
     ----------
@@ -510,13 +510,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     int
         0 when written or up to date; 1 with ``--check`` when the committed file is stale.
     """
-    ap = argparse.ArgumentParser(prog="python -m stringstab.codegen", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m stringstab.derive.codegen", description=__doc__.splitlines()[0])
     ap.add_argument("--check", action="store_true", help="exit 1 if the committed file is stale")
     args = ap.parse_args(argv)
     src = generate()
     if args.check:
         same = TARGET.is_file() and TARGET.read_text(encoding="utf-8") == src
-        print(f"{TARGET}: {'up to date' if same else 'STALE: run python -m stringstab.codegen'}")
+        print(f"{TARGET}: {'up to date' if same else 'STALE: run python -m stringstab.derive.codegen'}")
         return 0 if same else 1
     TARGET.write_text(src, encoding="utf-8")
     print(f"wrote {TARGET} ({len(src.splitlines())} lines)")

@@ -1,7 +1,7 @@
 """The verdicts of every certificate and the protocol of their results: one home.
 
-Every certificate of the toolkit — continuous time (:mod:`stringstab.certificate`), sampled
-data (:mod:`stringstab.sampled`) and robust over a parameter box (:mod:`stringstab.robust`) —
+Every certificate of the toolkit — continuous time (:mod:`stringstab.certify.continuous`), sampled
+data (:mod:`stringstab.certify.sampled`) and robust over a parameter box (:mod:`stringstab.certify.robust`) —
 answers with the same three verdicts, :data:`VERDICTS`, and returns its results in the same
 shape:
 
@@ -19,6 +19,7 @@ certificate imports it at no cost.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -27,8 +28,8 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
-from .errors import StringStabError
-from .io.results import TableColumn, records_from_columns
+from ..errors import StringStabError
+from ..io.results import TableColumn, records_from_columns
 
 __all__ = [
     "CERTIFIED",
@@ -40,6 +41,7 @@ __all__ = [
     "BatchResult",
     "Check",
     "SingleResult",
+    "Verdict",
     "chunks",
     "names",
     "num",
@@ -49,9 +51,60 @@ __all__ = [
 
 Array = npt.NDArray[np.float64]
 
-#: The three possible verdicts, by code: 0 certified, 1 not certified, 2 inconclusive.
-VERDICTS: tuple[str, str, str] = ("certified", "not_certified", "inconclusive")
-CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE = 0, 1, 2
+class Verdict(str, enum.Enum):
+    """The answer of every certificate: the one verdict vocabulary of the toolkit.
+
+    A ``Verdict`` is a ``str`` (``Verdict.CERTIFIED == "certified"``), so it is written to
+    JSON, CSV and tables as its value; arrays of verdicts hold its :attr:`code` (int8), the
+    position in :data:`VERDICTS`.
+
+    * ``certified`` — internally stable and ‖Γ‖_H∞ ≤ 1 with the exact delay, proven (IDL
+      Definition 1, eq 10);
+    * ``not_certified`` — proven not string stable (|Γ(jω)| > 1 at a frequency reported with
+      the result) or not internally stable;
+    * ``inconclusive`` — neither could be proven within the budget.
+    """
+
+    CERTIFIED = "certified"
+    NOT_CERTIFIED = "not_certified"
+    INCONCLUSIVE = "inconclusive"
+
+    # written as the value, as enum.StrEnum (Python 3.11) does
+    def __str__(self) -> str:
+        return str.__str__(self)
+
+    def __format__(self, format_spec: str) -> str:
+        return str.__format__(str(self), format_spec)
+
+    @property
+    def code(self) -> int:
+        """The verdict's code: its position in :data:`VERDICTS` (0, 1 or 2)."""
+        return VERDICTS.index(self)
+
+    @classmethod
+    def of_code(cls, code: int) -> Verdict:
+        """The verdict of a code (0 certified, 1 not certified, 2 inconclusive).
+
+        Parameters
+        ----------
+        code : int
+            A verdict code.
+
+        Returns
+        -------
+        Verdict
+            ``VERDICTS[code]``.
+        """
+        if not 0 <= int(code) < len(VERDICTS):
+            raise StringStabError(f"a verdict code is 0, 1 or 2; got {code!r}")
+        return VERDICTS[int(code)]
+
+
+#: The three verdicts in code order: 0 certified, 1 not certified, 2 inconclusive.
+VERDICTS: tuple[Verdict, Verdict, Verdict] = (Verdict.CERTIFIED, Verdict.NOT_CERTIFIED,
+                                              Verdict.INCONCLUSIVE)
+#: The verdict codes of arrays of verdicts (:attr:`Verdict.code`).
+CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE = (v.code for v in VERDICTS)
 
 #: Relative round-off slack of every certificate's comparisons: each bound on a margin is
 #: widened by this factor times the sum of the absolute values of its terms (hundreds of ulps).
@@ -124,7 +177,7 @@ def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
     {'n': 2, 'certified': 1, 'not_certified': 0, 'inconclusive': 1, 'm_fss': 0.5}
     """
     n = int(np.size(verdict))
-    counts = {v: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
+    counts = {v.value: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
     return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
 
 
@@ -270,7 +323,7 @@ class BatchResult:
 class Check:
     """Verdicts only, with the witness of each triple that is not certified.
 
-    Returned by :func:`stringstab.certificate.check` for every loop (continuous, sampled,
+    Returned by :func:`stringstab.certify.continuous.check` for every loop (continuous, sampled,
     robust); the sampled and robust forms fill the optional fields.
 
     Attributes

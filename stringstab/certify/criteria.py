@@ -1,9 +1,9 @@
 """Vectorised string-stability criteria: Hurwitz, Proposition 1 and the types I-IV.
 
 All functions broadcast over arrays of gains (and parameters) and evaluate the
-*derived* SymPy expressions of :mod:`stringstab.symbolic` (or, for the
-``printed`` source, those of :mod:`stringstab.printed`) through the numeric code
-generated from them (:mod:`stringstab._generated`, ``python -m stringstab.codegen``),
+*derived* SymPy expressions of :mod:`stringstab.derive.symbolic` (or, for the
+``printed`` source, those of :mod:`stringstab.derive.printed`) through the numeric code
+generated from them (:mod:`stringstab.derive.generated`, ``python -m stringstab.derive.codegen``),
 so no SymPy is imported at run time.
 
 Two Taylor-based verdicts are offered, because they differ:
@@ -17,7 +17,7 @@ Two Taylor-based verdicts are offered, because they differ:
     (Ψ1, Ψ2, Ψ3 ≥ 0) ∨ Λ ≤ 0, as a reader of the paper would apply it.
 
 Neither is a certificate (they truncate the frequency series at ω⁶); see
-:mod:`stringstab.certificate` for the exact one.
+:mod:`stringstab.certify.continuous` for the exact one.
 
 References
 ----------
@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from . import _generated as _gen
-from .errors import StringStabError
-from .params import as_gains, check_params
+from ..derive import generated as _gen
+from ..errors import StringStabError
+from ..params import as_gains, check_params
 
 __all__ = [
     "HURWITZ_LABELS",
@@ -68,8 +68,8 @@ def psi(
 ) -> tuple[Array, Array, Array, Array]:
     """Ψ1, Ψ2, Ψ3 and Λ = Ψ2² − 4Ψ1Ψ3 (IDL eqs 12-15), broadcast together.
 
-    ``source="derived"``: :func:`stringstab.symbolic.derived_psi` (exact-delay series);
-    ``"printed"``: the IDL paper's eqs 12-14 as printed (:mod:`stringstab.printed`).
+    ``source="derived"``: :func:`stringstab.derive.symbolic.derived_psi` (exact-delay series);
+    ``"printed"``: the IDL paper's eqs 12-14 as printed (:mod:`stringstab.derive.printed`).
     Λ is evaluated from Ψ1-Ψ3 by its definition (eq 15) rather than from its expanded
     form (~4x slower in NumPy and no more accurate).
 
@@ -119,7 +119,7 @@ def hurwitz_conditions(
 ) -> tuple[Array, ...]:
     """The values of the Hurwitz conditions of Γ's denominator; each must be > 0.
 
-    Generated from :func:`stringstab.symbolic.hurwitz_conditions`: k_x and
+    Generated from :func:`stringstab.derive.symbolic.hurwitz_conditions`: k_x and
     k_v + (T* − τ)k_x (:data:`HURWITZ_LABELS`).  Works on arrays and on floats.
 
     Parameters
@@ -201,7 +201,7 @@ def hurwitz(
 ) -> npt.NDArray[np.bool_]:
     """Internal stability of Γ: is τs³ + s² + (k_v + T*k_x)s + k_x Hurwitz?
 
-    The conditions, derived by :func:`stringstab.symbolic.hurwitz_conditions`, are
+    The conditions, derived by :func:`stringstab.derive.symbolic.hurwitz_conditions`, are
     k_x > 0 and k_v + (T* − τ)k_x > 0 (with τ > 0).  ``rtol`` demands each
     condition exceed ``rtol`` times the scale of its terms (a margin).
 

@@ -1,10 +1,10 @@
 """The derivation as a document: Γ(s), Ψ1-Ψ3, Λ, gradients, Hurwitz conditions and errata.
 
-:func:`derivation` derives everything once (:func:`stringstab.symbolic.derive_all`) and returns a
+:func:`derivation` derives everything once (:func:`stringstab.derive.symbolic.derive_all`) and returns a
 :class:`Derivation` that renders itself as JSON-ready data, text or LaTeX; ``stringstab derive``
 and the demo print or write these renderings.  :func:`sampled_derivation` does the same for the
 sampled-data loop (``stringstab derive --sample-time H``: H(z), the characteristic polynomial
-Δ(z) and its Schur conditions, from :mod:`stringstab.sampled_symbolic`).  SymPy is imported when
+Δ(z) and its Schur conditions, from :mod:`stringstab.derive.sampled_symbolic`).  SymPy is imported when
 a derivation is made.
 """
 
@@ -60,7 +60,7 @@ class Derivation:
 
     def json(self) -> str:
         """JSON rendering (``stringstab derive --format json``)."""
-        from .io import dumps_json
+        from ..io import dumps_json
 
         return dumps_json(self.document)
 
@@ -78,7 +78,7 @@ def derivation(
     substitute : str, optional
         ``"tau=0.1,delta=0.2,headway=1.1"``-style specialisation (also gains).
     with_errata : bool
-        Add the comparison with the IDL paper's printed formulas (:func:`stringstab.errata.errata`).
+        Add the comparison with the IDL paper's printed formulas (:func:`stringstab.derive.errata.errata`).
 
     Returns
     -------
@@ -209,7 +209,7 @@ def sampled_derivation(sample_time: float, substitute: str | None = None) -> Der
 
     Every vehicle samples with period H and holds its command (zero-order hold); the lag is
     discretised exactly and the delay δ = (m + ε)H is exact for any δ ≥ 0
-    (:mod:`stringstab.sampled_symbolic`).  H is substituted exactly (as the decimal it is
+    (:mod:`stringstab.derive.sampled_symbolic`).  H is substituted exactly (as the decimal it is
     written as); when δ is substituted too, so are m = ⌊δ/H⌋ and ε = δ/H − m.  The
     predecessor's lag ``tau_prev`` is τ (a homogeneous platoon) unless substituted.
 
@@ -241,8 +241,8 @@ def sampled_derivation(sample_time: float, substitute: str | None = None) -> Der
     """
     import sympy as sp
 
+    from ..params import sample_time as check_sample_time
     from . import sampled_symbolic as SS
-    from .params import sample_time as check_sample_time
     from .symbolic import SUBSTITUTABLE, parse_substitutions
 
     H = check_sample_time(sample_time)

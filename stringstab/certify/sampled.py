@@ -4,7 +4,7 @@ Every vehicle samples synchronously with period H (``sample_time``), holds its c
 over the period and has the actuator lag τ; the delayed predecessor acceleration
 a_{i−1}(kH − δ) is exact for any δ = mH + εH ≥ 0.  The string transfer function from
 the predecessor's acceleration samples to the follower's, derived symbolically by
-:mod:`stringstab.sampled_symbolic`, is in w = z − 1
+:mod:`stringstab.derive.sampled_symbolic`, is in w = z − 1
 
 .. math::
     H(z) = \\frac{φ_1}{φ_{1p}}\\,\\frac{n(w) + z^{-(m+1)} k_a w^2 \\ell(w)}{Δ(w)}
@@ -31,7 +31,7 @@ where P, Y_r (degree 2) and Y_i (degree 1) are polynomials in ρ computed from t
 coefficients above (:func:`sampled_margin`).  The constant terms of |Δ|² and |n|²
 cancel *exactly* (φ1p δ0 = φ1 ν0: H(1) = 1), which is what makes the division by
 ρ ∝ 1 − cos θ exact — the analogue of dividing by ω² in the continuous margin g.
-The normalisation makes g_H(ωH) → g(ω) of :func:`stringstab.frequency.margin_g` as
+The normalisation makes g_H(ωH) → g(ω) of :func:`stringstab.certify.frequency.margin_g` as
 H → 0.
 
 **The decision** of max_{θ∈[0,π]} |H(e^{jθ})| ≤ 1 is a branch and bound on g_H over the
@@ -45,7 +45,7 @@ round-off of the coefficients and of the evaluation.  A tangency (g_H = 0 somewh
 e.g. at θ = 0) is left ``inconclusive``, never ``certified``.
 
 **Internal stability** is Schur stability of Δ, decided in the well-conditioned w-form
-by the bilinear conditions of :func:`stringstab.sampled_symbolic.schur_conditions`
+by the bilinear conditions of :func:`stringstab.derive.sampled_symbolic.schur_conditions`
 (with a relative 10⁻¹² band left inconclusive).  The delay adds m + 1 poles at z = 0.
 
 Verdicts: ``certified`` (Schur and g_H ≥ 0 on [0, π], so sup_θ |H(e^{jθ})| = 1,
@@ -54,7 +54,7 @@ witness with |H(e^{jθ})| > 1), ``inconclusive`` (neither shown within the budge
 
 References
 ----------
-IDL paper, eqs 3-9 (model) and eq 4 (law); :mod:`stringstab.sampled_symbolic`.
+IDL paper, eqs 3-9 (model) and eq 4 (law); :mod:`stringstab.derive.sampled_symbolic`.
 N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2002),
 §3.1 (the error bound γ_n × the computation on absolute values).
 """
@@ -69,11 +69,11 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
+from ..io.results import TableColumn
+from ..params import Box, Params, as_gains, check_params, positive
+from ..params import sample_time as _sample_time
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes, zoom_max
 from .excess import EXCESS_SEARCH
-from .io.results import TableColumn
-from .params import Box, Params, as_gains, check_params, positive
-from .params import sample_time as _sample_time
 from .verdicts import CERTIFIED as CERTIFIED_CODE
 from .verdicts import (
     INCONCLUSIVE,
@@ -421,7 +421,7 @@ def _coefficients(
 
 
 # ---------------------------------------------------------------------------
-# Parameter cells: the mean-value form (used by stringstab.robust)
+# Parameter cells: the mean-value form (used by stringstab.certify.robust)
 # ---------------------------------------------------------------------------
 def _param_ad(lo: Array, hi: Array, i: int, d: int) -> _Ad:
     mid = np.ascontiguousarray(0.5 * (lo + hi))
@@ -685,9 +685,9 @@ def sampled_margin(
 ) -> Array:
     """g_H(θ) = τ²τ_p²(|D|² − |N|²)/(H⁶ ρ): ≥ 0 iff |H(e^{jθ})| ≤ 1 (module docstring).
 
-    Tends to the continuous margin g(ω) of :func:`stringstab.frequency.margin_g` at
+    Tends to the continuous margin g(ω) of :func:`stringstab.certify.frequency.margin_g` at
     θ = ωH as H → 0; at θ = 0 it is the sampled analogue of Ψ3
-    (:func:`stringstab.sampled_symbolic.dc_margin`).
+    (:func:`stringstab.derive.sampled_symbolic.dc_margin`).
 
     Parameters
     ----------
@@ -701,7 +701,7 @@ def sampled_margin(
 
     Examples
     --------
-    >>> from stringstab.frequency import margin_g
+    >>> from stringstab.certify.frequency import margin_g
     >>> kw = dict(tau=0.1, delta=0.2, headway=1.1)
     >>> gc = margin_g(1.5, 1.2, 0.5, 0.6, **kw)
     >>> [round(float(sampled_margin(H * 1.5, 1.2, 0.5, 0.6, sample_time=H, **kw) - gc), 3)
@@ -717,7 +717,7 @@ def sampled_margin(
 # Schur stability
 # ---------------------------------------------------------------------------
 def _schur_terms(delta: list[_Iv]) -> list[_Iv]:
-    """The five quantities of :func:`stringstab.sampled_symbolic.schur_conditions` (each > 0)."""
+    """The five quantities of :func:`stringstab.derive.sampled_symbolic.schur_conditions` (each > 0)."""
     d0, d1, d2 = delta
     b0 = d0
     b1 = 2.0 * d1 - 3.0 * d0
@@ -755,7 +755,7 @@ def schur(
 ) -> npt.NDArray[np.bool_]:
     """Internal stability of the sampled loop: is Δ(z) Schur (all roots inside |z| < 1)?
 
-    Decided by the bilinear conditions (:func:`stringstab.sampled_symbolic.schur_conditions`)
+    Decided by the bilinear conditions (:func:`stringstab.derive.sampled_symbolic.schur_conditions`)
     in the w-form; True only outside a relative 10⁻¹² band around the boundary.  Δ does not
     depend on δ, k_a or the predecessor's lag.
 
@@ -789,7 +789,7 @@ def schur_margins(
 ) -> Array:
     """The five Schur conditions of Δ(z), each divided by its leading order in H (> 0 iff Schur).
 
-    The conditions of :func:`stringstab.sampled_symbolic.schur_conditions` (b0, b1, b2, b3 and
+    The conditions of :func:`stringstab.derive.sampled_symbolic.schur_conditions` (b0, b1, b2, b3 and
     the Hurwitz determinant h2) divided by H²φ1, 2Hφ1, 4φ1, 8 and 8τx³ (x = H/τ, φ1 = 1 − e^{−x}),
     so that as H → 0 they tend to k_x, c = k_v + T*k_x, 1, 1 and k_v + (T* − τ)k_x: the
     continuous Hurwitz conditions and the same margins (the gain repair of
@@ -934,7 +934,7 @@ def _take(co: _Coeffs, idx: npt.NDArray[np.intp]) -> _Coeffs:
 
 
 def _point_evaluator(co: _Coeffs, m: int) -> Evaluate:
-    """The :data:`~stringstab.branch_bound.Evaluate` of g_H for point coefficients."""
+    """The :data:`~stringstab.certify.branch_bound.Evaluate` of g_H for point coefficients."""
     mm = np.full(co.P[0].lo.size, float(m))
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
@@ -960,7 +960,7 @@ def _bnb_points(
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SampledCheck(Check):
-    """Verdicts only (see :func:`check_sampled`): a :class:`~stringstab.verdicts.Check` whose
+    """Verdicts only (see :func:`check_sampled`): a :class:`~stringstab.certify.verdicts.Check` whose
     ``hurwitz`` is Schur stability of Δ(z), with ``sample_time`` and ``witness_theta``.
 
     Attributes

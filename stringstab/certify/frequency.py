@@ -1,15 +1,15 @@
 """Vectorised numeric frequency response of Γ(jω) with the exact delay.
 
 Direct NumPy evaluation of the derived transfer function (IDL eq 11, derived
-form, see :func:`stringstab.symbolic.gamma`)
+form, see :func:`stringstab.derive.symbolic.gamma`)
 
 .. math::
     Γ(jω) = \\frac{k_x + k_v jω − k_a ω² e^{−jδω}}
                  {k_x − ω² + j ω (k_v + T^* k_x − τ ω²)}
 
 from the real and imaginary parts of N(jω) and D(jω) generated from the SymPy
-derivation (:mod:`stringstab._generated`).  The margin g(ω) = (|D(jω)|² −
-|N(jω)|²)/ω², whose sign decides |Γ(jω)| ≤ 1, lives in :mod:`stringstab.margin`;
+derivation (:mod:`stringstab.derive.generated`).  The margin g(ω) = (|D(jω)|² −
+|N(jω)|²)/ω², whose sign decides |Γ(jω)| ≤ 1, lives in :mod:`stringstab.certify.margin`;
 :func:`margin_g` and :func:`margin_g_coefficients` are kept here as its names in
 the frequency-response API.  Every function broadcasts over gains, parameters and ω.
 """
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from . import _generated as _gen
+from ..derive import generated as _gen
 from . import margin as _margin
 
 __all__ = ["gain", "gain_squared", "gamma_jw", "margin_g", "margin_g_coefficients"]
@@ -130,7 +130,7 @@ def margin_g_coefficients(
     k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> tuple[Array, Array, Array, Array, Array]:
-    """Coefficients of g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.margin.coefficients`).
+    """Coefficients of g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.certify.margin.coefficients`).
 
     g(ω) = τ² ω⁴ + a ω² + b + 2 k_x k_a cos(δω) − 2 k_v k_a ω sin(δω), with
     c = k_v + T* k_x, a = 1 − 2τc − k_a², b = c² − 2k_x − k_v².
@@ -154,7 +154,7 @@ def margin_g(
     omega: ArrayLike, k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike,
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> Array:
-    """g(ω) = (|D(jω)|² − |N(jω)|²)/ω², continuous at ω = 0 where g(0) = Ψ3 (:func:`stringstab.margin.g`).
+    """g(ω) = (|D(jω)|² − |N(jω)|²)/ω², continuous at ω = 0 where g(0) = Ψ3 (:func:`stringstab.certify.margin.g`).
 
     |Γ(jω)| ≤ 1 at ω > 0 iff g(ω) ≥ 0.
 

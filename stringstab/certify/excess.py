@@ -4,13 +4,13 @@ A not-certified row must report a number that agrees with its verdict (issue 21,
 |Γ(jω)|² − 1 computed directly rounds to 0 when the violation is below double precision
 (Ψ3 just below 0, where |Γ|² = 1 − (Ψ3/k_x²) ω² + O(ω⁴) exceeds 1 only near ω = 0, by as
 little as 10⁻²⁰).  Written as −ω² g(ω)/|D(jω)|² with the margin g evaluated from its
-coefficients (:mod:`stringstab.margin`), it keeps its sign and digits.  Used by
-:mod:`stringstab.certificate` and, at the witness member, :mod:`stringstab.robust`;
+coefficients (:mod:`stringstab.certify.margin`), it keeps its sign and digits.  Used by
+:mod:`stringstab.certify.continuous` and, at the witness member, :mod:`stringstab.certify.robust`;
 reporting only — no verdict depends on it.
 
 References
 ----------
-IDL paper, eqs 10-14 (Γ, Ψ3); :mod:`stringstab.margin` (g).
+IDL paper, eqs 10-14 (Γ, Ψ3); :mod:`stringstab.certify.margin` (g).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from . import _generated as _gen
+from ..derive import generated as _gen
 from . import margin as _margin
 
 __all__ = ["EXCESS_SEARCH", "excess_squared", "violation_peak"]
@@ -53,7 +53,7 @@ def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, k
                    tau: npt.ArrayLike, delta: npt.ArrayLike, headway: npt.ArrayLike) -> Array:
     """|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
 
-    g (:mod:`stringstab.margin`) is evaluated from its coefficients, so an excess of 1e-20,
+    g (:mod:`stringstab.certify.margin`) is evaluated from its coefficients, so an excess of 1e-20,
     which |Γ|² computed directly rounds to exactly 1, keeps its sign and its digits.  Near
     ω = 0, g(ω) = Ψ3 + g₂ω² + O(ω⁴) with g₂ = a − c_x δ²/2 − c_v δ and |D(0)|² = k_x², so
 
@@ -77,7 +77,7 @@ def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, k
 
     Examples
     --------
-    >>> from stringstab.frequency import gain_squared
+    >>> from stringstab.certify.frequency import gain_squared
     >>> float(excess_squared(0.0, 1.0, 0.5, 0.2, 0.1, 0.2, 1.1))
     0.0
     >>> bool(np.isclose(excess_squared(2.0, 0.9, -0.5, 1.1, 0.1, 0.2, 1.1),

@@ -1,7 +1,7 @@
 """The frequency-domain margin g(ω) and everything computed from it: one home.
 
 For the derived transfer function Γ(s) = N(s)/D(s) (IDL eq 11, derived form,
-:func:`stringstab.symbolic.gamma`), |Γ(jω)| ≤ 1 at ω > 0 iff
+:func:`stringstab.derive.symbolic.gamma`), |Γ(jω)| ≤ 1 at ω > 0 iff
 
 .. math::
     g(ω) = \\frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
@@ -9,7 +9,7 @@ For the derived transfer function Γ(s) = N(s)/D(s) (IDL eq 11, derived form,
 
 with t₂ = τ², c = k_v + T*k_x, a = 1 − 2τc − k_a², b = c² − 2k_x − k_v²,
 c_x = 2k_xk_a, c_v = 2k_vk_a (g(0) = Ψ3).  Every formula here is *generated* from
-the SymPy derivation into :mod:`stringstab._generated` (``python -m stringstab.codegen``),
+the SymPy derivation into :mod:`stringstab.derive.generated` (``python -m stringstab.derive.codegen``),
 so the certificate, the region maps, the gain repair and the NLP evaluate the same
 expressions, in three forms:
 
@@ -19,7 +19,7 @@ expressions, in three forms:
   overhead dominates): :func:`newton_terms`;
 * **CasADi** (symbolic, for the projection NLP): :func:`casadi_g`.
 
-Beside them, the bounds the branch and bound of :mod:`stringstab.certificate`
+Beside them, the bounds the branch and bound of :mod:`stringstab.certify.continuous`
 rests on: :func:`curvature_bound` (M ≥ |g''| on [0, r]) and :func:`tail_bound`
 (Ω with g > 0 beyond it, from Fujiwara's root bound refined by Newton's method).
 
@@ -39,7 +39,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from . import _generated as _gen
+from ..derive import generated as _gen
 
 __all__ = [
     "MarginCoefficients",
@@ -142,7 +142,7 @@ def separable(
 
     Returns ((c, h2, h0, cx, cv), their Σ |term| scales); only c depends on the parameters
     (on T*), so the minimum of g over a box of τ, δ, T* has a closed form
-    (:mod:`stringstab.robust`).  Generated from the derivation (:func:`stringstab.codegen.margin_separable`).
+    (:mod:`stringstab.certify.robust`).  Generated from the derivation (:func:`stringstab.derive.codegen.margin_separable`).
 
     Parameters
     ----------

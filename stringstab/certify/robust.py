@@ -2,14 +2,14 @@
 
 A gain triple is *robustly certified* for the box τ ∈ [τ_lo, τ_hi], δ ∈ [δ_lo, δ_hi],
 T* ∈ [h_lo, h_hi] (any of them may be a point) when the certificate of
-:mod:`stringstab.certificate` (continuous time) or :mod:`stringstab.sampled` (sampled
+:mod:`stringstab.certify.continuous` (continuous time) or :mod:`stringstab.certify.sampled` (sampled
 data, period H) holds for *every* member of the box.  Since a vehicle's transfer function
 depends only on its own τ, δ, T* (and, sampled, its predecessor's lag), a certificate
 over the box covers a heterogeneous platoon whose vehicles each lie in it: every
 |Γ_i(jω)| ≤ 1, so the product along the platoon is ≤ 1 too.
 
 **Continuous time** (exact in the parameters).  The margin of
-:func:`stringstab.frequency.margin_g` separates:
+:func:`stringstab.certify.frequency.margin_g` separates:
 
 .. math::
     g(ω) = (τω^2 - c)^2 + (1 - k_a^2)ω^2 - 2k_x - k_v^2
@@ -22,17 +22,17 @@ of the end nearer 0; and 2k_xk_a cos ψ − 2k_vk_aω sin ψ = R cos(ψ + φ) ov
 ψ = δω ∈ [δ_lo ω, δ_hi ω] is −R if the shifted range contains an odd multiple of π,
 else the smaller end value.  The minimiser (τ*, δ*, T*) is the witness.
 
-The branch and bound of :mod:`stringstab.branch_bound` then runs on
+The branch and bound of :mod:`stringstab.certify.branch_bound` then runs on
 G(ω) = min_box g(ω): for every member, g ≥ min(g(l), g(r)) − M h²/8 ≥
 min(G(l), G(r)) − M h²/8 on [l, r] when M bounds |g''| *uniformly over the box*
 (the certificate's bound at τ_hi, δ_hi and the largest |a| over the corners, a being
-bilinear in τ and T*).  The tail bound of :func:`stringstab.certificate.tail_bound` is
+bilinear in τ and T*).  The tail bound of :func:`stringstab.certify.continuous.tail_bound` is
 taken with the box's worst coefficients (τ_lo² for τ², the smallest a and b), which
 bounds every member's g from below.  Internal stability over the box: with k_x > 0,
 the Hurwitz condition k_v + (T* − τ)k_x > 0 increases with T* and decreases with τ, so
 the worst member is (τ_hi, h_lo); with k_x ≤ 0 no member is stable.
 
-**Sampled data.**  g_H of :func:`stringstab.sampled.sampled_margin` has no closed-form
+**Sampled data.**  g_H of :func:`stringstab.certify.sampled.sampled_margin` has no closed-form
 minimum over the box, so the branch and bound also splits the parameters: each item is
 a cell (τ, τ_p, ε, T* intervals) whose coefficients are enclosed by interval arithmetic
 with a round-off companion; a frequency interval where the cell's width, not the
@@ -62,15 +62,15 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
+from ..io.results import TableColumn
+from ..params import Box, Interval, as_gains, as_interval, check_box, parse_interval
+from ..params import sample_time as _sample_time
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max
 from .criteria import hurwitz_bands
 from .excess import EXCESS_SEARCH
 from .excess import violation_peak as _violation_peak_continuous
 from .frequency import gain_squared, margin_g_coefficients
-from .io.results import TableColumn
 from .margin import curvature_bound, separable, tail_bound
-from .params import Box, Interval, as_gains, as_interval, check_box, parse_interval
-from .params import sample_time as _sample_time
 from .sampled import (
     _Ad,
     _cell_coefficients,
@@ -129,7 +129,7 @@ def _robust_g(
     """(min_box g(ω), τ*, δ*, T*, magnitude) at ω ≥ 0; gains broadcast against ω.
 
     g = (τω² − c)² + h2 ω² + h0 + cx cos δω − cv ω sin δω
-    (:func:`stringstab.margin.separable`, generated from the derivation): only the square
+    (:func:`stringstab.certify.margin.separable`, generated from the derivation): only the square
     depends on τ and T* (c = k_v + T*k_x is affine in T*), only the trigonometric terms on δ.
     """
     (t_lo, t_hi), (d_lo, d_hi), (h_lo, h_hi) = box.tau, box.delta, box.headway
@@ -174,7 +174,7 @@ def robust_margin(
     omega: npt.ArrayLike, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
     *, tau: Any, delta: Any, headway: Any,
 ) -> Array:
-    """min over the box of g(ω) (:func:`stringstab.frequency.margin_g`), exactly.
+    """min over the box of g(ω) (:func:`stringstab.certify.frequency.margin_g`), exactly.
 
     Parameters
     ----------
@@ -192,7 +192,7 @@ def robust_margin(
 
     Examples
     --------
-    >>> from stringstab.frequency import margin_g
+    >>> from stringstab.certify.frequency import margin_g
     >>> w = np.array([0.5, 2.0])
     >>> G = robust_margin(w, 1.2, 0.5, 0.6, tau=(0.1, 0.3), delta=0.2, headway=1.1)
     >>> bool(np.all(G <= margin_g(w, 1.2, 0.5, 0.6, tau=0.2, delta=0.2, headway=1.1)))
@@ -229,7 +229,7 @@ def _robust_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
         G, _, _, _, mag = _robust_g(X, col(kx, idx), col(kv, idx), col(ka, idx), box)
-        # M ≥ |g''| of every member: the bound of stringstab.margin with its largest
+        # M ≥ |g''| of every member: the bound of stringstab.certify.margin with its largest
         # coefficients (t2 at τ_hi, |a| over the box; b does not enter) and δ_hi
         M = curvature_bound(X[:, 1:], (t_hi * t_hi, col(a_absmax, idx), 0.0, col(cx, idx),
                                        col(cv, idx)), d_hi)
@@ -371,7 +371,7 @@ def _halfwidths(c: _Cells, heterogeneous: bool) -> Array:
 
 
 def _dims(heterogeneous: bool) -> list[str]:
-    """The cell fields in the order of :func:`stringstab.sampled._cell_coefficients`."""
+    """The cell fields in the order of :func:`stringstab.certify.sampled._cell_coefficients`."""
     return ["t", "tp", "e", "h"] if heterogeneous else ["t", "e", "h"]
 
 
@@ -862,7 +862,7 @@ def check_robust(
     headway: Any, sample_time: float | None = None, heterogeneous: bool = True,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
 ) -> Check:
-    """The robust certificate's verdicts and witnesses, as a :class:`~stringstab.verdicts.Check`.
+    """The robust certificate's verdicts and witnesses, as a :class:`~stringstab.certify.verdicts.Check`.
 
     The decision of :func:`certify_robust_batch`; ``hurwitz`` is stability of every member,
     and the witness member (τ, τ_prev, δ, T*) and frequency (ω, and θ when sampled) of each
