@@ -51,7 +51,7 @@ def add_parser(sub: Any) -> None:
                    help="stop after N collision-free episode ends (default 700; 0: only --steps)")
     p.add_argument("--paper", action="store_true",
                    help="IDL as printed: the eq-16 state, no gain rate limit, episodes started in "
-                        "equilibrium (without the trainer's phase-2 options; docs/training.md)")
+                        "equilibrium (without the toolkit's three IDL options observe, gain_rate and start_spread; docs/training.md)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
