@@ -60,7 +60,7 @@ from .errors import StringStabError
 from .excess import EXCESS_SEARCH, col
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
-from .io.results import TableColumn, columns_from_records
+from .io import TableColumn, columns_from_records
 from .margin import tail_bound
 from .params import Box, Params, as_gains, parameter_model
 from .params import sample_time as _sample_time

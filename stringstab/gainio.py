@@ -1,7 +1,7 @@
 """Former home of gain-file reading and result writing (kept importable).
 
 Reading gains lives in :mod:`stringstab.io.gains` and writing results in
-:mod:`stringstab.io.results`; this module re-exports the reader and keeps the record-based
+:mod:`stringstab.io`; this module re-exports the reader and keeps the record-based
 writer (``format_results(records, ...)``) of earlier versions, built on the columnar one.
 New code should use :func:`stringstab.io.read_gains` and :func:`stringstab.io.write_results`.
 """
@@ -12,8 +12,8 @@ import os
 from collections.abc import Mapping, Sequence
 from typing import IO, Any
 
+from . import io as _io
 from .errors import StringStabError
-from .io import results as _results
 from .io.gains import (
     GAIN_COLUMNS,
     INPUT_FORMATS,
@@ -92,8 +92,8 @@ def format_results(
         from .certificate import TABLE_COLUMNS
 
         table = TABLE_COLUMNS
-    columns = _results.columns_from_records([to_plain(r) for r in records])
-    return _results.format_results(columns, fmt, params=params, summary=summary, table=table)
+    columns = _io.columns_from_records([to_plain(r) for r in records])
+    return _io.format_results(columns, fmt, params=params, summary=summary, table=table)
 
 
 def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
@@ -112,7 +112,7 @@ def write_text(text: str, dest: str | os.PathLike[str] | IO[str]) -> None:
         When the file cannot be written.
     """
     try:
-        _results.write_text(text, dest)
+        _io.write_text(text, dest)
     except StringStabError as e:
         cause = e.__cause__
         reason = (getattr(cause, "strerror", None) or cause) if cause is not None else e

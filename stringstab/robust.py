@@ -67,7 +67,7 @@ from .criteria import hurwitz_bands
 from .excess import EXCESS_SEARCH
 from .excess import violation_peak as _violation_peak_continuous
 from .frequency import gain_squared, margin_g_coefficients
-from .io.results import TableColumn
+from .io import TableColumn
 from .margin import curvature_bound, separable, tail_bound
 from .params import Box, Interval, as_gains, as_interval, check_box, parse_interval
 from .params import sample_time as _sample_time

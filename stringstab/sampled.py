@@ -71,7 +71,7 @@ import numpy.typing as npt
 
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes, zoom_max
 from .excess import EXCESS_SEARCH
-from .io.results import TableColumn
+from .io import TableColumn
 from .params import Box, Params, as_gains, check_params, positive
 from .params import sample_time as _sample_time
 from .verdicts import CERTIFIED as CERTIFIED_CODE
