@@ -140,15 +140,16 @@ def _step_region(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from .io import read_gains
-    from .plots import save_figures
+    from .plots import save_figures, trajectory_verdicts
     from .regions import region_map
 
     g = np.linspace(-2.0, 2.0, 121)
     rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
                       progress=False)
     files = [rmap.save_npz(out / "region.npz").name]
-    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=read_gains(ROLLOUT),
-                                           dpi=110)]
+    rollout = read_gains(ROLLOUT)
+    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=rollout,
+                                           verdicts=trajectory_verdicts(rmap, rollout), dpi=110)]
     for line in rmap.report().splitlines():
         log(line)
     return {"files": files, "class_shares": rmap.class_shares(),

@@ -271,8 +271,7 @@ def run(args: argparse.Namespace) -> int:
     """
     import time
 
-    from ..io import OutputDir
-    from ..plots import FIGURE_FORMATS
+    from ..io import FIGURE_FORMATS, OutputDir
     from ..regions import region_map
 
     t0 = time.perf_counter()

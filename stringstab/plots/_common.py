@@ -128,7 +128,6 @@ GAIN_LABELS: dict[str, str] = {
     "k_v": r"$k_v$ (s$^{-1}$)",
     "k_a": r"$k_a$ (–)",
 }
-#: File formats :func:`save_figures` can write.
 
 
 def pyplot() -> Any:
