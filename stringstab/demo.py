@@ -174,7 +174,7 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from .io import atomic_path, columns_from_records, parse_triple, write_results
-    from .plots import plot_moves
+    from .plots import moves_projection, plot_moves
     from .tuning import project, region_growing
 
     results = []
@@ -198,7 +198,7 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     columns = columns_from_records(records)
     write_results(columns, out / "tune.json", "json", params=params, summary=summary)
     write_results(columns, out / "tune.txt", "table", params=params, summary=summary)
-    drawn = plot_moves(results, tau=TAU, delta=DELTA, headway=HEADWAY, k_a=0.6, n=101)
+    drawn = plot_moves(results, moves_projection(results, tau=TAU, delta=DELTA, headway=HEADWAY))
     fig = drawn["ax"].figure
     with atomic_path(out / "tune_moves.png") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight")

@@ -19,7 +19,7 @@ from numpy.testing import assert_allclose
 from stringstab.certificate import certify, certify_batch
 from stringstab.errors import StringStabError
 from stringstab.frequency import gain
-from stringstab.plots import plot_moves
+from stringstab.plots import moves_projection, plot_moves
 from stringstab.tuning import Projector, TuneResult, project, region_growing, tune
 
 P = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
@@ -364,7 +364,7 @@ def test_plot_moves():
     import matplotlib.pyplot as plt
 
     rs = [f((0.9, -0.5, 1.1), **P) for f in (region_growing, project)]
-    out = plot_moves(rs, **P, n=21)
+    out = plot_moves(rs, moves_projection(rs, **P, n=21))
     assert len(out["arrows"]) == 2
     assert out["ax"].get_xlabel() == "$k_x$ (s$^{-2}$)"  # the gain with its unit
     # the background is the region projected over the outputs' own k_a: each certified output

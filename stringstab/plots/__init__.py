@@ -24,6 +24,7 @@ module / function              shows
 :func:`save_figures`           the standard figures of a map, in every format
 :func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
 **gain repair**                (:mod:`stringstab.plots.tuning`)
+:func:`moves_projection`       the certified region over the repairs' k_a (compute)
 :func:`plot_moves`             repairs K0 → K over the certified region
 **platoons**                   (:mod:`stringstab.plots.traffic`)
 :func:`plot_vehicles`          one line per vehicle, coloured by position
@@ -44,7 +45,7 @@ from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
 from .traffic import plot_damping_ratios, plot_platoon, plot_vehicles
 from .trajectory import plot_trajectory, trajectory_verdicts
-from .tuning import moves_region, plot_moves
+from .tuning import moves_projection, moves_region, plot_moves
 
 __all__ = [
     "CLASS_COLORS",
@@ -54,6 +55,7 @@ __all__ = [
     "PlotResult",
     "draw_figure",
     "figure_stems",
+    "moves_projection",
     "moves_region",
     "plot_boundaries",
     "plot_class_map",
