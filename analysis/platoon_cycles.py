@@ -32,14 +32,13 @@ from matplotlib.figure import Figure
 
 from stringstab.certificate import certify
 from stringstab.frequency import gain
+from stringstab.plots import plot_damping_ratios, plot_platoon
 from stringstab.traffic import (
     CACCController,
     LinearController,
     leader_by_name,
-    plot_platoon,
     simulate,
 )
-from stringstab.traffic.plots import plot_damping_ratios
 
 TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
 K = (1.2, 0.5, 0.6)

@@ -68,9 +68,6 @@ def test_trajectory_with_verdicts_computed_beforehand_runs_no_certificate(monkey
 
 
 def test_traffic_figures_return_plot_results():
-    from stringstab.traffic import plots as old_home
-
-    assert old_home.plot_platoon is plots.plot_platoon  # re-exported from the old path
     t = np.linspace(0, 10, 50)
     v = np.vstack([np.sin(t), np.cos(t)])
     out = plots.plot_vehicles(t, v)

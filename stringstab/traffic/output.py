@@ -183,7 +183,7 @@ def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: 
     if figures:
         from matplotlib.figure import Figure
 
-        from .plots import plot_damping_ratios, plot_platoon
+        from ..plots.traffic import plot_damping_ratios, plot_platoon
 
         fig, _ = plot_platoon(result, title=title,
                               fig=Figure(figsize=(12, 7.5), layout="constrained"))
