@@ -36,7 +36,7 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "rate0.05+spread+ttc4": {"gain_rate": 0.05, "observe": ("accel", "gains"),
                              "start_spread": (0.3, 3.0), "reward_ttc_star": 4.0},
 }
-KEYS = ("TIT", "M_CI", "M_lss", "M_fss", "M_fss_sampled", "collisions", "min_gap",
+KEYS = ("TIT", "M_CI", "M_lss", "m_fss", "m_fss_sampled", "collisions", "min_gap",
         "median_headway")
 
 

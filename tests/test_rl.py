@@ -311,7 +311,7 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
     code = main(["evaluate", str(run), "--leaders", str(leader), "--platoon", "none"])
     assert code in (0, 1)
     doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
-    assert doc["summary"]["M_fss"] == 100.0  # the repair is on: every executed gain certified
+    assert doc["summary"]["m_fss"] == 1.0  # the repair is on: every executed gain certified
     assert code == (0 if doc["summary"]["collisions"] == 0 else 1)
     from stringstab.gainio import read_gains
 
@@ -357,7 +357,7 @@ def test_platoon_test_reports_m_p_per_vehicle():
     res = simulate(paper_mix(), CACCController(), 3, tau=TAU, delta=DELTA,
                    initial_gap=2.0 + HEADWAY * 20.0)
     np.testing.assert_allclose(p["m_p"], platoon_damping_ratios(res.accel), rtol=1e-5)
-    assert p["n"] == 3 and p["collisions"] == 0 and p["M_fss"] is None
+    assert p["n"] == 3 and p["collisions"] == 0 and p["m_fss"] is None
 
 
 def _bad(argv, match, capsys):
