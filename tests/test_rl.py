@@ -41,7 +41,7 @@ def tiny(algo: str, **kw):
                 stop_episodes=0, seed=3, hidden=(16, 16), repair_resolution=0.25,
                 checkpoint_every=10_000)
     base.update(kw)
-    # phase 1's configuration (the eq-16 state); tests of the phase-2 options pass them explicitly
+    # the paper's configuration (the eq-16 state); tests of the other options pass them explicitly
     return config_for(algo, paper=algo == "idl", **base)
 
 

@@ -238,7 +238,7 @@ def run(args: argparse.Namespace) -> int:
     params: dict[str, Any] = {**shown_params(model, H), "method": args.method,
                               "bounds": [lo, hi], "weights": weights}
     if not general:
-        del params["sample_time"]  # the continuous loop at one τ, δ, T*: as before
+        del params["sample_time"]  # the continuous loop at one τ, δ, T*: no sample time
     if "region-growing" in methods:
         params.update(r0=r0, grid=grid, max_iter=max_iter, criterion=args.criterion,
                       check_hurwitz=args.check_hurwitz, grow_ka=args.grow_ka)

@@ -53,7 +53,7 @@ class PlotResult:
     Notes
     -----
     ``result["name"]`` reads an artist (``"ax"``, ``"fig"`` and ``"axes"`` read the
-    figure's axes and the figure), as the dicts returned before did; ``fig, axes = result``
+    figure's axes and the figure), as a dict of artists would; ``fig, axes = result``
     unpacks like :func:`matplotlib.pyplot.subplots`.
     """
 

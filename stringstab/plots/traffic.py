@@ -111,7 +111,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     -------
     PlotResult
         The figure, the axes [speed, acceleration, spacing, time headway] and the
-        ``colorbar``; ``fig, axes = plot_platoon(...)`` unpacks as before.
+        ``colorbar``; ``fig, axes = plot_platoon(...)`` unpacks the figure and the axes.
     """
     from ._common import pyplot
 
