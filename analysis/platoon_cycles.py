@@ -32,14 +32,13 @@ from matplotlib.figure import Figure
 
 from stringstab.certify.continuous import certify
 from stringstab.certify.frequency import gain
+from stringstab.plots import plot_damping_ratios, plot_platoon
 from stringstab.traffic import (
     CACCController,
     LinearController,
     leader_by_name,
-    plot_platoon,
     simulate,
 )
-from stringstab.traffic.plots import plot_damping_ratios
 
 TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
 K = (1.2, 0.5, 0.6)
@@ -97,10 +96,10 @@ def main() -> None:
             mp = np.asarray(m["m_p"])
             key = f"{lead.name}_{n}"
             runs[key] = {k: m[k] for k in ("m_p", "max_m_p", "M_lss", "collisions", "min_gap", "TIT",
-                                            "M_CI", "M_effi", "M_fss")}
+                                            "M_CI", "M_effi", "m_fss")}
             print(f"{lead.name:>9s} N={n:<3d} max m_p = {m['max_m_p']:.4f} (vehicle {int(np.argmax(mp)) + 1}), "
                   f"M_lss = {m['M_lss']:.4f}, collisions = {m['collisions']}, "
-                  f"min gap = {m['min_gap']:.2f} m, TIT = {m['TIT']:.2f}, M_fss = {m['M_fss']}%")
+                  f"min gap = {m['min_gap']:.2f} m, TIT = {m['TIT']:.2f}, M_fss = {m['m_fss']}%")
             print("    m_p: " + ", ".join(f"{v:.3f}" for v in mp))
             plot_damping_ratios(mp, ax=ax10 if n == 10 else ax100, label=lead.name)
             fig = Figure(figsize=(12, 7.5), layout="constrained")

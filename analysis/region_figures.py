@@ -131,7 +131,8 @@ def printed_figures(g, out: Path, dpi: int) -> None:
               f"certified {m.stable('exact').mean():.4f}, printed stable {m.stable('printed').mean():.4f}")
     ax = plots.plot_comparison(cmp_maps[0])["ax"]
     paper = GainTable.from_triples([(0.9, -0.5, 1.1)], source="docs/certify.md")
-    drawn = plots.plot_trajectory(cmp_maps[0], paper, ax=ax, label="K of docs/certify.md")
+    drawn = plots.plot_trajectory(cmp_maps[0], paper, verdicts=plots.trajectory_verdicts(cmp_maps[0], paper),
+                                  ax=ax, label="K of docs/certify.md")
     ax.annotate("K = (0.9, −0.5, 1.1)", (-0.5, 1.1), xytext=(-1.9, 1.55), fontsize="small",
                 arrowprops=dict(arrowstyle="->", lw=0.8))
     print(f"  K = (0.9, -0.5, 1.1): exact {drawn['verdicts'][0]}")
@@ -170,7 +171,8 @@ def overlay_figure(out: Path, dpi: int) -> None:
     ov = region_map({"k_x": np.linspace(0.0, 1.5, 301), "k_v": np.linspace(-1.0, 1.0, 301)}, {"k_a": 0.3},
                     tau=0.1, delta=DELTA, headway=HEADWAY, methods=("exact",))
     ax = plots.plot_class_map(ov, "exact")["ax"]
-    drawn = plots.plot_trajectory(ov, read_gains(ROLLOUT), ax=ax)
+    rollout = read_gains(ROLLOUT)
+    drawn = plots.plot_trajectory(ov, rollout, verdicts=plots.trajectory_verdicts(ov, rollout), ax=ax)
     print(f"  verdicts of the {len(drawn['verdicts'])} rows: "
           + ", ".join(f"{v} {drawn['verdicts'].count(v)}" for v in sorted(set(drawn["verdicts"]))))
     save(ax.figure, out, "regions_overlay.png", dpi)

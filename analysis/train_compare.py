@@ -68,7 +68,7 @@ def main() -> None:
             pol = load_policy(root / "runs" / f"{algo}-s{seed}")
             ev = evaluate(pol, leaders, name=algo, **kw)
             groups.setdefault(algo, []).append(ev)
-            print(f"{algo}-s{seed}: {json.dumps({k: ev.summary.get(k) for k in ('TIT', 'M_CI', 'M_effi', 'M_lss', 'M_fss', 'collisions')})}", flush=True)
+            print(f"{algo}-s{seed}: {json.dumps({k: ev.summary.get(k) for k in ('TIT', 'M_CI', 'M_effi', 'M_lss', 'm_fss', 'collisions')})}", flush=True)
             if seed == seeds[0]:
                 platoons[algo] = {"run": f"{algo}-s{seed}",
                                   "tests": [platoon_test(pol, n, dt=p.dt, **kw) for n in (10, 100)]}

@@ -25,7 +25,7 @@ from stringstab.rl.episodes import default_leaders
 from stringstab.rl.evaluate import evaluate, platoon_test
 from stringstab.traffic import train_test_split
 
-#: The variants compared (TD3Config overrides of phase 1's defaults, config_for("idl", paper=True)).
+#: The variants compared (TD3Config overrides of the paper's configuration, config_for("idl", paper=True)).
 VARIANTS: dict[str, dict[str, Any]] = {
     "paper": {},
     "rate0.05": {"gain_rate": 0.05, "observe": ("accel", "gains")},
@@ -36,7 +36,7 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "rate0.05+spread+ttc4": {"gain_rate": 0.05, "observe": ("accel", "gains"),
                              "start_spread": (0.3, 3.0), "reward_ttc_star": 4.0},
 }
-KEYS = ("TIT", "M_CI", "M_lss", "M_fss", "M_fss_sampled", "collisions", "min_gap",
+KEYS = ("TIT", "M_CI", "M_lss", "m_fss", "m_fss_sampled", "collisions", "min_gap",
         "median_headway")
 
 

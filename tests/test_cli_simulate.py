@@ -18,7 +18,7 @@ def test_simulate_tiny_run(tmp_path, capsys):
         "damping.png", "metrics.json", "platoon.png", "report.html", "report.md", "trajectories.npz"]
     doc = json.loads((out / "metrics.json").read_text())
     assert len(doc["m_p"]) == 3 and doc["max_m_p"] < 1.0 and doc["collisions"] == 0
-    assert doc["M_fss"] == 100.0 and doc["certificate"]["verdict"] == "certified"
+    assert doc["m_fss"] == 1.0 and doc["certificate"]["verdict"] == "certified"
     assert doc["run"]["k_x"] == 1.2 and doc["run"]["delta"] == 0.2
     with np.load(out / "trajectories.npz") as z:
         assert z["speed"].shape == (4, 601) and z["gap"].shape == (3, 601)
@@ -39,7 +39,7 @@ def test_simulate_csv_leader_cacc_kinematic(tmp_path):
     assert lines[0] == "t,vehicle,position,speed,accel,gap,headway,command"
     assert len(lines) == 1 + 201 * 3
     doc = json.loads((out / "metrics.json").read_text())
-    assert doc["certificate"]["verdict"] == "not_certified" and doc["M_fss"] == 0.0
+    assert doc["certificate"]["verdict"] == "not_certified" and doc["m_fss"] == 0.0
 
 
 @pytest.mark.parametrize(
@@ -77,4 +77,4 @@ def test_simulate_time_varying_gains_file(tmp_path):
     assert main(["simulate", "--leader", "mix", "--duration", "10", "--followers", "2",
                  "--gains-file", str(gains), "--no-figures", "--out", str(out)]) == 0
     doc = json.loads((out / "metrics.json").read_text())
-    assert doc["M_fss"] == pytest.approx(100.0 * 50 / 101)  # steps 0-49 of 0-100 certified
+    assert doc["m_fss"] == pytest.approx(50 / 101)  # steps 0-49 of 0-100 certified

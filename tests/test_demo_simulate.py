@@ -9,7 +9,7 @@ def test_demo_simulate_step(tmp_path, capsys):
     assert main(["demo", "--out", str(tmp_path), "--only", "simulate"]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())["simulate"]
     cert, cacc = summary["certified"], summary["cacc"]
-    assert cert["max_m_p"] < 1.0 and cert["collisions"] == 0 and cert["M_fss"] == 100.0
-    assert cacc["max_m_p"] > 1.0 and cacc["M_fss"] == 0.0
+    assert cert["max_m_p"] < 1.0 and cert["collisions"] == 0 and cert["m_fss"] == 1.0
+    assert cacc["max_m_p"] > 1.0 and cacc["m_fss"] == 0.0
     for f in cert["files"] + cacc["files"]:
         assert (tmp_path / "simulate" / f).is_file()

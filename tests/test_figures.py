@@ -99,8 +99,11 @@ def test_region_figures(tmp_path, captured):
     g = np.linspace(-2, 2, 15)
     m2 = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1,
                     progress=False, workers=1)
-    save_figures(m2, tmp_path, formats=("png",), dpi=40,
-                 gains=read_gains("stringstab/data/examples/gain_rollout.csv"))
+    from stringstab.plots import trajectory_verdicts
+
+    rollout = read_gains("stringstab/data/examples/gain_rollout.csv")
+    save_figures(m2, tmp_path, formats=("png",), dpi=40, gains=rollout,
+                 verdicts=trajectory_verdicts(m2, rollout))
     m3 = region_map({"k_x": g[::2], "k_v": g[::2], "k_a": np.linspace(-1, 1, 3)}, tau=0.1,
                     delta=0.2, headway=1.1, methods="exact", progress=False, workers=1)
     save_figures(m3, tmp_path, prefix="r3", formats=("png",), dpi=40)

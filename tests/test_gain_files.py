@@ -12,6 +12,7 @@ from numpy.testing import assert_array_equal
 
 from stringstab.certify.continuous import TABLE_COLUMNS
 from stringstab.errors import StringStabError
+from stringstab.io import columns_from_records
 from stringstab.io import results as io_results
 from stringstab.io.gains import GainTable, parse_triple, read_gains
 from stringstab.io.plain import to_plain
@@ -19,7 +20,7 @@ from stringstab.io.plain import to_plain
 
 def format_results(records, fmt="table", **kw):
     """Records (one dict per triple) through the columnar writer, as the CLI writes them."""
-    columns = io_results.columns_from_records([to_plain(r) for r in records])
+    columns = columns_from_records([to_plain(r) for r in records])
     return io_results.format_results(columns, fmt, table=TABLE_COLUMNS if fmt == "table" else None,
                                      **kw)
 

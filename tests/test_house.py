@@ -299,8 +299,6 @@ KNOWN_PRIVATE_IMPORTS: set[tuple[str, str]] = {
     ("stringstab.certify.robust", "stringstab.certify.sampled._violation_peak"),
     ("stringstab.regions", "stringstab.regions.grid._blocks"),
     ("stringstab.traffic.synthetic", "stringstab.traffic.trajectory._grid"),
-    ("stringstab.tuning", "stringstab.tuning.predictor._g_and_grad"),
-    ("stringstab.tuning", "stringstab.tuning.predictor._g_full"),
 }
 
 

@@ -106,7 +106,7 @@ def test_collision_count():
 def test_fss_ratio_counts_certified_moments():
     """Eq 27: 3 moments with the certified triple, 1 with the van Arem gains (|Γ(j2)| ≈ 1.14)."""
     K = np.array([[1.2, 0.5, 0.6]] * 3 + [[0.1, 0.58, 1.0]])
-    assert fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1) == 75.0
+    assert fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1) == 0.75  # a fraction
     with pytest.raises(StringStabError):
         fss_ratio([np.nan], [0.5], [0.6], tau=0.1, delta=0.2, headway=1.1)
 

@@ -42,8 +42,8 @@ def test_plot_moves_draws_a_region_computed_beforehand():
     out = plots.plot_moves(rs, region=region)
     assert len(out["arrows"]) == 2
     assert_array_equal(out["region"].get_array().reshape(15, 15), region.stable("exact"))
-    with pytest.raises(StringStabError, match="region="):
-        plots.plot_moves(rs)
+    with pytest.raises(TypeError, match="region"):  # the background is computed beforehand
+        plots.plot_moves(rs)  # type: ignore[call-arg]
     taylor = region_map({"k_x": np.linspace(-2, 2, 5), "k_v": np.linspace(-2, 2, 5)},
                         {"k_a": 1.1}, **P, methods="taylor")
     with pytest.raises(StringStabError, match="exact verdicts"):
@@ -68,9 +68,6 @@ def test_trajectory_with_verdicts_computed_beforehand_runs_no_certificate(monkey
 
 
 def test_traffic_figures_return_plot_results():
-    from stringstab.traffic import plots as old_home
-
-    assert old_home.plot_platoon is plots.plot_platoon  # re-exported from the old path
     t = np.linspace(0, 10, 50)
     v = np.vstack([np.sin(t), np.cos(t)])
     out = plots.plot_vehicles(t, v)

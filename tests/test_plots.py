@@ -90,8 +90,9 @@ def test_trajectory_is_marked_by_its_own_verdicts(m2):
     K = np.array([[0.9, 0.5, 0.3], [0.9, -0.5, 1.1], [0.9, 1.0, 0.2], [-0.5, 1.0, 1.0]])
     table = GainTable(K[:, 0], K[:, 1], K[:, 2], t=np.arange(4.0), vehicle=np.array([1, 1, 2, 2]))
     ax = plots.plot_class_map(m2, "exact")["ax"]
-    out = plots.plot_trajectory(m2, table, ax=ax)
     expect = certify_batch(K[:, 0], K[:, 1], K[:, 2], **P).verdict.tolist()
+    assert plots.trajectory_verdicts(m2, table) == expect  # the compute step: the map's loop
+    out = plots.plot_trajectory(m2, table, verdicts=expect, ax=ax)
     assert out["verdicts"] == expect
     assert len(out["lines"]) == 2
     for v, coll in out["markers"].items():
@@ -102,7 +103,10 @@ def test_trajectory_is_marked_by_its_own_verdicts(m2):
     assert any(lab.startswith("certified") for lab in labels)
     assert any(lab.startswith("policy gains: not certified") for lab in labels)
     with pytest.raises(StringStabError, match=r"\(n, 3\)"):
-        plots.plot_trajectory(m2, np.zeros((3, 2)), ax=ax)
+        plots.plot_trajectory(m2, np.zeros((3, 2)), verdicts=["certified"] * 3, ax=ax)
+    # the figures draw results, they do not compute them: gains come with their verdicts
+    with pytest.raises(TypeError, match="verdicts"):
+        plots.plot_trajectory(m2, table, ax=ax)  # type: ignore[call-arg]
 
 
 def test_3d_views(m3):
@@ -152,3 +156,7 @@ def test_save_figures_writes_each_format(tmp_path, m2):
     assert m2.version in (tmp_path / "region_sup_gain.svg").read_text()
     with pytest.raises(StringStabError, match="formats"):
         plots.save_figures(m2, tmp_path, formats=("gif",))
+    with pytest.raises(StringStabError, match="verdicts"):  # gains come with their verdicts
+        plots.save_figures(m2, tmp_path, formats=("png",), gains=[[0.9, 0.5, 0.3]])
+    # each file was written atomically: no temporary file is left beside them
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in written)

@@ -106,13 +106,14 @@ def test_comparison_table_states_what_it_used_to_hide():
     from stringstab.rl.compare import table_markdown, table_rows
 
     summaries = {"idl": {"TIT": 0.294, "M_CI": 0.79, "M_effi": 2.04, "M_lss": 0.875,
-                         "M_fss": 100.0, "share_m_p_below_1": 1.0},
+                         "m_fss": 1.0, "share_m_p_below_1": 1.0},
                  "cacc": {"TIT": 0.0, "M_CI": 1.91, "M_effi": 2.75, "M_lss": 0.975,
-                          "M_fss": None, "share_m_p_below_1": 0.7857}}
+                          "m_fss": None, "share_m_p_below_1": 0.7857}}
     md = table_markdown(table_rows(summaries, "idl"))
     lines = {line.split(" | ")[0].strip("| "): line for line in md.splitlines()}
-    assert "M_fss (%, ↑)" in lines["strategy"] and "TIT (s², ↓)" in lines["strategy"]
-    assert "0% (no certified gains executed)" in lines["cacc"]  # not "–"
+    assert "m_fss (fraction, ↑)" in lines["strategy"] and "TIT (s², ↓)" in lines["strategy"]
+    assert "| 1 |" in lines["idl"]  # the fraction, as written
+    assert "0 (no certified gains executed)" in lines["cacc"]  # not "–"
     assert "m_p > 1 in 21% of episodes" in lines["cacc"] and "stable" not in lines["cacc"]
     assert "m_p < 1 in every episode" in lines["idl"]
     # TIT: CACC's is 0, so the percentage is undefined; the row says IDL is worse

@@ -41,7 +41,7 @@ def tiny(algo: str, **kw):
                 stop_episodes=0, seed=3, hidden=(16, 16), repair_resolution=0.25,
                 checkpoint_every=10_000)
     base.update(kw)
-    # phase 1's configuration (the eq-16 state); tests of the phase-2 options pass them explicitly
+    # the paper's configuration (the eq-16 state); tests of the other options pass them explicitly
     return config_for(algo, paper=algo == "idl", **base)
 
 
@@ -311,7 +311,7 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
     code = main(["evaluate", str(run), "--leaders", str(leader), "--platoon", "none"])
     assert code in (0, 1)
     doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
-    assert doc["summary"]["M_fss"] == 100.0  # the repair is on: every executed gain certified
+    assert doc["summary"]["m_fss"] == 1.0  # the repair is on: every executed gain certified
     assert code == (0 if doc["summary"]["collisions"] == 0 else 1)
     from stringstab.io.gains import read_gains
 
@@ -357,7 +357,7 @@ def test_platoon_test_reports_m_p_per_vehicle():
     res = simulate(paper_mix(), CACCController(), 3, tau=TAU, delta=DELTA,
                    initial_gap=2.0 + HEADWAY * 20.0)
     np.testing.assert_allclose(p["m_p"], platoon_damping_ratios(res.accel), rtol=1e-5)
-    assert p["n"] == 3 and p["collisions"] == 0 and p["M_fss"] is None
+    assert p["n"] == 3 and p["collisions"] == 0 and p["m_fss"] is None
 
 
 def _bad(argv, match, capsys):

@@ -31,9 +31,9 @@ def test_policy_drives_sumo_with_every_gain_certified(policy_run, tmp_path, caps
     doc = json.loads((out / "metrics.json").read_text())
     assert doc["run"]["simulator"] == "sumo" and doc["run"]["policy"] == str(policy_run)
     g = doc["executed_gains"]
-    assert g["n"] == 2 * 121 and g["M_fss"] == 100.0
+    assert g["n"] == 2 * 121 and g["m_fss"] == 1.0
     assert doc["m_fss"] == 1.0
-    assert "M_fss = 100.00 %" in text
+    assert "m_fss = 1 certified" in text
     traj = np.load(out / "trajectories.npz")
     assert traj["t"].size == 121
 
@@ -56,4 +56,4 @@ def test_policy_metrics_equal_the_toolkit_simulators(policy_run):
     for k in ("max_m_p", "M_lss", "TIT", "M_CI", "M_effi", "m_fss", "collisions"):
         assert m1[k] == pytest.approx(m2[k], abs=1e-6), k
     f = fss(co.gains, tau=p["tau"], delta=p["delta"], headway=p["headway"], dt=p["dt"])
-    assert f["M_fss"] == 100.0
+    assert f["m_fss"] == 1.0

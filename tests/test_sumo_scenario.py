@@ -28,7 +28,7 @@ def test_leader_change_outside_a_platoon():
     c1, c2 = r.summary["vehicles"]
     assert c1["leaders"] == ["exiting", "front"] and c1["leader_changes"] == 1
     assert c2["leaders"] == ["acc1"]  # SUMO's ACC vehicle
-    assert r.summary["collisions"] == 0 and r.summary["M_fss"] == 100.0
+    assert r.summary["collisions"] == 0 and r.summary["m_fss"] == 1.0
     cols = r.columns
     m = (cols["vehicle"] == 0) & (cols["controlled"] == 1)
     lead = cols["leader"][m]

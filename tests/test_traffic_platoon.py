@@ -175,7 +175,7 @@ def test_time_varying_gains_and_mixed_platoon():
     assert res.gains.shape == (2, T, 3)
     assert_allclose(res.gains[0, -1], UNCERTIFIED)
     # eq 27: the certified share of (vehicle, moment) pairs — the first T//2 moments of both
-    assert res.metrics()["M_fss"] == pytest.approx(100.0 * (T // 2) / T, abs=1e-9)
+    assert res.metrics()["m_fss"] == pytest.approx((T // 2) / T, abs=1e-9)
     mixed = MixedController([LinearController(*CERTIFIED), IDMController()], [0, 1, 0])
     res = simulate(lead, mixed, 3)
     assert res.gains is None and not res.collided.any()

@@ -19,7 +19,7 @@ from numpy.testing import assert_allclose
 from stringstab.certify.continuous import certify, certify_batch
 from stringstab.certify.frequency import gain
 from stringstab.errors import StringStabError
-from stringstab.plots import plot_moves
+from stringstab.plots import moves_projection, plot_moves
 from stringstab.tuning import Projector, TuneResult, project, region_growing, tune
 
 P = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
@@ -364,7 +364,7 @@ def test_plot_moves():
     import matplotlib.pyplot as plt
 
     rs = [f((0.9, -0.5, 1.1), **P) for f in (region_growing, project)]
-    out = plot_moves(rs, **P, n=21)
+    out = plot_moves(rs, moves_projection(rs, **P, n=21))
     assert len(out["arrows"]) == 2
     assert out["ax"].get_xlabel() == "$k_x$ (s$^{-2}$)"  # the gain with its unit
     # the background is the region projected over the outputs' own k_a: each certified output
@@ -381,13 +381,13 @@ def test_plot_moves():
 
 
 def test_hand_derivatives_of_g_match_sympy():
-    """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g equal SymPy's derivatives
-    of the derived margin (|D|² − |N|²)/ω² (stringstab.derive.symbolic)."""
+    """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g (stringstab.certify.margin.newton_terms
+    and its vectorised twin margin.gradient) equal SymPy's derivatives of the derived margin
+    (|D|² − |N|²)/ω² (stringstab.derive.symbolic)."""
     import sympy as sp
 
+    from stringstab.certify import margin
     from stringstab.derive import symbolic as S
-    from stringstab.params import Params
-    from stringstab.tuning import _g_and_grad, _g_full
 
     g = S.margin_exact() / S.omega**2
     K = list(S.GAINS)
@@ -401,9 +401,9 @@ def test_hand_derivatives_of_g_match_sympy():
         tau, delta, headway = rng.uniform(0.05, 0.6), rng.uniform(0, 0.5), rng.uniform(0.3, 2)
         om = rng.uniform(0.05, 8)
         ref = np.array(f(*k, tau, delta, headway, om), dtype=float)
-        val, gk, gw, gwk, gww, gkk = _g_full(om, k, Params(tau, delta, headway))
+        val, gk, gw, gwk, gww, gkk = margin.newton_terms(om, *k, tau, delta, headway)
         ours = np.concatenate([[val], gk, [gw], gwk, [gww], np.asarray(gkk).ravel()])
         assert_allclose(ours, ref, rtol=1e-9, atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
-        gv, gk2 = _g_and_grad(np.array([om]), k, Params(tau, delta, headway))  # vectorised twin
+        gv, gk2 = margin.gradient(np.array([om]), k, tau=tau, delta=delta, headway=headway)  # vectorised twin
         assert_allclose(np.concatenate([gv, gk2[0]]), ref[:4], rtol=1e-9,
                         atol=1e-9 * (1 + float(np.max(np.abs(ref)))))

@@ -54,7 +54,7 @@ import numpy.typing as npt
 
 from ..derive import generated as _gen
 from ..errors import StringStabError
-from ..io.results import TableColumn, columns_from_records
+from ..io import TableColumn, columns_from_records
 from ..params import Box, Params, as_gains, parameter_model
 from ..params import sample_time as _sample_time
 from . import margin as _margin
@@ -374,7 +374,7 @@ class CertificateBatch(BatchResult):
         """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27).
 
         ``m_fss`` is eq 27's M_fss without its ×100 % (docs/conventions.md): every M_fss of
-        the toolkit is a fraction; the simulator's metrics keep a percentage under an old key.
+        the toolkit is a fraction.
         """
         return super().summary()
 

@@ -62,7 +62,7 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
-from ..io.results import TableColumn
+from ..io import TableColumn
 from ..params import Box, Interval, as_gains, as_interval, check_box, parse_interval
 from ..params import sample_time as _sample_time
 from .branch_bound import CERTIFIED, PENDING, VIOLATED, branch_and_bound, verdict_codes, zoom_max

@@ -69,7 +69,7 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
-from ..io.results import TableColumn
+from ..io import TableColumn
 from ..params import Box, Params, as_gains, check_params, positive
 from ..params import sample_time as _sample_time
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes, zoom_max

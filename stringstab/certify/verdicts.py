@@ -29,7 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError
-from ..io.results import TableColumn, records_from_columns
+from ..io import TableColumn, records_from_columns
 
 __all__ = [
     "CERTIFIED",

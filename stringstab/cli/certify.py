@@ -226,8 +226,7 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
     from ..certify.continuous import certify_batch
     from ..identify.report import read_identified
-    from ..io import columns_from_records, write_results
-    from ..io.results import TableColumn
+    from ..io import TableColumn, columns_from_records, write_results
 
     if args.triples or args.file:
         raise StringStabError("expected --from or gain triples/--file, not both")

@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
             groups.setdefault(pol.algo, []).append(ev)
             print(f"{info['folder']} ({pol.algo}): TIT {ev.summary['TIT']:.3f}, "
                   f"M_CI {ev.summary['M_CI']:.3f}, collisions {ev.summary['collisions']}, "
-                  f"M_fss {ev.summary['M_fss'] if ev.summary['M_fss'] is not None else 'n/a'}")
+                  f"m_fss = {ev.summary['m_fss'] if ev.summary['m_fss'] is not None else 'n/a'}")
             if args.platoon and pol.algo not in platoons:
                 platoons[pol.algo] = {"run": info["folder"], "tests": [platoon_test(
                     pol, 10, dt=dt, **kw)]}

@@ -127,7 +127,7 @@ def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
             f"collisions {doc['collisions']}, TIT {doc['TIT']:.3f} s², "
             f"M_CI {doc['M_CI']:.3f} m²/s⁶, m_fss {doc['m_fss']}")
         summary[name] = {k: doc[k] for k in ("m_p", "max_m_p", "M_lss", "collisions", "TIT", "M_CI",
-                                             "M_effi", "m_fss", "M_fss")}
+                                             "M_effi", "m_fss")}
         summary[name]["files"] = [f"{name}/{f}" for f in files.values()]
     return summary
 
@@ -140,15 +140,16 @@ def _step_region(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from ..io import read_gains
-    from ..plots import save_figures
+    from ..plots import save_figures, trajectory_verdicts
     from ..regions import region_map
 
     g = np.linspace(-2.0, 2.0, 121)
     rmap = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=TAU, delta=DELTA, headway=HEADWAY,
                       progress=False)
     files = [rmap.save_npz(out / "region.npz").name]
-    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=read_gains(ROLLOUT),
-                                           dpi=110)]
+    rollout = read_gains(ROLLOUT)
+    files += [p.name for p in save_figures(rmap, out, formats=("png",), gains=rollout,
+                                           verdicts=trajectory_verdicts(rmap, rollout), dpi=110)]
     for line in rmap.report().splitlines():
         log(line)
     return {"files": files, "class_shares": rmap.class_shares(),
@@ -173,7 +174,7 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from ..io import atomic_path, columns_from_records, parse_triple, write_results
-    from ..plots import plot_moves
+    from ..plots import moves_projection, plot_moves
     from ..tuning import project, region_growing
 
     results = []
@@ -197,7 +198,7 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     columns = columns_from_records(records)
     write_results(columns, out / "tune.json", "json", params=params, summary=summary)
     write_results(columns, out / "tune.txt", "table", params=params, summary=summary)
-    drawn = plot_moves(results, tau=TAU, delta=DELTA, headway=HEADWAY, k_a=0.6, n=101)
+    drawn = plot_moves(results, moves_projection(results, tau=TAU, delta=DELTA, headway=HEADWAY))
     fig = drawn["ax"].figure
     with atomic_path(out / "tune_moves.png") as tmp:
         fig.savefig(tmp, dpi=110, bbox_inches="tight")
@@ -256,7 +257,7 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
 
     The budget is far below the results' (the policy is young: expect a worse table than
     docs/training.md's), but every executed gain is certified whatever the budget: the repair
-    guarantees it and the evaluation re-checks each one (M_fss, continuous and sampled).
+    guarantees it and the evaluation re-checks each one (m_fss, continuous and sampled).
     """
     import importlib.util
 
@@ -294,14 +295,14 @@ def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int 
         write_comparison(o, {"idl": [ev], "cacc": [cacc]}, reference="idl",
                          platoons={"idl": {"run": "run", "tests": platoons}}, **kw)
     s = ev.summary
-    log(f"held-out episodes: {s['episodes']}; M_fss {s['M_fss']:.2f}% of {s['n_gains']} executed "
-        f"gains (sampled-data at dt: {s['M_fss_sampled']:.2f}%), collisions {s['collisions']}, "
+    log(f"held-out episodes: {s['episodes']}; m_fss = {s['m_fss']:.4g} of {s['n_gains']} executed "
+        f"gains (sampled-data at dt: {s['m_fss_sampled']:.4g}), collisions {s['collisions']}, "
         f"TIT {s['TIT']:.3f} s² (CACC {cacc.summary['TIT']:.3f}), M_CI {s['M_CI']:.3f} m²/s⁶ "
         f"(CACC {cacc.summary['M_CI']:.3f}), M_lss {s['M_lss']:.3f}")
     for q in platoons:
         log(f"{q['n']}-vehicle platoon: max m_p {q['max_m_p']:.3f}")
     log(f"verdict: {text}")
-    keys = ("M_fss", "M_fss_sampled", "n_gains", "collisions", "TIT", "M_CI", "M_effi", "M_lss")
+    keys = ("m_fss", "m_fss_sampled", "n_gains", "collisions", "TIT", "M_CI", "M_effi", "M_lss")
     return {"steps": res.steps, "episodes": len(res.episodes),
             "train_seconds": round(t["total_seconds"], 2), "repair_share": t["repair_share"],
             "idl": {k: s.get(k) for k in keys}, "cacc": {k: cacc.summary.get(k) for k in keys},

@@ -30,7 +30,7 @@ def add_parser(sub: Any) -> None:
         description=(
             "Roll the policy of a run folder on held-out leaders (the bundled test episodes, or "
             "'t, v' CSV / NGSIM files), certify every executed gain with the exact certificate "
-            "(M_fss), compute TIT, M_CI, M_effi, m_p per episode and M_lss, collisions, and the "
+            "(m_fss), compute TIT, M_CI, M_effi, m_p per episode and M_lss, collisions, and the "
             "10- and 100-vehicle platoon test. Exit 0 when every executed gain is certified and "
             "nothing collided, 1 otherwise (an acceleration policy has no gains to certify), "
             "2 on bad input."),
@@ -123,15 +123,15 @@ def run(args: argparse.Namespace) -> int:
                                  command=command_line(args), verdict=verdict, passed=passed,
                                  started=t0).write(out)
     print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
-    fss = "n/a" if s["M_fss"] is None else f"{s['M_fss']:.2f}%"
+    fss = "n/a" if s["m_fss"] is None else f"{s['m_fss']:.4g}"
     mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"
-    if s.get("M_fss_sampled") is not None:
-        fss += f" (sampled-data at dt={p['dt']} s: {s['M_fss_sampled']:.2f}%)"
-    print(f"M_fss {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
+    if s.get("m_fss_sampled") is not None:
+        fss += f" (sampled-data at dt={p['dt']} s: {s['m_fss_sampled']:.4g})"
+    print(f"m_fss = {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
           f"TIT {s['TIT']:.3f}, M_CI {s['M_CI']:.3f}, M_effi {s['M_effi']:.3f}, M_lss {mlss}")
     for q in platoons:
         print(f"platoon of {q['n']}: max m_p {q['max_m_p']:.3f}, collisions {q['collisions']}, "
-              f"M_fss {q['M_fss'] if q['M_fss'] is not None else 'n/a'}")
+              f"m_fss = {q['m_fss'] if q['m_fss'] is not None else 'n/a'}")
     print(f"verdict: {verdict}")
     print(f"wrote {', '.join(files)} to {out.root}/")
     return 0 if passed else 1

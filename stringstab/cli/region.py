@@ -228,7 +228,7 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
 
 
 def _warm_up_outputs() -> None:
-    from ..io.results import warm_up as warm_up_writer
+    from ..io.text_formats import warm_up as warm_up_writer
     from ..plots._common import warm_up as warm_up_plots
 
     warm_up_plots()
@@ -271,8 +271,7 @@ def run(args: argparse.Namespace) -> int:
     """
     import time
 
-    from ..io import OutputDir
-    from ..plots import FIGURE_FORMATS
+    from ..io import FIGURE_FORMATS, OutputDir
     from ..regions import region_map
 
     t0 = time.perf_counter()

@@ -49,7 +49,7 @@ def add_parser(sub: Any) -> None:
             f"acceleration received delta late, limits (default, IDL Table 2) [{ACCEL_MIN:g}, {ACCEL_MAX:g}] m/s^2 and "
             f"[0, {SPEED_MAX:g}] m/s) behind a "
             "leader, and write trajectories, the IDL metrics (m_p, M_lss, TIT, M_CI, M_effi, "
-            "M_fss, collisions) and figures like the paper's Figs 7-8. A leader beyond the "
+            "m_fss, collisions) and figures like the paper's Figs 7-8. A leader beyond the "
             "followers' limits (--v-max, --a-min, --a-max) runs with a warning; refused: a leader "
             "above 70 m/s or beyond ±15 m/s², --dt longer than tau or delta, an output folder "
             "that cannot be written."

@@ -89,7 +89,7 @@ def add_parser(sub: Any) -> None:
         "run", help="drive a platoon (or named vehicles of a scenario) in SUMO; write what simulate writes",
         description="Drive N followers behind a leader in SUMO with fixed gains, a gain file or "
                     "a trained policy, and write trajectories, metrics.json (m_p, M_lss, TIT, "
-                    "M_CI, M_effi, M_fss, collisions) and figures as 'stringstab simulate' does. "
+                    "M_CI, M_effi, m_fss, collisions) and figures as 'stringstab simulate' does. "
                     "With --sumocfg FILE --controlled ID,...: those vehicles of the scenario are "
                     "driven by the controller, each following the vehicle SUMO reports as its "
                     "leader at every step, and the rest of the traffic is SUMO's.")
@@ -329,7 +329,7 @@ def run_platoon(args: argparse.Namespace) -> int:
 
         f = fss(result.gains, tau=case["tau"], delta=case["delta"], headway=case["headway"],
                 dt=case["dt"])
-        doc["executed_gains"] = {"M_fss": f["M_fss"], "M_fss_sampled": f["M_fss_sampled"],
+        doc["executed_gains"] = {"m_fss": f["m_fss"], "m_fss_sampled": f["m_fss_sampled"],
                                  "n": f["n"], "certificate": f["certificate"]}
     if "policy" in case:
         doc["run"]["policy"] = case["policy"]
@@ -347,8 +347,8 @@ def run_platoon(args: argparse.Namespace) -> int:
                    f"{case['label']}", doc)
     if "executed_gains" in doc:
         e = doc["executed_gains"]
-        print(f"executed gains: M_fss = {e['M_fss']:.2f} % certified (exact), "
-              f"{e['M_fss_sampled']:.2f} % (sampled-data at dt = {case['dt']:g} s) of {e['n']}")
+        print(f"executed gains: m_fss = {e['m_fss']:.4g} certified (exact), "
+              f"{e['m_fss_sampled']:.4g} (sampled-data at dt = {case['dt']:g} s) of {e['n']}")
     print(f"wrote {', '.join(files.values())} to {out.root}/")
     return 0
 
@@ -407,9 +407,9 @@ def _run_scenario(args: argparse.Namespace) -> int:
         print(f"  {v['vehicle']}: {v['steps_controlled']} steps driven, leaders "
               f"{' -> '.join(v['leaders']) or 'none'}, min gap {_fmt(v['min_gap'], '.2f', ' m')}, "
               f"collisions {v['collisions']}, m_p {_fmt(v['m_p'], '.3f')}")
-    if s.get("M_fss") is not None:
-        print(f"executed gains: M_fss = {s['M_fss']:.2f} % certified (exact), "
-              f"{s['M_fss_sampled']:.2f} % (sampled-data at dt = {case['dt']:g} s) of {s['n_gains']}")
+    if s.get("m_fss") is not None:
+        print(f"executed gains: m_fss = {s['m_fss']:.4g} certified (exact), "
+              f"{s['m_fss_sampled']:.4g} (sampled-data at dt = {case['dt']:g} s) of {s['n_gains']}")
     print(f"wrote {', '.join(SCENARIO_FILES)} to {out.root}/")
     return 0
 

@@ -238,7 +238,7 @@ def run(args: argparse.Namespace) -> int:
     params: dict[str, Any] = {**shown_params(model, H), "method": args.method,
                               "bounds": [lo, hi], "weights": weights}
     if not general:
-        del params["sample_time"]  # the continuous loop at one τ, δ, T*: as before
+        del params["sample_time"]  # the continuous loop at one τ, δ, T*: no sample time
     if "region-growing" in methods:
         params.update(r0=r0, grid=grid, max_iter=max_iter, criterion=args.criterion,
                       check_hurwitz=args.check_hurwitz, grow_ka=args.grow_ka)
@@ -275,12 +275,13 @@ def _write_report(out: Any, results: list[Any], params: dict[str, Any], general:
         if not general:
             from matplotlib.figure import Figure
 
-            from ..plots.tuning import plot_moves
+            from ..plots.tuning import moves_projection, plot_moves
 
             fig = Figure(figsize=(6.4, 6.4), layout="constrained")
-            plot_moves(results, tau=params["tau"], delta=params["delta"],
-                       headway=params["headway"], bounds=tuple(params["bounds"]), n=81,
-                       ax=fig.subplots())
+            background = moves_projection(results, tau=params["tau"], delta=params["delta"],
+                                          headway=params["headway"],
+                                          bounds=tuple(params["bounds"]), n=81)
+            plot_moves(results, background, ax=fig.subplots())
             fig.savefig(out.path("tune_moves.png"), dpi=110, bbox_inches="tight")
             figure = "tune_moves.png"
         tune_report(results, command=command_line(args), params=params, figure=figure,

@@ -1,7 +1,7 @@
 """Figures of an HCFS run, like the paper's Figs 4-6: speed, jerk with the limit drawn, switching.
 
 Every function takes ``ax=None`` (or ``fig=None``) and returns what it drew.  Followers are
-coloured by their position in the platoon (:func:`stringstab.traffic.plots.plot_vehicles`).
+coloured by their position in the platoon (:func:`stringstab.plots.plot_vehicles`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..traffic.plots import plot_vehicles
+from ..plots.traffic import plot_vehicles
 from .simulate import HCFSRun
 
 __all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_learning", "plot_speed", "plot_switching"]

@@ -4,7 +4,10 @@
 :mod:`~stringstab.io.platoon_logs` reads recorded platoons (OpenACC, plain CSV, NGSIM pairs) for
 ``stringstab identify``;
 :mod:`~stringstab.io.results` writes every command's result columns (table, JSON, CSV,
-Parquet, NPZ) with one vectorised writer.
+Parquet, NPZ) with one vectorised writer: the column model is :mod:`~stringstab.io.columns`,
+the renderers :mod:`~stringstab.io.table`, :mod:`~stringstab.io.text_formats` and
+:mod:`~stringstab.io.binary_formats`; :mod:`~stringstab.io.figures` saves a drawn figure in every
+format with its metadata.
 
 Every command checks its output paths with :func:`check_output_file` or :class:`OutputDir`
 *before* it starts work, and writes through :func:`atomic_write_text`,
@@ -14,6 +17,8 @@ complete or absent and an output folder never holds a mix of two runs.
 
 from __future__ import annotations
 
+from .columns import Categorical, columns_from_records, flatten_columns, records_from_columns
+from .figures import FIGURE_FORMATS, check_figure_formats, figure_metadata, save_figure
 from .gains import (
     GAIN_COLUMNS,
     INPUT_FORMATS,
@@ -33,22 +38,12 @@ from .outputs import (
 )
 from .plain import dumps_json, to_plain
 from .platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
-from .results import (
-    BINARY_FORMATS,
-    RESULT_FORMATS,
-    Categorical,
-    TableColumn,
-    columns_from_records,
-    flatten_columns,
-    format_results,
-    records_from_columns,
-    render_table,
-    write_results,
-    write_text,
-)
+from .results import BINARY_FORMATS, RESULT_FORMATS, format_results, write_results, write_text
+from .table import TableColumn, render_table
 
 __all__ = [
     "BINARY_FORMATS",
+    "FIGURE_FORMATS",
     "GAIN_COLUMNS",
     "INPUT_FORMATS",
     "MANIFEST",
@@ -63,11 +58,13 @@ __all__ = [
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
+    "check_figure_formats",
     "check_output_dir",
     "check_output_file",
     "clean_segments",
     "columns_from_records",
     "dumps_json",
+    "figure_metadata",
     "flatten_columns",
     "format_results",
     "parse_triple",
@@ -75,6 +72,7 @@ __all__ = [
     "read_platoon_logs",
     "records_from_columns",
     "render_table",
+    "save_figure",
     "to_plain",
     "write_results",
     "write_text",

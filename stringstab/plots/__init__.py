@@ -9,7 +9,7 @@ artists), so figures can be composed and tested.
 =============================  ===============================================================
 module / function              shows
 =============================  ===============================================================
-**region maps**                (:mod:`stringstab.plots.regions`)
+**region maps**                (:mod:`~stringstab.plots.regions`, ``regions_3d``, ``region_sets``)
 :func:`plot_class_map`         classes of one method (types, or exact verdicts)
 :func:`plot_comparison`        where exact, taylor and printed agree and disagree
 :func:`plot_sup_gain`          sup_ω |Γ(jω)| (log scale), with the certified boundary
@@ -17,10 +17,14 @@ module / function              shows
 :func:`plot_region_3d`         the boundary of the certified region in 3-D
 :func:`plot_facets`            one class map per τ (or δ): how the region shrinks
 :func:`plot_boundaries`        the certified boundaries of several maps on one axes
+**gain trajectories**          (:mod:`stringstab.plots.trajectory`)
+:func:`trajectory_verdicts`    the exact verdict of each triple for a map's loop (compute)
 :func:`plot_trajectory`        a policy's gain trajectory over a map, by verdict
+**files of a map**             (:mod:`stringstab.plots.outputs`)
 :func:`save_figures`           the standard figures of a map, in every format
 :func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
 **gain repair**                (:mod:`stringstab.plots.tuning`)
+:func:`moves_projection`       the certified region over the repairs' k_a (compute)
 :func:`plot_moves`             repairs K0 → K over the certified region
 **platoons**                   (:mod:`stringstab.plots.traffic`)
 :func:`plot_vehicles`          one line per vehicle, coloured by position
@@ -28,31 +32,20 @@ module / function              shows
 :func:`plot_damping_ratios`    m_p of each follower (IDL eq 29)
 =============================  ===============================================================
 
-matplotlib is imported on first use.  ``stringstab.traffic.plots`` re-exports its functions
-from here.
+matplotlib is imported on first use.
 """
 
 from __future__ import annotations
 
+from ..io.figures import FIGURE_FORMATS
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult
-from .outputs import save_region_outputs
-from .regions import (
-    FIGURE_FORMATS,
-    draw_figure,
-    figure_stems,
-    plot_boundaries,
-    plot_class_map,
-    plot_comparison,
-    plot_facets,
-    plot_region_3d,
-    plot_slices,
-    plot_sup_gain,
-    plot_trajectory,
-    save_figures,
-    trajectory_verdicts,
-)
+from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
+from .region_sets import plot_boundaries, plot_facets
+from .regions import plot_class_map, plot_comparison, plot_sup_gain
+from .regions_3d import plot_region_3d, plot_slices
 from .traffic import plot_damping_ratios, plot_platoon, plot_vehicles
-from .tuning import moves_region, plot_moves
+from .trajectory import plot_trajectory, trajectory_verdicts
+from .tuning import moves_projection, moves_region, plot_moves
 
 __all__ = [
     "CLASS_COLORS",
@@ -62,6 +55,7 @@ __all__ = [
     "PlotResult",
     "draw_figure",
     "figure_stems",
+    "moves_projection",
     "moves_region",
     "plot_boundaries",
     "plot_class_map",

@@ -53,7 +53,7 @@ class PlotResult:
     Notes
     -----
     ``result["name"]`` reads an artist (``"ax"``, ``"fig"`` and ``"axes"`` read the
-    figure's axes and the figure), as the dicts returned before did; ``fig, axes = result``
+    figure's axes and the figure), as a dict of artists would; ``fig, axes = result``
     unpacks like :func:`matplotlib.pyplot.subplots`.
     """
 
@@ -128,7 +128,6 @@ GAIN_LABELS: dict[str, str] = {
     "k_v": r"$k_v$ (s$^{-1}$)",
     "k_a": r"$k_a$ (–)",
 }
-#: File formats :func:`save_figures` can write.
 
 
 def pyplot() -> Any:

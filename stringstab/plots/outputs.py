@@ -1,26 +1,216 @@
-"""All the files of a region map at once: data and figures, shared between two processes.
+"""The files of a region map: its standard figures, and all its files at once in two processes.
+
+:func:`figure_stems` names the standard figures of a map and :func:`draw_figure` draws one;
+:func:`save_figures` draws them and saves each in every format (:func:`stringstab.io.save_figure`),
+optionally in forked processes (:func:`stringstab.regions.pool.map_forked`).
 
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
-CSV table (2-D maps) and the standard figures (:func:`~stringstab.plots.save_figures`) — and
-splits that work between this process and one forked process (on a machine with two cores,
-writing is then about half as long): the tasks (the NPZ, the CSV, one task per figure) are
-dealt out by their estimated cost, the larger first, each to the process with less work so
-far (the longest-processing-time rule); each task writes its own file.  Files are staged in a
-:class:`stringstab.io.OutputDir` or written into a folder.
+CSV table (2-D maps) and the standard figures — and splits that work between this process
+and one forked process (on a machine with two cores, writing is then about half as long):
+the tasks (the NPZ, the CSV, one task per figure) are dealt out by their estimated cost, the
+larger first, each to the process with less work so far (the longest-processing-time rule);
+each task writes its own file.  Files are staged in a :class:`stringstab.io.OutputDir` or
+written into a folder.
+
+Every function here draws results computed beforehand: a gain trajectory comes with its
+verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
 """
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ..errors import StringStabError
+from ..io.figures import check_figure_formats, figure_metadata, save_figure
 from ..regions import RegionMap
-from ..regions.pool import in_background
-from .regions import FIGURE_FORMATS, figure_stems, save_figures, trajectory_verdicts
+from ..regions.pool import in_background, map_forked
+from ._common import pyplot
+from .map_axes import method_title
+from .projection import plot_projected_region, projected_region
+from .regions import plot_class_map, plot_comparison, plot_sup_gain
+from .regions_3d import plot_region_3d, plot_slices
+from .trajectory import gain_rows, plot_trajectory
 
-__all__ = ["save_region_outputs"]
+__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs"]
+
+
+def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
+    """The names (without prefix and format) of the standard figures of ``rmap``.
+
+    2-D map: ``class_<method>`` for each method, ``compare`` (two or more methods),
+    ``sup_gain`` (``exact``) and, with ``overlay``, ``overlay``.  3-D map:
+    ``slices_<method>`` and ``3d_<method>`` for each method.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The computed map.
+    overlay : bool, default False
+        Include the ``overlay`` figure (2-D maps only; it needs gains to draw).
+
+    Returns
+    -------
+    list of str
+        The stems, in drawing order.
+    """
+    if rmap.ndim == 2:
+        stems = [f"class_{m}" for m in rmap.methods]
+        if len(rmap.methods) >= 2:
+            stems.append("compare")
+        if "exact" in rmap.methods:
+            stems.append("sup_gain")
+        if overlay:
+            stems.append("overlay")
+        return stems
+    return [s for m in rmap.methods for s in (f"slices_{m}", f"3d_{m}")]
+
+
+def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = None) -> Any:
+    """Draw the standard figure ``stem`` (:func:`figure_stems`) of ``rmap``; returns its Figure.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The computed map.
+    stem : str
+        One of :func:`figure_stems` ``(rmap, True)``.
+    gains : GainTable or array_like of shape (n, 3), optional
+        The gain trajectory; required for ``overlay`` (drawn over the exact region projected
+        over the points' own values of the map's fixed gain, computed here).
+    verdicts : CertificateBatch or sequence of str, optional
+        The exact verdict of each gain triple (:func:`~stringstab.plots.trajectory_verdicts`);
+        required for ``overlay``.
+
+    Returns
+    -------
+    matplotlib Figure
+        The new figure (the caller saves and closes it).
+
+    Raises
+    ------
+    StringStabError
+        On an unknown stem, or ``overlay`` without valid gains and their verdicts.
+    """
+    if stem.startswith("class_"):
+        return plot_class_map(rmap, stem[len("class_"):]).figure
+    if stem == "compare":
+        return plot_comparison(rmap).figure
+    if stem == "sup_gain":
+        return plot_sup_gain(rmap).figure
+    if stem == "overlay":
+        # not the map's slice: the points need not share its fixed gain, so the background is
+        # the certified region projected over the points' own values of that gain
+        if gains is None or verdicts is None:
+            raise StringStabError("the overlay figure needs the gains and their verdicts "
+                                  "(plots.trajectory_verdicts); got "
+                                  f"{'no gains' if gains is None else 'no verdicts'}")
+        K, _ = gain_rows(gains)
+        xy = K[:, [("k_x", "k_v", "k_a").index(a) for a in rmap.axis_names]]
+        lo = min(min(float(a[0]) for a in rmap.axes.values()), float(xy.min()))
+        hi = max(max(float(a[-1]) for a in rmap.axes.values()), float(xy.max()))
+        pad = 0.03 * (hi - lo)
+        p = rmap.params
+        proj = projected_region(K, tau=p.tau, delta=p.delta, headway=p.headway,
+                                plane=(rmap.axis_names[0], rmap.axis_names[1]), bounds=(lo - pad, hi + pad),
+                                sample_time=rmap.sample_time, n=81)
+        loop = "; ".join(t for t in rmap.title().split("; ") if not t.startswith(tuple(rmap.fixed)))
+        ax = plot_projected_region(proj, title=f"{method_title(rmap, 'exact')}; {loop}").ax
+        plot_trajectory(rmap, gains, ax=ax, verdicts=verdicts)
+        return ax.figure
+    if stem.startswith("slices_"):
+        return plot_slices(rmap, stem[len("slices_"):]).figure
+    if stem.startswith("3d_"):
+        return plot_region_3d(rmap, stem[len("3d_"):]).figure
+    raise StringStabError(f"unknown figure {stem!r}; expected one of {figure_stems(rmap, True)}")
+
+
+def save_figures(
+    rmap: RegionMap, out: Any, *, prefix: str = "region",
+    formats: Sequence[str] = ("png", "pdf"), gains: Any = None, verdicts: Any = None,
+    dpi: int = 150, workers: int = 1, stems: Sequence[str] | None = None,
+) -> list[Path]:
+    """Draw the standard figures of a map and save each in every format.
+
+    Each file carries the tool version and :meth:`RegionMap.metadata` (τ, δ,
+    T*, axes, methods) as JSON in its own metadata (:func:`stringstab.io.figure_metadata`)
+    and is written atomically (:func:`stringstab.io.save_figure`).  The figures are
+    :func:`figure_stems`, saved as ``<prefix>_<stem>.<format>``.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The map.
+    out : path or OutputDir
+        An existing folder, or a :class:`stringstab.io.OutputDir` (the files are
+        staged in it and appear when its run succeeds).
+    prefix : str
+        File name stem.
+    formats : sequence of str
+        Among :data:`FIGURE_FORMATS`.
+    gains : GainTable or array_like, optional
+        A gain trajectory to overlay (2-D maps only).
+    verdicts : CertificateBatch or sequence of str, optional
+        The exact verdicts of ``gains``, computed beforehand
+        (:func:`~stringstab.plots.trajectory_verdicts`); required with ``gains``.
+    dpi : int
+        Resolution of raster formats.
+    workers : int
+        Processes drawing the figures (forked, :func:`stringstab.regions.pool.map_forked`;
+        1 draws them here, one after another).
+    stems : sequence of str, optional
+        Draw only these of :func:`figure_stems`.
+
+    Returns
+    -------
+    list of Path
+        The files written (their final paths).
+
+    Raises
+    ------
+    StringStabError
+        On an unknown format, ``gains`` with a 3-D map, or ``gains`` without ``verdicts``.
+    """
+    formats = check_figure_formats(formats)
+    if gains is not None and rmap.ndim != 2:
+        raise StringStabError(f"a gain trajectory can be overlaid on a 2-D map only; got a {rmap.ndim}-D map")
+    _need_verdicts(gains, verdicts)
+    every = figure_stems(rmap, gains is not None)
+    if stems is None:
+        stems = every
+    elif any(s not in every for s in stems):
+        raise StringStabError(f"figures must be among {every}; got {list(stems)}")
+    jobs = [(stem, [(f, _stage(out, f"{prefix}_{stem}.{f}")) for f in formats]) for stem in stems]
+    map_forked(_FigureJob(rmap, gains, verdicts, dpi), jobs, workers)
+    return [_final(out, f"{prefix}_{stem}.{f}") for stem in stems for f in formats]
+
+
+class _FigureJob:
+    """Draw one standard figure of a map and save it in its formats."""
+
+    def __init__(self, rmap: RegionMap, gains: Any, verdicts: Any, dpi: int) -> None:
+        self.rmap, self.gains, self.verdicts, self.dpi = rmap, gains, verdicts, dpi
+        self.metadata = figure_metadata(f"stringstab {rmap.version}",
+                                        json.dumps(rmap.metadata(), ensure_ascii=False))
+
+    def __call__(self, job: tuple[str, list[tuple[str, Path]]]) -> None:
+        stem, targets = job
+        fig = draw_figure(self.rmap, stem, self.gains, self.verdicts)
+        try:
+            save_figure(fig, targets, metadata=self.metadata, dpi=self.dpi)
+        finally:
+            pyplot().close(fig)
+
+
+def _need_verdicts(gains: Any, verdicts: Any) -> None:
+    """Refuse gains without their verdicts: the figures draw results, they do not compute them."""
+    if gains is not None and verdicts is None:
+        raise StringStabError("a gain trajectory needs its exact verdicts (verdicts=, e.g. from "
+                              "stringstab.plots.trajectory_verdicts(rmap, gains)); got none")
+
 
 #: Estimated costs (s) on one core: per grid point of the NPZ archive and per CSV row and
 #: column; per figure file; importing pyplot in a process.  Only their ratios matter.
@@ -72,10 +262,12 @@ def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: st
 
 
 def _stage(out: Any, name: str) -> Path:
+    """Where to write ``name``: staged in an OutputDir (which registers it), or in the folder."""
     return Path(out.path(name)) if hasattr(out, "path") else Path(out) / name
 
 
 def _final(out: Any, name: str) -> Path:
+    """Where ``name`` will be once the run succeeds."""
     return Path(out.final(name)) if hasattr(out, "final") else Path(out) / name
 
 
@@ -93,8 +285,7 @@ def save_region_outputs(
         An existing folder, or an :class:`stringstab.io.OutputDir` inside its ``with``
         block (the files appear when its run succeeds).
     prefix, formats, gains, verdicts, dpi
-        As for :func:`~stringstab.plots.save_figures` (``verdicts`` are computed here,
-        once, when ``gains`` come without them).
+        As for :func:`save_figures` (``verdicts`` are required with ``gains``).
     processes : int
         1 writes everything here; 2 (default) shares the work with one forked process.
 
@@ -106,7 +297,8 @@ def save_region_outputs(
     Raises
     ------
     StringStabError
-        On a bad format, or when a file cannot be written (in either process).
+        On a bad format, ``gains`` without ``verdicts``, or when a file cannot be written (in
+        either process).
 
     Examples
     --------
@@ -117,13 +309,8 @@ def save_region_outputs(
     >>> [p.name for p in save_region_outputs(m, tempfile.mkdtemp(), formats=("png",), dpi=20)]
     ['region.npz', 'region.csv', 'region_class_taylor.png']
     """
-    for f in formats:
-        if f not in FIGURE_FORMATS:
-            from ..errors import StringStabError
-
-            raise StringStabError(f"figure formats must be among {list(FIGURE_FORMATS)}; got {f!r}")
-    if gains is not None and verdicts is None:
-        verdicts = trajectory_verdicts(rmap, gains)
+    formats = check_figure_formats(formats)
+    _need_verdicts(gains, verdicts)
     stems = figure_stems(rmap, gains is not None)
     names = [f"{prefix}.npz", *([f"{prefix}.csv"] if rmap.ndim == 2 else []),
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]

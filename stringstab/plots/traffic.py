@@ -3,8 +3,7 @@
 Every function takes a result computed beforehand (a :class:`~stringstab.traffic.PlatoonResult`
 or its arrays) and ``ax=None`` (or ``fig=None``), and returns a
 :class:`~stringstab.plots.PlotResult`, so figures can be composed; vehicles are coloured by
-their position in the platoon (0 = leader).  Also importable from
-:mod:`stringstab.traffic.plots`, their former home.
+their position in the platoon (0 = leader).
 """
 
 from __future__ import annotations
@@ -112,7 +111,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     -------
     PlotResult
         The figure, the axes [speed, acceleration, spacing, time headway] and the
-        ``colorbar``; ``fig, axes = plot_platoon(...)`` unpacks as before.
+        ``colorbar``; ``fig, axes = plot_platoon(...)`` unpacks the figure and the axes.
     """
     from ._common import pyplot
 

@@ -1,4 +1,8 @@
-"""Figures of gain repairs (:mod:`stringstab.tuning`): the moves K0 → K over the certified region."""
+"""Figures of gain repairs (:mod:`stringstab.tuning`): the moves K0 → K over the certified region.
+
+The background is computed first (:func:`moves_projection` or :func:`moves_region`), then
+drawn with the moves (:func:`plot_moves`).
+"""
 
 from __future__ import annotations
 
@@ -14,8 +18,9 @@ from ._common import PlotResult, pyplot
 if TYPE_CHECKING:
     from ..regions import RegionMap
     from ..tuning import TuneResult
+    from .projection import ProjectedRegion
 
-__all__ = ["moves_region", "plot_moves"]
+__all__ = ["moves_projection", "moves_region", "plot_moves"]
 
 
 def moves_region(results: Sequence[TuneResult], *, tau: float, delta: float, headway: float,
@@ -59,42 +64,68 @@ def moves_region(results: Sequence[TuneResult], *, tau: float, delta: float, hea
                       methods="exact", workers=1, progress=False)
 
 
+def moves_projection(results: Sequence[TuneResult], *, tau: float, delta: float,
+                     headway: float, bounds: tuple[float, float] = GAIN_BOUNDS,
+                     n: int = 101) -> ProjectedRegion:
+    """The exact region behind :func:`plot_moves`, projected over the outputs' k_a (compute step).
+
+    The certified region in the (k_x, k_v) plane projected over the output k_a values
+    (:func:`stringstab.plots.projection.projected_region`: certified at every / some / none
+    of them), so every repaired gain lies where its own verdict says, whatever its k_a.
+
+    Parameters
+    ----------
+    results : sequence of TuneResult
+        The repairs (their output gains give the k_a values).
+    tau : float
+        Actuator lag τ (s).
+    delta : float
+        Communication delay δ (s).
+    headway : float
+        Time headway T* (s).
+    bounds : tuple of float, default GAIN_BOUNDS
+        Range (lo, hi) of k_x (1/s²) and k_v (1/s), padded by 5 % so gains on a bound are
+        not clipped.
+    n : int, default 101
+        Grid points per axis.
+
+    Returns
+    -------
+    ProjectedRegion
+        The plane's grid and the certified share at each of its points.
+    """
+    from ..tuning.inputs import as_bounds
+    from .projection import projected_region
+
+    lo, hi = as_bounds(bounds)
+    pad = 0.05 * (hi - lo)
+    ends = np.array([r.k for r in results], dtype=float).reshape(-1, 3)
+    return projected_region(ends, tau=tau, delta=delta, headway=headway,
+                            bounds=(lo - pad, hi + pad), n=n)
+
+
 def plot_moves(
     results: Sequence[TuneResult],
+    region: RegionMap | ProjectedRegion,
     *,
-    region: RegionMap | None = None,
-    tau: float | None = None,
-    delta: float | None = None,
-    headway: float | None = None,
-    k_a: float | None = None,
-    bounds: tuple[float, float] = GAIN_BOUNDS,
-    n: int = 121,
     ax: Any = None,
 ) -> PlotResult:
     """Draw repairs as arrows K0 → K over the certified region in the (k_x, k_v) plane.
 
-    Without ``region`` the background is the exact certified region *projected over the output
-    k_a values* (:func:`stringstab.plots.projection.projected_region`: certified at every / some
-    / none of them), so every repaired gain lies where its own verdict says, whatever its k_a;
-    with ``region`` (a 2-D k_x–k_v :class:`~stringstab.regions.RegionMap` with ``exact``,
-    e.g. from :func:`moves_region`) it is that one slice, and the title says so.  The arrows are
-    the moves projected onto (k_x, k_v), coloured by method; each input is numbered in the
-    order of ``results`` (the report's table gives its output k_a and distance moved).
+    The background is computed beforehand: the exact certified region projected over the
+    output k_a values (a :class:`~stringstab.plots.projection.ProjectedRegion` from
+    :func:`moves_projection`), so every repaired gain lies where its own verdict says, or one
+    k_x–k_v slice (a 2-D :class:`~stringstab.regions.RegionMap` with ``exact``, e.g. from
+    :func:`moves_region`), and the title says so.  The arrows are the moves projected onto
+    (k_x, k_v), coloured by method; each input is numbered in the order of ``results`` (the
+    report's table gives its output k_a and distance moved).
 
     Parameters
     ----------
     results : sequence of TuneResult
         The repairs.
-    region : RegionMap, optional
-        A slice to draw instead of the projection.
-    tau, delta, headway : float, optional
-        The loop's parameters (needed without ``region``).
-    k_a : float, optional
-        Unused without ``region`` (kept for :func:`moves_region`'s callers).
-    bounds : (float, float)
-        Gain bounds of the background's axes (padded so gains on a bound are not clipped).
-    n : int
-        Grid points per axis of the background.
+    region : ProjectedRegion or RegionMap
+        The background: :func:`moves_projection` or :func:`moves_region` of the results.
     ax : matplotlib Axes, optional
         Where to draw.
 
@@ -106,30 +137,22 @@ def plot_moves(
     Raises
     ------
     StringStabError
-        If ``region`` is not a k_x–k_v slice with the exact verdicts, or neither it nor the
-        parameters are given.
+        If ``region`` is neither a projection nor a k_x–k_v slice with the exact verdicts.
     """
     from ._common import GAIN_LABELS
+    from .projection import ProjectedRegion, plot_projected_region
 
     if ax is None:
         _, ax = pyplot().subplots(figsize=(6.4, 6.4), layout="constrained")
-    if region is None:
-        if tau is None or delta is None or headway is None:
-            raise StringStabError("plot_moves needs region= (a RegionMap) or tau, delta and headway")
-        from ..tuning.inputs import as_bounds
-        from .projection import plot_projected_region, projected_region
-
-        lo, hi = as_bounds(bounds)
-        pad = 0.05 * (hi - lo)
-        ends = np.array([r.k for r in results], dtype=float).reshape(-1, 3)
-        proj = projected_region(ends, tau=tau, delta=delta, headway=headway,
-                                bounds=(lo - pad, hi + pad), n=min(n, 101))
-        mesh = plot_projected_region(proj, ax=ax, title="repairs K0 → K (arrows, by method)")["image"]
+    if isinstance(region, ProjectedRegion):
+        mesh = plot_projected_region(region, ax=ax, title="repairs K0 → K (arrows, by method)")["image"]
     else:
-        if region.axis_names != ("k_x", "k_v") or "exact" not in region.methods:
+        if getattr(region, "axis_names", None) != ("k_x", "k_v") or "exact" not in region.methods:
             raise StringStabError(
-                f"plot_moves draws over a k_x-k_v slice with the exact verdicts; got axes "
-                f"{list(region.axis_names)} and methods {list(region.methods)}")
+                "plot_moves draws over a projection (moves_projection) or a k_x-k_v slice with "
+                f"the exact verdicts; got {type(region).__name__} with axes "
+                f"{list(getattr(region, 'axis_names', []))} and methods "
+                f"{list(getattr(region, 'methods', []))}")
         KX, KV, _ = region.gains()
         mesh = ax.pcolormesh(KX, KV, region.stable("exact").astype(float), cmap="Greens",
                              vmin=0.0, vmax=1.6, shading="auto")

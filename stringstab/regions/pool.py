@@ -1,8 +1,10 @@
-"""Evaluating the blocks of a region map, in this process or in a pool of worker processes.
+"""Running a region map's work in worker processes: its blocks, its files, a background task.
 
 Knows nothing of what a block holds: :func:`run_blocks` calls the evaluation function it is
 given on each block and yields the results as they finish, with at most two blocks per
-worker in flight (memory bounded by the block size, not the grid).
+worker in flight (memory bounded by the block size, not the grid).  :func:`map_forked` runs
+one callable on every item of a list in forked processes (a map's figures), and
+:func:`in_background` one task in a forked process while this one works on.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any
 
 from ..errors import StringStabError
 
-__all__ = ["Block", "cpu_count", "in_background", "in_daemon", "run_blocks"]
+__all__ = ["Block", "cpu_count", "in_background", "in_daemon", "map_forked", "run_blocks"]
 
 #: A block [i0:i1, j0:j1, :] of the internal 3-D grid.
 Block = tuple[int, int, int, int]
@@ -170,3 +172,48 @@ def _child(send: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
         send.send(msg.replace("\n", " "))
     finally:
         send.close()
+
+
+def map_forked(fn: Callable[[Any], Any], items: Sequence[Any], workers: int) -> None:
+    """``fn(item)`` for every item, in ``workers`` forked processes (``fn`` is inherited, not sent).
+
+    The callable and whatever it holds (a region map, say) are inherited by the forked
+    processes, not pickled; only the items are.  Where processes cannot be forked (no
+    ``fork`` start method, or this process is a daemon), or with ``workers`` ≤ 1 or one item,
+    the items are done here, in order.  Return values are discarded.
+
+    Parameters
+    ----------
+    fn : callable
+        The work on one item.
+    items : sequence
+        The items (picklable).
+    workers : int
+        The largest number of processes.
+
+    Raises
+    ------
+    Exception
+        Whatever ``fn`` raised, in this process or re-raised from a worker.
+    """
+    if workers <= 1 or len(items) <= 1 or "fork" not in multiprocessing.get_all_start_methods() \
+            or in_daemon():
+        for item in items:
+            fn(item)
+        return
+    global _FORKED
+    _FORKED = fn
+    try:
+        with multiprocessing.get_context("fork").Pool(min(workers, len(items))) as pool:
+            pool.map(_call_forked, items, chunksize=1)
+    finally:
+        _FORKED = None
+
+
+#: The callable of the running :func:`map_forked` (inherited by its forked workers).
+_FORKED: Callable[[Any], Any] | None = None
+
+
+def _call_forked(item: Any) -> None:
+    assert _FORKED is not None
+    _FORKED(item)

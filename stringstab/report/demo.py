@@ -142,7 +142,7 @@ def _tune(rep: Report, s: Mapping[str, Any], root: Path) -> None:
 
 _SIM_METRICS = [("max_m_p", "max m_p", ""), ("M_lss", "M_lss", ""), ("collisions", "collisions", ""),
                 ("TIT", "TIT", "s²"), ("M_CI", "M_CI", "m²/s⁶"), ("M_effi", "M_effi", "s"),
-                ("M_fss", "M_fss", "%")]
+                ("m_fss", "m_fss", "fraction")]
 
 
 def _simulate(rep: Report, s: Mapping[str, Any], root: Path) -> None:
@@ -150,7 +150,7 @@ def _simulate(rep: Report, s: Mapping[str, Any], root: Path) -> None:
                       "The certified triple K = (1.2, 0.5, 0.6) against the CACC baseline, "
                       "10 followers, τ = 0.1 s, δ = 0.2 s. m_p (IDL eq 29) is the ratio of a "
                       "follower's acceleration energy to its predecessor's: below 1, disturbances "
-                      "shrink along the platoon. M_fss is the share of vehicle-moments whose gains "
+                      "shrink along the platoon. m_fss is the share of vehicle-moments whose gains "
                       "are certified (CACC's gains, in its own form, are not).")
     rows = []
     for name in ("certified", "cacc"):
@@ -158,7 +158,7 @@ def _simulate(rep: Report, s: Mapping[str, Any], root: Path) -> None:
             r = s[name]
             rows.append({"controller": name, **{label: r.get(k) for k, label, _ in _SIM_METRICS}})
     if rows:
-        sec.table(rows, caption="Platoon metrics (lower is better except M_fss).",
+        sec.table(rows, caption="Platoon metrics (lower is better except m_fss).",
                   units={label: u for _, label, u in _SIM_METRICS if u})
     for name in ("certified", "cacc"):
         if name in s:

@@ -1,9 +1,9 @@
 """The IDL paper's Table 4 layout: one row per strategy, and the reference's improvement over each.
 
 Columns: TIT (mean per episode, eqs 31-32, s²), M_CI (eq 34, m²/s⁶), M_effi (eq 35, s) and
-M_lss (eq 30, the mean m_p) — lower is better — and M_fss (eq 27, %: the share of executed gains
-certified) — higher is better; a strategy that executes no certified gain (CACC and IDM in their
-own form, an acceleration policy) has M_fss 0 %.  M_lss is shown with the share of episodes whose
+M_lss (eq 30, the mean m_p) — lower is better — and m_fss (eq 27's M_fss as a fraction in
+[0, 1]: the share of executed gains certified) — higher is better; a strategy that executes no
+certified gain (CACC and IDM in their own form, an acceleration policy) has m_fss 0.  M_lss is shown with the share of episodes whose
 m_p exceeds 1 (a mean below 1 does not make every episode damp).  The improvement of the
 reference strategy R over strategy S in a lower-is-better metric m is 100 (m_S − m_R)/m_S % (the
 paper's "↑" when positive), as in Table 4; where m_S = 0 it is undefined and the row states both
@@ -22,7 +22,7 @@ __all__ = ["METRICS", "improvement", "table_csv", "table_markdown", "table_rows"
 #: (summary key, column title) of Table 4.
 METRICS: tuple[tuple[str, str], ...] = (("TIT", "TIT (s², ↓)"), ("M_CI", "M_CI (m²/s⁶, ↓)"),
                                         ("M_effi", "M_effi (s, ↓)"), ("M_lss", "M_lss (↓)"),
-                                        ("M_fss", "M_fss (%, ↑)"))
+                                        ("m_fss", "m_fss (fraction, ↑)"))
 
 
 def improvement(reference: float | None, other: float | None) -> float | None:
@@ -88,7 +88,7 @@ def table_rows(summaries: Mapping[str, Mapping[str, Any]],
             row: dict[str, Any] = {"strategy": f"{reference} compared to {name}", "improvement": True}
             for k, _ in METRICS:
                 r, o = val(ref.get(k)), val(s.get(k))
-                if k == "M_fss":
+                if k == "m_fss":
                     row[k] = None
                 elif o == 0 and r is not None:  # 100 (o − r)/o undefined: say what it hides
                     row[k] = "equal (both 0)" if r == 0 else f"worse: {r:.3g} vs 0"
@@ -102,15 +102,15 @@ def _cell(key: str, v: Any, improvement_row: bool, row: Mapping[str, Any] | None
     if isinstance(v, str):
         return v
     if v is None:
-        if key == "M_fss" and not improvement_row:
-            return "0% (no certified gains executed)"
+        if key == "m_fss" and not improvement_row:
+            return "0 (no certified gains executed)"
         return "–"
     if improvement_row:
         return f"{v:+.2f}%"
     if isinstance(v, Mapping):
         text = f"{v['mean']:.3g} ± {v['std']:.2g}"
-    elif key == "M_fss":
-        return f"{v:.2f}%"
+    elif key == "m_fss":
+        return f"{v:.4g}"
     else:
         text = f"{v:.3f}" if key == "M_lss" else f"{v:.3g}"
     if key == "M_lss" and row is not None and row.get("share_m_p_below_1") is not None:

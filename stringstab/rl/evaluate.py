@@ -8,8 +8,9 @@ and speed for an NGSIM pair, else the IDL equilibrium gap l_0 + T* v at the lead
 
 Metrics (:mod:`stringstab.traffic.metrics`): m_p of each episode (eq 29, follower over leader) and their
 mean M_lss (eq 30), TIT per episode (eqs 31-32) and its mean, M_CI (eq 34, pooled), M_effi
-(eq 35, pooled), collisions, and for gain policies M_fss (eq 27): the share of executed
-(vehicle, moment) gains certified by the exact certificate, and beside it M_fss_sampled, the
+(eq 35, pooled), collisions, and for gain policies m_fss (eq 27's M_fss, as a fraction in
+[0, 1]): the share of executed (vehicle, moment) gains certified by the exact certificate, and
+beside it m_fss_sampled, the
 share certified by the sampled-data certificate of the zero-order-hold loop at the control step
 ``dt`` (:mod:`stringstab.certify.sampled`).  Both are computed in one place, :func:`fss`.
 
@@ -55,7 +56,7 @@ BASELINES = ("cacc", "idm")
 
 def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         dt: float) -> dict[str, Any]:
-    """M_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
+    """m_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
 
     The continuous certificate is what the repair guarantees (and what the exit code of
     ``stringstab evaluate`` requires); the sampled one is the loop the simulator actually runs
@@ -78,8 +79,9 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     Returns
     -------
     dict
-        ``"M_fss"``: % of triples certified by the exact continuous-time certificate (IDL eqs
-        27-28, :func:`stringstab.traffic.metrics.fss_ratio`); ``"M_fss_sampled"``: % certified by the
+        ``"m_fss"``: the fraction in [0, 1] of triples certified by the exact continuous-time
+        certificate (IDL eqs 27-28 without the ×100 %, :func:`stringstab.traffic.metrics.fss_ratio`);
+        ``"m_fss_sampled"``: the fraction certified by the
         sampled-data certificate of the zero-order-hold loop at ``dt``
         (:func:`stringstab.certify.sampled.check_sampled`); ``"n"``: the number of triples;
         ``"certificate"``, ``"dt"``: what was checked.
@@ -93,13 +95,13 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
 
     K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
     if not K.shape[0]:
-        raise StringStabError("M_fss needs at least one executed gain triple")
+        raise StringStabError("m_fss needs at least one executed gain triple")
     uniq, inverse = np.unique(K, axis=0, return_inverse=True)
     cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
                        headway=headway, sample_time=dt)
     ok_s = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
-    return {"M_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
-            "M_fss_sampled": float(100.0 * ok_s.mean()), "n": int(K.shape[0]),
+    return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
+            "m_fss_sampled": float(ok_s.mean()), "n": int(K.shape[0]),
             "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",
             "dt": dt}
 
@@ -199,7 +201,7 @@ class Evaluation:
 
     def episodes_csv(self) -> str:
         """One row per episode."""
-        cols = ["episode", "leader", "seconds", "m_p", "TIT", "collisions", "min_gap", "M_fss"]
+        cols = ["episode", "leader", "seconds", "m_p", "TIT", "collisions", "min_gap", "m_fss"]
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(cols)
@@ -251,11 +253,11 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
     -------
     Evaluation
         ``episodes``: one dict per leader (``m_p`` of eq 29, ``TIT``, ``collisions``,
-        ``min_gap``, ``M_fss``); ``summary``: ``episodes``, ``M_lss`` (eq 30),
+        ``min_gap``, ``m_fss``); ``summary``: ``episodes``, ``M_lss`` (eq 30),
         ``share_m_p_below_1``, ``TIT`` (mean per episode), ``TIT_total``, ``M_CI`` (eq 34),
         ``M_effi`` (eq 35), ``median_headway``, ``collisions``, ``collided_episodes``,
-        ``min_gap``, and for gain policies ``M_fss`` (eq 27, with ``n_gains``) and
-        ``M_fss_sampled``; ``gains``: the executed gains, rows (t, episode, k_x, k_v, k_a).
+        ``min_gap``, and for gain policies ``m_fss`` (eq 27 as a fraction, with ``n_gains``)
+        and ``m_fss_sampled``; ``gains``: the executed gains, rows (t, episode, k_x, k_v, k_a).
 
     Raises
     ------
@@ -298,12 +300,12 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
                            "m_p": float(mp[j]) if np.isfinite(mp[j]) else None,
                            "TIT": float(tit[j]),
                            "collisions": int(res.collision_events[j, 0]),
-                           "min_gap": float(res.min_gap[j, 0]), "M_fss": None}
+                           "min_gap": float(res.min_gap[j, 0]), "m_fss": None}
         if res.gains is not None and res.gains.shape[2] == res.t.size:
             G = res.gains[:, 0, :, :]
             for j, i in enumerate(idx):
                 f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt)
-                episodes[i]["M_fss"] = f["M_fss"]
+                episodes[i]["m_fss"] = f["m_fss"]
                 gains_rows.append(np.column_stack([res.t, np.full(res.t.size, i), G[j]]))
         if progress is not None:
             progress(len(idx))
@@ -327,14 +329,14 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         "collisions": int(sum(e["collisions"] for e in episodes)),
         "collided_episodes": int(sum(e["collisions"] > 0 for e in episodes)),
         "min_gap": float(min(e["min_gap"] for e in episodes)),
-        "M_fss": None,
+        "m_fss": None,
     }
     gains = None
     if gains_rows:
         gains = np.concatenate(gains_rows)
         f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=min(dts))
-        summary["M_fss"], summary["n_gains"] = f["M_fss"], f["n"]
-        summary["M_fss_sampled"] = f["M_fss_sampled"]
+        summary["m_fss"], summary["n_gains"] = f["m_fss"], f["n"]
+        summary["m_fss_sampled"] = f["m_fss_sampled"]
         summary["certificate"] = f["certificate"]
     samples = {"ttc": np.concatenate(ttc_all), "jerk_sq": jerk, "headway": hw, "m_p": mps[ok]}
     return Evaluation(label, episodes, summary, gains, samples)
@@ -371,8 +373,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     -------
     dict
         ``"n"``, ``"leader"``, ``"m_p"`` (per vehicle, eq 29), ``"max_m_p"``, ``"M_lss"``
-        (eq 30), ``"collisions"``, ``"TIT"``, and for gain policies ``"M_fss"`` and
-        ``"M_fss_sampled"`` (:func:`fss` of every vehicle's executed gains at every step;
+        (eq 30), ``"collisions"``, ``"TIT"``, and for gain policies ``"m_fss"`` and
+        ``"m_fss_sampled"`` (:func:`fss` of every vehicle's executed gains at every step;
         None otherwise).
     """
     from ..traffic.leaders import paper_mix
@@ -386,8 +388,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     m = platoon_metrics(res, certificate=False)
     out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
            "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],
-           "TIT": m["TIT"], "M_fss": None, "M_fss_sampled": None}
+           "TIT": m["TIT"], "m_fss": None, "m_fss_sampled": None}
     if res.gains is not None and res.gains.shape[-2] == res.t.size:
         f = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt)
-        out["M_fss"], out["M_fss_sampled"] = f["M_fss"], f["M_fss_sampled"]
+        out["m_fss"], out["m_fss_sampled"] = f["m_fss"], f["m_fss_sampled"]
     return out

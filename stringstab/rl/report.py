@@ -47,7 +47,7 @@ def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True
         mp = p["m_p"]
         out.append(f"**{p['n']} vehicles** behind {p['leader']}: max m_p {p['max_m_p']:.3f}, "
                    f"M_lss {p['M_lss']:.3f}, collisions {p['collisions']}, TIT {p['TIT']:.3f}, "
-                   f"M_fss {_fmt(p['M_fss'])}, M_fss sampled at dt {_fmt(p.get('M_fss_sampled'))}\n")
+                   f"m_fss {_fmt(p['m_fss'])}, m_fss sampled at dt {_fmt(p.get('m_fss_sampled'))}\n")
         if p["n"] == 10:
             out.append("\n| vehicle | " + " | ".join(str(i + 1) for i in range(10)) + " |\n")
             out.append("|---|" + "---|" * 10 + "\n")
@@ -69,8 +69,8 @@ def platoon_markdown(platoons: Sequence[Mapping[str, Any]], *, note: bool = True
 
 #: Each metric of an evaluation's summary: (what it is, unit).
 EVALUATION_METRICS: dict[str, tuple[str, str]] = {
-    "M_fss": ("executed gains certified, continuous time (eq 27; ↑)", "%"),
-    "M_fss_sampled": ("executed gains certified, sampled-data loop at dt (↑)", "%"),
+    "m_fss": ("share of executed gains certified, continuous time (eq 27; ↑)", "fraction"),
+    "m_fss_sampled": ("share of executed gains certified, sampled-data loop at dt (↑)", "fraction"),
     "n_gains": ("executed gains checked", "count"),
     "collisions": ("collisions", "count"),
     "collided_episodes": ("episodes with a collision", "count"),
@@ -115,8 +115,9 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
     for k, (what, unit) in EVALUATION_METRICS.items():
         if k in s:
             lines.append(f"| {what} ({k}) | {_fmt(s[k])} | {unit} |\n")
-    lines.append("\nM_fss: share of executed (episode, moment) gains certified by the exact, "
-                 "delay-aware certificate (continuous time, frozen gains); M_fss_sampled: by the "
+    lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
+                 "certified by the exact, delay-aware certificate (continuous time, frozen gains); "
+                 "m_fss_sampled: by the "
                  "sampled-data certificate of the zero-order-hold loop at the control step "
                  f"dt = {run.get('dt')} s, which the simulator runs.\n\n")
     lines.append("## Platoon test\n\n" + platoon_markdown(platoons))
@@ -142,8 +143,8 @@ def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) 
         The verdict and whether it passes.
     """
     s = ev.summary
-    gains_ok = s["M_fss"] is not None and s["M_fss"] == 100.0 and all(
-        q["M_fss"] == 100.0 for q in platoons)
+    gains_ok = s["m_fss"] is not None and s["m_fss"] == 1.0 and all(
+        q["m_fss"] == 1.0 for q in platoons)
     no_coll = s["collisions"] == 0 and all(q["collisions"] == 0 for q in platoons)
     if action != "gains":
         return "not certified: an acceleration policy executes no gains to certify", False
@@ -232,21 +233,21 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         plot_ttc_distribution,
     )
 
-    keys = ("TIT", "M_CI", "M_effi", "M_lss", "M_fss", "M_fss_sampled", "collisions",
+    keys = ("TIT", "M_CI", "M_effi", "M_lss", "m_fss", "m_fss_sampled", "collisions",
             "share_m_p_below_1", "median_headway")
     summaries = {name: {k: _mean_std([e.summary.get(k) for e in evs]) for k in keys}
                  for name, evs in groups.items()}
     rows = table_rows(summaries, reference)
     md = ["# Comparison on the held-out episodes (IDL paper Table 4 layout)\n\n",
-          "↓: lower is better (TIT, M_CI, M_effi, M_lss); ↑: higher is better (M_fss, the share of "
+          "↓: lower is better (TIT, M_CI, M_effi, M_lss); ↑: higher is better (m_fss, the share of "
           "executed gains certified; CACC and IDM execute no certified gains). Rows 'X compared "
           "to Y': 100 (Y − X)/Y %, positive when X is better; where Y is 0 the row gives both "
           "values. Mean ± standard deviation over seeds where several runs are given.\n\n",
           table_markdown(rows), "\n| strategy | collisions | share of episodes with m_p < 1 | "
-          "median headway (s) | M_fss sampled at dt (%) |\n|---|---|---|---|---|\n"]
+          "median headway (s) | m_fss sampled at dt (fraction) |\n|---|---|---|---|---|\n"]
     md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
            f"{_ms(s['median_headway'])} | "
-           f"{'0 (no certified gains executed)' if s['M_fss_sampled'] is None else _ms(s['M_fss_sampled'])} |\n"
+           f"{'0 (no certified gains executed)' if s['m_fss_sampled'] is None else _ms(s['m_fss_sampled'])} |\n"
            for n, s in summaries.items()]
     if platoons:
         md.append("\n## Platoon tests (§5.1)\n\n")

@@ -64,7 +64,7 @@ class ScenarioRun:
     summary : dict
         Per vehicle and overall: steps controlled, leader changes (the leaders in order),
         minimum gap, collisions (entries into gap ≤ 0), m_p over the controlled steps (eq 29:
-        its acceleration energy over its leaders'), and M_fss of the executed gains.
+        its acceleration energy over its leaders'), and m_fss of the executed gains.
     """
 
     columns: dict[str, Any]
@@ -288,10 +288,10 @@ def _summary(cols: dict[str, Any], ids: list[str], tau: float, delta: float,
     out: dict[str, Any] = {"vehicles": per,
                            "leader_changes": sum(p["leader_changes"] for p in per),
                            "collisions": sum(p["collisions"] for p in per),
-                           "M_fss": None}
+                           "m_fss": None}
     if K_all and controller.headway is not None:
         from ..rl.evaluate import fss
 
         f = fss(np.concatenate(K_all), tau=tau, delta=delta, headway=controller.headway, dt=dt)
-        out.update(M_fss=f["M_fss"], M_fss_sampled=f["M_fss_sampled"], n_gains=f["n"])
+        out.update(m_fss=f["m_fss"], m_fss_sampled=f["m_fss_sampled"], n_gains=f["n"])
     return out

@@ -301,7 +301,7 @@ def write_outputs(spec: SweepSpec, root: str | Path) -> list[str]:
             else:
                 paper = dict(TABLE5)
                 title = "Table 5: reward ablation"
-            md, text = _table_vs_paper(gs, paper, metrics, title, "M_fss (% of executed gains certified) is in "
+            md, text = _table_vs_paper(gs, paper, metrics, title, "m_fss (the fraction of executed gains certified) is in "
                                        "results.csv; the paper's rows are matched by label.\n")
             rep.write_text(f"{spec.study}.md", md)
             rep.write_text(f"{spec.study}.csv", text)

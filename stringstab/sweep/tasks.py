@@ -28,7 +28,7 @@ from ..errors import StringStabError
 __all__ = ["run_point"]
 
 #: Metrics of a training point's evaluation copied into its record (IDL eqs 27-35).
-EVAL_METRICS = ("TIT", "M_CI", "M_effi", "M_lss", "M_fss", "M_fss_sampled", "collisions",
+EVAL_METRICS = ("TIT", "M_CI", "M_effi", "M_lss", "m_fss", "m_fss_sampled", "collisions",
                 "collided_episodes", "share_m_p_below_1", "min_gap", "episodes")
 
 

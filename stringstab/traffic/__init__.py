@@ -9,8 +9,9 @@
   :func:`simulate`;
 * :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM;
 * :mod:`~stringstab.traffic.reward` — the IDL reward (eqs 18-24);
-* :mod:`~stringstab.traffic.env` — a Gymnasium environment and a batched version for training;
-* :mod:`~stringstab.traffic.plots` — figures like the IDL paper's Figs 7-8.
+* :mod:`~stringstab.traffic.env` — a Gymnasium environment and a batched version for training.
+
+Their figures (like the IDL paper's Figs 7-8) are in :mod:`stringstab.plots.traffic`.
 """
 
 from __future__ import annotations
@@ -46,7 +47,6 @@ from .leaders import (
 )
 from .output import RUN_FILES, run_document, save_trajectories, write_run
 from .platoon import Limits, Platoon, PlatoonResult, check_leader, simulate
-from .plots import plot_damping_ratios, plot_platoon, plot_vehicles
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
 
 __all__ = [
@@ -82,9 +82,6 @@ __all__ = [
     "load_csv",
     "load_ngsim_pairs",
     "paper_mix",
-    "plot_damping_ratios",
-    "plot_platoon",
-    "plot_vehicles",
     "reward",
     "run_document",
     "safety_reward",

@@ -16,7 +16,7 @@ M_effi                      :func:`efficiency_index`             35
 m_p (damping ratio)         :func:`damping_ratio`,                29
                             :func:`damping_ratios_from_energy`
 M_lss                       :func:`lss_index`                    30
-M_fss                       :func:`fss_ratio`                    27-28
+m_fss (M_fss, a fraction)   :func:`fss_ratio`                    27-28
 all of a simulated run      :func:`platoon_metrics`              —
 collisions                  :func:`collision_count`              —
 ==========================  ===================================  ==========
@@ -39,8 +39,7 @@ Notes on the printed equations
 * Eq 34 divides by N·T; M_CI is called the *mean* squared jerk, so the mean over the N·(T−1)
   jerk samples is returned.
 * Eq 27 multiplies by 100 %; the toolkit reports M_fss as a fraction in [0, 1] (key ``m_fss``,
-  as ``stringstab certify`` does; docs/conventions.md).  :func:`fss_ratio` and the key
-  ``M_fss`` of :func:`platoon_metrics` keep the percentage of earlier versions.
+  as ``stringstab certify`` does; docs/conventions.md).
 
 Layering: these functions work on arrays.  :func:`platoon_metrics` reads a run's arrays
 (:class:`stringstab.traffic.PlatoonResult` is one such run) and calls nothing back on it;
@@ -368,13 +367,14 @@ def lss_index(m_p: ArrayLike) -> Array:
 
 
 def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, delta: float,
-              headway: float, percent: bool = True) -> float:
-    """M_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
+              headway: float) -> float:
+    """m_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
 
     m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
     (:func:`stringstab.certify.continuous.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
-    else 0 ("inconclusive" counts as 0); M_fss = 100 · Σ m_fss / (N · T/Δt).  Identical
-    triples are certified once.
+    else 0 ("inconclusive" counts as 0); the share is Σ m_fss / (N · T/Δt), eq 27's M_fss
+    without its ×100 % (a fraction, as everywhere in the toolkit: docs/conventions.md).
+    Identical triples are certified once.
 
     Parameters
     ----------
@@ -382,20 +382,20 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
         Gains at every (vehicle, moment), any common shape.
     tau, delta, headway : float
         τ, δ and T*, s.
-    percent : bool
-        Return eq 27's percentage in [0, 100] (the default, as in earlier versions), or the
-        fraction in [0, 1] the toolkit reports (``percent=False``; docs/conventions.md).
 
     Returns
     -------
     float
+        The fraction in [0, 1] of the triples certified.
+
+    Raises
+    ------
+    StringStabError
+        On no triple, or non-finite gains.
 
     Examples
     --------
     >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1)
-    50.0
-    >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1,
-    ...           percent=False)
     0.5
     """
     from ..certify.continuous import certify_batch
@@ -408,7 +408,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     uniq, inverse = np.unique(K, axis=0, return_inverse=True)
     cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway)
     ok = np.asarray(cert.verdict == "certified")[np.ravel(inverse)]
-    return float(100.0 * ok.mean()) if percent else float(ok.mean())
+    return float(ok.mean())
 
 
 def collision_count(gap: ArrayLike, *, axis: int = -1) -> npt.NDArray[np.int64]:
@@ -468,9 +468,8 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
         ``m_p`` (eq 29, per follower), ``max_m_p``, ``M_lss`` (eq 30), ``TIT`` (eqs 31-32,
         summed over followers) and ``TIT_per_vehicle``, ``M_CI`` (eq 34), ``M_effi`` (eq 35),
         ``min_ttc``, ``min_gap``, ``min_headway``, ``collisions`` (events) and
-        ``collided_vehicles`` (1-based positions), ``m_fss`` (eq 27 as a fraction in [0, 1])
-        and ``M_fss`` (the same in %, the key of earlier versions) — both None if the
-        controller is not of the eq-4 form or ``certificate`` is False.  Units: s² for TIT,
+        ``collided_vehicles`` (1-based positions), ``m_fss`` (eq 27 as a fraction in [0, 1];
+        None if the controller is not of the eq-4 form or ``certificate`` is False).  Units: s² for TIT,
         m²/s⁶ for M_CI, s for M_effi, min_ttc and min_headway, m for min_gap.
     """
     mp = damping_ratios_from_energy(result.sum_sq_accel)
@@ -497,17 +496,14 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
             min_headway=float(np.nanmin(h)) if np.isfinite(h).any() else float("nan"),
             ttc_star=ttc_star,
         )
-    out["M_fss"] = None
     out["m_fss"] = None
     if certificate and result.gains is not None and result.params.get("headway") is not None:
         taus = np.unique(np.asarray(result.params["tau"], dtype=np.float64))
         if taus.size == 1:
             G = result.gains
-            share = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
-                              delta=result.params["delta"], headway=result.params["headway"],
-                              percent=False)
-            out["m_fss"] = share
-            out["M_fss"] = 100.0 * share
+            out["m_fss"] = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
+                                     delta=result.params["delta"],
+                                     headway=result.params["headway"])
     for key in ("min_ttc", "min_headway", "M_effi"):
         if key in out and not math.isfinite(out[key]):
             out[key] = None

@@ -28,7 +28,7 @@ Format = Literal["npz", "csv", "parquet"]
 UNITS: dict[str, str] = {
     "m_p": "", "max_m_p": "", "M_lss": "", "collisions": "", "collided_vehicles": "",
     "min_gap": "m", "TIT": "s^2", "TIT_per_vehicle": "s^2", "M_CI": "m^2/s^6", "M_effi": "s",
-    "min_ttc": "s", "min_headway": "s", "ttc_star": "s", "m_fss": "", "M_fss": "%",
+    "min_ttc": "s", "min_headway": "s", "ttc_star": "s", "m_fss": "",
 }
 
 #: Every file :func:`write_run` may write (its folder holds these and nothing of another run).
@@ -183,7 +183,7 @@ def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: 
     if figures:
         from matplotlib.figure import Figure
 
-        from .plots import plot_damping_ratios, plot_platoon
+        from ..plots.traffic import plot_damping_ratios, plot_platoon
 
         fig, _ = plot_platoon(result, title=title,
                               fig=Figure(figsize=(12, 7.5), layout="constrained"))

@@ -566,13 +566,13 @@ class PlatoonResult:
         ttc_star : float
             TTC* of the time-integrated TTC (eqs 31-32), s.
         certificate : bool
-            Also compute M_fss (eq 27) of the executed gains with the exact certificate.
+            Also compute m_fss (eq 27) of the executed gains with the exact certificate.
 
         Returns
         -------
         dict
             ``m_p`` (eq 29), ``M_lss`` (eq 30), ``TIT``, ``M_CI`` (eq 34), ``M_effi`` (eq 35),
-            ``collisions``, ``m_fss``/``M_fss`` (eq 27; None without ``certificate``), ...
+            ``collisions``, ``m_fss`` (eq 27 as a fraction; None without ``certificate``), ...
         """
         return platoon_metrics(self, ttc_star=ttc_star, certificate=certificate)
 

@@ -28,9 +28,10 @@ certifies are returned unchanged, without any search or solve.
 
 Modules: :mod:`~stringstab.tuning.result` (the result types),
 :mod:`~stringstab.tuning.inputs` (input checks),
-:mod:`~stringstab.tuning.region_growing`, :mod:`~stringstab.tuning.projection` (the NLP,
-the exchange and the :class:`Projector`), :mod:`~stringstab.tuning.predictor` (the Newton
-predictor) and :mod:`~stringstab.tuning.methods` (:func:`tune`); the figure
+:mod:`~stringstab.tuning.region_growing`, :mod:`~stringstab.tuning.projection`
+(:func:`project`), :mod:`~stringstab.tuning.projector` (the :class:`Projector`),
+:mod:`~stringstab.tuning.nlp` (the CasADi/IPOPT problems), :mod:`~stringstab.tuning.exchange`
+(the exchange method), :mod:`~stringstab.tuning.predictor` (the Newton predictor) and :mod:`~stringstab.tuning.methods` (:func:`tune`); the figure
 :func:`~stringstab.plots.plot_moves` lives in :mod:`stringstab.plots.tuning` (the
 plots import the tuning, never the reverse).
 
@@ -45,9 +46,8 @@ applications", SIAM Review 35 (1993) 380-429 (the exchange method).
 from __future__ import annotations
 
 from .methods import METHODS, tune
-from .predictor import _g_and_grad as _g_and_grad  # for tests: the predictor's derivatives
-from .predictor import _g_full as _g_full
-from .projection import Projector, project
+from .projection import project
+from .projector import Projector
 from .region_growing import region_growing
 from .result import TuneResult, TuneResults
 
