@@ -34,9 +34,42 @@ from ..traffic.env import BatchedCarFollowingEnv, limit_rate
 from .config import TD3Config
 from .repair import GainRepair, repair_for
 
-__all__ = ["RepairedGains", "make_env", "repair_of"]
+__all__ = ["RepairedGains", "executed_gains", "make_env", "repair_of"]
 
 Array = npt.NDArray[np.float64]
+
+
+def executed_gains(proposed: npt.ArrayLike, repair: GainRepair, *,
+                   prev_gains: npt.ArrayLike | None = None,
+                   fresh: npt.ArrayLike | bool = False, gain_rate: float = 0.0) -> Array:
+    """The gains executed for proposed ones: clip to the box, rate limit, repair (module docstring).
+
+    The one map from a gain policy's proposal to what the eq-4 law executes, used by
+    :class:`RepairedGains` in training and by
+    :meth:`~stringstab.rl.policy.Policy.step_gains` in evaluation.
+
+    Parameters
+    ----------
+    proposed : array_like (n, 3)
+        The proposed gains (k_x, k_v, k_a) of eq 4 (the policy's action, eq 17).
+    repair : GainRepair
+        The repair (§3.3); its gain box is the one clipped to.
+    prev_gains : array_like (n, 3), optional
+        The gains executed at the previous step; None: no rate limit (an episode's first step).
+    fresh : array_like of bool (n,), or bool
+        True where an episode takes its first step (those rows are not rate limited).
+    gain_rate : float
+        Largest change r of each gain per step (0: no limit).
+
+    Returns
+    -------
+    ndarray (n, 3)
+        The executed gains, each certified by the repair (unless it is ``"off"``).
+    """
+    K = np.clip(np.asarray(proposed, dtype=np.float64).reshape(-1, 3), *repair.bounds)
+    if gain_rate > 0 and prev_gains is not None:
+        K = limit_rate(K, prev_gains, gain_rate, fresh=fresh)
+    return np.asarray(repair(K), dtype=np.float64)
 
 
 class RepairedGains(VectorActionWrapper):
@@ -113,10 +146,8 @@ class RepairedGains(VectorActionWrapper):
         a = np.asarray(actions, dtype=np.float64)
         if a.size != 3 * n:
             raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
-        K = np.clip(a.reshape(n, 3), *self.base.gain_bounds)
-        if self.gain_rate > 0:
-            K = limit_rate(K, self.base.prev_gains, self.gain_rate, fresh=self.base.first_step)
-        return np.asarray(self.repair(K), dtype=np.float64).reshape(n, 3)
+        return executed_gains(a.reshape(n, 3), self.repair, prev_gains=self.base.prev_gains,
+                              fresh=self.base.first_step, gain_rate=self.gain_rate)
 
     def state_dict(self) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
         """The wrapped environment's state (the wrapper has none): see

@@ -122,20 +122,26 @@ class Policy:
         Returns
         -------
         ndarray (n, 3)
-            The executed gains (k_x, k_v, k_a) of eq 4.
+            The executed gains (k_x, k_v, k_a) of eq 4
+            (:func:`~stringstab.rl.envs.executed_gains`, as in training).
+
+        Raises
+        ------
+        StringStabError
+            If the policy outputs accelerations.
         """
-        from ..traffic.env import extend_state, limit_rate
+        from ..traffic.env import extend_state
+        from .envs import executed_gains
 
         s = np.asarray(state, dtype=np.float64).reshape(-1, 3)
         fresh = prev_gains is None
         prev = np.zeros((s.shape[0], 3)) if fresh else np.asarray(prev_gains, np.float64).reshape(-1, 3)
         a = np.zeros(s.shape[0]) if accel is None else np.asarray(accel, np.float64).reshape(-1)
         x = extend_state(s, observe=self.observe, accel=a, prev_gains=prev)
-        K = np.clip(self(x), self.info["low"][0], self.info["high"][0])
-        if self.gain_rate > 0 and not fresh:
-            K = limit_rate(K, prev, self.gain_rate)
-        assert self.repair is not None
-        return self.repair(K)
+        if self.repair is None:
+            raise StringStabError(f"policy of {self.algo!r} outputs accelerations, not gains")
+        return executed_gains(self(x), self.repair, prev_gains=None if fresh else prev,
+                              gain_rate=self.gain_rate)
 
     def gains(self, obs: npt.ArrayLike) -> Array:
         """The executed gains of an IDL policy: μ(s) repaired (each certified unless repair off).
