@@ -160,7 +160,7 @@ def test_bad_env_arguments():
 def test_linear_law_is_the_eq4_law_of_the_linear_controller():
     """The vectorised eq-4 law the environment executes agrees with LinearController.command
     (which expands k_x (gap − T* v − l_0) into three products: another rounding path)."""
-    from stringstab.traffic.controllers import Observation, linear_law
+    from stringstab.traffic import Observation, linear_law
 
     rng = np.random.default_rng(0)
     gap, speed, rel, ad = rng.uniform(0, 40, 50), rng.uniform(0, 30, 50), rng.normal(size=50), rng.normal(size=50)

@@ -5,9 +5,9 @@ before ``learning_starts``), Gaussian exploration noise is added (std ``explorat
 action half-range, Table 1) and the result clipped to the bounds; the environments apply them —
 for IDL through the action wrapper that rate limits and repairs the proposed gains
 (:class:`~stringstab.rl.envs.RepairedGains`, built with the environments by
-:func:`~stringstab.rl.envs.make_env`); the transitions enter the replay memory (a sub-episode that ended contributes
-its last state from ``info["final_obs"]``; only a termination, i.e. a collision, stops the
-bootstrap); then ``updates_per_step`` gradient steps are taken (:class:`~stringstab.rl.agent.Agent`).
+:func:`~stringstab.rl.envs.make_env`); the transitions enter the replay memory (a sub-episode
+that ended contributes its last state from ``info["final_obs"]``; only a termination, i.e. a
+collision, stops the bootstrap); then ``updates_per_step`` gradient steps are taken (:class:`~stringstab.rl.agent.Agent`).
 
 Stopping (§4.1.2): after ``stop_episodes`` collision-free episode ends (700 in the paper) or
 ``total_steps`` environment steps, whichever comes first.
