@@ -120,7 +120,7 @@ class RepairedGains(VectorActionWrapper):
         if isinstance(gain_rate, bool) or not isinstance(gain_rate, (int, float)) \
                 or not (np.isfinite(gain_rate) and gain_rate >= 0):
             raise StringStabError(f"gain_rate must be a number >= 0; got {show(gain_rate)}")
-        self.base = base
+        self._base = base
         self.repair = repair
         self.gain_rate = float(gain_rate)
 
@@ -142,12 +142,12 @@ class RepairedGains(VectorActionWrapper):
         StringStabError
             If ``actions`` is not one triple per sub-environment.
         """
-        n = self.base.num_envs
+        n = self._base.num_envs
         a = np.asarray(actions, dtype=np.float64)
         if a.size != 3 * n:
             raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
-        return executed_gains(a.reshape(n, 3), self.repair, prev_gains=self.base.prev_gains,
-                              fresh=self.base.first_step, gain_rate=self.gain_rate)
+        return executed_gains(a.reshape(n, 3), self.repair, prev_gains=self._base.prev_gains,
+                              fresh=self._base.first_step, gain_rate=self.gain_rate)
 
     def state_dict(self) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
         """The wrapped environment's state (the wrapper has none): see
@@ -160,7 +160,7 @@ class RepairedGains(VectorActionWrapper):
         arrays : dict of str to ndarray
             The environment's arrays (previous executed gains included).
         """
-        return self.base.state_dict()
+        return self._base.state_dict()
 
     def load_state_dict(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
         """Restore :meth:`state_dict` output into the wrapped environment.
@@ -172,7 +172,7 @@ class RepairedGains(VectorActionWrapper):
         arrays : dict of str to ndarray
             The arrays of :meth:`state_dict`.
         """
-        self.base.load_state_dict(meta, arrays)
+        self._base.load_state_dict(meta, arrays)
 
 
 def repair_of(envs: VectorEnv) -> GainRepair | None:
