@@ -140,9 +140,9 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     pytest.importorskip("torch")
     import importlib
 
-    rl_train = importlib.import_module("stringstab.rl.train")  # the package exports train()
+    rl_envs = importlib.import_module("stringstab.rl.envs")
 
-    real = rl_train.make_env
+    real = rl_envs.make_env
     calls = {"n": 0}
 
     def make_env(config, leaders=None):
@@ -158,7 +158,7 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
         env.step = stepped
         return env
 
-    monkeypatch.setattr(rl_train, "make_env", make_env)
+    monkeypatch.setattr(rl_envs, "make_env", make_env)
     handler = signal.getsignal(signal.SIGINT)  # SIG_IGN when pytest runs in a background job
     out = tmp_path / "run"
     argv = ["train", "--algo", "ddpg", "--steps", "64", "--num-envs", "4", "--out", str(out),
@@ -172,7 +172,7 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     for name in ("train_log.csv", "summary.json", "policy.json", "checkpoint"):
         assert (out / name).exists(), name
     assert signal.getsignal(signal.SIGINT) is handler  # handler restored
-    monkeypatch.setattr(rl_train, "make_env", real)
+    monkeypatch.setattr(rl_envs, "make_env", real)
     assert main([*argv, "--resume"]) == 0
     assert "trained ddpg: 64 steps" in capsys.readouterr().out
 

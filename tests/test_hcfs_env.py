@@ -110,8 +110,8 @@ def test_train_ddpg_through_the_contract(monkeypatch, tmp_path):
             directory.mkdir(parents=True, exist_ok=True)
             (directory / "config.json").write_text("{}")
 
-    def train(config, env=None):
-        seen["config"], seen["env"] = config, env
+    def train(config, envs=None):
+        seen["config"], seen["env"] = config, envs
         return types.SimpleNamespace(policy=Policy())
 
     fake = types.ModuleType("stringstab.rl")

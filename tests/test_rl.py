@@ -29,7 +29,8 @@ torch = pytest.importorskip("torch")
 pytest.importorskip("safetensors")
 
 from stringstab.rl import config_for, load_policy, train  # noqa: E402
-from stringstab.rl.repair import GainRepair  # noqa: E402
+from stringstab.rl.envs import RepairedGains, make_env, repair_of  # noqa: E402
+from stringstab.rl.repair import GainRepair, repair_for  # noqa: E402
 
 pytestmark = pytest.mark.torch
 
@@ -41,7 +42,7 @@ def tiny(algo: str, **kw):
                 stop_episodes=0, seed=3, hidden=(16, 16), repair_resolution=0.25,
                 checkpoint_every=10_000)
     base.update(kw)
-    # the paper's configuration (the eq-16 state); tests of the other options pass them explicitly
+    # the paper's configuration (the eq-16 state); tests of the IDL_OPTIONS pass them explicitly
     return config_for(algo, paper=algo == "idl", **base)
 
 
@@ -204,7 +205,7 @@ def test_stop_rule_counts_collision_free_episode_ends():
 
 def test_contract_custom_env_and_policy_save_load(tmp_path):
     env = BatchedCarFollowingEnv(2, short_leaders(), action="accel")
-    res = train(tiny("ddpg", num_envs=2), env=env, progress=False)
+    res = train(tiny("ddpg", num_envs=2), envs=env, progress=False)
     res.policy.save(tmp_path / "pol")
     pol = load_policy(tmp_path / "pol")
     obs = np.random.default_rng(1).normal(size=(4, 3))
@@ -476,7 +477,8 @@ def test_limit_rate_clips_to_the_previous_gains(rows, rate):
 def test_options_change_the_state_and_bound_the_gain_steps():
     """Repair off: the executed gains move at most gain_rate per step (after an episode's first)."""
     lead = [sinusoid(omega=0.8, amplitude=3.0, speed=15.0, duration=6.0)]
-    env = BatchedCarFollowingEnv(2, lead, gain_rate=0.03, observe=("accel", "gains"))
+    env = RepairedGains(BatchedCarFollowingEnv(2, lead, observe=("accel", "gains")),
+                        GainRepair("off", tau=TAU, delta=DELTA, headway=HEADWAY), gain_rate=0.03)
     obs, _ = env.reset(seed=0)
     assert obs.shape == (2, 7)
     np.testing.assert_array_equal(obs[:, 3:], 0.0)  # no previous gains yet
@@ -527,10 +529,8 @@ def test_rate_limited_policy_runs_in_evaluation_as_in_training():
     assert pol.info["obs_dim"] == 7 and pol.gain_rate == 0.05
     lead = sinusoid(omega=1.0, amplitude=3.0, speed=15.0, duration=4.0)
     ev = evaluate(pol, [lead], tau=TAU, delta=DELTA, headway=HEADWAY)
-    from stringstab.rl.train import make_env
-
     env = make_env(cfg.replace(num_envs=1, start_spread=(0.0, 0.0)), leaders=[lead])
-    env._core.terminate_on_collision = False
+    env.unwrapped._core.terminate_on_collision = False
     obs, _ = env.reset(seed=0)
     rows = []
     for _ in range(lead.n_steps - 1):
@@ -575,3 +575,77 @@ def test_cli_train_paper_flag_is_for_idl_only(tmp_path, capsys):
                  "--out", str(tmp_path / "r")]) == 2
     assert "--paper applies to --algo idl" in capsys.readouterr().err
     assert not (tmp_path / "r").exists()
+
+
+# --------------------------------------------------------------------------- the repair wrapper
+def test_wrapper_rate_limits_then_repairs_so_every_executed_gain_is_certified():
+    """Proposal → clip → rate limit (from the previous *executed* gains) → repair: where the
+    rate-limited proposal is certified it is executed as is, every executed triple is certified
+    by the independent sweep, and the repair does move some."""
+    import stringstab as ss
+    from stringstab.traffic.env import limit_rate
+
+    rate = 0.05
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3)
+    envs = RepairedGains(BatchedCarFollowingEnv(2, short_leaders(), observe=("gains",)), rep,
+                         gain_rate=rate)
+    envs.reset(seed=0)
+    rng = np.random.default_rng(5)
+    prev, moved, kept = None, 0, 0
+    for _ in range(12):
+        a = rng.uniform(-2.5, 2.5, (2, 3))
+        _, _, term, trunc, info = envs.step(a)
+        K = info["gains"]
+        want = np.clip(a, -2, 2) if prev is None else limit_rate(np.clip(a, -2, 2), prev, rate)
+        ok = ss.check(want[:, 0], want[:, 1], want[:, 2], tau=TAU, delta=DELTA,
+                      headway=HEADWAY).verdict == "certified"
+        np.testing.assert_array_equal(K[ok], want[ok])
+        kept += int(ok.sum())
+        moved += int((~ok).sum())
+        for k in K:
+            assert independent_certified(k), k
+        assert not (term | trunc).any()
+        prev = K
+    assert moved and kept and rep.stats["rows"] == 24
+
+
+def test_make_env_wraps_gain_actions_only_and_train_needs_the_wrapper():
+    from gymnasium.vector import VectorWrapper
+
+    idl = tiny("idl")
+    envs = make_env(idl, leaders=short_leaders())
+    assert isinstance(envs, RepairedGains) and repair_of(envs) is envs.repair
+    assert repair_of(VectorWrapper(envs)) is envs.repair  # found through other wrappers
+    assert envs.repair.describe() == repair_for(idl).describe()
+    td3 = make_env(tiny("td3"), leaders=short_leaders())
+    assert isinstance(td3, BatchedCarFollowingEnv) and repair_of(td3) is None
+    with pytest.raises(StringStabError, match="gain actions need the environments wrapped"):
+        train(idl, envs=BatchedCarFollowingEnv(4, short_leaders()), progress=False)
+    with pytest.raises(StringStabError, match="gain box"):
+        RepairedGains(BatchedCarFollowingEnv(1, short_leaders(), gain_bounds=(-1.0, 1.0)),
+                      GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY))
+
+
+def test_a_loaded_policy_repairs_as_training_did_and_missing_keys_are_refused(tmp_path):
+    cfg = tiny("idl", repair_refine=2)
+    pol = train(cfg, leaders=short_leaders(), progress=False).policy
+    pol.save(tmp_path / "p")
+    loaded = load_policy(tmp_path / "p")
+    assert loaded.repair is not None and loaded.repair.describe() == repair_for(cfg).describe()
+    K = np.random.default_rng(2).uniform(-2, 2, (20, 3))
+    np.testing.assert_array_equal(loaded.repair(K), repair_for(cfg)(K))
+    doc = json.loads((tmp_path / "p" / "policy.json").read_text())
+    for key in ("observe", "gain_rate", "repair"):
+        (tmp_path / "p" / "policy.json").write_text(
+            json.dumps({k: v for k, v in doc.items() if k != key}))
+        with pytest.raises(StringStabError, match=f"expected key '{key}' in .*policy.json, "
+                                                  r"found keys \['act_dim', 'action', "):
+            load_policy(tmp_path / "p")
+    bad = {**doc, "repair": {k: v for k, v in doc["repair"].items() if k != "refine"}}
+    (tmp_path / "p" / "policy.json").write_text(json.dumps(bad))
+    with pytest.raises(StringStabError, match=r"expected key 'refine' in .*policy.json's repair "
+                                              r"settings, found keys \['bounds', "):
+        load_policy(tmp_path / "p")
+    info = {k: v for k, v in pol.info.items() if k != "gain_rate"}
+    with pytest.raises(StringStabError, match="expected key 'gain_rate' in policy info"):
+        type(pol)(pol.actor, info)

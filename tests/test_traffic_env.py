@@ -100,19 +100,23 @@ def test_following_pair_starts_where_the_human_was():
     assert_allclose(obs[1] * 2.5, 1.0, rtol=1e-5)
 
 
-def test_gain_filter_and_sequential_order():
+def test_action_wrapper_and_sequential_order():
+    """A gain filter is a standard gymnasium action wrapper; the env clips what it executes."""
+    import gymnasium as gym
+
     seen = []
 
     def filt(k):
-        seen.append(k.copy())
+        seen.append(np.array(k, copy=True))
         return np.clip(k, 0.0, None)
 
     leads = [paper_mix(), hard_braking()]
-    env = CarFollowingEnv(leads, gain_filter=filt, order="sequential")
+    base = CarFollowingEnv(leads, order="sequential")
+    env = gym.wrappers.TransformAction(base, filt, base.action_space)
     assert env.reset(seed=0)[1]["leader_index"] == 0
     _, _, _, _, info = env.step(np.array([-1.0, 0.5, 3.0], dtype=np.float32))
-    assert_allclose(seen[0], [[-1.0, 0.5, 2.0]])  # clipped to the Table 2 bounds first
-    assert_allclose(info["gains"], [0.0, 0.5, 2.0])
+    assert_allclose(seen[0], [-1.0, 0.5, 3.0])  # the proposal, as given
+    assert_allclose(info["gains"], [0.0, 0.5, 2.0])  # filtered, then clipped to Table 2's box
     assert env.reset()[1]["leader_index"] == 1
     assert env.reset(options={"index": 0})[1]["leader_index"] == 0
 
@@ -151,3 +155,38 @@ def test_bad_env_arguments():
     env.reset(seed=0)
     with pytest.raises(StringStabError, match="gain actions"):
         env.step(np.zeros(2, dtype=np.float32))
+
+
+def test_linear_law_is_the_eq4_law_of_the_linear_controller():
+    """The vectorised eq-4 law the environment executes agrees with LinearController.command
+    (which expands k_x (gap − T* v − l_0) into three products: another rounding path)."""
+    from stringstab.traffic import Observation, linear_law
+
+    rng = np.random.default_rng(0)
+    gap, speed, rel, ad = rng.uniform(0, 40, 50), rng.uniform(0, 30, 50), rng.normal(size=50), rng.normal(size=50)
+    z = np.zeros(50)
+    obs = Observation(0, 0.0, 0.1, gap=gap, speed=speed, accel=z, pred_speed=speed + rel,
+                      rel_speed=rel, pred_accel=z, pred_accel_delayed=ad)
+    Ks = rng.uniform(-2, 2, (50, 3))
+    u = linear_law(Ks, obs, headway=1.1, standstill=2.0)
+    want = [LinearController(*k, headway=1.1, standstill=2.0).command(obs)[i] for i, k in enumerate(Ks)]
+    assert_allclose(u, want, rtol=1e-12, atol=1e-12)
+    # by hand for one follower: 1.2 (27 − 1.1·20 − 2) + 0.5·1 + 0.6·0.5 = 4.4
+    one = Observation(0, 0.0, 0.1, gap=np.array([27.0]), speed=np.array([20.0]), accel=z[:1],
+                      pred_speed=np.array([21.0]), rel_speed=np.array([1.0]), pred_accel=z[:1],
+                      pred_accel_delayed=np.array([0.5]))
+    assert_allclose(linear_law([1.2, 0.5, 0.6], one, headway=1.1, standstill=2.0), [4.4], rtol=1e-14)
+
+
+def test_environment_state_without_a_key_is_refused_in_one_line():
+    env = BatchedCarFollowingEnv(2, [paper_mix()], observe=("gains",))
+    env.reset(seed=0)
+    env.step(np.tile(K, (2, 1)))
+    meta, arrays = env.state_dict()
+    del arrays["prev_gains"]
+    with pytest.raises(StringStabError, match=r"expected key 'prev_gains' in the environment's "
+                                              r"arrays, found keys \['k', 'platoon\."):
+        BatchedCarFollowingEnv(2, [paper_mix()], observe=("gains",)).load_state_dict(meta, arrays)
+    meta2 = {k: v for k, v in meta.items() if k != "rng"}
+    with pytest.raises(StringStabError, match="expected key 'rng' in the environment's meta data"):
+        BatchedCarFollowingEnv(2, [paper_mix()]).load_state_dict(meta2, env.state_dict()[1])

@@ -3,7 +3,7 @@ DDPG that ships with the package.
 
 :func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the algorithm of Lillicrap et al.) on
 :class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS reward (eqs 4-6) through
-``stringstab.rl.train(DDPGConfig(...), env=...)`` and returns it as an acceleration policy on
+``stringstab.rl.train(DDPGConfig(...), envs=...)`` and returns it as an acceleration policy on
 SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the trainer's run folder
 (policy, checkpoint, ``train_log.csv``, ``rolling_reward.png``, ``summary.json``) receives
 ``hcfs_policy.json`` beside it, and the folder is what ``stringstab hcfs verify --policy DIR``
@@ -171,7 +171,7 @@ def train_hcfs_ddpg(*, total_steps: int = 100_000, seed: int = 0, env: HCFSVecto
 
         kwargs["log"] = log
     try:
-        result = rl.train(cfg, env=env, **kwargs)
+        result = rl.train(cfg, envs=env, **kwargs)
         if getattr(result, "stopped_by", None) == "interrupted":
             raise KeyboardInterrupt
     except ModuleNotFoundError as e:

@@ -3,7 +3,11 @@
 * :mod:`~stringstab.rl.config` — :class:`TD3Config`, :class:`DDPGConfig` (IDL Table 1 defaults),
   :func:`config_for` ("idl", "td3", "ddpg");
 * :mod:`~stringstab.rl.episodes` — training and test leaders;
-* :mod:`~stringstab.rl.repair` — the §3.3 repair for a training loop (certified lookup);
+* :mod:`~stringstab.rl.repair` — the §3.3 repair for a training loop (certified lookup) and
+  :func:`~stringstab.rl.repair.repair_for`, the one way to rebuild it from a config or policy;
+* :mod:`~stringstab.rl.envs` — :func:`~stringstab.rl.envs.make_env` (the training environments
+  of a config) and :class:`~stringstab.rl.envs.RepairedGains`, the action wrapper that rate
+  limits and repairs the proposed gains;
 * :mod:`~stringstab.rl.networks`, :mod:`~stringstab.rl.buffer`, :mod:`~stringstab.rl.agent` —
   actor/critics, replay memory, the TD3 and DDPG update rules;
 * :mod:`~stringstab.rl.train` — :func:`train` → :class:`TrainResult`;

@@ -123,10 +123,10 @@ class TD3Config:
     proposal_penalty: float = 1.0
     #: Largest change of each executed gain per control step, gain units (not in the paper; 0:
     #: off).  The proposal is clipped to within ``gain_rate`` of the previous executed gains,
-    #: then repaired.  Phase 1 found that most of the IDL policy's jerk (M_CI) comes from its
-    #: gains changing every step (u = K·Y jumps when K does): frozen at their median, the same
-    #: policy's gains give a third of its M_CI.  Use with ``observe`` containing "gains" (the
-    #: limit makes the previous gains part of the state).
+    #: then repaired (:class:`stringstab.rl.envs.RepairedGains`).  Much of an IDL policy's jerk
+    #: (M_CI) can come from its gains changing every step (u = K·Y jumps when K does;
+    #: docs/training.md).  Use with ``observe`` containing "gains" (the limit makes the
+    #: previous gains part of the state).
     gain_rate: float = 0.0
     #: Extras appended to the eq-16 state (not in the paper): "accel" (the follower's own
     #: acceleration, which the comfort reward of eq 21 penalises changes of and eq 16 omits)
@@ -134,8 +134,8 @@ class TD3Config:
     observe: tuple[str, ...] = ()
     #: Random start of training episodes off equilibrium (not in the paper): initial gap scaled by
     #: 1 + s_g·U(−1, 1) and speed offset by s_v·U(−1, 1), (s_g, s_v) in (fraction, m/s); NGSIM
-    #: pairs start as recorded.  (0, 0): every episode starts in equilibrium; phase 1's
-    #: policies then met no collision in training and learnt nothing about avoiding one.
+    #: pairs start as recorded.  (0, 0): every episode starts in equilibrium, where training
+    #: may meet no collision and so teach nothing about avoiding one (docs/training.md).
     start_spread: tuple[float, float] = (0.0, 0.0)
     #: TTC* of the safety reward (eq 20), s.  Table 2's 3 s is also the threshold of the TIT
     #: metric (eq 31); a larger value in the reward (not in the paper) is a safety margin: the
@@ -304,8 +304,8 @@ def _check(c: TD3Config) -> None:
             f"config field batch_size ({c.batch_size}) must not exceed buffer_size ({c.buffer_size})")
 
 
-#: The options ``config_for("idl")`` adds to :class:`TD3Config` (phase 2 of the trainer, none in
-#: the paper; chosen on a validation split of the training episodes by
+#: The options ``config_for("idl")`` adds to :class:`TD3Config` (none in the paper; chosen on
+#: a validation split of the training episodes by
 #: ``analysis/train_validate.py``, see docs/training.md).  ``config_for("idl", paper=True)``
 #: leaves them out.
 IDL_OPTIONS: dict[str, Any] = {"gain_rate": 0.02, "observe": ("accel", "gains"),
@@ -317,7 +317,7 @@ def config_for(algo: str, *, paper: bool = False, **overrides: Any) -> TD3Config
 
     ``idl`` is :class:`TD3Config` with gain actions, the projection repair and
     :data:`IDL_OPTIONS` (without them when ``paper`` is true: the eq-16 state, no gain rate
-    limit, episodes started in equilibrium, phase 1's defaults); ``td3`` is
+    limit, episodes started in equilibrium); ``td3`` is
     :class:`TD3Config` with acceleration actions and exploration noise 0.25 (the best for pure
     TD3 in the paper's §5.1(2)); ``ddpg`` is :class:`DDPGConfig`.
 

@@ -23,12 +23,15 @@ import numpy.typing as npt
 from ..errors import StringStabError
 from ..io import atomic_write_text, check_output_dir, dumps_json
 from .checkpoint import read_json, read_tensors, write_tensors
-from .repair import GainRepair
+from .repair import GainRepair, repair_for
 
-__all__ = ["POLICY_FORMAT", "Policy", "load_policy"]
+__all__ = ["POLICY_FORMAT", "POLICY_KEYS", "Policy", "load_policy"]
 
 #: Format tag of ``policy.json``.
 POLICY_FORMAT = "stringstab-rl-policy/1"
+#: The keys of a policy's info (``policy.json`` without ``format`` and ``sha256``).
+POLICY_KEYS = ("algo", "action", "obs_dim", "act_dim", "low", "high", "hidden", "tau", "delta",
+               "headway", "dt", "observe", "gain_rate", "repair")
 
 Array = npt.NDArray[np.float64]
 
@@ -40,24 +43,28 @@ class Policy:
     ----------
     info : dict
         ``algo``, ``action`` ("gains" or "accel"), ``obs_dim``, ``act_dim``, ``low``, ``high``,
-        ``hidden``, the model parameters (``tau``, ``delta``, ``headway``, ``dt``) and the
-        ``repair`` settings.
+        ``hidden``, the model parameters (``tau``, ``delta``, ``headway``, ``dt``), the state
+        extras ``observe``, the ``gain_rate`` and the ``repair`` settings (every key of
+        :data:`POLICY_KEYS`).
     repair : GainRepair or None
-        The repair of a gain policy (None for an acceleration policy).
+        The repair of a gain policy, rebuilt from ``info["repair"]`` by
+        :func:`~stringstab.rl.repair.repair_for` (None for an acceleration policy).
+
+    Raises
+    ------
+    StringStabError
+        If ``info`` lacks a key of :data:`POLICY_KEYS` or holds invalid repair settings.
     """
 
-    def __init__(self, actor: Any, info: dict[str, Any]) -> None:
+    def __init__(self, actor: Any, info: dict[str, Any], *, where: str = "policy info") -> None:
         self.actor = actor
         self.actor.eval()
         self.info = dict(info)
-        self.repair: GainRepair | None = None
-        if self.info.get("action") == "gains":
-            r = self.info.get("repair") or {}
-            self.repair = GainRepair(
-                r.get("method", "projection"), tau=self.info["tau"], delta=self.info["delta"],
-                headway=self.info["headway"], bounds=(self.info["low"][0], self.info["high"][0]),
-                resolution=r.get("resolution", 0.05), refine=r.get("refine", 4),
-                sample_time=r.get("sample_time"))
+        for key in POLICY_KEYS:
+            if key not in self.info:
+                raise StringStabError(f"expected key {key!r} in {where}, found keys "
+                                      f"{sorted(self.info)}")
+        self.repair: GainRepair | None = repair_for(self.info, where=where)
 
     @property
     def algo(self) -> str:
@@ -85,13 +92,13 @@ class Policy:
 
     @property
     def observe(self) -> tuple[str, ...]:
-        """Extras of the state beyond eq 16 (``TD3Config.observe``; empty for phase-1 policies)."""
-        return tuple(self.info.get("observe") or ())
+        """Extras of the state beyond eq 16 (``TD3Config.observe``)."""
+        return tuple(self.info["observe"])
 
     @property
     def gain_rate(self) -> float:
         """Per-step limit on each gain's change (``TD3Config.gain_rate``; 0: none)."""
-        return float(self.info.get("gain_rate") or 0.0)
+        return float(self.info["gain_rate"])
 
     def step_gains(self, state: npt.ArrayLike, *, accel: npt.ArrayLike | None = None,
                    prev_gains: npt.ArrayLike | None = None) -> Array:
@@ -115,20 +122,26 @@ class Policy:
         Returns
         -------
         ndarray (n, 3)
-            The executed gains (k_x, k_v, k_a) of eq 4.
+            The executed gains (k_x, k_v, k_a) of eq 4
+            (:func:`~stringstab.rl.envs.executed_gains`, as in training).
+
+        Raises
+        ------
+        StringStabError
+            If the policy outputs accelerations.
         """
-        from ..traffic.env import extend_state, limit_rate
+        from ..traffic.env import extend_state
+        from .envs import executed_gains
 
         s = np.asarray(state, dtype=np.float64).reshape(-1, 3)
         fresh = prev_gains is None
         prev = np.zeros((s.shape[0], 3)) if fresh else np.asarray(prev_gains, np.float64).reshape(-1, 3)
         a = np.zeros(s.shape[0]) if accel is None else np.asarray(accel, np.float64).reshape(-1)
         x = extend_state(s, observe=self.observe, accel=a, prev_gains=prev)
-        K = np.clip(self(x), self.info["low"][0], self.info["high"][0])
-        if self.gain_rate > 0 and not fresh:
-            K = limit_rate(K, prev, self.gain_rate)
-        assert self.repair is not None
-        return self.repair(K)
+        if self.repair is None:
+            raise StringStabError(f"policy of {self.algo!r} outputs accelerations, not gains")
+        return executed_gains(self(x), self.repair, prev_gains=None if fresh else prev,
+                              gain_rate=self.gain_rate)
 
     def gains(self, obs: npt.ArrayLike) -> Array:
         """The executed gains of an IDL policy: μ(s) repaired (each certified unless repair off).
@@ -208,7 +221,8 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
     ------
     StringStabError
         If the folder or a file is missing, a file was altered or truncated, the JSON is not a
-        stringstab policy, or the weights do not fit the described network.
+        stringstab policy or lacks a key of :data:`POLICY_KEYS`, or the weights do not fit the
+        described network.
     """
     import torch
 
@@ -220,6 +234,9 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
                               "policy.json and policy.safetensors")
     where = str(d / "policy.json")
     info = read_json(d / "policy.json", fmt=POLICY_FORMAT, what="policy")
+    for key in (*POLICY_KEYS, "sha256"):
+        if key not in info:
+            raise StringStabError(f"expected key {key!r} in {where}, found keys {sorted(info)}")
     obs_dim = _need(info, "obs_dim", int, where)
     act_dim = _need(info, "act_dim", int, where)
     hidden = _need(info, "hidden", list, where)
@@ -234,7 +251,7 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
         raise StringStabError(f"{where}: low/high must have act_dim={act_dim} entries")
     from ..traffic.env import OBSERVE, state_dim
 
-    observe = info.get("observe") or []  # absent from phase-1 policies: the eq-16 state
+    observe = info["observe"]
     if (not isinstance(observe, list) or not set(observe) <= set(OBSERVE)
             or len(set(observe)) != len(observe)):
         raise StringStabError(f"{where}: observe must list names from {list(OBSERVE)}; "
@@ -243,7 +260,7 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
     if observe and obs_dim != want_dim:  # (without extras a custom environment's states may be any size)
         raise StringStabError(f"{where}: obs_dim must be {want_dim} for observe {observe}; "
                               f"found {obs_dim}")
-    rate = info.get("gain_rate") or 0.0
+    rate = info["gain_rate"]
     if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 <= rate < float("inf"):
         raise StringStabError(f"{where}: gain_rate must be a number >= 0; found {rate!r}")
     arrays = read_tensors(d / "policy.safetensors", expected_sha256=_need(info, "sha256", str, where),
@@ -262,4 +279,4 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
         raise StringStabError(f"policy: weights do not fit the network in {where} ({e})") from e
     info.pop("format", None)
     info.pop("sha256", None)
-    return Policy(actor, info)
+    return Policy(actor, info, where=where)

@@ -2,11 +2,12 @@
 
 Each vector step: the actor proposes actions for all ``num_envs`` environments (uniformly random
 before ``learning_starts``), Gaussian exploration noise is added (std ``exploration_noise`` × the
-action half-range, Table 1) and the result clipped to the bounds; the environment applies them —
-for IDL after the repair (:class:`~stringstab.rl.repair.GainRepair`, the environment's
-``gain_filter``); the transitions enter the replay memory (a sub-episode that ended contributes
-its last state from ``info["final_obs"]``; only a termination, i.e. a collision, stops the
-bootstrap); then ``updates_per_step`` gradient steps are taken (:class:`~stringstab.rl.agent.Agent`).
+action half-range, Table 1) and the result clipped to the bounds; the environments apply them —
+for IDL through the action wrapper that rate limits and repairs the proposed gains
+(:class:`~stringstab.rl.envs.RepairedGains`, built with the environments by
+:func:`~stringstab.rl.envs.make_env`); the transitions enter the replay memory (a sub-episode
+that ended contributes its last state from ``info["final_obs"]``; only a termination, i.e. a
+collision, stops the bootstrap); then ``updates_per_step`` gradient steps are taken (:class:`~stringstab.rl.agent.Agent`).
 
 Stopping (§4.1.2): after ``stop_episodes`` collision-free episode ends (700 in the paper) or
 ``total_steps`` environment steps, whichever comes first.
@@ -38,7 +39,7 @@ from ..io import atomic_path, atomic_write_text, check_output_dir, dumps_json
 from .config import TD3Config, config_from_dict
 from .policy import Policy
 
-__all__ = ["RUN_FORMAT", "TrainResult", "make_env", "train"]
+__all__ = ["RUN_FORMAT", "TrainResult", "train"]
 
 #: Format tag of a run folder's ``run.json``.
 RUN_FORMAT = "stringstab-rl-run/1"
@@ -83,49 +84,6 @@ class TrainResult:
     timing: dict[str, float] = field(default_factory=dict)
     repair: dict[str, float] | None = None
     out: Path | None = None
-
-
-def make_env(config: TD3Config, leaders: list[Any] | None = None) -> Any:
-    """The default training environment of ``config``: the batched car-following environment.
-
-    Leaders: ``leaders`` or the bundled training episodes
-    (:func:`~stringstab.rl.episodes.default_leaders`); gains go through the config's repair.
-
-    Parameters
-    ----------
-    config : TD3Config
-        Supplies the number of environments, action mode, τ, δ, T*, gain bounds, reward
-        weights (eq 18) and TTC* (eq 20), the repair, gain rate, ``observe`` and start spread.
-    leaders : list, optional
-        The training leaders (trajectories or following pairs).
-
-    Returns
-    -------
-    BatchedCarFollowingEnv
-        The environment, with the :class:`~stringstab.rl.repair.GainRepair` it applies (None
-        for acceleration actions) as its ``repair`` attribute.
-    """
-    from ..traffic.env import BatchedCarFollowingEnv
-    from .episodes import default_leaders
-    from .repair import GainRepair
-
-    if leaders is None:
-        leaders = list(default_leaders("train", seconds=config.episode_seconds, dt=config.dt))
-    repair = None
-    if config.action == "gains":
-        repair = GainRepair(config.repair, tau=config.tau, delta=config.delta,
-                            headway=config.headway, bounds=config.gain_bounds,
-                            resolution=config.repair_resolution, refine=config.repair_refine,
-                            sample_time=config.dt if config.repair_sampled else None)
-    env = BatchedCarFollowingEnv(config.num_envs, leaders, action=config.action, tau=config.tau,
-                                 delta=config.delta, headway=config.headway,
-                                 gain_bounds=config.gain_bounds, weights=config.weights,
-                                 terminate_on_collision=True, gain_filter=repair,
-                                 ttc_star=config.reward_ttc_star,
-                                 gain_rate=config.gain_rate, observe=config.observe,
-                                 start_spread=config.start_spread)
-    env.repair = repair  # type: ignore[attr-defined]
-    return env
 
 
 def _rolling(returns: list[float], window: int = 10) -> float:
@@ -203,7 +161,7 @@ def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
                               "--resume to continue the run in it")
 
 
-def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | None = None,
+def train(config: TD3Config, *, envs: Any = None, out: str | os.PathLike[str] | None = None,
           resume: bool = False, progress: bool | None = None, leaders: list[Any] | None = None,
           log: Any = None) -> TrainResult:
     """Train a TD3 or DDPG agent (IDL or pure RL) and return its policy.
@@ -212,10 +170,13 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     ----------
     config : TD3Config or DDPGConfig
         Hyper-parameters (:func:`~stringstab.rl.config.config_for` builds them by name).
-    env : gymnasium VectorEnv, optional
+    envs : gymnasium VectorEnv, optional
         Box spaces, same-step autoreset, ``info["final_obs"]`` / ``info["_final_obs"]`` (as
-        :class:`~stringstab.traffic.env.BatchedCarFollowingEnv`).  Default: :func:`make_env`.
-        Resuming needs ``state_dict``/``load_state_dict`` on the environment.
+        :class:`~stringstab.traffic.env.BatchedCarFollowingEnv`).  Default:
+        :func:`~stringstab.rl.envs.make_env` of ``config`` and ``leaders``.  For gain actions
+        they must be wrapped in the repair (:class:`~stringstab.rl.envs.RepairedGains`), which
+        the loop reads for the proposal penalty, the timings and the repair statistics.
+        Resuming needs ``state_dict``/``load_state_dict`` on the environments.
     out : path, optional
         Run folder (checkpoints, policy, log, figure, summary).
     resume : bool
@@ -250,7 +211,7 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     """
     interrupt = _StepInterrupt(active=out is not None)
     try:
-        result = _train(config, env=env, out=out, resume=resume, progress=progress,
+        result = _train(config, envs=envs, out=out, resume=resume, progress=progress,
                         leaders=leaders, log=log, interrupt=interrupt)
     finally:
         interrupt.restore()
@@ -261,7 +222,7 @@ def train(config: TD3Config, *, env: Any = None, out: str | os.PathLike[str] | N
     return result
 
 
-def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, resume: bool,
+def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, resume: bool,
            progress: bool | None, leaders: list[Any] | None, log: Any,
            interrupt: _StepInterrupt) -> TrainResult:
     import torch
@@ -277,16 +238,22 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
         raise StringStabError("resume needs the run folder (out)")
     torch.set_num_threads(config.torch_threads)
     torch.manual_seed(config.seed)
-    env = make_env(config, leaders) if env is None else env
-    obs_dim, act_dim, low, high = _check_env(env)
-    n_env = int(env.num_envs)
-    repair = getattr(env, "repair", None)
+    from .envs import make_env, repair_of
+
+    envs = make_env(config, leaders) if envs is None else envs
+    obs_dim, act_dim, low, high = _check_env(envs)
+    n_env = int(envs.num_envs)
+    repair = repair_of(envs)
+    if config.action == "gains" and repair is None:
+        raise StringStabError("envs: gain actions need the environments wrapped in the repair "
+                              "(stringstab.rl.envs.RepairedGains, as make_env builds them); "
+                              "found no RepairedGains")
     agent = Agent(config, obs_dim, act_dim, low=low, high=high,
                   action_filter=repair.approximate if repair is not None else None)
     buffer = ReplayBuffer(config.buffer_size, obs_dim=obs_dim, act_dim=act_dim, seed=config.seed + 1)
     rng = np.random.default_rng(config.seed + 2)
     half = (high - low) / 2.0
-    obs, _ = env.reset(seed=config.seed)
+    obs, _ = envs.reset(seed=config.seed)
     step, clean_ends = 0, 0
     ep_ret, ep_len = np.zeros(n_env), np.zeros(n_env, dtype=np.int64)
     episodes: list[dict[str, Any]] = []
@@ -304,7 +271,7 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
             raise StringStabError(
                 "--resume: the checkpoint was written with another configuration (only the step "
                 "budget and the checkpoint interval may change on resume)")
-        if not hasattr(env, "load_state_dict"):
+        if not hasattr(envs, "load_state_dict"):
             raise StringStabError("resume: the environment has no load_state_dict()")
         agent.load_state(state["agent"], {k: torch.as_tensor(np.array(v))
                                           for k, v in tensors["agent"].items()
@@ -314,7 +281,7 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
                       if k.startswith("buffer.")}
         buffer.load_state(state["buffer"], buf_arrays)
         env_arrays = {k[len("env."):]: v for k, v in tensors["buffer"].items() if k.startswith("env.")}
-        env.load_state_dict(state["env"], env_arrays)
+        envs.load_state_dict(state["env"], env_arrays)
         obs = np.array(tensors["buffer"]["obs_now"])
         rng.bit_generator.state = state["rng"]
         c = state["counters"]
@@ -331,7 +298,7 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
         agent_meta, agent_t = agent.state()
         arrs = {k: v.numpy() for k, v in agent_t.items()}
         arrs["rng.torch"] = torch.get_rng_state().numpy()
-        env_meta, env_arrays = env.state_dict() if hasattr(env, "state_dict") else ({}, {})
+        env_meta, env_arrays = envs.state_dict() if hasattr(envs, "state_dict") else ({}, {})
         barr: dict[str, Any] = {f"buffer.{k}": v for k, v in buffer.arrays().items()}
         barr.update({f"env.{k}": v for k, v in env_arrays.items()})
         barr.update(obs_now=np.asarray(obs), ep_ret=ep_ret, ep_len=ep_len)
@@ -377,7 +344,7 @@ def _train(config: TD3Config, *, env: Any, out: str | os.PathLike[str] | None, r
             actions += rng.normal(0.0, 1.0, size=actions.shape) * (half * config.exploration_noise)
             actions = np.clip(actions, low, high)
         t0 = time.perf_counter()
-        next_obs, reward, term, trunc, info = env.step(actions.astype(np.float32))
+        next_obs, reward, term, trunc, info = envs.step(actions.astype(np.float32))
         t_env += time.perf_counter() - t0
         real_next = np.array(next_obs, dtype=np.float32, copy=True)
         done = np.asarray(term) | np.asarray(trunc)

@@ -25,6 +25,7 @@ from .controllers import (
     MixedController,
     Observation,
     TimeVaryingLinearController,
+    linear_law,
 )
 from .env import SCALES, BatchedCarFollowingEnv, CarFollowingEnv, state_vector
 from .leaders import (
@@ -79,6 +80,7 @@ __all__ = [
     "hard_braking",
     "headway_density",
     "leader_by_name",
+    "linear_law",
     "load_csv",
     "load_ngsim_pairs",
     "paper_mix",

@@ -51,6 +51,7 @@ __all__ = [
     "MixedController",
     "Observation",
     "TimeVaryingLinearController",
+    "linear_law",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -93,6 +94,46 @@ class Observation:
     rel_speed: Array
     pred_accel: Array
     pred_accel_delayed: Array
+
+
+def linear_law(gains: npt.ArrayLike, obs: Observation, *, headway: float,
+               standstill: float = DEFAULT_STANDSTILL) -> Array:
+    """The IDL linear law (eqs 3-4) for the gains in force, vectorised over a batch.
+
+    u = k_x (gap − T* v − l_0) + k_v Δv + k_a a_{i−1}(t − δ), the spacing error Δp of eq 3
+    inside the eq-4 law, with a gain triple per follower (or one broadcast to all).
+
+    Parameters
+    ----------
+    gains : array_like, shape (..., 3)
+        K = (k_x [1/s²], k_v [1/s], k_a [-]) per follower; the leading axes broadcast against
+        ``obs.gap`` (e.g. ``(n, 1, 3)`` for ``n`` platoons of one follower).
+    obs : Observation
+        What every follower knows at this step.
+    headway : float
+        Desired time headway T* of eq 3, s.
+    standstill : float
+        Standstill spacing l_0 of eq 3, m.
+
+    Returns
+    -------
+    ndarray
+        u, m/s², shaped like ``obs.gap`` broadcast with ``gains[..., 0]``, before the
+        platoon's limits and actuator lag.
+
+    Examples
+    --------
+    >>> z = np.zeros(1)
+    >>> obs = Observation(0, 0.0, 0.1, gap=np.array([27.0]), speed=np.array([20.0]),
+    ...                   accel=z, pred_speed=np.array([21.0]), rel_speed=np.array([1.0]),
+    ...                   pred_accel=z, pred_accel_delayed=np.array([0.5]))
+    >>> linear_law([1.2, 0.5, 0.6], obs, headway=1.1, standstill=2.0).round(6).tolist()
+    [4.4]
+    """
+    K = np.asarray(gains, dtype=np.float64)
+    k_x, k_v, k_a = K[..., 0], K[..., 1], K[..., 2]
+    return np.asarray(k_x * (obs.gap - headway * obs.speed - standstill)
+                      + k_v * obs.rel_speed + k_a * obs.pred_accel_delayed)
 
 
 class Controller:
@@ -461,12 +502,8 @@ class TimeVaryingLinearController(Controller):
         array
             u = k_x (gap − T* v − l_0) + k_v Δv + k_a a_{i−1}(t − δ), m/s².
         """
-        K = self.gains(obs)
-        k_x, k_v, k_a = K[..., 0], K[..., 1], K[..., 2]
-        return np.asarray(
-            k_x * (obs.gap - self._headway * obs.speed - self.standstill)
-            + k_v * obs.rel_speed + k_a * obs.pred_accel_delayed
-        )
+        return linear_law(self.gains(obs), obs, headway=self._headway,
+                          standstill=self.standstill)
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
         """l_0 + T* v (eq 3), whatever the gains.

@@ -9,8 +9,8 @@ limits and collision detection).
 Two action modes:
 
 ``action="gains"`` (IDL, eq 17)
-    the action is K = (k_x, k_v, k_a) ∈ [−2, 2]³ (Table 2); an optional ``gain_filter`` (e.g. a
-    string-stability repair, §3.3) maps it before the eq-4 law computes u;
+    the action is the executed K = (k_x, k_v, k_a) ∈ [−2, 2]³ (Table 2, clipped to the box),
+    from which the eq-4 law (:func:`~stringstab.traffic.controllers.linear_law`) computes u;
 ``action="accel"`` (pure RL)
     the action is the desired acceleration u ∈ [−7.6, 3] m/s².
 
@@ -19,12 +19,14 @@ State (eq 16): s = [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc] with Δp = g
 follower's own acceleration a_i/α_acc and the gains it executed at the previous step
 (K_{t−1}/2, zero at an episode's first step) are appended (:func:`extend_state`): the eq-16
 state does not say what the vehicle is doing now, which the comfort reward (eq 21) penalises
-changes of, nor which gains it runs, which a ``gain_rate`` limit makes part of the dynamics.
+changes of, nor which gains it runs, which a gain rate limit makes part of the dynamics.
 
-Gain actions may be rate limited (``gain_rate`` r > 0, not in the paper): each proposed gain is
-first clipped to within r of the gain executed at the previous step
-(:func:`limit_rate`), then the ``gain_filter`` (the repair) acts, so every
-executed gain is still certified.  Training episodes may start off equilibrium
+The environment executes the gains it is given.  What turns a policy's *proposed* gains into
+executed ones — a gain rate limit (:func:`limit_rate`, not in the paper) and then the repair
+(§3.3), so every executed gain is certified — is an action wrapper around the environment
+(:class:`stringstab.rl.envs.RepairedGains`), which reads the previous step's executed gains
+(:attr:`BatchedCarFollowingEnv.prev_gains`) and the episode starts
+(:attr:`BatchedCarFollowingEnv.first_step`).  Training episodes may start off equilibrium
 (``start_spread``, not in the paper): the initial gap scaled by 1 + s_g·U(−1, 1) and the speed
 offset by s_v·U(−1, 1) m/s, so that closing situations are met in training.
 
@@ -41,7 +43,7 @@ the (simple) API.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any, Literal, TypeGuard
 
 import gymnasium as gym
@@ -54,7 +56,7 @@ from gymnasium.vector.utils import batch_space
 from ..constants import DT, GAIN_BOUNDS, STATE_SCALES, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from .controllers import DEFAULT_STANDSTILL, Observation
+from .controllers import DEFAULT_STANDSTILL, Observation, linear_law
 from .cycles import cycle
 from .loaders import FollowingPair
 from .metrics import time_headway, time_to_collision
@@ -242,7 +244,6 @@ class _Core:
                  limits: Limits | None, length: float, gain_bounds: tuple[float, float],
                  weights: tuple[float, float, float], ttc_star: float,
                  scales: tuple[float, float, float], terminate_on_collision: bool,
-                 gain_filter: Callable[[Array], npt.ArrayLike] | None, gain_rate: float = 0.0,
                  observe: Sequence[str] = (), start_spread: tuple[float, float] = (0.0, 0.0)
                  ) -> None:
         items = list(leaders)
@@ -268,14 +269,12 @@ class _Core:
         self.action, self.gain_bounds = action, (lo, hi)
         self.headway, self.standstill = float(headway), float(standstill)
         self.weights, self.ttc_star, self.scales = weights, float(ttc_star), scales
-        self.terminate_on_collision, self.gain_filter = terminate_on_collision, gain_filter
-        if not (np.isfinite(gain_rate) and gain_rate >= 0):
-            raise StringStabError(f"gain_rate must be a number >= 0; got {show(gain_rate)}")
+        self.terminate_on_collision = terminate_on_collision
         spread = tuple(float(x) for x in start_spread)
         if len(spread) != 2 or not all(np.isfinite(x) and x >= 0 for x in spread):
             raise StringStabError(f"start_spread must be (gap fraction, speed m/s) >= 0; got {show(start_spread)}")
         state_dim(observe)  # checks the names
-        self.gain_rate, self.extras, self.start_spread = float(gain_rate), tuple(observe), spread
+        self.extras, self.start_spread = tuple(observe), spread
         self.lengths = np.array([tr.n_steps for tr in trs])
         T = int(self.lengths.max())
         pad = [(tr.position, tr.speed, tr.accel) for tr in trs]
@@ -346,14 +345,8 @@ class _Core:
         if a.shape[1] != 3:
             raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
         K = np.clip(a, *self.gain_bounds)
-        if self.gain_rate > 0:
-            K = limit_rate(K, self.prev_gains, self.gain_rate, fresh=self.k == 0)
-        if self.gain_filter is not None:
-            K = np.asarray(self.gain_filter(K), dtype=np.float64).reshape(self.n, 3)
         self.prev_gains = K.copy()
-        o = self.obs
-        u = (K[:, :1] * (o.gap - self.headway * o.speed - self.standstill)
-             + K[:, 1:2] * o.rel_speed + K[:, 2:3] * o.pred_accel_delayed)
+        u = linear_law(K[:, None, :], self.obs, headway=self.headway, standstill=self.standstill)
         return u, K
 
     def step(self, actions: npt.ArrayLike) -> tuple[Array, npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]]:
@@ -422,8 +415,6 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
         α_p, α_v, α_acc of eq 16.
     terminate_on_collision : bool
         End the episode at a collision (training, §4.1.2).
-    gain_filter : callable, optional
-        ``K (n, 3) -> K' (n, 3)`` applied to gain actions (e.g. a string-stability repair).
     order : {"random", "sequential"}
         How :meth:`reset` picks the next leader (``options={"index": i}`` picks one).
 
@@ -449,7 +440,6 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True,
-                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None,
                  order: Literal["random", "sequential"] = "random") -> None:
         if order not in ("random", "sequential"):
             raise StringStabError(f"order must be 'random' or 'sequential'; got {show(order)}")
@@ -457,7 +447,7 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                            tau=tau, delta=delta, headway=headway, standstill=standstill, model=model,
                            limits=limits, length=length, gain_bounds=gain_bounds, weights=weights,
                            ttc_star=ttc_star, scales=scales,
-                           terminate_on_collision=terminate_on_collision, gain_filter=gain_filter)
+                           terminate_on_collision=terminate_on_collision)
         self.observation_space, self.action_space = _spaces(action, gain_bounds, limits)  # type: ignore[assignment]
         self.order = order
         self._next = 0
@@ -511,8 +501,8 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
         Parameters
         ----------
         action : array_like
-            Gains K = (k_x, k_v, k_a) (eq 17; rate limited and filtered as configured) or the
-            desired acceleration u, m/s², by the action mode.
+            Gains K = (k_x, k_v, k_a) (eq 17, clipped to the gain box) or the desired
+            acceleration u, m/s², by the action mode.
 
         Returns
         -------
@@ -546,11 +536,11 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
     """``num_envs`` independent car-following episodes stepped together (NumPy, no subprocesses).
 
     The same model and parameters as :class:`CarFollowingEnv` (see it for the parameters);
-    episodes draw their leader at random from ``leaders`` (seeded by :meth:`reset`).  Three
-    training options, none in the paper (module docstring): ``gain_rate`` (a per-step limit
-    on each gain's change, before ``gain_filter``), ``observe`` (extras appended to the eq-16
-    state: ``"accel"``, ``"gains"``) and ``start_spread`` (random initial gap fraction and
-    speed offset, m/s, for trajectory leaders).
+    episodes draw their leader at random from ``leaders`` (seeded by :meth:`reset`).  Two
+    training options, none in the paper (module docstring): ``observe`` (extras appended to the
+    eq-16 state: ``"accel"``, ``"gains"``) and ``start_spread`` (random initial gap fraction and
+    speed offset, m/s, for trajectory leaders).  :attr:`prev_gains` and :attr:`first_step` are
+    what an action wrapper needs to limit the rate of the gains (module docstring).
 
     API (a Gymnasium ``VectorEnv`` with *same-step* autoreset):
 
@@ -584,9 +574,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                  gain_bounds: tuple[float, float] = GAIN_BOUNDS,
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
-                 terminate_on_collision: bool = True,
-                 gain_filter: Callable[[Array], npt.ArrayLike] | None = None,
-                 gain_rate: float = 0.0, observe: Sequence[str] = (),
+                 terminate_on_collision: bool = True, observe: Sequence[str] = (),
                  start_spread: tuple[float, float] = (0.0, 0.0)) -> None:
         if int(num_envs) < 1:
             raise StringStabError(f"num_envs must be >= 1; got {show(num_envs)}")
@@ -596,12 +584,37 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                            standstill=standstill, model=model, limits=limits, length=length,
                            gain_bounds=gain_bounds, weights=weights, ttc_star=ttc_star,
                            scales=scales, terminate_on_collision=terminate_on_collision,
-                           gain_filter=gain_filter, gain_rate=gain_rate, observe=observe,
-                           start_spread=start_spread)
+                           observe=observe, start_spread=start_spread)
         self.single_observation_space, self.single_action_space = _spaces(action, gain_bounds,
                                                                           limits, observe)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
+
+    @property
+    def action_mode(self) -> ActionMode:
+        """``"gains"`` (IDL, eq 17) or ``"accel"`` (pure RL)."""
+        return self._core.action
+
+    @property
+    def gain_bounds(self) -> tuple[float, float]:
+        """The gain box (low, high) every gain action is clipped to (Table 2: (−2, 2))."""
+        return self._core.gain_bounds
+
+    @property
+    def prev_gains(self) -> Array:
+        """The gains executed at the previous step, ``(num_envs, 3)`` (read-only view).
+
+        Zeros at an episode's first step (see :attr:`first_step`); with ``action="accel"``
+        always zeros.
+        """
+        v = self._core.prev_gains.view()
+        v.flags.writeable = False
+        return v
+
+    @property
+    def first_step(self) -> npt.NDArray[np.bool_]:
+        """``(num_envs,)`` bool: true where the episode has taken no step yet (no previous gains)."""
+        return np.asarray(self._core.k == 0)
 
     def _draw(self, n: int) -> npt.NDArray[np.int64]:
         return np.asarray(self.np_random.integers(len(self._core.items), size=n), dtype=np.int64)
@@ -663,23 +676,27 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         Raises
         ------
         StringStabError
-            If the number of environments or leaders differs, an array is missing or has another
-            shape.
+            If the number of environments or leaders differs, a key of ``meta`` or an array is
+            missing, or an array has another shape.
         """
         c, p = self._core, self._core.platoon
         if meta.get("num_envs") != self.num_envs or meta.get("n_leaders") != len(c.items):
             raise StringStabError(
                 f"environment state: expected {self.num_envs} environments over {len(c.items)} "
                 f"leaders; found {meta.get('num_envs')} over {meta.get('n_leaders')}")
-        try:
-            for name in ("which", "k", "ret"):
-                self._restore(getattr(c, name), arrays[name], name)
-            if "prev_gains" in arrays:  # absent from checkpoints of phase 1 (always zero there)
-                self._restore(c.prev_gains, arrays["prev_gains"], "prev_gains")
-            for a in _PLATOON_STATE:
-                self._restore(getattr(p, a), arrays[f"platoon.{a}"], f"platoon.{a}")
-        except KeyError as e:
-            raise StringStabError(f"environment state: missing array {e}") from e
+        for key in ("step", "any_in_collision", "rng"):
+            if key not in meta:
+                raise StringStabError(f"environment state: expected key {key!r} in the "
+                                      f"environment's meta data, found keys {sorted(meta)}")
+        names = ["which", "k", "ret", "prev_gains", *(f"platoon.{a}" for a in _PLATOON_STATE)]
+        for name in names:
+            if name not in arrays:
+                raise StringStabError(f"environment state: expected key {name!r} in the "
+                                      f"environment's arrays, found keys {sorted(arrays)}")
+        for name in ("which", "k", "ret", "prev_gains"):
+            self._restore(getattr(c, name), arrays[name], name)
+        for a in _PLATOON_STATE:
+            self._restore(getattr(p, a), arrays[f"platoon.{a}"], f"platoon.{a}")
         p.step = int(meta["step"])
         p._any_in_collision = bool(meta["any_in_collision"])
         self.np_random.bit_generator.state = meta["rng"]
