@@ -297,8 +297,6 @@ KNOWN_PRIVATE_IMPORTS: set[tuple[str, str]] = {
     ("stringstab.certify.robust", "stringstab.certify.sampled._schur_terms"),
     ("stringstab.certify.robust", "stringstab.certify.sampled._spread"),
     ("stringstab.certify.robust", "stringstab.certify.sampled._violation_peak"),
-    ("stringstab.regions", "stringstab.regions.grid._blocks"),
-    ("stringstab.traffic.synthetic", "stringstab.traffic.trajectory._grid"),
 }
 
 

@@ -15,10 +15,10 @@ from stringstab.errors import StringStabError
 from stringstab.regions import (
     EXACT_CLASSES,
     TYPE_CLASSES,
-    _blocks,
     load_npz,
     region_map,
 )
+from stringstab.regions.grid import grid_blocks
 
 TAU, DELTA, HEADWAY = 0.1, 0.2, 1.1
 P = dict(tau=TAU, delta=DELTA, headway=HEADWAY)
@@ -194,7 +194,7 @@ def test_map_inside_a_daemonic_worker_runs_in_one_process():
 @pytest.mark.parametrize("shape,target", [((7, 5, 3), 10), ((3, 40, 2), 9), ((1, 1, 1), 5), ((50, 1, 1), 7)])
 def test_blocks_cover_the_grid_once(shape, target):
     seen = np.zeros(shape, dtype=int)
-    for i0, i1, j0, j1 in _blocks(*shape, target):
+    for i0, i1, j0, j1 in grid_blocks(*shape, target):
         seen[i0:i1, j0:j1] += 1
         assert (i1 - i0) * (j1 - j0) * shape[2] <= max(target, shape[2])
     assert_array_equal(seen, 1)

@@ -70,7 +70,6 @@ IDL paper, Proposition 1 (eqs 12-15), §3.3 (types I-IV), Definition 1 (eq 10).
 from __future__ import annotations
 
 from .grid import EXACT_BLOCK, TAYLOR_BLOCK, region_map
-from .grid import _blocks as _blocks  # for tests
 from .result import (
     CONTINUOUS,
     EXACT_CLASSES,

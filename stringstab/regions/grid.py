@@ -155,8 +155,21 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
     return out
 
 
-def _blocks(n0: int, n1: int, n2: int, target: int) -> list[tuple[int, int, int, int]]:
-    """Split the (n0, n1, n2) grid into blocks [i0:i1, j0:j1, :] of about ``target`` points."""
+def grid_blocks(n0: int, n1: int, n2: int, target: int) -> list[tuple[int, int, int, int]]:
+    """Split an (n0, n1, n2) grid into blocks ``[i0:i1, j0:j1, :]`` of about ``target`` points.
+
+    Parameters
+    ----------
+    n0, n1, n2 : int
+        The grid's shape (points along k_x, k_v, k_a).
+    target : int
+        The wanted number of points per block (a block holds whole k_a lines).
+
+    Returns
+    -------
+    list of tuple of int
+        ``(i0, i1, j0, j1)`` per block, in order; together they cover the grid once.
+    """
     row = n1 * n2
     if row <= target:
         step = max(1, target // row)
@@ -342,7 +355,7 @@ def region_map(
     target = int(block) if block is not None else (EXACT_BLOCK if exact else TAYLOR_BLOCK)
     if target < 1:
         raise StringStabError(f"block must be >= 1 grid points; got {block!r}")
-    blocks = _blocks(n0, n1, n2, target)
+    blocks = grid_blocks(n0, n1, n2, target)
     cost = _COST[H is not None, box] + (CONTINUOUS in ms)
     seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:

@@ -14,7 +14,7 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT
 from ..errors import StringStabError, show
 from ..params import positive
-from .trajectory import Trajectory, _grid, from_accel_segments
+from .trajectory import Trajectory, from_accel_segments, time_grid
 
 __all__ = [
     "PAPER_MIX_SEGMENTS",
@@ -71,7 +71,7 @@ def sinusoid(
         raise StringStabError(
             f"amplitude must be between 0 and the mean speed {show(speed)} m/s; got {show(amplitude)}"
         )
-    t = _grid(0.0, float(duration), d)
+    t = time_grid(0.0, float(duration), d)
     if t.shape[0] < 2:
         raise StringStabError(f"duration must be at least one step; got {show(duration)}")
     wt = omega * t

@@ -21,7 +21,7 @@ from ..constants import DT, SPEED_MAX
 from ..errors import StringStabError, show
 from ..params import positive
 
-__all__ = ["Trajectory", "from_accel_segments", "from_speed"]
+__all__ = ["Trajectory", "from_accel_segments", "from_speed", "time_grid"]
 
 Array = npt.NDArray[np.float64]
 
@@ -176,7 +176,21 @@ class Trajectory:
         return self.window(0, max(n, 2))
 
 
-def _grid(t0: float, t1: float, dt: float) -> Array:
+def time_grid(t0: float, t1: float, dt: float) -> Array:
+    """The sample times t0, t0 + dt, ... up to t1 (included within 1e-9 of a step).
+
+    Parameters
+    ----------
+    t0, t1 : float
+        First and last time, s.
+    dt : float
+        Step, s (> 0).
+
+    Returns
+    -------
+    ndarray
+        ``t0 + k dt`` for k = 0 … ⌊(t1 − t0)/dt⌋.
+    """
     n = math.floor((t1 - t0) / dt + 1e-9) + 1
     return np.asarray(t0 + np.arange(n, dtype=np.float64) * dt, dtype=np.float64)
 
@@ -260,7 +274,7 @@ def from_speed(
     if (vv < 0).any():
         i = int(np.argmax(vv < 0))
         raise StringStabError(f"speed must be >= 0 m/s; got {show(vv[i])} at t={show(tt[i])}")
-    grid = _grid(tt[0], tt[-1], d)
+    grid = time_grid(tt[0], tt[-1], d)
     if grid.shape[0] < 2:
         raise StringStabError(f"the profile lasts {show(tt[-1] - tt[0])} s, shorter than one step dt={show(d)} s")
     v = np.interp(grid, tt, vv)
