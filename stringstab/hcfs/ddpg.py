@@ -1,7 +1,6 @@
-"""Training the HCFS DDPG with the trainer of :mod:`stringstab.rl` (imported lazily), and the
-DDPG that ships with the package.
+"""The HCFS DDPG: its training with the trainer of :mod:`stringstab.rl`, and the one shipped.
 
-:func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the algorithm of Lillicrap et al.) on
+The trainer is imported lazily.  :func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the algorithm of Lillicrap et al.) on
 :class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS reward (eqs 4-6) through
 ``stringstab.rl.train(DDPGConfig(...), env=...)`` and returns it as an acceleration policy on
 SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the trainer's run folder
@@ -321,8 +320,10 @@ def load_bundled_ddpg() -> ScaledPolicy:
 
 
 def candidate(spec: str, *, what: str = "--policy") -> AccelerationPolicy:
-    """The learned candidate a1 named by ``spec``: ``"bundled"`` (:func:`load_bundled_ddpg`),
-    ``"stand-in"`` (:class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`) or a folder written by
+    """The learned candidate a1 named by ``spec``: the bundled DDPG, the stand-in or a folder.
+
+    ``"bundled"`` is :func:`load_bundled_ddpg`, ``"stand-in"``
+    :class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`, and a folder is one written by
     ``stringstab hcfs train`` / :func:`save_ddpg`.
 
     Parameters
