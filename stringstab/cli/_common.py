@@ -146,7 +146,8 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     """The loop asked for, checked: the model (a point or a box) and the sample time H.
 
     The model is (τ, δ, T*) as :class:`Params` or, with any ``LO:HI``, a :class:`Box`; the
-    sample time H is None for continuous time.  Warns on stderr (one line each) for values beyond their sensible range.
+    sample time H is None for continuous time.  Warns on stderr (one line each) for values
+    beyond their sensible range.
 
     Parameters
     ----------

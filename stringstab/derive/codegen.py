@@ -423,8 +423,8 @@ def _source() -> str:
         "    Returns\n"
         "    -------\n"
         "    tuple of tuple\n"
-        "        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of ``gain``\n"
-        "        first, evaluated at ``values``.\n"
+        "        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of\n"
+        "        ``gain`` first, evaluated at ``values``.\n"
         '    """\n'
         "    flat = _PSI_POLY[source, gain](**values)\n"
         "    sizes = _PSI_POLY_SIZES[source, gain]\n"

@@ -477,8 +477,8 @@ def psi_polynomials(source: str, gain: str, **values: Any) -> tuple[tuple[Any, .
     Returns
     -------
     tuple of tuple
-        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of ``gain``
-        first, evaluated at ``values``.
+        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of
+        ``gain`` first, evaluated at ``values``.
     """
     flat = _PSI_POLY[source, gain](**values)
     sizes = _PSI_POLY_SIZES[source, gain]

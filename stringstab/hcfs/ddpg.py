@@ -1,14 +1,15 @@
 """The HCFS DDPG: its training with the trainer of :mod:`stringstab.rl`, and the one shipped.
 
-The trainer is imported lazily.  :func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the algorithm of Lillicrap et al.) on
-:class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS reward (eqs 4-6) through
-``stringstab.rl.train(DDPGConfig(...), env=...)`` and returns it as an acceleration policy on
-SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the trainer's run folder
-(policy, checkpoint, ``train_log.csv``, ``rolling_reward.png``, ``summary.json``) receives
-``hcfs_policy.json`` beside it, and the folder is what ``stringstab hcfs verify --policy DIR``
-reads.  :func:`save_ddpg` / :func:`load_ddpg` store and load a policy with its observation
-scales; loading goes through :func:`stringstab.rl.load_policy`, which checks the SHA-256 of the
-safetensors file and never runs code from it.
+The trainer is imported lazily.  :func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the
+algorithm of Lillicrap et al.) on :class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS
+reward (eqs 4-6) through ``stringstab.rl.train(DDPGConfig(...), env=...)`` and returns it as an
+acceleration policy on SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the
+trainer's run folder (policy, checkpoint, ``train_log.csv``, ``rolling_reward.png``,
+``summary.json``) receives ``hcfs_policy.json`` beside it, and the folder is what
+``stringstab hcfs verify --policy DIR`` reads.  :func:`save_ddpg` / :func:`load_ddpg` store and
+load a policy with its observation scales; loading goes through
+:func:`stringstab.rl.load_policy`, which checks the SHA-256 of the safetensors file and never
+runs code from it.
 
 :func:`load_bundled_ddpg` loads the DDPG shipped in ``stringstab/data/policies/hcfs_ddpg``
 (its README says which command, seed and commit produced it).

@@ -1,7 +1,7 @@
 """One BLAS thread while fitting, where threads cost more than they give.
 
-The fits' matrices are tall and thin (10⁴ × 10), and on a shared machine a multi-threaded OpenBLAS waiting for busy
-cores made the same fit 6-8x slower (``analysis/bench_identify.py``).
+The fits' matrices are tall and thin (10⁴ × 10), and on a shared machine a multi-threaded
+OpenBLAS waiting for busy cores made the same fit 6-8x slower (``analysis/bench_identify.py``).
 
 :func:`single_threaded_blas` sets the thread count of every OpenBLAS library loaded in the
 process (NumPy's and SciPy's wheels each bundle one) to 1 and restores it afterwards — what
