@@ -1,4 +1,4 @@
-"""stringstab: is this car-following controller string stable?
+"""stringstab: exact, delay-aware string-stability analysis of car-following controllers.
 
 The package is laid out in layers, each a subpackage whose ``__init__`` says what lives there:
 

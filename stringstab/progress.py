@@ -124,8 +124,9 @@ class Progress:
             self._line(now)
 
     def timing(self, now: float | None = None) -> str:
-        """``"<elapsed> elapsed, ~<left> left"`` (the time left from this call's pace; omitted
-        before the first unit and once all are done).
+        """``"<elapsed> elapsed, ~<left> left"``, the time left from the pace so far.
+
+        The time left is omitted before the first unit and once all are done.
 
         Parameters
         ----------
@@ -149,8 +150,10 @@ class Progress:
               f"{self.timing(now)}", file=self.stream, flush=True)
 
     def close(self) -> None:
-        """Close the bar, or print the last line (the time it took) when lines were printed or
-        the work took longer than ``every``."""
+        """Close the bar, or print the last line (the time it took).
+
+        The last line is printed when lines were printed or the work took longer than ``every``.
+        """
         if self._bar is not None:
             self._bar.close()
             self._bar = None

@@ -1,4 +1,4 @@
-"""Physically meaningful magnitudes of the toolkit's inputs: warned beyond, refused far beyond.
+r"""Physically meaningful magnitudes of the toolkit's inputs: warned beyond, refused far beyond.
 
 Each quantity has a *sensible* range (the values a car-following study uses; beyond it a
 command runs and says so on stderr) and an *absurd* bound (beyond it no vehicle exists and the
@@ -9,7 +9,7 @@ with :class:`~stringstab.errors.StringStabError` before any solver sees it).
 =============  ================  ============  ==========================================
 quantity       sensible          refused       why
 =============  ================  ============  ==========================================
-gain k         \\|k\\| <= 10        \\|k\\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s² turns 1 m of
+gain k         \|k\| <= 10        \|k\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s² turns 1 m of
                                                spacing error into 1e6 m/s²
 τ              (0, 2] s          > 100 s       actuator lags are 0.1-1 s
 δ              [0, 2] s          > 100 s       V2V delays are 0.01-0.5 s

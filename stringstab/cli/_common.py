@@ -143,10 +143,11 @@ def add_model_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
-    """The loop asked for: (τ, δ, T*) as :class:`Params` or, with any ``LO:HI``, a :class:`Box`;
-    and the sample time H (None: continuous time), each checked.
+    """The loop asked for, checked: the model (a point or a box) and the sample time H.
 
-    Warns on stderr (one line each) for values beyond their sensible range.
+    The model is (τ, δ, T*) as :class:`Params` or, with any ``LO:HI``, a :class:`Box`; the
+    sample time H is None for continuous time.  Warns on stderr (one line each) for values
+    beyond their sensible range.
 
     Parameters
     ----------
@@ -421,8 +422,11 @@ def gains_from_args(args: Any) -> GainTable:
 
 
 def _warn_gains(args: Any, table: GainTable) -> None:
-    """Refuse a gain beyond the physical bound (:mod:`stringstab.ranges`: the certificate's
-    coefficients would overflow), naming its row; warn once beyond the sensible range."""
+    """Refuse a gain beyond the physical bound, naming its row; warn beyond the sensible range.
+
+    The physical bound (:mod:`stringstab.ranges`) is where the certificate's coefficients would
+    overflow; the warning is given once.
+    """
     from ..ranges import RANGES
 
     for name in ("k_x", "k_v", "k_a"):

@@ -211,8 +211,10 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
 
 
 def _step_hcfs(out: Path, log: Log, *, final: Path | None = None) -> dict[str, Any]:
-    """``hcfs verify`` with the bundled DDPG behind the paper's case 1 (its analogue on UDDS at
-    half speed, 20 s, 8 followers): the jerk theorem at every frame for J = 2.5 m/s³."""
+    """``hcfs verify`` of the bundled DDPG on the paper's case 1: the jerk theorem at every frame.
+
+    Case 1 is played by its analogue on UDDS at half speed (20 s, 8 followers); J = 2.5 m/s³.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -249,8 +251,10 @@ TRAIN_STEPS = 30_000
 
 def _step_train(out: Path, log: Log, *, steps: int = TRAIN_STEPS, episodes: int | None = None,
                 platoon: int = 10) -> dict[str, Any]:
-    """Train an IDL policy for a small budget, evaluate it on the held-out test episodes beside
-    CACC, certify every gain it executed, and draw the comparison (docs/training.md).
+    """Train an IDL policy for a small budget, evaluate it beside CACC and certify its gains.
+
+    The evaluation runs on the held-out test episodes, every gain the policy executed is
+    certified, and the comparison is drawn (docs/training.md).
 
     ``episodes`` keeps only the first held-out episodes and ``platoon`` sets the platoon test's
     size (0: none); the demo uses all 57 and 10 (the tests use less).

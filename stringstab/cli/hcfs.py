@@ -1,5 +1,8 @@
-"""``stringstab hcfs verify`` (check the HCFS jerk theorem in closed loop, write a report) and
-``stringstab hcfs train`` (train the HCFS DDPG into a folder that ``verify --policy`` reads)."""
+"""The ``stringstab hcfs`` commands: ``verify`` (the HCFS jerk theorem) and ``train`` (its DDPG).
+
+``stringstab hcfs verify`` checks the HCFS jerk theorem in closed loop and writes a report;
+``stringstab hcfs train`` trains the HCFS DDPG into a folder that ``verify --policy`` reads.
+"""
 
 from __future__ import annotations
 

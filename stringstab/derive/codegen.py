@@ -407,8 +407,24 @@ def _source() -> str:
             blocks.append(f"_PSI_POLY_SIZES_{source.upper()}_{g0.name.upper()} = {tuple(sizes)!r}\n")
     blocks.append(
         "\ndef psi_polynomials(source: str, gain: str, **values: Any) -> tuple[tuple[Any, ...], ...]:\n"
-        '    """Ψ1, Ψ2, Ψ3, Λ as polynomials in ``gain``: four tuples of coefficients (highest\n'
-        "    power first) in the other two gains and the parameters, passed by name.\n"
+        '    """Ψ1, Ψ2, Ψ3 (IDL eqs 12-14) and Λ as polynomials in ``gain``, '
+        "as coefficient tuples.\n"
+        "\n"
+        "    Parameters\n"
+        "    ----------\n"
+        "    source : str\n"
+        '        ``"derived"`` (from the model) or ``"printed"`` (the paper\'s forms).\n'
+        "    gain : str\n"
+        '        The polynomial variable: ``"k_x"``, ``"k_v"`` or ``"k_a"``.\n'
+        "    **values : Any\n"
+        "        The other two gains and ``tau``, ``delta``, ``headway``, by name (numbers or\n"
+        "        broadcastable arrays).\n"
+        "\n"
+        "    Returns\n"
+        "    -------\n"
+        "    tuple of tuple\n"
+        "        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of\n"
+        "        ``gain`` first, evaluated at ``values``.\n"
         '    """\n'
         "    flat = _PSI_POLY[source, gain](**values)\n"
         "    sizes = _PSI_POLY_SIZES[source, gain]\n"

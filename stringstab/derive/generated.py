@@ -462,8 +462,23 @@ _PSI_POLY_SIZES_PRINTED_K_A = (2, 3, 2, 5)
 
 
 def psi_polynomials(source: str, gain: str, **values: Any) -> tuple[tuple[Any, ...], ...]:
-    """Ψ1, Ψ2, Ψ3, Λ as polynomials in ``gain``: four tuples of coefficients (highest
-    power first) in the other two gains and the parameters, passed by name.
+    """Ψ1, Ψ2, Ψ3 (IDL eqs 12-14) and Λ as polynomials in ``gain``, as coefficient tuples.
+
+    Parameters
+    ----------
+    source : str
+        ``"derived"`` (from the model) or ``"printed"`` (the paper's forms).
+    gain : str
+        The polynomial variable: ``"k_x"``, ``"k_v"`` or ``"k_a"``.
+    **values : Any
+        The other two gains and ``tau``, ``delta``, ``headway``, by name (numbers or
+        broadcastable arrays).
+
+    Returns
+    -------
+    tuple of tuple
+        Four tuples (Ψ1, Ψ2, Ψ3, Λ), each the coefficients, highest power of
+        ``gain`` first, evaluated at ``values``.
     """
     flat = _PSI_POLY[source, gain](**values)
     sizes = _PSI_POLY_SIZES[source, gain]

@@ -1,4 +1,4 @@
-"""Symbolic derivation of the sampled-data (zero-order hold) string transfer function H(z).
+r"""Symbolic derivation of the sampled-data (zero-order hold) string transfer function H(z).
 
 Every vehicle of a homogeneous platoon samples synchronously with period H
 (``sample_time``), holds its command over each period (zero-order hold), and has the
@@ -6,7 +6,7 @@ actuator lag of the IDL paper, τ ȧ = u − a (eq 7).  The command is the IDL l
 evaluated at the sampling instants,
 
 .. math::
-    u_k = k_x Δp(kH) + k_v Δv(kH) + k_a\\,a_{i-1}(kH - δ),
+    u_k = k_x Δp(kH) + k_v Δv(kH) + k_a\,a_{i-1}(kH - δ),
 
 where the delayed predecessor acceleration is the *exact* continuous-time value
 a_{i−1}(kH − δ) for any δ ≥ 0 (δ = mH + εH, m integer, 0 ≤ ε < 1), not an interpolation.
@@ -243,15 +243,15 @@ W_COEFFICIENT_NAMES = ("delta0", "delta1", "delta2", "delta3", "nu0", "nu1", "nu
 
 @lru_cache(maxsize=1)
 def w_coefficients() -> dict[str, sp.Expr]:
-    """Coefficients of H(z) in w = z − 1, derived (the form the numeric code evaluates).
+    r"""Coefficients of H(z) in w = z − 1, derived (the form the numeric code evaluates).
 
     With w = z − 1,
 
     .. math::
-        H(z) = \\frac{1 - E}{1 - E_p}\\,
-               \\frac{n(w) + z^{-(m+1)}\\,k_a w^2 \\ell(w)}{Δ(w)},\\quad
-        Δ = \\sum_{k=0}^{3} δ_k w^k,\\; n = \\sum_{k=0}^{2} ν_k w^k,\\;
-        \\ell = \\ell_0 + \\ell_1 w ,
+        H(z) = \frac{1 - E}{1 - E_p}\,
+               \frac{n(w) + z^{-(m+1)}\,k_a w^2 \ell(w)}{Δ(w)},\quad
+        Δ = \sum_{k=0}^{3} δ_k w^k,\; n = \sum_{k=0}^{2} ν_k w^k,\;
+        \ell = \ell_0 + \ell_1 w ,
 
     where the factor k_a w² (z−1)² of the delayed path is found by SymPy, not assumed.
 

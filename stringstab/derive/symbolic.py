@@ -99,14 +99,14 @@ class VehicleModel:
 
 @lru_cache(maxsize=1)
 def vehicle_model() -> VehicleModel:
-    """Build the state-space model of eqs 5-9 from the kinematics.
+    r"""Build the state-space model of eqs 5-9 from the kinematics.
 
     The spacing error is Δp = Δx − (v_i T* + l_0) (eqs 3-4), so with the
     third-order vehicle (eqs 5-7)
 
     .. math::
-        \\dot{Δp} = Δv − T^* a_i,\\quad \\dot{Δv} = a_{i-1} − a_i,\\quad
-        \\dot a_i = (u − a_i)/τ .
+        \dot{Δp} = Δv − T^* a_i,\quad \dot{Δv} = a_{i-1} − a_i,\quad
+        \dot a_i = (u − a_i)/τ .
 
     Returns
     -------

@@ -209,4 +209,16 @@ class CACC:
         self.label = f"CACC (eq 11, derived form, k1-k4 = {', '.join(f'{g:g}' for g in self.gains)})"
 
     def __call__(self, state: npt.ArrayLike) -> Array:
+        """The eq-11 accelerations of a batch of states (:func:`cacc_acceleration`, no limits).
+
+        Parameters
+        ----------
+        state : array_like (..., 6)
+            The eq-3 state (:func:`stringstab.hcfs.mdp.state`), SI units.
+
+        Returns
+        -------
+        array (...)
+            Desired accelerations, m/s².
+        """
         return cacc_acceleration(state, self.gains, dt=self.dt)

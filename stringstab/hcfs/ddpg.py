@@ -1,15 +1,15 @@
-"""Training the HCFS DDPG with the trainer of :mod:`stringstab.rl` (imported lazily), and the
-DDPG that ships with the package.
+"""The HCFS DDPG: its training with the trainer of :mod:`stringstab.rl`, and the one shipped.
 
-:func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the algorithm of Lillicrap et al.) on
-:class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS reward (eqs 4-6) through
-``stringstab.rl.train(DDPGConfig(...), envs=...)`` and returns it as an acceleration policy on
-SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the trainer's run folder
-(policy, checkpoint, ``train_log.csv``, ``rolling_reward.png``, ``summary.json``) receives
-``hcfs_policy.json`` beside it, and the folder is what ``stringstab hcfs verify --policy DIR``
-reads.  :func:`save_ddpg` / :func:`load_ddpg` store and load a policy with its observation
-scales; loading goes through :func:`stringstab.rl.load_policy`, which checks the SHA-256 of the
-safetensors file and never runs code from it.
+The trainer is imported lazily.  :func:`train_hcfs_ddpg` trains a DDPG (HCFS §III-A, the
+algorithm of Lillicrap et al.) on :class:`~stringstab.hcfs.env.HCFSVectorEnv` with the HCFS
+reward (eqs 4-6) through ``stringstab.rl.train(DDPGConfig(...), envs=...)`` and returns it as an
+acceleration policy on SI states; :func:`train_ddpg` returns only that policy.  With ``out`` the
+trainer's run folder (policy, checkpoint, ``train_log.csv``, ``rolling_reward.png``,
+``summary.json``) receives ``hcfs_policy.json`` beside it, and the folder is what
+``stringstab hcfs verify --policy DIR`` reads.  :func:`save_ddpg` / :func:`load_ddpg` store and
+load a policy with its observation scales; loading goes through
+:func:`stringstab.rl.load_policy`, which checks the SHA-256 of the safetensors file and never
+runs code from it.
 
 :func:`load_bundled_ddpg` loads the DDPG shipped in ``stringstab/data/policies/hcfs_ddpg``
 (its README says which command, seed and commit produced it).
@@ -321,8 +321,10 @@ def load_bundled_ddpg() -> ScaledPolicy:
 
 
 def candidate(spec: str, *, what: str = "--policy") -> AccelerationPolicy:
-    """The learned candidate a1 named by ``spec``: ``"bundled"`` (:func:`load_bundled_ddpg`),
-    ``"stand-in"`` (:class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`) or a folder written by
+    """The learned candidate a1 named by ``spec``: the bundled DDPG, the stand-in or a folder.
+
+    ``"bundled"`` is :func:`load_bundled_ddpg`, ``"stand-in"``
+    :class:`~stringstab.hcfs.policy.LeaderSpeedMatcher`, and a folder is one written by
     ``stringstab hcfs train`` / :func:`save_ddpg`.
 
     Parameters

@@ -64,8 +64,10 @@ Obs = npt.NDArray[np.float32]
 
 
 def default_training_leaders(*, dt: float = DT) -> list[Trajectory]:
-    """The paper's training leader as far as the bundled data allows: UDDS at half speed from
-    600 s to the end (HCFS §IV; :func:`stringstab.hcfs.leaders.training_leader`), at step ``dt``.
+    """The paper's training leader as far as the bundled data allows, at step ``dt``.
+
+    UDDS at half speed from 600 s to the end (HCFS §IV;
+    :func:`stringstab.hcfs.leaders.training_leader`).
 
     Parameters
     ----------

@@ -194,8 +194,10 @@ def paper_cases(*, dt: float = DT) -> list[tuple[Trajectory, int]]:
 
 
 def hcfs_leader(spec: str, *, dt: float = DT, duration: float | None = None) -> Trajectory:
-    """A leader by name: ``hcfs-train``, ``hcfs-case1`` … ``hcfs-case3``, or any spec of
-    :func:`~stringstab.traffic.leaders.leader_by_name` (cycles, synthetic profiles, CSV files).
+    """A leader by name: ``hcfs-train``, ``hcfs-case1`` … ``hcfs-case3`` or another leader spec.
+
+    The other specs are those of :func:`~stringstab.traffic.leaders.leader_by_name` (cycles,
+    synthetic profiles, CSV files).
 
     Parameters
     ----------

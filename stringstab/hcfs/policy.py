@@ -40,7 +40,20 @@ Array = npt.NDArray[np.float64]
 class AccelerationPolicy(Protocol):
     """A callable ``policy(state (n, 6)) -> accelerations (n,) or (n, 1)`` in m/s²."""
 
-    def __call__(self, state: Array, /) -> Any: ...
+    def __call__(self, state: Array, /) -> Any:
+        """The desired accelerations of a batch of states.
+
+        Parameters
+        ----------
+        state : array (n, 6)
+            Eq-3 states in SI units (:func:`stringstab.hcfs.mdp.state`).
+
+        Returns
+        -------
+        array (n,) or (n, 1)
+            Desired accelerations, m/s².
+        """
+        ...
 
 
 def policy_label(policy: AccelerationPolicy) -> str:
@@ -175,6 +188,18 @@ class LeaderSpeedMatcher:
                       "(hand-written, deliberately imperfect; not a DDPG)")
 
     def __call__(self, state: Array) -> Array:
+        """a = −κ e_v(k,0) / T for each state (no limits).
+
+        Parameters
+        ----------
+        state : array (..., 6)
+            Eq-3 states in SI units; component 3 is e_v(k,0), the speed error to the leader.
+
+        Returns
+        -------
+        array (...)
+            Desired accelerations, m/s².
+        """
         return np.asarray(-self.kappa * np.asarray(state)[..., 3] / self.dt)
 
 
@@ -213,6 +238,18 @@ class ScaledPolicy:
         self.torch_threads = torch_threads
 
     def __call__(self, state: Array) -> Any:
+        """The wrapped network's output on the normalised states ``state / scales``.
+
+        Parameters
+        ----------
+        state : array (n, 6)
+            Eq-3 states in SI units.
+
+        Returns
+        -------
+        Any
+            What the network returns: accelerations, m/s², shape (n,) or (n, 1).
+        """
         z = np.asarray(state, dtype=np.float64) / self.scales
         if self.torch_threads is None:
             return self.policy(z)

@@ -1,6 +1,7 @@
-"""One BLAS thread while fitting: the fits' matrices are tall and thin (10⁴ × 10), where threads
-cost more than they give, and on a shared machine a multi-threaded OpenBLAS waiting for busy
-cores made the same fit 6-8x slower (``analysis/bench_identify.py``).
+"""One BLAS thread while fitting, where threads cost more than they give.
+
+The fits' matrices are tall and thin (10⁴ × 10), and on a shared machine a multi-threaded
+OpenBLAS waiting for busy cores made the same fit 6-8x slower (``analysis/bench_identify.py``).
 
 :func:`single_threaded_blas` sets the thread count of every OpenBLAS library loaded in the
 process (NumPy's and SciPy's wheels each bundle one) to 1 and restores it afterwards — what
@@ -26,8 +27,10 @@ _NAMES = (("scipy_openblas_get_num_threads64_", "scipy_openblas_set_num_threads6
 
 @functools.lru_cache(maxsize=1)
 def _libraries() -> list[tuple[Any, Any]]:
-    """(get, set) thread-count functions of the OpenBLAS libraries mapped in this process
-    (looked up once: call after NumPy and SciPy's linear algebra are imported)."""
+    """(get, set) thread-count functions of the OpenBLAS libraries mapped in this process.
+
+    Looked up once: call after NumPy and SciPy's linear algebra are imported.
+    """
     try:
         with open("/proc/self/maps", encoding="utf-8") as fh:
             paths = sorted({ln.split()[-1] for ln in fh if "openblas" in ln.lower() and ".so" in ln})

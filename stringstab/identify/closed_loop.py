@@ -98,9 +98,11 @@ def _charpoly(M: Array) -> Array:
 
 
 def _numerators(F: Array, B: Array) -> Array:
-    """Numerators (s and v rows) over det(zI − F) of x_{k+1} = F x_k + B u_k, y = (x[0], x[1]):
-    the SISO identity C adj(zI − F) B = det(zI − F + B C) − det(zI − F) (as in
-    :func:`scipy.signal.ss2tf`, without its checks)."""
+    """Numerators (s and v rows) over det(zI − F) of x_{k+1} = F x_k + B u_k, y = (x[0], x[1]).
+
+    By the SISO identity C adj(zI − F) B = det(zI − F + B C) − det(zI − F) (as in
+    :func:`scipy.signal.ss2tf`, without its checks).
+    """
     den = _charpoly(F)
     out = np.empty((2, den.size))
     for r in range(2):

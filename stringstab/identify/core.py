@@ -1,5 +1,6 @@
-"""``identify(log)``: fit each follower of a recorded platoon, certify it, bootstrap it, and set it
-beside the data's own amplification.
+"""``identify(log)``: fit, certify and bootstrap each follower of a recorded platoon.
+
+Each is also set beside the data's own amplification.
 
 Per follower (a vehicle whose predecessor and gap are in the log):
 
@@ -326,7 +327,6 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     StringStabError
         If no follower has a usable segment, or an option is out of range.
     """
-
     logs = [log] if isinstance(log, PlatoonLog) else list(log)
     if model not in PARAMETERS:
         raise StringStabError(f"model must be 'acc' or 'cacc'; got {show(model)}")
@@ -477,8 +477,10 @@ def _box(p: dict[str, float], bp: dict[str, Array], model: str, H: float | None)
 
 
 def _disagreement(v: VehicleResult) -> list[str]:
-    """Where the model's verdict and the data's own amplification part ways
-    (:mod:`stringstab.identify.empirical`: ±2ε around |Ĝ|)."""
+    """Where the model's verdict and the data's own amplification part ways.
+
+    The data's amplification is |Ĝ| ± 2ε (:mod:`stringstab.identify.empirical`).
+    """
     e = v.empirical
     sup = float(v.certificate.sup_gain)
     model_amplifies = v.certificate.verdict == "not_certified"

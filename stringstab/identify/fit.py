@@ -83,8 +83,11 @@ class FollowerData:
         return sum(len(s) for s in self.segments)
 
     def scales(self) -> tuple[float, float]:
-        """Normalisers of the speed and gap residuals: the spread (std) of each measured
-        signal over the segments, floored at 0.1 m/s and 0.5 m."""
+        """Normalisers of the speed and gap residuals (m/s, m).
+
+        The spread (std) of each measured signal over the segments, floored at 0.1 m/s and
+        0.5 m.
+        """
         v = np.concatenate([self.v[s.start:s.stop] for s in self.segments])
         g = np.concatenate([self.gap[s.start:s.stop] for s in self.segments])
         return max(float(v.std()), 0.1), max(float(g.std()), 0.5)
@@ -116,8 +119,10 @@ INITIAL_WINDOW = 20
 
 
 def initial_state(v: Array, dt: float) -> tuple[float, float]:
-    """Initial speed and acceleration of a segment: the straight line fitted by least squares
-    to its first :data:`INITIAL_WINDOW` speeds (a difference of two noisy GPS speeds would make
+    """Initial speed and acceleration of a segment, from a line through its first speeds.
+
+    The straight line is fitted by least squares to the first :data:`INITIAL_WINDOW` speeds (a
+    difference of two noisy GPS speeds would make
     a0 err by ~σ√2/Δt, 0.7 m/s² for σ = 0.05 m/s at 10 Hz).
 
     Parameters
@@ -138,8 +143,9 @@ def initial_state(v: Array, dt: float) -> tuple[float, float]:
 
 
 def measured_initial(data: FollowerData) -> Array:
-    """(s0, v0, a0) of each segment from the data: straight lines fitted to its first
-    :data:`INITIAL_WINDOW` gaps and speeds; the starting values of the fit's initial states.
+    """(s0, v0, a0) of each segment from the data: the starting values of the fit's initial states.
+
+    Straight lines are fitted to each segment's first :data:`INITIAL_WINDOW` gaps and speeds.
 
     Parameters
     ----------
@@ -167,8 +173,9 @@ INITIAL_SLACK = (3.0, 1.0, 2.0)
 
 def simulate_segments(m: FollowerModel, data: FollowerData,
                       initial: Array | None = None) -> tuple[list[Array], list[Array]]:
-    """Simulated gap and speed on every segment from its initial state (default the measured
-    one, :func:`measured_initial`).
+    """Simulated gap and speed on every segment from its initial state.
+
+    The initial states default to the measured ones (:func:`measured_initial`).
 
     Parameters
     ----------
@@ -212,8 +219,10 @@ def _residuals(x: Array, names: tuple[str, ...], data: FollowerData, sv: float, 
 
 
 def residual_weights(data: FollowerData, counts: Array) -> Array:
-    """Per-residual weights √c_k from per-sample counts c_k (the block bootstrap's multiplicities),
-    in the order of the residual vector (speed then gap of each segment).
+    """Per-residual weights √c_k from per-sample counts c_k.
+
+    c_k is the block bootstrap's multiplicity of sample k; the weights are in the order of the
+    residual vector (speed then gap of each segment).
 
     Parameters
     ----------
@@ -277,8 +286,10 @@ class FitResult:
 
 def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.Generator,
             fixed: dict[str, float] | None = None) -> list[Array]:
-    """Starting points: a typical ACC first, then draws from plausible ranges; l_0 from the
-    data's mean gap at the drawn T*."""
+    """Starting points: a typical ACC first, then draws from plausible ranges.
+
+    Each l_0 comes from the data's mean gap at the drawn T*.
+    """
     vbar = float(np.mean([data.v[s.start:s.stop].mean() for s in data.segments]))
     gbar = float(np.mean([data.gap[s.start:s.stop].mean() for s in data.segments]))
     typical = {"k_x": 0.1, "k_v": 0.4, "tau": 0.5, "headway": 1.2, "k_a": 0.3, "delta": 0.2}

@@ -58,8 +58,9 @@ def read_ngsim(path: Path, min_duration: float) -> list[PlatoonLog]:
 
 
 def read_logs(path: str | Path, *, min_duration: float = 30.0) -> list[PlatoonLog]:
-    """Read an OpenACC, plain CSV or NGSIM log (:func:`stringstab.io.read_platoon_logs` with the
-    NGSIM reader :func:`read_ngsim`).
+    """Read an OpenACC, plain CSV or NGSIM log.
+
+    Through :func:`stringstab.io.read_platoon_logs` with the NGSIM reader :func:`read_ngsim`.
 
     Parameters
     ----------

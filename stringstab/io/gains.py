@@ -610,7 +610,7 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
 
 
 def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = None) -> GainTable:
-    """Read gain triples from a CSV, JSON, NPZ or Parquet file (see the module docstring).
+    r"""Read gain triples from a CSV, JSON, NPZ or Parquet file (see the module docstring).
 
     Parameters
     ----------
@@ -635,10 +635,10 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
     Examples
     --------
     >>> import io
-    >>> g = read_gains(io.StringIO("t,k_x,k_v,k_a\\n0.0,0.9,-0.5,1.1\\n0.1,1.3,0,0.6\\n"))
+    >>> g = read_gains(io.StringIO("t,k_x,k_v,k_a\n0.0,0.9,-0.5,1.1\n0.1,1.3,0,0.6\n"))
     >>> g.t.tolist(), g.k_x.tolist()
     ([0.0, 0.1], [0.9, 1.3])
-    >>> read_gains(io.StringIO("t,k_x,kv,k_a\\n0,1,1,1\\n"))
+    >>> read_gains(io.StringIO("t,k_x,kv,k_a\n0,1,1,1\n"))
     Traceback (most recent call last):
     ...
     stringstab.errors.StringStabError: <stream>: missing column 'k_v'; expected columns k_x, k_v, k_a (optional t, vehicle); found 't', 'k_x', 'kv', 'k_a'; is 'kv' a misspelling of 'k_v'?

@@ -257,7 +257,7 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str =
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "output file") -> Path:
-    """Write UTF-8 ``text`` to ``path`` atomically (temporary file + rename); returns the path.
+    r"""Write UTF-8 ``text`` to ``path`` atomically (temporary file + rename); returns the path.
 
     Parameters
     ----------
@@ -276,9 +276,9 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "o
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> p = atomic_write_text(pathlib.Path(tempfile.mkdtemp()) / "r.txt", "Γ ≤ 1\\n")
+    >>> p = atomic_write_text(pathlib.Path(tempfile.mkdtemp()) / "r.txt", "Γ ≤ 1\n")
     >>> p.read_text(encoding="utf-8")
-    'Γ ≤ 1\\n'
+    'Γ ≤ 1\n'
     """
     return atomic_write_bytes(path, text.encode("utf-8"), what=what)
 
@@ -448,6 +448,13 @@ class OutputDir:
 
     @property
     def staging(self) -> Path:
+        """The hidden staging folder the run writes into, moved in on success.
+
+        Raises
+        ------
+        RuntimeError
+            Outside the ``with`` block (there is no staging folder then).
+        """
         if self._staging is None:
             raise RuntimeError("OutputDir is used outside its 'with' block")
         return self._staging

@@ -102,9 +102,11 @@ def _csv_quote(x: str) -> str:
 
 
 def _join_rows(rows: Any, sep: str) -> str:
-    """The rows joined by ``sep``: each row gets ``sep`` appended in C, and the text is the
-    array's character buffer read once, without the last ``sep`` (no list of rows, no second
-    join, no copy to cut the end)."""
+    """The rows joined by ``sep``, built in C from the array's character buffer.
+
+    Each row gets ``sep`` appended in C, and the text is the array's character buffer read
+    once, without the last ``sep`` (no list of rows, no second join, no copy to cut the end).
+    """
     pa, pc = _pa()
     if len(rows) == 0:
         return ""

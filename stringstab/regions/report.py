@@ -18,26 +18,80 @@ class ReportedMap(Protocol):
     """
 
     @property
-    def axes(self) -> Mapping[str, Any]: ...
+    def axes(self) -> Mapping[str, Any]:
+        """The grid's axes: gain name (``"k_x"``, ``"k_v"``, ``"k_a"``) to its coordinates."""
+        ...
 
     @property
-    def methods(self) -> tuple[str, ...]: ...
+    def methods(self) -> tuple[str, ...]:
+        """The methods evaluated (``"exact"``, ``"continuous"``, ``"taylor"``, ``"printed"``)."""
+        ...
 
     @property
-    def shape(self) -> tuple[int, ...]: ...
+    def shape(self) -> tuple[int, ...]:
+        """The grid shape."""
+        ...
 
     @property
-    def size(self) -> int: ...
+    def size(self) -> int:
+        """Number of grid points."""
+        ...
 
-    def title(self) -> str: ...
+    def title(self) -> str:
+        """A one-line description: the fixed gain, the parameters (or the box), the sample time.
 
-    def class_shares(self) -> dict[str, dict[str, float]]: ...
+        Returns
+        -------
+        str
+            The description.
+        """
+        ...
 
-    def verdict_shares(self) -> dict[str, dict[str, float]]: ...
+    def class_shares(self) -> dict[str, dict[str, float]]:
+        """Share of grid points in each class of each method's class map.
 
-    def disagreements(self) -> dict[str, int]: ...
+        Returns
+        -------
+        dict of str to dict of str to float
+            Method -> class label -> share in [0, 1].
+        """
+        ...
 
-    def stable(self, method: str) -> np.ndarray: ...
+    def verdict_shares(self) -> dict[str, dict[str, float]]:
+        """Share of grid points of each verdict of each method.
+
+        Returns
+        -------
+        dict of str to dict of str to float
+            Method -> verdict label -> share in [0, 1].
+        """
+        ...
+
+    def disagreements(self) -> dict[str, int]:
+        """Number of points where methods disagree on string stability.
+
+        Returns
+        -------
+        dict of str to int
+            ``"a vs b"`` per pair of methods, ``"any"`` and ``"inconclusive"`` (as
+            :meth:`stringstab.regions.RegionMap.disagreements`).
+        """
+        ...
+
+    def stable(self, method: str) -> np.ndarray:
+        """Where ``method`` says string stable.
+
+        Parameters
+        ----------
+        method : str
+            One of :attr:`methods`.
+
+        Returns
+        -------
+        bool ndarray, shape :attr:`shape`
+            True where the method's verdict is string stable.
+        """
+        ...
 
 
 def percent(x: float) -> str:

@@ -1,6 +1,7 @@
-"""The reports of the commands that write a folder, each built from the objects the command
-already has (a region map, a simulated run's metrics document, an evaluation, a comparison, a
-verification).  A command calls one function and writes the result::
+"""The reports of the commands that write a folder, from the objects the command already has.
+
+Those are a region map, a simulated run's metrics document, an evaluation, a comparison, a
+verification.  A command calls one function and writes the result::
 
     region_report(rmap, files, command=command_line(args), started=t0).write(out)
 """
@@ -37,8 +38,9 @@ def _pngs(names: Iterable[str]) -> list[str]:
 
 def region_report(rmap: Any, files: Sequence[Any], *, command: str,
                   started: float | None = None) -> Report:
-    """The report of ``stringstab region``: the grid, each method's class shares, where the
-    methods disagree, and every figure.
+    """The report of ``stringstab region``.
+
+    The grid, each method's class shares, where the methods disagree, and every figure.
 
     Parameters
     ----------
@@ -85,8 +87,10 @@ def region_report(rmap: Any, files: Sequence[Any], *, command: str,
 
 def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command: str,
                     title: str = "", started: float | None = None) -> Report:
-    """The report of ``stringstab simulate``: the set-up, the certificate of the gains, the
-    metrics with their units and meaning, m_p per follower, and the figures.
+    """The report of ``stringstab simulate``.
+
+    The set-up, the certificate of the gains, the metrics with their units and meaning, m_p per
+    follower, and the figures.
 
     Parameters
     ----------
@@ -243,8 +247,10 @@ def compare_report(markdown: str, files: Sequence[str], *, command: str,
 
 def identify_report(res: Any, files: Sequence[Any], *, command: str,
                     started: float | None = None) -> Report:
-    """The report of ``stringstab identify``: the per-follower table with the verdicts and the
-    bootstrap shares, the data's own amplification, the notes, and every figure.
+    """The report of ``stringstab identify``.
+
+    The per-follower table with the verdicts and the bootstrap shares, the data's own
+    amplification, the notes, and every figure.
 
     Parameters
     ----------
@@ -316,8 +322,10 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
 
 def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[str],
                  root: str | Path, *, command: str, started: float | None = None) -> Report:
-    """The report of ``stringstab sweep``: how many points finished, the results table, the
-    failures, and the study's tables and figures (``report/``) the sweep already wrote.
+    """The report of ``stringstab sweep``.
+
+    How many points finished, the results table, the failures, and the study's tables and
+    figures (``report/``) the sweep already wrote.
 
     Parameters
     ----------
@@ -371,8 +379,10 @@ def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[s
 
 
 def scenario_report(doc: Mapping[str, Any], *, command: str, started: float | None = None) -> Report:
-    """The report of ``stringstab sumo run --sumocfg``: the scenario, the vehicles driven, what
-    each met (leaders, smallest gap, collisions, m_p) and the share of executed gains certified.
+    """The report of ``stringstab sumo run --sumocfg``.
+
+    The scenario, the vehicles driven, what each met (leaders, smallest gap, collisions, m_p)
+    and the share of executed gains certified.
 
     Parameters
     ----------

@@ -1,5 +1,7 @@
-"""The demo's report: the front page of the toolkit, read top to bottom as the story of the two
-papers checked (IDL: derive, certify, map, repair, simulate, train; HCFS: the jerk theorem).
+"""The demo's report: the front page of the toolkit, the story of the two papers checked.
+
+Read top to bottom: IDL (derive, certify, map, repair, simulate, train), then HCFS (the jerk
+theorem).
 
 Built from the summaries the demo steps return (:func:`stringstab.cli.demo_steps.run_demo`), never from
 re-reading their files; the figures are the files the steps wrote, found in the output folder.

@@ -292,7 +292,7 @@ def _shift_headings(md: str, by: int) -> str:
 
 
 class Report:
-    """A run's report, written as ``report.md`` and a self-contained ``report.html``.
+    r"""A run's report, written as ``report.md`` and a self-contained ``report.html``.
 
     Parameters
     ----------
@@ -316,7 +316,7 @@ class Report:
     >>> print(rep.markdown(wall_time=1.5).split("## Verdicts")[1].strip())
     | what was checked | result | evidence |
     |---|---|---|
-    | K = (1.2, 0.5, 0.6) string stable | **yes** | sup\\|Γ\\| = 0.93 |
+    | K = (1.2, 0.5, 0.6) string stable | **yes** | sup\|Γ\| = 0.93 |
     """
 
     def __init__(self, title: str, *, command: str, params: Mapping[str, Any] | None = None,
@@ -500,8 +500,10 @@ _IMG = re.compile(r'(<img\b[^>]*?\bsrc=")([^"]+)(")')
 
 
 def _embed_images(html: str, root: Path) -> str:
-    """Replace the ``src`` of each local image by a base64 ``data:`` URI; a missing file is
-    replaced by a visible note."""
+    """Replace the ``src`` of each local image by a base64 ``data:`` URI.
+
+    A missing file is replaced by a visible note.
+    """
 
     def repl(m: re.Match[str]) -> str:
         src = m.group(2)

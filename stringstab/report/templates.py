@@ -74,8 +74,9 @@ def _cell(v: Any) -> str:
 
 @lru_cache(maxsize=1)
 def environment() -> Any:
-    """The Jinja2 environment of the templates (no autoescaping: the Markdown is escaped by the
-    converter; a ``cell`` filter escapes table cells).
+    """The Jinja2 environment of the templates, with a ``cell`` filter escaping table cells.
+
+    No autoescaping: the Markdown is escaped by the converter.
 
     Returns
     -------

@@ -76,8 +76,10 @@ TUNED_STEP = 0.1
 
 @dataclass(frozen=True)
 class CACCType:
-    """A vType of SUMO's CACC model: where it came from and its parameters (SUMO's defaults
-    filled in)."""
+    """A vType of SUMO's CACC model: where it came from and its parameters.
+
+    SUMO's defaults are filled in for the parameters not given.
+    """
 
     id: str
     source: str
@@ -280,8 +282,10 @@ def _no_lag_closed_form(law: ModeLaw) -> dict[str, Any]:
 
 
 def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
-    """Each mode's law with its certificates: continuous and sampled at ``dt`` (τ = 1 ms,
-    δ = 0), the closed-form no-lag condition, and the exact discrete sweep.
+    """Each mode's law with its certificates.
+
+    Continuous and sampled at ``dt`` (τ = 1 ms, δ = 0), the closed-form no-lag condition, and
+    the exact discrete sweep.
 
     Parameters
     ----------

@@ -185,30 +185,37 @@ class SumoPlatoon:
 
     @property
     def position(self) -> Array:
+        """Positions of the current step, m, shape (1, N + 1), in the leader's coordinates."""
         return self.inner.position
 
     @property
     def speed(self) -> Array:
+        """Speeds of the current step, m/s, shape (1, N + 1); column 0 is the leader."""
         return self.inner.speed
 
     @property
     def accel(self) -> Array:
+        """Accelerations of the current step, m/s², shape (1, N + 1); column 0 is the leader."""
         return self.inner.accel
 
     @property
     def step(self) -> int:
+        """Steps taken by the toolkit's side of the platoon (its inner :class:`Platoon`)."""
         return self.inner.step
 
     @property
     def limits(self) -> Limits:
+        """The toolkit's acceleration and speed bounds."""
         return self.inner.limits
 
     def _read(self) -> tuple[Array, Array]:
         return vehicle_state(self.session, self.ids, self.session.simulation.getTime())
 
     def reset(self, accel: npt.ArrayLike = 0.0) -> None:
-        """Take the followers' gaps and speeds from SUMO; set their accelerations (and the
-        delay history) to ``accel``."""
+        """Take the followers' gaps and speeds from SUMO; set their accelerations to ``accel``.
+
+        The delay history is set to ``accel`` too.
+        """
         x, v = self._read()
         x = x + self.offset
         gaps = x[:-1] - x[1:] - self.inner.length
@@ -345,8 +352,9 @@ def _version(session: SumoSession) -> str:
 
 def run_loop(plat: Any, controller: Controller, T: int, *, progress: bool = False,
              on_step: Any = None, desc: str = "sumo") -> PlatoonResult:
-    """Step a platoon with the observe/advance contract ``T`` times, recording like
-    :func:`~stringstab.traffic.simulate` (``record=True``); returns the result without
+    """Step a platoon with the observe/advance contract ``T`` times, recording as it goes.
+
+    Records like :func:`~stringstab.traffic.simulate` (``record=True``); the result has no
     ``params`` beyond ``dt``.
 
     Parameters

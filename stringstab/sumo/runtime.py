@@ -353,8 +353,11 @@ class SumoSession:
             raise StringStabError(f"SUMO stopped: {_one_line(e)}{self._stderr()}") from e
 
     def close(self) -> None:
-        """Stop SUMO (idempotent): close libsumo, or close the TraCI connection and end the
-        subprocess this session started (killed after 10 s if it does not exit)."""
+        """Stop SUMO (idempotent): close libsumo, or the TraCI connection and its subprocess.
+
+        The subprocess is the one this session started; it is killed after 10 s if it does not
+        exit.
+        """
         if self.api == "libsumo":
             if self in _ACTIVE_LIBSUMO:
                 _ACTIVE_LIBSUMO.remove(self)

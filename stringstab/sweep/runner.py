@@ -30,8 +30,11 @@ from .tasks import run_point
 __all__ = ["run_sweep"]
 
 class _Progress:
-    """A tqdm bar on a terminal (:class:`stringstab.progress.Progress`); otherwise a log line per
-    finished point (at most every ``every`` s; every failure), with the time left."""
+    """A tqdm bar on a terminal; otherwise a log line per finished point, with the time left.
+
+    The bar is :class:`stringstab.progress.Progress`; the lines come at most every ``every`` s,
+    and for every failure.
+    """
 
     def __init__(self, total: int, done: int, log: Callable[[str], None], bar: bool | None,
                  every: float = 5.0) -> None:

@@ -89,7 +89,7 @@ class Trajectory:
         return np.asarray(np.arange(self.n_steps) * self.dt, dtype=np.float64)
 
     def hold(self, seconds: float) -> Trajectory:
-        """This trajectory followed by ``seconds`` at its final speed (zero acceleration).
+        """The trajectory followed by ``seconds`` at its final speed (zero acceleration).
 
         Lets a long platoon settle before its damping ratios are measured (eq 29 sums over the
         whole run).
