@@ -207,6 +207,9 @@ def check_sampled(
                         witness_theta=bb.argmin)
 
 
+# ---------------------------------------------------------------------------
+# The certificate: verdicts, peaks and the result types
+# ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SampledCertificate(SingleResult):
     """The sampled-data certificate of one gain triple.

@@ -18,15 +18,10 @@ c = k_v + T* k_x, φ1 = 1 − e^{−x}, ψ2 = x − φ1, ψ3 = x²/2 − ψ2 at 
 ``p`` forms at H/τ_p, the predecessor's lag) and C = e^{−(1−ε)H/τ_p}.  Every coefficient
 is a sum of terms of one order in H, so nothing cancels as H → 0.
 
-On the unit circle z = e^{jθ}, with ρ = |w|² = 4 sin²(θ/2), the margin of the sampled
-certificate (:mod:`stringstab.certify.sampled`) is
-
-.. math::
-    g_H(θ) = P(ρ) + \\cos(mθ)\\,Y_r(ρ) + \\sin(mθ)\\sin θ\\,Y_i(ρ),
-
-and :func:`build` computes the coefficients of P, Y_r (degree 2) and Y_i (degree 1) with
-δ, ν and ℓ (:class:`Coefficients`).  The constant terms of |Δ|² and |n|² cancel *exactly*
-(φ1p δ0 = φ1 ν0: H(1) = 1), so the division by ρ is exact.
+With δ, ν and ℓ, :func:`build` computes the coefficients of the polynomials P, Y_r (degree
+2) and Y_i (degree 1) in ρ = 4 sin²(θ/2) of the margin g_H (:class:`Coefficients`;
+:mod:`stringstab.certify.sampled_frequency`); the constant terms of |Δ|² and |n|² cancel
+*exactly* (φ1p δ0 = φ1 ν0: H(1) = 1), so the division by ρ is exact.
 
 Everything is computed in the arithmetic of :mod:`stringstab.certify.interval`: at a point
 (:func:`point_coefficients`: one gain triple per row), over a cell of parameters
@@ -142,20 +137,9 @@ class Coefficients:
 
     Each entry is an :class:`~stringstab.certify.interval.Interval` (points, or intervals
     over a cell) or an :class:`~stringstab.certify.interval.IntervalAD` over a cell, one
-    row per gain triple or cell; polynomials are lists, constant term first.
-
-    Attributes
-    ----------
-    delta : list
-        δ0, δ1, δ2 of Δ(w) (δ3 = 1).
-    nu : list
-        ν0, ν1, ν2 of n(w).
-    ell : list
-        ℓ0 = φ1p and ℓ1 = 1 − C of ℓ(w).
-    phi1, phi1p : Interval or IntervalAD
-        φ1 at H/τ and at H/τ_p.
-    P, Yr, Yi : list
-        The margin polynomials in ρ (module docstring).
+    row per gain triple or cell: ``delta`` = [δ0, δ1, δ2] (δ3 = 1), ``nu`` = [ν0, ν1, ν2],
+    ``ell`` = [φ1p, 1 − C], ``phi1`` and ``phi1p`` (φ1 at H/τ and H/τ_p), and the margin
+    polynomials ``P``, ``Yr``, ``Yi`` in ρ, constant term first (module docstring).
     """
 
     delta: list[Any]
