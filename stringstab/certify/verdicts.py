@@ -43,6 +43,7 @@ __all__ = [
     "SingleResult",
     "Verdict",
     "chunks",
+    "codes",
     "names",
     "num",
     "one_triple",
@@ -75,6 +76,11 @@ class Verdict(str, enum.Enum):
 
     def __format__(self, format_spec: str) -> str:
         return str.__format__(str(self), format_spec)
+
+    @property
+    def words(self) -> str:
+        """The verdict in words, for legends and class names (``"not certified"``)."""
+        return self.value.replace("_", " ")
 
     @property
     def code(self) -> int:
@@ -140,6 +146,39 @@ def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:
     ['certified', 'inconclusive']
     """
     return np.array(VERDICTS)[np.asarray(codes, dtype=np.intp)]
+
+
+def codes(verdict: npt.ArrayLike) -> npt.NDArray[np.int8]:
+    """Verdict names as their codes (the inverse of :func:`names`).
+
+    Parameters
+    ----------
+    verdict : array_like of str
+        Verdict names (``"certified"``, ``"not_certified"``, ``"inconclusive"``).
+
+    Returns
+    -------
+    ndarray of int8
+        The codes (:attr:`Verdict.code`), of the shape of ``verdict``.
+
+    Raises
+    ------
+    StringStabError
+        If a name is not a verdict.
+
+    Examples
+    --------
+    >>> codes(["inconclusive", "certified"]).tolist()
+    [2, 0]
+    """
+    v = np.asarray(verdict)
+    out = np.full(v.shape, -1, dtype=np.int8)
+    for w in VERDICTS:
+        out[v == w.value] = w.code
+    if (out < 0).any():
+        raise StringStabError(f"verdicts are {[w.value for w in VERDICTS]}; "
+                              f"got {v[out < 0].ravel()[0]!r}")
+    return out
 
 
 def num(x: float) -> float | None:
