@@ -172,7 +172,7 @@ def _loop_certified_points(K, params, sample_time, heterogeneous=True):
 
 
 BOX = Box((0.08, 0.12), (0.15, 0.25), (1.0, 1.2))
-LOOPS = [(P, None, 9), (P, 0.1, 9), (BOX, None, 9), (BOX, 0.1, 5)]
+LOOPS = [(P, None, 9), (P, 0.1, 9), (BOX, None, 9), (BOX, 0.1, 4)]
 
 
 @pytest.mark.parametrize(("params", "sample_time", "n"), LOOPS)

@@ -217,7 +217,7 @@ def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
     """
     n = int(np.size(verdict))
     counts = {v.value: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
-    return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+    return {"n": n, **counts, "m_fss": counts[Verdict.CERTIFIED.value] / n if n else float("nan")}
 
 
 def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
@@ -284,7 +284,7 @@ class SingleResult:
     @property
     def certified(self) -> bool:
         """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
+        return self.verdict == Verdict.CERTIFIED
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON row of this triple: the batch's columns, non-finite numbers as None."""
@@ -312,7 +312,7 @@ class BatchResult:
     @property
     def certified(self) -> npt.NDArray[np.bool_]:
         """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
+        return np.asarray(self.verdict == Verdict.CERTIFIED)
 
     def __getitem__(self, i: int) -> Any:
         values = {}
@@ -404,4 +404,4 @@ class Check:
     @property
     def certified(self) -> npt.NDArray[np.bool_]:
         """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
+        return np.asarray(self.verdict == Verdict.CERTIFIED)
