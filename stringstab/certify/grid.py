@@ -12,8 +12,11 @@ box of parameters — and :func:`certified_lattice` applies it to the lattice of
   |Γ(jω)| > 1 at a fixed frequency: a proof of failure) drops rows, then
   :func:`stringstab.certify.continuous.check` decides the rest;
 * a box: a gain certified for every member is string stable at the box's centre, so the
-  centre's screen (continuous loop) and the centre's point certificate (of the same loop, far
-  cheaper than the robust one) pick the rows the robust certificate then decides;
+  centre's screen (continuous loop) drops rows soundly; then the centre's point certificate
+  (of the same loop, far cheaper than the robust one) picks the rows the robust certificate
+  decides.  That step is sound only as far as the point certificate is never inconclusive
+  where the robust one (with its looser bounds) certifies: not proven, never observed
+  (``tests/test_certify_grid.py`` compares with the robust certificate on every row);
 * the sampled-data loop: its certificate decides every row (the continuous screen says
   nothing about it), after the continuous certificate when both are asked for
   (``also_continuous``: the gains a sampled controller executes in the repair's training loop).
@@ -111,10 +114,10 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
     Returns
     -------
     ndarray of bool, shape (n,)
-        True where certified: exactly the rows whose
-        :func:`stringstab.certify.continuous.check` verdict (of that loop, and of the
-        continuous loop with ``also_continuous``) is ``"certified"`` — the cheap steps of the
-        module docstring only skip rows that cannot be.
+        True where certified: the rows whose :func:`stringstab.certify.continuous.check`
+        verdict (of that loop, and of the continuous loop with ``also_continuous``) is
+        ``"certified"`` — the cheap steps of the module docstring only skip rows that cannot
+        be (for a box, see there).
 
     Examples
     --------
