@@ -124,14 +124,38 @@ def test_lattice_order_and_input_errors():
         certified_lattice(-1.0, 1.0, 3, P, sample_time=0.1, hurwitz_margin=1e-3)
 
 
+def _repair_certified(K, p, sample_time=None):
+    """rl/repair.py's ``_certified`` before it called the helper (verbatim, its screen inlined:
+    Hurwitz, then g(ω) ≥ 0 at the 48 fixed frequencies, then ``check``, then the sampled one)."""
+    out = np.zeros(K.shape[0], dtype=bool)
+    cand = hurwitz(K[:, 0], K[:, 1], tau=p.tau, headway=p.headway)
+    if cand.any():
+        idx = np.flatnonzero(cand)
+        g = margin_g(SCREEN_OMEGA[None, :], K[idx, 0:1], K[idx, 1:2], K[idx, 2:3],
+                     tau=p.tau, delta=p.delta, headway=p.headway)
+        idx = idx[g.min(axis=1) >= 0.0]
+        if idx.size:
+            ok = _certified_by_check(K[idx], p)
+            if sample_time is not None and ok.any():
+                ok[ok] = _certified_by_check(K[idx[ok]], p, sample_time=sample_time)
+            out[idx] = ok
+    return out
+
+
 @pytest.mark.parametrize("sample_time", [None, 0.1])
 def test_same_points_as_the_rl_repair_lattice(sample_time):
     from stringstab.rl.repair import certified_lattice as repair_lattice
 
-    old = repair_lattice(0.1, 0.2, 1.1, -2.0, 2.0, 0.5, sample_time)
+    K = lattice(-2.0, 2.0, 9)
     new = certified_lattice(-2.0, 2.0, 9, P, sample_time=sample_time, also_continuous=True)
-    np.testing.assert_array_equal(new, old)
+    np.testing.assert_array_equal(new, K[_repair_certified(K, P, sample_time)])
+    np.testing.assert_array_equal(new, repair_lattice(0.1, 0.2, 1.1, -2.0, 2.0, 0.5, sample_time))
     assert len(new) > 20
+    # and on random triples (the repair's bisection certifies arbitrary points)
+    R = np.random.default_rng(5).uniform(-2.0, 2.0, (1000 if sample_time else 5000, 3))
+    np.testing.assert_array_equal(
+        certified(R, P, sample_time=sample_time, also_continuous=True),
+        _repair_certified(R, P, sample_time))
 
 
 def _projection_certified_map(tau, delta, headway, lo, hi, margin, n):
