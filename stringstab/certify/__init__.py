@@ -12,7 +12,9 @@ Also here: the Padé cross-check (:func:`certify_pade`, never a verdict), the br
 (:mod:`~stringstab.certify.branch_bound`), the margin g(ω) and its tail bound
 (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
 (:mod:`~stringstab.certify.criteria`), |Γ(jω)| (:mod:`~stringstab.certify.frequency`) and
-sup |Γ| − 1 (:mod:`~stringstab.certify.excess`).
+sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screen
+(:mod:`~stringstab.certify.screen`) and the certified points of a grid of gains
+(:mod:`~stringstab.certify.grid`).
 
 The function :func:`certify` and this subpackage share a name: ``stringstab.certify`` is the
 function (the façade binds it); import the modules with ``from stringstab.certify import

@@ -36,14 +36,19 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from .verdicts import CERTIFIED, INCONCLUSIVE, VERDICTS
+from .verdicts import NOT_CERTIFIED as VIOLATED
+
 __all__ = ["CERTIFIED", "INCONCLUSIVE", "PENDING", "VIOLATED", "BranchAndBound", "branch_and_bound",
            "verdict_codes", "zoom_max"]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
 
-#: Item outcomes.
-CERTIFIED, VIOLATED, INCONCLUSIVE, PENDING = 0, 1, 2, 3
+#: Item outcomes: :data:`CERTIFIED`, :data:`VIOLATED` and :data:`INCONCLUSIVE` *are* the verdict
+#: codes of :mod:`stringstab.certify.verdicts` (imported above: a violated item is not certified);
+#: PENDING, the engine's own fourth outcome (intervals handed back), is the first code after them.
+PENDING = len(VERDICTS)
 
 #: ``evaluate(idx, X)`` with X of shape (len(idx), k + 1), sorted along axis 1, returns
 #: (point values, lower bounds, slacks) of shape (len(idx), k + 1) and curvature bounds
@@ -99,8 +104,8 @@ def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
     """Item outcomes as verdict codes (:data:`stringstab.certify.verdicts.VERDICTS`): certified 0,
     violated 1 (not certified), anything else 2 (inconclusive).
 
-    The outcome codes are chosen so that CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict
-    codes 0, 1, 2; only PENDING is mapped (to inconclusive).
+    CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict codes 0, 1, 2 (imported from
+    :mod:`stringstab.certify.verdicts`); only PENDING is mapped (to inconclusive).
 
     Parameters
     ----------

@@ -43,6 +43,7 @@ __all__ = [
     "SingleResult",
     "Verdict",
     "chunks",
+    "codes",
     "names",
     "num",
     "one_triple",
@@ -75,6 +76,11 @@ class Verdict(str, enum.Enum):
 
     def __format__(self, format_spec: str) -> str:
         return str.__format__(str(self), format_spec)
+
+    @property
+    def words(self) -> str:
+        """The verdict in words, for legends and class names (``"not certified"``)."""
+        return self.value.replace("_", " ")
 
     @property
     def code(self) -> int:
@@ -142,6 +148,39 @@ def names(codes: npt.ArrayLike) -> npt.NDArray[np.str_]:
     return np.array(VERDICTS)[np.asarray(codes, dtype=np.intp)]
 
 
+def codes(verdict: npt.ArrayLike) -> npt.NDArray[np.int8]:
+    """Verdict names as their codes (the inverse of :func:`names`).
+
+    Parameters
+    ----------
+    verdict : array_like of str
+        Verdict names (``"certified"``, ``"not_certified"``, ``"inconclusive"``).
+
+    Returns
+    -------
+    ndarray of int8
+        The codes (:attr:`Verdict.code`), of the shape of ``verdict``.
+
+    Raises
+    ------
+    StringStabError
+        If a name is not a verdict.
+
+    Examples
+    --------
+    >>> codes(["inconclusive", "certified"]).tolist()
+    [2, 0]
+    """
+    v = np.asarray(verdict)
+    out = np.full(v.shape, -1, dtype=np.int8)
+    for w in VERDICTS:
+        out[v == w.value] = w.code
+    if (out < 0).any():
+        raise StringStabError(f"verdicts are {[w.value for w in VERDICTS]}; "
+                              f"got {v[out < 0].ravel()[0]!r}")
+    return out
+
+
 def num(x: float) -> float | None:
     """``x`` as a float, or None when it is not finite (a JSON row's ``null``).
 
@@ -178,7 +217,7 @@ def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
     """
     n = int(np.size(verdict))
     counts = {v.value: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
-    return {"n": n, **counts, "m_fss": counts["certified"] / n if n else float("nan")}
+    return {"n": n, **counts, "m_fss": counts[Verdict.CERTIFIED.value] / n if n else float("nan")}
 
 
 def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
@@ -245,7 +284,7 @@ class SingleResult:
     @property
     def certified(self) -> bool:
         """True iff the verdict is ``"certified"``."""
-        return self.verdict == "certified"
+        return self.verdict == Verdict.CERTIFIED
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON row of this triple: the batch's columns, non-finite numbers as None."""
@@ -273,7 +312,7 @@ class BatchResult:
     @property
     def certified(self) -> npt.NDArray[np.bool_]:
         """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
+        return np.asarray(self.verdict == Verdict.CERTIFIED)
 
     def __getitem__(self, i: int) -> Any:
         values = {}
@@ -365,4 +404,4 @@ class Check:
     @property
     def certified(self) -> npt.NDArray[np.bool_]:
         """Boolean array: verdict == "certified"."""
-        return np.asarray(self.verdict == "certified")
+        return np.asarray(self.verdict == Verdict.CERTIFIED)

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ..certify.verdicts import Verdict
 from ..io import OutputDir, TableColumn, columns_from_records, format_results, write_results
 from .core import IdentifyResult, VehicleResult, simulated
 
@@ -40,7 +41,7 @@ TABLE = [
     TableColumn("sup|Γ| 5-95%", "sup_interval", "%s"),
     TableColumn("ω_peak[rad/s]", "peak_omega", "%.3g"),
     TableColumn("verdict", "verdict", "%s"),
-    TableColumn("certified", "certified_share", "%.2f"),
+    TableColumn(Verdict.CERTIFIED.value, "certified_share", "%.2f"),
     TableColumn("box", "box_verdict", "%s"),
     TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),
     TableColumn("data>1", "data_amplifies", "%s"),

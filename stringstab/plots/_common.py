@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from ..certify.verdicts import Verdict
+
 __all__ = [
     "CLASS_COLORS",
     "GAIN_LABELS",
@@ -118,9 +120,9 @@ CLASS_COLORS: dict[str, str] = {
     "type IV": OKABE_ITO["orange"],
     "type I": OKABE_ITO["blue"],
     "type II": OKABE_ITO["sky"],
-    "not certified": OKABE_ITO["vermillion"],
-    "inconclusive": OKABE_ITO["black"],
-    "certified": OKABE_ITO["blue"],
+    Verdict.NOT_CERTIFIED.words: OKABE_ITO["vermillion"],
+    Verdict.INCONCLUSIVE.words: OKABE_ITO["black"],
+    Verdict.CERTIFIED.words: OKABE_ITO["blue"],
 }
 #: Axis labels of the gains, with units (u = k_x Δp + k_v Δv + k_a a in m/s²).
 GAIN_LABELS: dict[str, str] = {

@@ -23,12 +23,13 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify.criteria import hurwitz, proposition1, stability_type
+from ..certify.verdicts import codes
 from ..derive import generated as _gen
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model
 from ..params import sample_time as _sample_time
 from .pool import cpu_count, in_daemon, run_blocks
-from .result import CONTINUOUS, GAIN_NAMES, INCONCLUSIVE, METHODS, STABLE, UNSTABLE, RegionMap
+from .result import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE, RegionMap
 
 __all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
 
@@ -89,13 +90,6 @@ class _Spec:
         return self.sample_time is None and isinstance(self.params, Params)
 
 
-def _codes(verdict: npt.NDArray[np.str_]) -> npt.NDArray[np.int8]:
-    code = np.full(verdict.shape, INCONCLUSIVE, dtype=np.int8)
-    code[verdict == "certified"] = STABLE
-    code[verdict == "not_certified"] = UNSTABLE
-    return code
-
-
 def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, int]) -> dict[str, Any]:
     """A sampled or robust block: ``exact`` (and ``continuous``) with their stability."""
     from ..certify.continuous import certify_batch
@@ -105,12 +99,12 @@ def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, in
     b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway,
                       sample_time=spec.sample_time, heterogeneous=spec.heterogeneous)
     out["hurwitz"] = np.asarray(b.stable).reshape(shape)
-    out["verdict_exact"] = _codes(b.verdict).reshape(shape)
+    out["verdict_exact"] = codes(b.verdict).reshape(shape)
     out["sup_gain"] = b.sup_gain.reshape(shape)
     out["margin"] = b.margin.reshape(shape)
     if CONTINUOUS in spec.methods:
         c = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
-        out["verdict_continuous"] = _codes(c.verdict).reshape(shape)
+        out["verdict_continuous"] = codes(c.verdict).reshape(shape)
         out["hurwitz_continuous"] = np.asarray(c.stable).reshape(shape)
     return out
 
@@ -149,7 +143,7 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
 
         full = [np.broadcast_to(gains[g], shape).ravel() for g in GAIN_NAMES]
         b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
-        out["verdict_exact"] = _codes(b.verdict).reshape(shape)
+        out["verdict_exact"] = codes(b.verdict).reshape(shape)
         out["sup_gain"] = b.sup_gain.reshape(shape)
         out["margin"] = b.margin.reshape(shape)
     return out

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify.criteria import TYPE_NAMES
+from ..certify.verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, VERDICTS, Verdict
 from ..errors import StringStabError
 from ..io import atomic_write_text, dumps_json
 from ..params import Box, Params
@@ -49,12 +50,23 @@ METHODS: tuple[str, str, str] = ("exact", "taylor", "printed")
 #: The comparison method of a sampled-data map: the continuous-time certificate at the same
 #: parameters (or box), beside ``exact`` (the sampled certificate).
 CONTINUOUS = "continuous"
-#: Labels of the verdict codes 0, 1, 2 per method (code 0 means "says string stable").
+#: Every method's per-point codes are the verdict codes (:mod:`stringstab.certify.verdicts`):
+#: 0 says string stable, 1 says not, 2 cannot tell.
+STABLE, UNSTABLE = CERTIFIED, NOT_CERTIFIED
+#: The labels of those codes for a certificate: the verdicts themselves.
+_CERTIFICATE_LABELS: tuple[str, str, str] = (VERDICTS[0].value, VERDICTS[1].value,
+                                             VERDICTS[2].value)
+#: The labels of those codes for the Taylor methods (derived and printed Ψ, IDL Proposition 1).
+#: They say "stable" / "unstable", never "certified": a test on a Taylor approximation of the
+#: delay is not a certificate (it can call unstable gains stable), so its answer must not read
+#: as the certificate's.  Code 2 is never produced by them; its label is kept for a uniform table.
+_APPROXIMATION_LABELS: tuple[str, str, str] = ("stable", "unstable", Verdict.INCONCLUSIVE.value)
+#: Labels of the codes 0, 1, 2 per method.
 VERDICT_LABELS: dict[str, tuple[str, str, str]] = {
-    "exact": ("certified", "not_certified", "inconclusive"),
-    "taylor": ("stable", "unstable", "inconclusive"),
-    "printed": ("stable", "unstable", "inconclusive"),
-    CONTINUOUS: ("certified", "not_certified", "inconclusive"),
+    "exact": _CERTIFICATE_LABELS,
+    "taylor": _APPROXIMATION_LABELS,
+    "printed": _APPROXIMATION_LABELS,
+    CONTINUOUS: _CERTIFICATE_LABELS,
 }
 #: Methods decided by a certificate (tri-state verdicts, the classes of :data:`EXACT_CLASSES`).
 _CERTIFICATES = ("exact", CONTINUOUS)
@@ -62,13 +74,11 @@ _CERTIFICATES = ("exact", CONTINUOUS)
 TYPE_CLASSES: tuple[str, ...] = (
     "not internally stable", "type III", "type IV", "type I", "type II",
 )
-#: Classes of the ``exact`` class map, by code 0-3.
+#: Classes of the ``exact`` class map, by code 0-3: not internally stable, then the verdicts.
 EXACT_CLASSES: tuple[str, ...] = (
-    "not internally stable", "not certified", "inconclusive", "certified",
+    "not internally stable", Verdict.NOT_CERTIFIED.words, Verdict.INCONCLUSIVE.words,
+    Verdict.CERTIFIED.words,
 )
-
-#: Verdict codes: says string stable, says not, cannot tell (exact certificate only).
-STABLE, UNSTABLE, INCONCLUSIVE = 0, 1, 2
 # stability_type code (1 = I, ..., 4 = IV) -> TYPE_CLASSES code
 _TYPE_TO_CLASS = np.array([0, 3, 4, 1, 2], dtype=np.int8)
 

@@ -41,6 +41,7 @@ import numpy.typing as npt
 
 from ..certify import margin as _margin
 from ..certify.criteria import hurwitz_conditions
+from ..certify.grid import certified
 from ..params import Box, Params
 
 __all__ = ["FORM_SIZE", "Loop", "Member", "Slot", "quadratic_form"]
@@ -406,8 +407,8 @@ class Loop:
     def certified_points(self, K: Array) -> npt.NDArray[np.bool_]:
         """Which rows of K (n, 3) this loop's certificate certifies.
 
-        For a box, the point certificate at the box's centre screens first (a gain certified
-        for the box is certified at its centre), then the robust one decides.
+        :func:`stringstab.certify.grid.certified` on this loop (its cheap steps first: the
+        screen, and for a box the certificate at the box's centre).
 
         Parameters
         ----------
@@ -419,19 +420,5 @@ class Loop:
         bool ndarray, shape (n,)
             True where certified.
         """
-        from ..certify.continuous import certify_batch
-
-        b, c = self.box, self.centre()
-        ok = np.zeros(len(K), dtype=bool)
-        if not len(K):
-            return ok
-        screen = certify_batch(K[:, 0], K[:, 1], K[:, 2], tau=c.tau, delta=c.delta,
-                               headway=c.headway, sample_time=self.sample_time).certified
-        if isinstance(self.params, Params):
-            return np.asarray(screen)
-        idx = np.flatnonzero(screen)
-        r = certify_batch(K[idx, 0], K[idx, 1], K[idx, 2], tau=b.tau, delta=b.delta,
-                          headway=b.headway, sample_time=self.sample_time,
-                          heterogeneous=self.heterogeneous)
-        ok[idx] = r.certified
-        return ok
+        return certified(K, self.params, sample_time=self.sample_time,
+                         heterogeneous=self.heterogeneous)

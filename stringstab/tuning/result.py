@@ -14,15 +14,16 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..certify import verdicts
 from ..certify.continuous import Certificate
 from ..io import TableColumn
 
 __all__ = [
-    "CERTIFIED",
+    "CERTIFIED_BY_CHECK",
     "TABLE_COLUMNS",
     "TuneResult",
     "TuneResults",
-    "Verdict",
+    "VerdictAndGain",
     "make_result",
     "triple",
     "wdist",
@@ -45,9 +46,9 @@ class TuneResult:
         The output gains (K0 itself when unchanged or when no solution was found).
     certified : bool
         The output is certified string stable by the exact certificate.
-    verdict : str
-        The exact certificate's verdict on the output
-        (``"certified"``, ``"not_certified"`` or ``"inconclusive"``).
+    verdict : Verdict
+        The exact certificate's verdict on the output (:class:`stringstab.certify.verdicts.Verdict`,
+        a ``str``: ``"certified"``, ``"not_certified"`` or ``"inconclusive"``).
     status : str
         ``"unchanged"`` (the input was already certified), ``"repaired"`` (a new
         output was found), ``"taylor_stable"`` (region growing only: the
@@ -74,7 +75,7 @@ class TuneResult:
     k_in: tuple[float, float, float]
     k: tuple[float, float, float]
     certified: bool
-    verdict: str
+    verdict: verdicts.Verdict
     status: str
     distance: float
     iterations: int
@@ -120,7 +121,7 @@ TABLE_COLUMNS: tuple[TableColumn, ...] = (
     TableColumn("k_x [1/s²]", "k_x", "%.6g"),
     TableColumn("k_v [1/s]", "k_v", "%.6g"),
     TableColumn("k_a [-]", "k_a", "%.6g"),
-    TableColumn("certified", "certified", "%s"),
+    TableColumn(verdicts.Verdict.CERTIFIED.value, "certified", "%s"),
     TableColumn("status", "status", "%s"),
     TableColumn("distance", "distance", "%.4g"),
     TableColumn("iter", "iterations", "%d"),
@@ -262,7 +263,7 @@ def triple(k: Array) -> tuple[float, float, float]:
 
 
 @dataclass(frozen=True)
-class Verdict:
+class VerdictAndGain:
     """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
 
     Built from a full :class:`~stringstab.certify.continuous.Certificate` or, in the
@@ -273,15 +274,16 @@ class Verdict:
     search is needed; for any other verdict the full certificate is computed.
     """
 
-    verdict: str
+    verdict: verdicts.Verdict
     sup_gain: float
 
     @property
     def certified(self) -> bool:
-        return self.verdict == "certified"
+        """The verdict is :attr:`~stringstab.certify.verdicts.Verdict.CERTIFIED`."""
+        return self.verdict is verdicts.Verdict.CERTIFIED
 
     @classmethod
-    def of(cls, cert: Certificate) -> Verdict:
+    def of(cls, cert: Certificate) -> VerdictAndGain:
         """The verdict and sup |Γ| of a full certificate.
 
         Parameters
@@ -291,17 +293,19 @@ class Verdict:
 
         Returns
         -------
-        Verdict
-            ``cert.verdict`` and ``float(cert.sup_gain)``.
+        VerdictAndGain
+            ``cert.verdict`` (as a :class:`~stringstab.certify.verdicts.Verdict`) and
+            ``float(cert.sup_gain)``.
         """
-        return cls(cert.verdict, float(cert.sup_gain))
+        return cls(verdicts.Verdict(cert.verdict), float(cert.sup_gain))
 
 
-#: The verdict of a triple that :func:`stringstab.certify.continuous.check` certified.
-CERTIFIED = Verdict("certified", 1.0)
+#: What a triple that :func:`stringstab.certify.continuous.check` certified reports: certified,
+#: and ‖Γ‖_H∞ = 1 (see :class:`VerdictAndGain`).
+CERTIFIED_BY_CHECK = VerdictAndGain(verdicts.Verdict.CERTIFIED, 1.0)
 
 
-def make_result(method: str, K0: Array, K: Array, cert: Certificate | Verdict, status: str,
+def make_result(method: str, K0: Array, K: Array, cert: Certificate | VerdictAndGain, status: str,
                 w: Array, iterations: int, t0: float, message: str, **details: Any) -> TuneResult:
     """A :class:`TuneResult` of ``method`` that moved ``K0`` to ``K``, timed from ``t0``.
 
@@ -313,7 +317,7 @@ def make_result(method: str, K0: Array, K: Array, cert: Certificate | Verdict, s
         The input gains (k_x [1/s²], k_v [1/s], k_a [-]; IDL eq 4).
     K : ndarray, shape (3,)
         The output gains.
-    cert : Certificate or Verdict
+    cert : Certificate or VerdictAndGain
         The exact certificate of K (or the verdict and sup |Γ| taken from it).
     status : str
         The method's exit status (recorded as is).
@@ -333,10 +337,17 @@ def make_result(method: str, K0: Array, K: Array, cert: Certificate | Verdict, s
     TuneResult
         ``certified`` and ``verdict`` come from ``cert``, never from ``status``.
     """
-    v = cert if isinstance(cert, Verdict) else Verdict.of(cert)
+    v = cert if isinstance(cert, VerdictAndGain) else VerdictAndGain.of(cert)
     return TuneResult(
         method=method, k_in=triple(K0), k=triple(K), certified=v.certified,
         verdict=v.verdict, status=status, distance=float(wdist(K, K0, w)),
         iterations=iterations, seconds=time.perf_counter() - t0, message=message,
         sup_gain=v.sup_gain, details=details,
     )
+
+
+# Transitional, for stringstab/tuning/projection.py only (another helper's file while issue 20 is
+# under way), which still imports the two old names: delete these two lines when it imports
+# VerdictAndGain and CERTIFIED_BY_CHECK instead.
+Verdict = VerdictAndGain
+CERTIFIED = CERTIFIED_BY_CHECK
