@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..certify.verdicts import Verdict
 from ..errors import StringStabError
 from ..regions import RegionMap
 from ._common import OKABE_ITO, PlotResult, legend_below, new_ax
@@ -19,9 +20,9 @@ from .map_axes import need_2d
 __all__ = ["gain_rows", "plot_trajectory", "trajectory_verdicts"]
 
 _VERDICT_MARKERS = {
-    "certified": dict(marker="o", facecolor="white", edgecolor="black"),
-    "not_certified": dict(marker="X", facecolor="black", edgecolor="white"),
-    "inconclusive": dict(marker="D", facecolor=OKABE_ITO["yellow"], edgecolor="black"),
+    Verdict.CERTIFIED: dict(marker="o", facecolor="white", edgecolor="black"),
+    Verdict.NOT_CERTIFIED: dict(marker="X", facecolor="black", edgecolor="white"),
+    Verdict.INCONCLUSIVE: dict(marker="D", facecolor=OKABE_ITO["yellow"], edgecolor="black"),
 }
 
 

@@ -10,9 +10,10 @@ so calling them per environment step would dominate training.  The default metho
 *certified lookup*:
 
 ``"projection"`` (default)
-    1. a cheap screen drops triples that surely fail (not internally stable, k_x ≤ 0 or
-       k_v + (T* − τ)k_x ≤ 0, or g(ω) < 0 at one of 48 fixed frequencies, where g is the
-       margin of :func:`stringstab.certify.frequency.margin_g`: |Γ(jω)| > 1 there);
+    1. a cheap screen drops triples that surely fail
+       (:func:`stringstab.certify.screen.surely_uncertifiable`: not internally stable, or g(ω)
+       below its round-off threshold at one of 48 fixed frequencies, where g is the margin of
+       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there);
     2. the rest are checked by the exact certificate in one vectorised call; certified triples
        are executed unchanged;
     3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
@@ -52,53 +53,16 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify.continuous import check
-from ..certify.criteria import hurwitz
-from ..certify.frequency import margin_g
+from ..certify import grid
+from ..certify.screen import surely_uncertifiable
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Params, positive
 from .config import REPAIRS, TD3Config
 
-__all__ = ["REPAIR_KEYS", "SCREEN_OMEGA", "GainRepair", "certified_lattice", "repair_for"]
+__all__ = ["REPAIR_KEYS", "GainRepair", "certified_lattice", "repair_for"]
 
 Array = npt.NDArray[np.float64]
-
-#: Frequencies (rad/s) of the cheap screen: g(ω) < 0 at any of them means |Γ(jω)| > 1.
-SCREEN_OMEGA = np.concatenate([np.linspace(0.0, 2.0, 33)[1:], np.linspace(2.25, 6.0, 16)])
-
-
-def _certified(K: Array, p: Params, sample_time: float | None = None) -> npt.NDArray[np.bool_]:
-    """Exact-certificate verdict (``check``) for the rows of K that pass the screen.
-
-    With ``sample_time`` H, a row counts only if the sampled-data certificate of the
-    zero-order-hold loop at H (:func:`stringstab.certify.sampled.check_sampled`) certifies it too.
-    """
-    out = np.zeros(K.shape[0], dtype=bool)
-    if not K.shape[0]:
-        return out
-    cand = hurwitz(K[:, 0], K[:, 1], tau=p.tau, headway=p.headway)
-    if cand.any():
-        idx = np.flatnonzero(cand)
-        g = margin_g(SCREEN_OMEGA[None, :], K[idx, 0:1], K[idx, 1:2], K[idx, 2:3],
-                     tau=p.tau, delta=p.delta, headway=p.headway)
-        idx = idx[g.min(axis=1) >= 0.0]
-        if idx.size:
-            c = check(K[idx, 0], K[idx, 1], K[idx, 2], tau=p.tau, delta=p.delta, headway=p.headway)
-            ok = c.verdict == "certified"
-            if sample_time is not None and ok.any():
-                ok[ok] = _sampled_ok(K[idx[ok]], p, sample_time)
-            out[idx] = ok
-    return out
-
-
-def _sampled_ok(K: Array, p: Params, sample_time: float) -> npt.NDArray[np.bool_]:
-    """Sampled-data certificate (zero-order hold at ``sample_time``) of every row of K."""
-    from ..certify.sampled import check_sampled
-
-    c = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=p.tau, delta=p.delta, headway=p.headway,
-                      sample_time=sample_time)
-    return np.asarray(c.verdict == "certified")
 
 
 @lru_cache(maxsize=8)
@@ -107,10 +71,11 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
     (and, with ``sample_time``, by the sampled-data certificate at that step).
 
-    A point is kept when it is internally stable (Hurwitz), passes a cheap screen g(ω) ≥ 0 at
-    :data:`SCREEN_OMEGA` and the exact certificate (:func:`stringstab.certify.continuous.check`)
-    certifies it.  The grid has round((hi − lo)/resolution) + 1 points per axis, so its
-    spacing is ``resolution`` only when that divides hi − lo.  Cached (8 entries).
+    The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
+    ``also_continuous``): the screen of :mod:`stringstab.certify.screen` first, then the exact
+    certificate (:func:`stringstab.certify.continuous.check`) decides.  The grid has
+    round((hi − lo)/resolution) + 1 points per axis, so its spacing is ``resolution`` only
+    when that divides hi − lo.  Cached (8 entries).
 
     Parameters
     ----------
@@ -144,16 +109,13 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     >>> pts.shape[1], bool((pts[:, 0] > 0).all())
     (3, True)
     """
-    p = Params(tau, delta, headway)
     n = round((hi - lo) / resolution) + 1
-    g = np.linspace(lo, hi, n)
-    K = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
-    pts = np.ascontiguousarray(K[_certified(K, p, sample_time)])
+    pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway), sample_time=sample_time,
+                                 also_continuous=True)
     if not pts.shape[0]:
         raise StringStabError(
             f"no certified gains on the {n}^3 lattice over [{lo}, {hi}]^3 at tau={tau}, "
             f"delta={delta}, headway={headway}; expected parameters with a certified region")
-    pts.setflags(write=False)
     return pts
 
 
@@ -248,7 +210,7 @@ class GainRepair:
             for _ in range(self.refine):  # bisection under the continuous certificate
                 mid = 0.5 * (lo + hi)
                 C = P + mid[:, None] * (K0 - P)
-                ok = _certified(C, self.params)
+                ok = grid.certified(C, self.params)
                 best[ok] = C[ok]
                 moved |= ok
                 lo = np.where(ok, mid, lo)
@@ -271,7 +233,7 @@ class GainRepair:
                 r = region_growing(k, tau=p.tau, delta=p.delta, headway=p.headway,
                                    bounds=self.bounds)
             kr = np.asarray(r.k, dtype=np.float64)
-            if r.certified and _certified(kr[None], p)[0]:
+            if r.certified and grid.certified(kr[None], p)[0]:
                 out[i] = kr
             else:
                 out[i] = self._nearest(k[None])[0][0]
@@ -302,13 +264,7 @@ class GainRepair:
             return K0
         p = self.params
         out = K0.copy()
-        ok = hurwitz(K0[:, 0], K0[:, 1], tau=p.tau, headway=p.headway)
-        if ok.any():
-            idx = np.flatnonzero(ok)
-            g = margin_g(SCREEN_OMEGA[None, :], K0[idx, 0:1], K0[idx, 1:2], K0[idx, 2:3],
-                         tau=p.tau, delta=p.delta, headway=p.headway)
-            ok[idx[g.min(axis=1) < 0.0]] = False
-        bad = np.flatnonzero(~ok)
+        bad = np.flatnonzero(surely_uncertifiable(K0, p))
         if bad.size:
             _, idx = self._kdtree().query(K0[bad])
             out[bad] = self.lattice()[np.asarray(idx)]
@@ -324,7 +280,7 @@ class GainRepair:
         out = K0.copy()
         if self.method != "off":
             p = self.params
-            ok = _certified(K0, p)  # continuous-time certificate (``check``)
+            ok = grid.certified(K0, p)  # continuous-time certificate (``check``)
             bad = np.flatnonzero(~ok)
             pending = ok.copy()  # rows whose executed gains still need the sampled check
             if bad.size:
@@ -337,7 +293,7 @@ class GainRepair:
             if self.sample_time is not None and pending.any():
                 # one sampled-data call per step; where it fails, the nearest lattice point
                 j = np.flatnonzero(pending)
-                keep = _sampled_ok(out[j], p, self.sample_time)
+                keep = grid.certified(out[j], p, sample_time=self.sample_time)
                 if (~keep).any():
                     jj = j[~keep]
                     _, idx = self._kdtree().query(K0[jj])

@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify import margin as _margin
-from ..certify.continuous import certify, certify_batch, check
-from ..certify.criteria import hurwitz_conditions, hurwitz_ok
+from ..certify.continuous import certify, check
+from ..certify.grid import certified_lattice
+from ..certify.screen import surely_uncertifiable
+from ..certify.screen import violating_dips as screen_dips
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model, positive
@@ -38,7 +39,7 @@ from .exchange import (
 from .inputs import as_bounds, as_k0, as_weights
 from .nlp import solve_projection, solve_quadratic
 from .predictor import predict, predict_dips, violating_dips
-from .result import CERTIFIED, TuneResult, Verdict, make_result, wdist
+from .result import CERTIFIED_BY_CHECK, TuneResult, VerdictAndGain, make_result, wdist
 
 __all__ = ["Projector"]
 
@@ -56,33 +57,24 @@ _PRED_CLUSTER = (1.0, 0.98, 1.02)
 
 
 def _surely_uncertifiable(K: Array, p: Params) -> tuple[bool, list[float]]:
-    """(True, frequencies) when K provably cannot be certified: not Hurwitz or g(ω) < 0 found.
+    """(True, frequencies) when K provably cannot be certified (the one screen).
 
-    A violation g(ω) < −1e-9·scale at any ω means |Γ(jω)| > 1 there, so the
-    (sound) certificate can never certify K; no certificate call is needed.
+    The screen of :mod:`stringstab.certify.screen`: not Hurwitz, or a dip of g below its
+    round-off threshold (|Γ(jω)| > 1 there, so the sound certificate can never certify K).
     """
-    _, a, b, cx, cv = (float(c) for c in _margin.coefficients(
-        K[0], K[1], K[2], tau=p.tau, delta=p.delta, headway=p.headway))
-    scale = 1.0 + abs(a) + abs(b) + abs(cx) + abs(cv)
-    _, dips = violating_dips(K, p, threshold=-1e-9 * scale)
-    stable = hurwitz_ok(float(K[0]), float(K[1]), float(K[2]), tau=p.tau, headway=p.headway)
-    return (not stable) or bool(dips), dips
+    dips = screen_dips(K, p)
+    return bool(dips) or bool(surely_uncertifiable(K, p, omega=())[0]), dips
 
 
 @lru_cache(maxsize=16)
 def _certified_map(tau: float, delta: float, headway: float, lo: float, hi: float,
                    margin: float, n: int = 21) -> Array:
-    """Certified points of an n³ grid over the bounds (starting points and fallbacks)."""
-    g = np.linspace(lo, hi, n)
-    KX, KV, KA = np.meshgrid(g, g, g, indexing="ij")
-    kx, kv, ka = KX.ravel(), KV.ravel(), KA.ravel()
-    keep = np.all([c >= margin for c in hurwitz_conditions(kx, kv, ka, tau=tau, headway=headway)],
-                  axis=0)
-    b = certify_batch(kx[keep], kv[keep], ka[keep], tau=tau, delta=delta, headway=headway)
-    pts = np.column_stack([kx[keep], kv[keep], ka[keep]])[b.certified]
-    pts.setflags(write=False)
-    return pts
+    """Certified points of an n³ grid over the bounds (starting points and fallbacks).
 
+    :func:`stringstab.certify.grid.certified_lattice`, keeping the points whose Hurwitz
+    conditions are ≥ ``margin``.
+    """
+    return certified_lattice(lo, hi, n, Params(tau, delta, headway), hurwitz_margin=margin)
 
 
 @lru_cache(maxsize=16)
@@ -190,7 +182,7 @@ class Projector:
         self.max_exchange = int(max_exchange)
         self.cache_size = int(cache_size)
         self.cache_decimals = int(cache_decimals)
-        self._cache: OrderedDict[tuple[float, ...], tuple[Array, Verdict]] = OrderedDict()
+        self._cache: OrderedDict[tuple[float, ...], tuple[Array, VerdictAndGain]] = OrderedDict()
         self._last: Array | None = None
         self.predictor = bool(predictor)
         self.warm_from_previous = bool(warm_from_previous)
@@ -263,7 +255,7 @@ class Projector:
             verdict0, hz0, wit0 = self._check(k0)
             if verdict0 == "certified":
                 self._remember(key, k0, use_state)
-                return make_result(method, k0, k0, CERTIFIED, "unchanged", w, 0, t0,
+                return make_result(method, k0, k0, CERTIFIED_BY_CHECK, "unchanged", w, 0, t0,
                                "already certified by the exact certificate; returned unchanged")
             if hz0 and wit0 > 0:
                 dips = [*dips, wit0]
@@ -360,7 +352,7 @@ class Projector:
                "nearest certified point: Newton's method on the KKT system with active "
                f"{'; '.join(active)} (no IPOPT solve)" if predicted else
                f"nearest certified point: {n_solves} solve(s), {len(omegas)} frequencies")
-        return make_result(method, k0, best, CERTIFIED, "repaired", w, n_solves, t0, msg,
+        return make_result(method, k0, best, CERTIFIED_BY_CHECK, "repaired", w, n_solves, t0, msg,
                        start=start, fallback=fallback, predictor=predicted and not fallback,
                        active=active, frequencies=omegas,
                        ipopt_iterations=ipopt_iters, ipopt_status=statuses)
@@ -396,7 +388,7 @@ class Projector:
         verdict0, _, wit0 = loop.check(k0)
         if verdict0 == "certified":
             self._remember(key, k0, use_state)
-            return make_result(method, k0, k0, CERTIFIED, "unchanged", w, 0, t0,
+            return make_result(method, k0, k0, CERTIFIED_BY_CHECK, "unchanged", w, 0, t0,
                                f"already certified for the {self._loop_name()} loop; returned unchanged")
         slots = self._first_slots(loop, k0, wit0)
         M = self._map()
@@ -455,7 +447,7 @@ class Projector:
                f"{self._loop_name()} loop (the NLP solution was not nearer)" if fallback else
                f"nearest point certified for the {self._loop_name()} loop: {n_solves} solve(s), "
                f"{len(slots)} constraints")
-        return make_result(method, k0, best, CERTIFIED, "repaired", w, n_solves, t0, msg,
+        return make_result(method, k0, best, CERTIFIED_BY_CHECK, "repaired", w, n_solves, t0, msg,
                            start=start, fallback=fallback, constraints=len(slots),
                            ipopt_iterations=ipopt_iters, ipopt_status=statuses)
 
@@ -468,6 +460,6 @@ class Projector:
         """Cache gains that the exact certificate certified."""
         if not (use_state and self.cache_size):
             return
-        self._cache[key] = (k, CERTIFIED)
+        self._cache[key] = (k, CERTIFIED_BY_CHECK)
         if len(self._cache) > self.cache_size:
             self._cache.popitem(last=False)

@@ -345,9 +345,3 @@ def make_result(method: str, K0: Array, K: Array, cert: Certificate | VerdictAnd
         sup_gain=v.sup_gain, details=details,
     )
 
-
-# Transitional, for stringstab/tuning/projection.py only (another helper's file while issue 20 is
-# under way), which still imports the two old names: delete these two lines when it imports
-# VerdictAndGain and CERTIFIED_BY_CHECK instead.
-Verdict = VerdictAndGain
-CERTIFIED = CERTIFIED_BY_CHECK
