@@ -104,13 +104,13 @@ def _sampled_ok(K: Array, p: Params, sample_time: float) -> npt.NDArray[np.bool_
 @lru_cache(maxsize=8)
 def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
                       resolution: float, sample_time: float | None = None) -> Array:
-    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
-    (and, with ``sample_time``, by the sampled-data certificate at that step).
+    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``.
 
     A point is kept when it is internally stable (Hurwitz), passes a cheap screen g(ω) ≥ 0 at
     :data:`SCREEN_OMEGA` and the exact certificate (:func:`stringstab.certify.continuous.check`)
-    certifies it.  The grid has round((hi − lo)/resolution) + 1 points per axis, so its
-    spacing is ``resolution`` only when that divides hi − lo.  Cached (8 entries).
+    certifies it; with ``sample_time``, the sampled-data certificate at that step must certify it
+    too.  The grid has round((hi − lo)/resolution) + 1 points per axis, so its spacing is
+    ``resolution`` only when that divides hi − lo.  Cached (8 entries).
 
     Parameters
     ----------
@@ -236,8 +236,11 @@ class GainRepair:
         return self._tree
 
     def _nearest(self, K0: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
-        """Lattice point, refined by bisection under the continuous certificate; and which rows
-        moved off the lattice (those still need the sampled-data check, if any)."""
+        """The lattice points nearest K0, refined by bisection under the continuous certificate.
+
+        Also returns which rows moved off the lattice (those still need the sampled-data check,
+        if any).
+        """
         _, idx = self._kdtree().query(K0)
         P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
         moved = np.zeros(K0.shape[0], dtype=bool)
