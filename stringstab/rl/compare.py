@@ -28,7 +28,6 @@ METRICS: tuple[tuple[str, str], ...] = (("TIT", "TIT (s², ↓)"), ("M_CI", "M_C
 def improvement(reference: float | None, other: float | None) -> float | None:
     """100 (other − reference)/other, the reference's gain over ``other`` (None if undefined).
 
-
     Parameters
     ----------
     reference, other : float or None

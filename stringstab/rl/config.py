@@ -221,10 +221,12 @@ class DDPGConfig(TD3Config):
 
     @property
     def twin_critics(self) -> bool:
+        """DDPG uses a single critic (no clipped double Q-learning)."""
         return False
 
     @property
     def smoothing(self) -> bool:
+        """DDPG does not smooth the target policy."""
         return False
 
 

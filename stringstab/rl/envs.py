@@ -150,8 +150,9 @@ class RepairedGains(VectorActionWrapper):
                               fresh=self._base.first_step, gain_rate=self.gain_rate)
 
     def state_dict(self) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
-        """The wrapped environment's state (the wrapper has none): see
-        :meth:`~stringstab.traffic.env.BatchedCarFollowingEnv.state_dict`.
+        """The wrapped environment's state (the wrapper has none).
+
+        See :meth:`~stringstab.traffic.env.BatchedCarFollowingEnv.state_dict`.
 
         Returns
         -------

@@ -1,5 +1,4 @@
-"""The leaders a policy trains and is tested on: episodes cut from the bundled cycles, synthetic
-disturbances, and a user's own CSV or NGSIM file.
+"""The leaders a policy trains and is tested on: cycle episodes, synthetic disturbances, user files.
 
 The IDL paper trains on 900 NGSIM car-following pairs and tests on 386 others (§4.1.1).  NGSIM
 cannot ship with the toolkit, so the default data are the four bundled driving cycles (EPA UDDS,

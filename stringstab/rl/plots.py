@@ -138,8 +138,10 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
 def plot_ttc_distribution(ttc: Mapping[str, npt.ArrayLike], *, ax: Any = None,
                           max_ttc: float = 100.0, bins: int = 40, min_ttc: float = 0.1,
                           ttc_star: float | None = None) -> dict[str, Any]:
-    """Distribution of finite TTC values per strategy (Fig. 9), on a logarithmic TTC axis so
-    the safety-relevant short times are visible; the range below TTC* is shaded.
+    """Distribution of finite TTC values per strategy (Fig. 9), on a logarithmic TTC axis.
+
+    The logarithmic axis makes the safety-relevant short times visible; the range below TTC* is
+    shaded.
 
     Parameters
     ----------

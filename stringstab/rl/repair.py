@@ -68,8 +68,7 @@ Array = npt.NDArray[np.float64]
 @lru_cache(maxsize=8)
 def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
                       resolution: float, sample_time: float | None = None) -> Array:
-    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``
-    (and, with ``sample_time``, by the sampled-data certificate at that step).
+    """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``.
 
     The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
     ``also_continuous``): the screen of :mod:`stringstab.certify.screen` first, then the exact
@@ -198,8 +197,11 @@ class GainRepair:
         return self._tree
 
     def _nearest(self, K0: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
-        """Lattice point, refined by bisection under the continuous certificate; and which rows
-        moved off the lattice (those still need the sampled-data check, if any)."""
+        """The lattice points nearest K0, refined by bisection under the continuous certificate.
+
+        Also returns which rows moved off the lattice (those still need the sampled-data check,
+        if any).
+        """
         _, idx = self._kdtree().query(K0)
         P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
         moved = np.zeros(K0.shape[0], dtype=bool)

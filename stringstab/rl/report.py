@@ -125,8 +125,10 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
 
 
 def verdict(ev: Evaluation, platoons: Sequence[Mapping[str, Any]], action: str) -> tuple[str, bool]:
-    """The one-line verdict of an evaluation and whether it passes (``stringstab evaluate``'s
-    exit 0): every executed gain certified and no collision, on the episodes and platoons.
+    """The one-line verdict of an evaluation and whether it passes.
+
+    It passes (``stringstab evaluate`` exits 0) when every executed gain is certified and there is
+    no collision, on the episodes and platoons.
 
     Parameters
     ----------
@@ -199,8 +201,10 @@ def _mean_std(vals: list[Any]) -> Any:
 def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]], *,
                      reference: str | None, tau: float, delta: float, headway: float,
                      platoons: Mapping[str, Mapping[str, Any]] | None = None) -> list[str]:
-    """Stage the Table-4 comparison (``table.md``, ``table.csv``, ``comparison.json``) and the
-    figures ``fig6_mp.png``, ``fig9_ttc.png``, ``fig11_jerk.png``, ``fig12_headway.png`` and
+    """Stage the Table-4 comparison tables and its figures in ``out``.
+
+    The tables are ``table.md``, ``table.csv`` and ``comparison.json``; the figures
+    ``fig6_mp.png``, ``fig9_ttc.png``, ``fig11_jerk.png``, ``fig12_headway.png`` and
     ``gains_region.png``.
 
     ``groups`` maps a strategy label to its evaluations (several seeds give mean ± spread).

@@ -158,10 +158,10 @@ class Controller:
         raise NotImplementedError
 
     def equilibrium_gap(self, speed: npt.ArrayLike) -> Array:
-        """The gap (m) at which a follower cruising at ``speed`` behind an equal-speed leader
-        has u = 0 (used to start a platoon in equilibrium).
+        """The gap (m) where u = 0 for a follower at ``speed`` behind an equal-speed leader.
 
-        The base class returns the IDL spacing policy l_0 + T* v (eq 3) with the defaults.
+        It is used to start a platoon in equilibrium.  The base class returns the IDL spacing
+        policy l_0 + T* v (eq 3) with the defaults.
 
         Parameters
         ----------
@@ -176,8 +176,9 @@ class Controller:
         return DEFAULT_STANDSTILL + DEFAULT_HEADWAY * np.asarray(speed, dtype=np.float64)
 
     def gains(self, obs: Observation) -> Array | None:
-        """The eq-4 gain vector K = (k_x, k_v, k_a) in force, shape ``(..., 3)``, or None if
-        the controller is not of the eq-4 form (then M_fss, eq 27, is undefined).
+        """The eq-4 gain vector K = (k_x, k_v, k_a) in force, shape ``(..., 3)``, or None.
+
+        None means the controller is not of the eq-4 form (then M_fss, eq 27, is undefined).
 
         Parameters
         ----------
@@ -234,6 +235,7 @@ class LinearController(Controller):
 
     @property
     def headway(self) -> float:
+        """T* of the eq-3 spacing policy, s (the ``headway`` given at construction)."""
         return self._headway
 
     def command(self, obs: Observation) -> Array:
@@ -287,6 +289,14 @@ class LinearController(Controller):
         return self._K
 
     def describe(self) -> dict[str, Any]:
+        """A JSON-ready description of the law and its fixed gains.
+
+        Returns
+        -------
+        dict
+            ``controller`` (``"linear"``), the gains ``k_x``, ``k_v``, ``k_a`` (as lists),
+            ``headway`` T* (s) and ``standstill`` l_0 (m).
+        """
         return {"controller": "linear", "k_x": self.k_x.tolist(), "k_v": self.k_v.tolist(),
                 "k_a": self.k_a.tolist(), "headway": self._headway, "standstill": self.standstill}
 
@@ -456,6 +466,7 @@ class TimeVaryingLinearController(Controller):
 
     @property
     def headway(self) -> float:
+        """T* of the eq-3 spacing policy, s (the ``headway`` given at construction)."""
         return self._headway
 
     def gains(self, obs: Observation) -> Array:
@@ -521,6 +532,14 @@ class TimeVaryingLinearController(Controller):
         return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
 
     def describe(self) -> dict[str, Any]:
+        """A JSON-ready description of the law (without the gains, which change over time).
+
+        Returns
+        -------
+        dict
+            ``controller`` (``"time-varying linear"``), ``headway`` T* (s) and ``standstill``
+            l_0 (m).
+        """
         return {"controller": "time-varying linear", "headway": self._headway,
                 "standstill": self.standstill}
 
@@ -568,6 +587,7 @@ class CACCController(Controller):
 
     @property
     def headway(self) -> float:
+        """T* of the equivalent eq-4 law: the time gap ``t_system``, s."""
         return self.t_system
 
     def command(self, obs: Observation) -> Array:
@@ -620,6 +640,14 @@ class CACCController(Controller):
         return self._K
 
     def describe(self) -> dict[str, Any]:
+        """A JSON-ready description of the CACC and its parameters.
+
+        Returns
+        -------
+        dict
+            ``controller`` (``"cacc (van Arem et al. 2006)"``), the gains ``k_a``, ``k_v``,
+            ``k_d``, ``k``, ``t_system`` (s), ``r_min`` (m) and ``speed_intended`` (m/s).
+        """
         return {"controller": "cacc (van Arem et al. 2006)", "k_a": self.k_a, "k_v": self.k_v,
                 "k_d": self.k_d, "k": self.k, "t_system": self.t_system, "r_min": self.r_min,
                 "speed_intended": self.speed_intended}
@@ -688,6 +716,15 @@ class IDMController(Controller):
         return (self.s0 + v * self.T) / np.sqrt(1.0 - (v / self.v0) ** self.exponent)
 
     def describe(self) -> dict[str, Any]:
+        """A JSON-ready description of the IDM and its parameters.
+
+        Returns
+        -------
+        dict
+            ``controller`` (``"idm (Treiber et al. 2000)"``), ``desired_speed`` v_0 (m/s),
+            ``time_headway`` T (s), ``min_gap`` s_0 (m), ``max_accel`` a and
+            ``comfortable_decel`` b (m/s²) and ``exponent``.
+        """
         return {"controller": "idm (Treiber et al. 2000)", "desired_speed": self.v0,
                 "time_headway": self.T, "min_gap": self.s0, "max_accel": self.a,
                 "comfortable_decel": self.b, "exponent": self.exponent}
@@ -801,6 +838,7 @@ class MixedController(Controller):
 
     @property
     def headway(self) -> float | None:
+        """The candidates' common T*, s, or None if they differ or one of them has none."""
         hs = {c.headway for c in self.controllers}
         return hs.pop() if len(hs) == 1 else None
 

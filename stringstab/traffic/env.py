@@ -114,8 +114,9 @@ def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
 
 
 def state_dim(observe: Sequence[str] = ()) -> int:
-    """Length of the state with the ``observe`` extras: 3 (eq 16), 1 more for ``"accel"``, 3
-    more for ``"gains"`` (:func:`extend_state`).
+    """Length of the state with the ``observe`` extras (:func:`extend_state`).
+
+    It is 3 (eq 16), 1 more for ``"accel"`` and 3 more for ``"gains"``.
 
     Parameters
     ----------

@@ -74,14 +74,14 @@ def project(
     max_exchange: int = 25,
     predictor: bool = True,
 ) -> TuneResult:
-    """The certified gains nearest to K0: min ‖K − K0‖_W subject to string stability.
+    r"""The certified gains nearest to K0: min ‖K − K0‖_W subject to string stability.
 
     Solves, with CasADi and IPOPT,
 
     .. math::
-        \\min_K \\sum_i w_i (K_i - K_{0,i})^2 \\quad\\text{s.t.}\\quad
-        k_x \\ge m,\\; k_v + (T^* - τ)k_x \\ge m,\\;
-        g(ω_j; K) \\ge ε \\;(j = 1..n),\\; K \\in [\\text{lo}, \\text{hi}]^3,
+        \min_K \sum_i w_i (K_i - K_{0,i})^2 \quad\text{s.t.}\quad
+        k_x \ge m,\; k_v + (T^* - τ)k_x \ge m,\;
+        g(ω_j; K) \ge ε \;(j = 1..n),\; K \in [\text{lo}, \text{hi}]^3,
 
     where g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (:func:`stringstab.certify.frequency.margin_g`;
     g(0) = Ψ3), so g(ω_j) ≥ ε is |D(jω_j)|² − |N(jω_j)|² ≥ ε ω_j².  The frequency

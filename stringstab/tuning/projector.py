@@ -80,8 +80,11 @@ def _certified_map(tau: float, delta: float, headway: float, lo: float, hi: floa
 @lru_cache(maxsize=16)
 def _loop_map(box: Box, sample_time: float | None, heterogeneous: bool, lo: float, hi: float,
               margin: float, n: int = 21) -> Array:
-    """Certified points of an n³ grid over the bounds for a sampled or robust loop, whose
-    stability conditions (at the box's corners) are ≥ ``margin`` (starting points, fallbacks)."""
+    """Certified points of an n³ grid over the bounds for a sampled or robust loop.
+
+    Only points whose stability conditions (at the box's corners) are ≥ ``margin`` are kept;
+    they serve as starting points and fallbacks.
+    """
     loop = Loop(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0]),
                 sample_time, heterogeneous)
     g = np.linspace(lo, hi, n)
@@ -364,8 +367,14 @@ class Projector:
                                hurwitz_margin=self.hurwitz_margin, eps=eps)
 
     def _first_slots(self, loop: Loop, k0: Array, witnesses: list[tuple[Member, float]]) -> list[Slot]:
-        """Stability at the box's corners, the margin at 0 at every corner and on a ladder of
-        frequencies at the centre, and at the certificate's witness for K0 (±5 %)."""
+        """The exchange's first constraint slots for ``loop`` (duplicates removed).
+
+        They are stability at the corners of the (τ, T*) box (sampled loop) or at its member with
+        the largest τ = τ_p and the smallest T* (robust loop), δ at its centre; the margin at 0
+        at every corner of the box and at its centre, and on a ladder of frequencies at the
+        centre; and the margin at the certificate's witnesses for K0 (at each witness frequency
+        and 5 % and 10 % below it).
+        """
         slots: list[Slot] = []
         worst = loop.corners() if loop.sampled else [Member(loop.box.tau[1], loop.box.tau[1],
                                                             loop.centre().delta,
@@ -382,8 +391,11 @@ class Projector:
 
     def _repair_loop(self, loop: Loop, k0: Array, key: tuple[float, ...], use_state: bool,
                      warm_start: Sequence[float] | None, t0: float) -> TuneResult:
-        """Repair for the sampled or robust loop: exchange on :func:`~stringstab.tuning.nlp.quadratic_nlp`, every output
-        decided by that loop's certificate (:meth:`Loop.check`)."""
+        """Repair K0 for the sampled or robust loop.
+
+        The exchange runs on :func:`~stringstab.tuning.nlp.quadratic_nlp`; every output is
+        decided by that loop's certificate (:meth:`Loop.check`).
+        """
         method, w = "projection", self.weights
         verdict0, _, wit0 = loop.check(k0)
         if verdict0 == "certified":

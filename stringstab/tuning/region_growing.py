@@ -82,7 +82,7 @@ def region_growing(
     grow_ka: bool = False,
     check_hurwitz: bool = False,
 ) -> TuneResult:
-    """Repair K0 with the IDL paper's region-growing search (§3.3, Steps 1-6).
+    r"""Repair K0 with the IDL paper's region-growing search (§3.3, Steps 1-6).
 
     Step 1 sets the initial region R1 = K0 ± r0 in each gain.  Step 2 grid-searches
     it: for a type-III input the slice {k_x = k_x0, k_v ∈ [k_v0 − r0, k_v0],
@@ -90,7 +90,7 @@ def region_growing(
     or k_a only lowers Ψ3, eq 26); for a type-IV input the whole R1 is searched.
     A grid point is accepted when the Taylor test calls it type I or II.
     Steps 3-5 grow the region: R_k has k_x ∈ k_x0 ± k r0, k_v ∈ k_v0 ± k r0 and,
-    *as printed*, k_a ∈ k_a0 ± r0; R_{k−1} joins R_N, so only R_k \\ R_{k−1} is
+    *as printed*, k_a ∈ k_a0 ± r0; R_{k−1} joins R_N, so only R_k \ R_{k−1} is
     searched; points outside ``bounds`` are dropped.  Step 6 stops at the first
     region with an accepted point, or outputs K0 with the message "No optimized
     solution found" after ``max_iter`` regions or once R_k covers the bounds.
