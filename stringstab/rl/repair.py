@@ -72,7 +72,8 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
 
     The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
     ``also_continuous``): the screen of :mod:`stringstab.certify.screen` first, then the exact
-    certificate (:func:`stringstab.certify.continuous.check`) decides.  The grid has
+    certificate (:func:`stringstab.certify.continuous.check`) decides; with ``sample_time``,
+    the sampled-data certificate at that step must certify the point too.  The grid has
     round((hi − lo)/resolution) + 1 points per axis, so its spacing is ``resolution`` only
     when that divides hi − lo.  Cached (8 entries).
 
