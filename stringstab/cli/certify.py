@@ -1,7 +1,7 @@
 """``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
 
 Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
-certifies them with :func:`stringstab.certify.continuous.certify_batch` — the continuous-time loop,
+certifies them with :func:`stringstab.certify.api.certify_batch` — the continuous-time loop,
 the sampled-data loop (``--sample-time``) or every member of a box of parameters (``--tau``,
 ``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
 (:meth:`~stringstab.certify.continuous.CertificateBatch.columns`) as a table, JSON, CSV, Parquet or
@@ -176,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
                       f"expected at most about {int(max(_available() - BYTES_BASE, 0) // BYTES_PER_ROW)} "
                       "rows at once on this machine: split the file")
 
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
     from ..io import write_results
 
     n = len(table)
@@ -224,7 +224,7 @@ def _for_table(params: dict[str, Any]) -> dict[str, Any]:
 
 def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
     from ..identify.report import read_identified
     from ..io import columns_from_records, write_results
     from ..io.results import TableColumn

@@ -793,7 +793,7 @@ def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
     >>> trajectory_verdicts(m, [[1.5, 0.3, -0.1], [0.9, -0.5, 1.1]])
     ['certified', 'not_certified']
     """
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
 
     K, _ = _gain_rows(gains)
     p = rmap.params
@@ -814,9 +814,9 @@ def plot_trajectory(
     vehicle are joined in order; the first point of each is labelled.
 
     Compute, then draw: pass the verdicts computed beforehand
-    (:func:`stringstab.certify.continuous.certify_batch` of the triples, or its ``.verdict``).
+    (:func:`stringstab.certify.api.certify_batch` of the triples, or its ``.verdict``).
     Without them, as python-control's ``bode_plot(sys)`` computes the response it draws,
-    they are computed here first (one :func:`~stringstab.certify.continuous.certify_batch`
+    they are computed here first (one :func:`~stringstab.certify.api.certify_batch`
     call); the toolkit's own callers always pass them.
 
     Parameters

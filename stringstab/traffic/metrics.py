@@ -372,7 +372,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     """M_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
 
     m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
-    (:func:`stringstab.certify.continuous.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
+    (:func:`stringstab.certify.api.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
     else 0 ("inconclusive" counts as 0); M_fss = 100 · Σ m_fss / (N · T/Δt).  Identical
     triples are certified once.
 
@@ -398,7 +398,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     ...           percent=False)
     0.5
     """
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
     from ..params import as_gains
 
     kx, kv, ka = as_gains(k_x, k_v, k_a)

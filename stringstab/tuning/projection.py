@@ -3,7 +3,7 @@
 :func:`project` (and the stateful :class:`Projector`, for a control loop) solves
 min ‖K − K0‖_W subject to the internal-stability conditions with a margin and the exact
 frequency condition g(ω_j; K) ≥ ε on a finite set of frequencies, refined by exchange until
-the exact certificate (:func:`stringstab.certify.continuous.check`) certifies; first, the Newton
+the exact certificate (:func:`stringstab.certify.api.check`) certifies; first, the Newton
 predictor of :mod:`stringstab.tuning.predictor` answers without IPOPT when it can.  The NLP's
 constraints are the generated Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
 and g (:func:`stringstab.certify.margin.casadi_g`).
@@ -34,7 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify import margin as _margin
-from ..certify.continuous import certify, certify_batch, check
+from ..certify.api import certify, certify_batch, check
 from ..certify.criteria import hurwitz_conditions, hurwitz_ok
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
@@ -196,8 +196,8 @@ class Projector:
       over: along a trajectory that set grows and slows every later solve).
 
     Every output reported certified has been certified by the exact
-    certificate, :func:`stringstab.certify.continuous.check` (the verdicts of
-    :func:`~stringstab.certify.continuous.certify` without its reporting extras; a
+    certificate, :func:`stringstab.certify.api.check` (the verdicts of
+    :func:`~stringstab.certify.api.certify` without its reporting extras; a
     cache hit returns gains that were).
 
     Parameters
@@ -314,7 +314,7 @@ class Projector:
         return np.asarray(sol["x"], dtype=float).ravel(), str(st["return_status"]), int(st["iter_count"])
 
     def _check(self, K: Array) -> tuple[str, bool, float]:
-        """The exact certificate's verdict on K (:func:`stringstab.certify.continuous.check`).
+        """The exact certificate's verdict on K (:func:`stringstab.certify.api.check`).
 
         Returns (verdict, internally stable, witness frequency: where the
         smallest g(ω) was found; |Γ(jω)| > 1 there when K is internally stable
@@ -696,7 +696,7 @@ def project(
     repaired gains (the dip of g at the nearest point of the linearised
     constraint, followed twice; each also at 0.98 and 1.02 times itself).  It
     is refined by *exchange*: after each solve the exact certificate
-    (:func:`stringstab.certify.continuous.check`) is asked; if it does not certify
+    (:func:`stringstab.certify.api.check`) is asked; if it does not certify
     K, its witness frequency (where |Γ(jω)| > 1) and the local minima of
     g(·; K) below 0 found by a dense scan are added, each with neighbours at
     ±5 %.  The loop ends when the certificate certifies K, when nothing new

@@ -266,10 +266,10 @@ class Verdict:
     """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
 
     Built from a full :class:`~stringstab.certify.continuous.Certificate` or, in the
-    projection's fast path, from :func:`stringstab.certify.continuous.check` (the same
+    projection's fast path, from :func:`stringstab.certify.api.check` (the same
     sound decision without the reporting extras).  A certified triple has
     ‖Γ‖_{H∞} = 1 exactly (Γ(0) = 1 and |Γ(jω)| ≤ 1), which is what
-    :func:`~stringstab.certify.continuous.certify` reports for it too, so no peak
+    :func:`~stringstab.certify.api.certify` reports for it too, so no peak
     search is needed; for any other verdict the full certificate is computed.
     """
 
@@ -297,7 +297,7 @@ class Verdict:
         return cls(cert.verdict, float(cert.sup_gain))
 
 
-#: The verdict of a triple that :func:`stringstab.certify.continuous.check` certified.
+#: The verdict of a triple that :func:`stringstab.certify.api.check` certified.
 CERTIFIED = Verdict("certified", 1.0)
 
 
