@@ -5,7 +5,7 @@ repair (the ablation, the baseline of the ratio); the default repair (certified 
 projection, continuous and sampled-data certificates); the same with the sampled-data check as
 it was before the point-path fix of issue 11 phase 2 ("before": the lag primitives of ``check_sampled`` built as
 zero-width intervals, reproduced here by forcing the interval path of the first two
-``_phi_iv`` calls of each build); the continuous certificate alone (``repair_sampled=False``);
+``phi_interval`` calls of each build, :mod:`stringstab.certify.zoh`); the continuous certificate alone (``repair_sampled=False``);
 and the exact projection (:class:`stringstab.tuning.Projector`) for a shorter stretch.  Also
 ``check_sampled`` per call on 8 triples (one control step of 8 environments), before and after.
 Also the repair's per-triple latency against :func:`stringstab.tuning.project` on the same
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from stringstab.certify import sampled
+from stringstab.certify import sampled, zoh
 from stringstab.rl import config_for, train
 from stringstab.rl.repair import GainRepair
 from stringstab.tuning import project
@@ -46,7 +46,7 @@ def arm(name: str, steps: int, **kw: object) -> dict[str, float]:
 @contextlib.contextmanager
 def sampled_before() -> Iterator[None]:
     """``check_sampled`` as before the point-path fix: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
-    prim, phi = sampled._primitives_iv, sampled._phi_iv
+    prim, phi = zoh.primitives, zoh.phi_interval
     left = [0]
 
     def phi_before(lo: Any, hi: Any) -> Any:
@@ -59,11 +59,11 @@ def sampled_before() -> Iterator[None]:
         left[0] = 2
         return prim(*a, **k)
 
-    sampled._primitives_iv, sampled._phi_iv = prim_before, phi_before  # type: ignore[assignment]
+    zoh.primitives, zoh.phi_interval = prim_before, phi_before  # type: ignore[assignment]
     try:
         yield
     finally:
-        sampled._primitives_iv, sampled._phi_iv = prim, phi  # type: ignore[assignment]
+        zoh.primitives, zoh.phi_interval = prim, phi  # type: ignore[assignment]
 
 
 def per_call(n_calls: int = 200) -> float:

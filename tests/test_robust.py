@@ -19,7 +19,6 @@ from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.frequency import margin_g
 from stringstab.certify.robust import (
     Box,
-    _robust_g,
     as_interval,
     certify_robust,
     certify_robust_batch,
@@ -27,6 +26,7 @@ from stringstab.certify.robust import (
     parse_interval,
     robust_margin,
 )
+from stringstab.certify.robust_continuous import box_margin
 from stringstab.certify.sampled import certify_sampled, check_sampled
 from stringstab.errors import StringStabError
 
@@ -95,7 +95,7 @@ def test_box_helpers():
        dd=st.floats(0.0, 0.4), h0=st.floats(0.3, 2.0), dh=st.floats(0.0, 0.6))
 def test_robust_margin_is_the_minimum_over_the_box(kx, kv, ka, w, t0, dt, d0, dd, h0, dh):
     box = Box((t0, t0 + dt), (d0, d0 + dd), (h0, h0 + dh))
-    G, t_, d_, h_, mag = _robust_g(np.array(w), kx, kv, ka, box)
+    G, t_, d_, h_, mag = box_margin(np.array(w), kx, kv, ka, box)
     assert robust_margin(w, kx, kv, ka, tau=box.tau, delta=box.delta, headway=box.headway) == G
     # attained at the reported member, which lies in the box
     assert box.tau[0] <= t_ <= box.tau[1] and box.delta[0] <= d_ <= box.delta[1]

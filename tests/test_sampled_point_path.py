@@ -1,7 +1,7 @@
 """The sampled certificate's point path: point parameters give point coefficients.
 
 ``check_sampled`` (the repair's inner loop in :mod:`stringstab.rl.repair`) builds its
-coefficients with the interval type of :mod:`stringstab.certify.sampled`; with point parameters every
+coefficients with the interval type of :mod:`stringstab.certify.interval` (:mod:`stringstab.certify.zoh`); with point parameters every
 coefficient must be a point, or each operation pays for interval arithmetic (four products and
 a min/max) on intervals of zero width.  The verdicts of both paths are equal (the interval
 operations on equal end points return those end points), which the second test checks against
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from stringstab.certify import sampled
+from stringstab.certify import zoh
 from stringstab.params import Params
 
 
@@ -27,7 +27,7 @@ def _gains(n: int = 64) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 @pytest.mark.parametrize("tau_prev", [0.1, 0.15])
 def test_point_parameters_give_point_coefficients(tau_prev: float) -> None:
     kx, kv, ka = _gains()
-    co, _ = sampled._point_coeffs(kx, kv, ka, Params(0.1, 0.2, 1.1), 0.1, tau_prev)
+    co, _ = zoh.point_coefficients(kx, kv, ka, Params(0.1, 0.2, 1.1), 0.1, tau_prev)
     items = [*co.delta, *co.nu, *co.ell, co.phi1, co.phi1p, *co.P, *co.Yr, *co.Yi]
     assert all(x.point for x in items)
 
@@ -35,18 +35,18 @@ def test_point_parameters_give_point_coefficients(tau_prev: float) -> None:
 def test_point_path_equals_the_interval_path() -> None:
     kx, kv, ka = _gains()
     n, H = kx.size, 0.1
-    m, eps = sampled.split_delay(0.2, H)
+    m, eps = zoh.split_delay(0.2, H)
     c = kv + 1.1 * kx
 
     def arr(v: float) -> np.ndarray:
         return np.full(n, v)
 
-    point = sampled._coefficients(kx, kv, ka, H=H, tau=(t := arr(0.1), t), tau_p=(t, t),
-                                  eps=(e := arr(eps), e), c=(c, c))
+    point = zoh.coefficients(kx, kv, ka, H=H, tau=(t := arr(0.1), t), tau_p=(t, t),
+                             eps=(e := arr(eps), e), c=(c, c))
     # equal values in distinct arrays: the interval path, on intervals of zero width
-    interval = sampled._coefficients(kx, kv, ka, H=H, tau=(arr(0.1), arr(0.1)),
-                                     tau_p=(arr(0.1), arr(0.1)), eps=(arr(eps), arr(eps)),
-                                     c=(c, c.copy()))
+    interval = zoh.coefficients(kx, kv, ka, H=H, tau=(arr(0.1), arr(0.1)),
+                                tau_p=(arr(0.1), arr(0.1)), eps=(arr(eps), arr(eps)),
+                                c=(c, c.copy()))
     assert not all(x.point for x in interval.P)
     for a, b in zip([*point.delta, *point.P, *point.Yr, *point.Yi],
                     [*interval.delta, *interval.P, *interval.Yr, *interval.Yi]):

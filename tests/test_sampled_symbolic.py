@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
 
-from stringstab.certify import sampled as S
+from stringstab.certify import zoh as S
 from stringstab.derive import sampled_symbolic as SS
 from stringstab.derive import symbolic as C
 
@@ -65,13 +65,13 @@ def test_symbolic_H_equals_direct_construction(kx, kv, ka, tau, tp, H, d, h):
 
 @given(kx=gain, kv=gain, ka=gain, tau=lag, tp=lag, H=period, d=delay, h=hw)
 def test_numeric_w_coefficients_equal_the_derivation(kx, kv, ka, tau, tp, H, d, h):
-    """The closed forms evaluated by stringstab.certify.sampled are the SymPy coefficients."""
+    """The closed forms evaluated by stringstab.certify.zoh are the SymPy coefficients."""
     _, eps = S.split_delay(d, H)
     want = _w_coefficients()(kx, kv, ka, tau, d, h, H, tp, eps)
     one = np.ones(1)
-    co = S._coefficients(kx * one, kv * one, ka * one, H=H, tau=(tau * one,) * 2,
-                         tau_p=(tp * one,) * 2, eps=(eps * one,) * 2,
-                         c=((kv + h * kx) * one,) * 2)
+    co = S.coefficients(kx * one, kv * one, ka * one, H=H, tau=(tau * one,) * 2,
+                        tau_p=(tp * one,) * 2, eps=(eps * one,) * 2,
+                        c=((kv + h * kx) * one,) * 2)
     got = [*(v.lo[0] for v in co.delta), 1.0, *(v.lo[0] for v in co.nu),
            *(v.lo[0] for v in co.ell)]
     # atol: the lambdified 1 − e^{−y} cancels for y ~ 1e-16 where ours does not
@@ -94,7 +94,7 @@ def test_delayed_path_carries_z_minus_1_squared_and_dc_gain_is_one():
 
 def test_phi_functions_are_accurate_for_small_and_large_x():
     x = np.array([1e-8, 1e-4, 0.03, 0.5, 0.999, 1.0, 1.001, 3.0, 40.0])
-    got = S._phi(x)
+    got = S.phi(x)
     for k, expr in enumerate(SS.phi_functions(sp.Symbol("x"))):
         for xi, gi in zip(x, got[k]):
             exact = float(sp.N(expr.subs(sp.Symbol("x"), sp.Rational(str(xi))), 40))

@@ -23,7 +23,7 @@ import numpy.typing as npt
 from ..derive import generated as _gen
 from . import margin as _margin
 
-__all__ = ["EXCESS_SEARCH", "excess_squared", "violation_peak"]
+__all__ = ["EXCESS_SEARCH", "excess_squared", "searched_excess", "violation_peak"]
 
 #: Not-certified rows whose directly computed sup gain − 1 is below this get the
 #: cancellation-free search (:func:`violation_peak` and its sampled twin); above it the
@@ -158,3 +158,35 @@ def violation_peak(kx: Array, kv: Array, ka: Array, tau: Any, delta: Any, headwa
         best_w = np.where(better, Wl[rows, k], best_w)
         step = step / 3.0
     return best, best_w
+
+
+def searched_excess(e2: Array, direct: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
+    """sup gain − 1 from the searched sup gain² − 1, and where it replaces the direct value.
+
+    The searches (:func:`violation_peak` and its sampled twin,
+    :func:`stringstab.certify.sampled_excess.violation_peak`) include the direct peak among
+    their candidates, so their value replaces the directly computed gain − 1 (whose last
+    bits are round-off at this size) unless they found nothing above 1.  Shared by every
+    certificate that reports ``sup_gain_excess``.
+
+    Parameters
+    ----------
+    e2 : ndarray
+        The largest |gain|² − 1 found by the search, per row.
+    direct : ndarray
+        The directly computed sup gain − 1 of the same rows.
+
+    Returns
+    -------
+    (ndarray, ndarray of bool)
+        e1 = e2 / (1 + √(1 + e2)) = sup gain − 1 without cancellation, and the rows where it
+        replaces ``direct`` (e1 > 0 or e1 ≥ ``direct``).
+
+    Examples
+    --------
+    >>> e1, take = searched_excess(np.array([1e-20, -1.0]), np.array([0.0, 0.0]))
+    >>> e1.tolist(), take.tolist()
+    ([5e-21, -0.5], [True, False])
+    """
+    e1 = e2 / (1.0 + np.sqrt(1.0 + np.maximum(e2, 0.0)))
+    return e1, (e1 > 0) | (e1 >= direct)

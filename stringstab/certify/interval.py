@@ -1,0 +1,242 @@
+"""Interval arithmetic with a round-off companion, and derivative enclosures over a cell.
+
+The sampled-data certificate (:mod:`stringstab.certify.sampled`) and the robust one over a
+box of parameters (:mod:`stringstab.certify.robust_sampled`) compute the coefficients of the
+sampled loop (:mod:`stringstab.certify.zoh`) in this arithmetic, vectorised over rows (one
+gain triple, or one parameter cell, per row):
+
+* :class:`Interval` — [lo, hi] with ``mag``, a bound on the magnitude of every intermediate
+  quantity (the same computation on absolute values), so that the round-off of the end
+  points is at most γ_n × ``mag`` (a few hundred ulps × ``mag`` for the depths used here);
+  a *point* (lo = hi, one array) takes a faster path with the same numbers;
+* :class:`IntervalAD` — forward-mode differentiation on intervals: a value at the cell's
+  centre, an enclosure over the cell and an enclosure of each partial derivative over the
+  cell, for the mean-value form value(p) ∈ value(c) + Σ_i ∂_i(cell) (p_i − c_i);
+* polynomials with interval coefficients (ascending lists): :func:`poly_add`,
+  :func:`poly_scale`.
+
+Only +, − and × are defined (the coefficients of the loop need nothing else); the end points
+are not rounded outward: every comparison made with them carries a slack proportional to
+``mag`` instead (:data:`stringstab.certify.verdicts.ROUNDOFF_SLACK`).
+
+References
+----------
+R. E. Moore, R. B. Kearfott, M. J. Cloud, *Introduction to Interval Analysis*, SIAM (2009),
+§2-3 (interval arithmetic) and §6.4 (the mean-value form).
+N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2002),
+§3.1 (the error bound γ_n × the computation on absolute values).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Interval", "IntervalAD", "interval", "poly_add", "poly_scale"]
+
+Array = npt.NDArray[np.float64]
+
+
+class Interval:
+    """[lo, hi] with ``mag`` ≥ the magnitude of every intermediate (round-off bound).
+
+    A point has ``hi is lo``.  Only +, −, × are defined: the computed end points are
+    within 10⁻¹³ × ``mag`` of the exact interval operations (γ_n for depth n ≤ 400).
+
+    Parameters
+    ----------
+    lo : array_like
+        Lower ends.
+    hi : array_like, optional
+        Upper ends; None (default) makes a point (``hi is lo``).
+    mag : ndarray, optional
+        The magnitude companion; default max(|lo|, |hi|).
+    """
+
+    __slots__ = ("hi", "lo", "mag")
+
+    def __init__(self, lo: Any, hi: Any = None, mag: Any = None) -> None:
+        self.lo = np.asarray(lo, dtype=float)
+        self.hi = self.lo if hi is None else np.asarray(hi, dtype=float)
+        self.mag = np.maximum(np.abs(self.lo), np.abs(self.hi)) if mag is None else mag
+
+    @property
+    def point(self) -> bool:
+        """True for a point (``hi is lo``): the fast path, one array for both ends."""
+        return self.hi is self.lo
+
+    @staticmethod
+    def of(v: Any) -> Interval:
+        """``v`` itself if it is an :class:`Interval`, else the point ``v``."""
+        return v if isinstance(v, Interval) else Interval(np.asarray(v, dtype=float))
+
+    def __add__(self, o: Any) -> Interval:
+        o = Interval.of(o)
+        if self.point and o.point:
+            return Interval(self.lo + o.lo, None, self.mag + o.mag)
+        return Interval(self.lo + o.lo, self.hi + o.hi, self.mag + o.mag)
+
+    __radd__ = __add__
+
+    def __neg__(self) -> Interval:
+        if self.point:
+            return Interval(-self.lo, None, self.mag)
+        return Interval(-self.hi, -self.lo, self.mag)
+
+    def __sub__(self, o: Any) -> Interval:
+        return self + (-Interval.of(o))
+
+    def __rsub__(self, o: Any) -> Interval:
+        return Interval.of(o) + (-self)
+
+    def __mul__(self, o: Any) -> Interval:
+        o = Interval.of(o)
+        if self.point and o.point:
+            return Interval(self.lo * o.lo, None, self.mag * o.mag)
+        p = (self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi)
+        return Interval(np.minimum.reduce(p), np.maximum.reduce(p), self.mag * o.mag)
+
+    __rmul__ = __mul__
+
+    def const(self, v: Any) -> Interval:
+        """A point constant of this item's shape."""
+        return Interval(np.zeros_like(self.lo) + v)
+
+    def take(self, idx: npt.NDArray[np.intp]) -> Interval:
+        """The rows ``idx`` (a point stays a point)."""
+        lo = self.lo[idx]
+        return Interval(lo, None, self.mag[idx]) if self.point else Interval(lo, self.hi[idx],
+                                                                            self.mag[idx])
+
+
+class IntervalAD:
+    """Forward-mode derivative enclosures over a parameter cell (the mean-value form).
+
+    ``c`` is the value at the cell's centre (a point :class:`Interval`), ``r`` an enclosure
+    of the value over the cell and ``g[i]`` an enclosure of ∂/∂p_i over the cell.  For any
+    member p: value(p) ∈ c + Σ_i g[i] (p_i − c_i) (mean-value theorem), which is
+    tighter than ``r`` (the natural interval extension) on small cells.
+
+    Parameters
+    ----------
+    c : Interval
+        The value at the centre of the cell (a point).
+    r : Interval
+        An enclosure of the value over the cell.
+    g : tuple of Interval
+        Enclosures of the partial derivatives over the cell, one per parameter.
+    """
+
+    __slots__ = ("c", "g", "r")
+
+    def __init__(self, c: Interval, r: Interval, g: tuple[Interval, ...]) -> None:
+        self.c, self.r, self.g = c, r, g
+
+    @staticmethod
+    def variable(lo: Array, hi: Array, i: int, d: int) -> IntervalAD:
+        """Parameter ``i`` of ``d`` ranging over the cell [lo, hi]: ∂/∂p_i = 1, the others 0."""
+        mid = np.ascontiguousarray(0.5 * (lo + hi))
+        c = Interval(mid)
+        return IntervalAD(c, Interval(lo, hi), tuple(c.const(1.0 if j == i else 0.0)
+                                                     for j in range(d)))
+
+    def const(self, v: Any) -> IntervalAD:
+        """A constant of this item's shape (zero derivatives)."""
+        k = self.c.const(v)
+        z = self.c.const(0.0)
+        return IntervalAD(k, k, tuple(z for _ in self.g))
+
+    @staticmethod
+    def of(v: Any, like: IntervalAD) -> IntervalAD:
+        """``v`` itself if it is an :class:`IntervalAD`, else a constant shaped as ``like``."""
+        return v if isinstance(v, IntervalAD) else like.const(v)
+
+    def __add__(self, o: Any) -> IntervalAD:
+        o = IntervalAD.of(o, self)
+        return IntervalAD(self.c + o.c, self.r + o.r, tuple(a + b for a, b in zip(self.g, o.g)))
+
+    __radd__ = __add__
+
+    def __neg__(self) -> IntervalAD:
+        return IntervalAD(-self.c, -self.r, tuple(-a for a in self.g))
+
+    def __sub__(self, o: Any) -> IntervalAD:
+        return self + (-IntervalAD.of(o, self))
+
+    def __rsub__(self, o: Any) -> IntervalAD:
+        return IntervalAD.of(o, self) + (-self)
+
+    def __mul__(self, o: Any) -> IntervalAD:
+        if not isinstance(o, IntervalAD):
+            k = Interval.of(o)
+            return IntervalAD(self.c * k, self.r * k, tuple(a * k for a in self.g))
+        return IntervalAD(self.c * o.c, self.r * o.r,
+                          tuple(a * o.r + self.r * b for a, b in zip(self.g, o.g)))
+
+    __rmul__ = __mul__
+
+    def take(self, idx: npt.NDArray[np.intp]) -> IntervalAD:
+        """The rows ``idx`` of the value, the enclosure and every derivative."""
+        return IntervalAD(self.c.take(idx), self.r.take(idx), tuple(g.take(idx) for g in self.g))
+
+
+def interval(lo: Array, hi: Array) -> Interval:
+    """[lo, hi], a point when ``hi is lo`` (the same array for both ends).
+
+    Parameters
+    ----------
+    lo, hi : ndarray
+        The ends; pass the same array twice for a point.
+
+    Returns
+    -------
+    Interval
+        The interval, on the point path when ``hi is lo``.
+    """
+    return Interval(lo) if hi is lo else Interval(lo, hi)
+
+
+def poly_add(a: list[Any], b: list[Any], sign: float = 1.0) -> list[Any]:
+    """a + sign·b for polynomials with interval coefficients (ascending powers).
+
+    Parameters
+    ----------
+    a, b : list of Interval or IntervalAD
+        Coefficients, constant term first (of any lengths).
+    sign : float
+        +1 (default) adds, −1 subtracts ``b``.
+
+    Returns
+    -------
+    list
+        The coefficients of the sum, of the longer length.
+    """
+    n = max(len(a), len(b))
+    out = []
+    for k in range(n):
+        x = a[k] if k < len(a) else None
+        y = b[k] if k < len(b) else None
+        if y is not None and sign < 0:
+            y = -y
+        out.append(x if y is None else y if x is None else x + y)
+    return out
+
+
+def poly_scale(c: Any, p: list[Any]) -> list[Any]:
+    """c·p for a polynomial p with interval coefficients.
+
+    Parameters
+    ----------
+    c : Interval, IntervalAD or float
+        The factor.
+    p : list of Interval or IntervalAD
+        Coefficients, constant term first.
+
+    Returns
+    -------
+    list
+        ``[c * q for q in p]``.
+    """
+    return [c * q for q in p]
