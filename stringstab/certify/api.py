@@ -12,8 +12,10 @@ the sample time H or None) and decides which certificate answers, :attr:`Loop.ki
 * ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`).
 
 The gains are broadcast, checked finite and within range, and flattened once
-(:func:`gains`).  The kernels of the three certificates are then called with these arrays
-and checked values and check nothing again.  The command line builds its :class:`Loop` from
+(:func:`gains`).  The kernels of the three certificates (``certify_kernel`` and
+``check_kernel`` of :mod:`~stringstab.certify.continuous`, :mod:`~stringstab.certify.sampled`
+and :mod:`~stringstab.certify.robust`) are then called with these arrays and checked values
+and check nothing again.  The command line builds its :class:`Loop` from
 the values it has already checked (with its own flag names in the messages) and asks it
 directly (:meth:`Loop.certify_batch`), so a parameter is checked once on every path.
 """
@@ -30,7 +32,8 @@ import numpy.typing as npt
 from ..errors import StringStabError
 from ..params import Box, Params, as_gains, parameter_model, positive
 from ..params import sample_time as checked_sample_time
-from .continuous import Certificate, CertificateBatch, certify_continuous_batch, check_continuous
+from . import continuous
+from .continuous import Certificate, CertificateBatch
 from .verdicts import Check, one_triple
 
 if TYPE_CHECKING:
@@ -161,6 +164,13 @@ class Loop:
         return dataclasses.replace(loop, tau_prev=tp)
 
     @property
+    def predecessor_lag(self) -> float:
+        """The predecessor's lag τ_p (s) of a sampled point loop: ``tau_prev``, or τ."""
+        if isinstance(self.model, Box):
+            raise StringStabError("a box of parameters has no single predecessor lag")
+        return self.model.tau if self.tau_prev is None else self.tau_prev
+
+    @property
     def kind(self) -> LoopKind:
         """Which certificate answers: ``"continuous"``, ``"sampled"`` or ``"robust"``."""
         if isinstance(self.model, Box):
@@ -219,19 +229,18 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
            max_rounds: int, max_intervals: int) -> Check:
     model, H = loop.model, loop.sample_time
     if isinstance(model, Box):
-        from .robust import check_robust
+        from . import robust
 
-        return check_robust(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
-                            sample_time=H, heterogeneous=loop.heterogeneous, n_grid=n_grid,
-                            max_rounds=max_rounds, max_intervals=max_intervals)
+        return robust.check_of(robust.certify_kernel(
+            kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals))
     if H is not None:
-        from .sampled import check_sampled
+        from . import sampled
 
-        return check_sampled(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
-                             sample_time=H, tau_prev=loop.tau_prev, n_grid=n_grid,
-                             max_rounds=max_rounds, max_intervals=max_intervals)
-    return check_continuous(kx, kv, ka, model, n_grid=n_grid or 64, max_rounds=max_rounds,
-                            max_intervals=max_intervals)
+        return sampled.check_kernel(kx, kv, ka, model, H, loop.predecessor_lag, n_grid=n_grid,
+                                    max_rounds=max_rounds, max_intervals=max_intervals)
+    return continuous.check_kernel(kx, kv, ka, model, n_grid=n_grid or 64,
+                                   max_rounds=max_rounds, max_intervals=max_intervals)
 
 
 def _certify(
@@ -240,22 +249,20 @@ def _certify(
 ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
     model, H = loop.model, loop.sample_time
     if isinstance(model, Box):
-        from .robust import certify_robust_batch
+        from . import robust
 
-        return certify_robust_batch(
-            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
-            heterogeneous=loop.heterogeneous, progress=progress, chunk=chunk, n_grid=n_grid,
-            max_rounds=max_rounds, max_intervals=max_intervals)
+        return robust.certify_kernel(
+            kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, progress=progress,
+            chunk=chunk, n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
     if H is not None:
-        from .sampled import certify_sampled_batch
+        from . import sampled
 
-        return certify_sampled_batch(
-            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
-            tau_prev=loop.tau_prev, progress=progress, chunk=chunk, n_grid=n_grid,
-            max_rounds=max_rounds, max_intervals=max_intervals)
-    batch = certify_continuous_batch(kx, kv, ka, model, progress=progress, chunk=chunk,
-                                     n_grid=n_grid or 64, max_rounds=max_rounds,
-                                     max_intervals=max_intervals)
+        return sampled.certify_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, progress=progress, chunk=chunk,
+            n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    batch = continuous.certify_kernel(kx, kv, ka, model, progress=progress, chunk=chunk,
+                                      n_grid=n_grid or 64, max_rounds=max_rounds,
+                                      max_intervals=max_intervals)
     if loop.method == "pade":
         from .pade import cross_check
 

@@ -78,8 +78,8 @@ __all__ = [
     "TABLE_COLUMNS",
     "Certificate",
     "CertificateBatch",
-    "certify_continuous_batch",
-    "check_continuous",
+    "certify_kernel",
+    "check_kernel",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -403,7 +403,7 @@ TABLE_COLUMNS: list[TableColumn] = [
 # ---------------------------------------------------------------------------
 # The kernels: inputs already checked by stringstab.certify (the way in, stringstab.certify.api)
 # ---------------------------------------------------------------------------
-def check_continuous(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64,
+def check_kernel(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64,
                      max_rounds: int = 30, max_intervals: int = 1024) -> Check:
     """The continuous-time verdicts alone (the kernel of :func:`stringstab.certify.check`).
 
@@ -417,7 +417,7 @@ def check_continuous(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int 
     p : Params
         τ, δ, T* (checked on construction).
     n_grid, max_rounds, max_intervals : int
-        As for :func:`certify_continuous_batch`.
+        As for :func:`certify_kernel`.
 
     Returns
     -------
@@ -432,7 +432,7 @@ def check_continuous(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int 
     return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
 
 
-def certify_continuous_batch(
+def certify_kernel(
     kx: Array, kv: Array, ka: Array, p: Params, *, progress: bool = False, chunk: int = 4096,
     n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 1024,
 ) -> CertificateBatch:

@@ -191,13 +191,12 @@ def run(args: argparse.Namespace) -> int:
                                   "headway": model.headway, "method": args.method}
     else:
         params = {**shown_params(model, H), "method": args.method}
-    columns = _table_columns(batch)
     if args.method == "pade":
         params["pade_order"] = order
     summary = batch.summary()
     write_results({**table.meta_columns(), **batch.columns()}, out, args.format,
                   params=_for_table(params) if args.format == "table" else params,
-                  summary=summary, table=columns, what="--out")
+                  summary=summary, table=batch.table_columns(), what="--out")
     if args.method == "pade":
         _warn_disagreements([{**table.meta(i), **r} for i, r in enumerate(batch.records())], order)
     if out is not None:
@@ -207,24 +206,6 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return 0 if summary["certified"] == summary["n"] else 1
-
-
-def _table_columns(batch: Any) -> Any:
-    """The human table's columns: the result's own (each batch type names them)."""
-    if loop_kind := getattr(batch, "table_columns", None):
-        try:
-            return loop_kind()
-        except NotImplementedError:
-            pass
-    from ..certify.robust import RobustCertificateBatch
-
-    if isinstance(batch, RobustCertificateBatch):
-        from ..certify.robust import TABLE_COLUMNS as robust_columns
-
-        return robust_columns
-    from ..certify.sampled import TABLE_COLUMNS as sampled_columns
-
-    return sampled_columns
 
 
 def _for_table(params: dict[str, Any]) -> dict[str, Any]:
