@@ -56,7 +56,13 @@ from ..io.results import TableColumn, columns_from_records
 from ..params import Params
 from . import margin as _margin
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
-from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
+from .criteria import (
+    TYPE_NAMES,
+    TaylorCriteria,
+    hurwitz_bands_kernel,
+    hurwitz_margin_kernel,
+    taylor_criteria_kernel,
+)
 from .excess import EXCESS_SEARCH, col
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
@@ -424,7 +430,7 @@ def check_kernel(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64
     Check
         Verdicts, internal stability, min g found and where.
     """
-    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
+    hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
     ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
                       max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
     v = ex.verdict.copy()
@@ -471,8 +477,8 @@ def certify_kernel(
     worst_w = np.empty(n)
 
     # internal stability, with an inconclusive band around the boundary
-    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
-    hz_margin = hurwitz_margin(kx, kv, tau=p.tau, headway=p.headway)
+    hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
+    hz_margin = hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway)
 
     for sl in chunks(n, chunk, progress=progress):
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
@@ -511,8 +517,10 @@ def certify_kernel(
         sup[viol] = np.where(take, 1.0 + e1, sup[viol])
     excess = np.where(hz_sure, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
-    td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")
-    tp = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="printed")
+    td = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
+                                source="derived")
+    tp = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
+                                source="printed")
     vnames = names(verdict)
     return CertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, hurwitz=np.asarray(hz_sure),
