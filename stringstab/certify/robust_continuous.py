@@ -126,7 +126,7 @@ def robust_margin(
     k_x, k_v, k_a : array_like
         Gains.
     tau, delta, headway : float, (lo, hi) or "LO:HI"
-        The box (module docstring).
+        The box of lag τ, delay δ and headway T*, s; a plain number is a point interval.
 
     Returns
     -------
