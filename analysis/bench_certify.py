@@ -2,7 +2,7 @@
 
 The same ``--n`` random gain triples K uniform in [-2, 2]³ (``--seed``) are certified
 
-(a) by :func:`stringstab.certify.continuous.certify_batch` (exact delay, sound), in one call;
+(a) by :func:`stringstab.certify.api.certify_batch` (exact delay, sound), in one call;
 (b) the python-control way, one triple at a time: the delay replaced by
     ``control.pade(delta, 5)``, our own stability check of the poles
     (``control.poles``), then ``control.norm(sys, "inf")`` (which alone returns
@@ -24,7 +24,7 @@ satisfies |m| ≤ 1e-6 (m → Ψ3/k_x² as ω → 0, where |Γ| → 1; the plain
 |Γ(0)| = 1).  Otherwise the sweep decides: certified iff Hurwitz and m > 0.
 
 (d) the other loops, in the same run, on the same triples, through the same entry points
-    (:func:`stringstab.certify.continuous.certify_batch` and :func:`~stringstab.certify.continuous.check`
+    (:func:`stringstab.certify.api.certify_batch` and :func:`~stringstab.certify.api.check`
     with ``sample_time`` and intervals): the sampled-data certificate at Δt = 0.1 s (δ on a
     multiple of Δt) and at Δt = 0.08 s (δ/Δt = 2.5), the robust certificate over
     τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25], T* ∈ [1.0, 1.2] in continuous time and, on the first
@@ -50,7 +50,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from stringstab.certify.continuous import certify_batch, check
+from stringstab.certify.api import certify_batch, check
 from stringstab.certify.frequency import gain
 from stringstab.params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 

@@ -6,7 +6,7 @@
 2. **Fast outputs.**  ``stringstab certify --file`` on ``--n`` (10⁵) triples uniform in the
    IDL action box [−2, 2]³, end to end (a fresh process: start, reading the CSV, certifying,
    writing ``--out`` in each ``--formats``), per triple, against the per-triple cost of
-   python-control's Padé-5 ``norm`` (:func:`stringstab.certify.continuous.certify_pade`, on
+   python-control's Padé-5 ``norm`` (:func:`stringstab.certify.pade.certify_pade`, on
    ``--pade-n`` triples of the same set, in this process).  Target ≥ 100×.  Whether slycot
    (which python-control's ``norm`` uses when present) is installed is printed.
 3. **Region map through the CLI.**  ``stringstab region`` on an ``--region-n``² (801²) exact
@@ -57,7 +57,7 @@ def _wall(cmd: list[str], **kw: object) -> float:
 
 def bench_start(repeat: int) -> None:
     base_cmd = [sys.executable, "-c", "import numpy, scipy.linalg"]
-    lib_cmd = [sys.executable, "-c", "import stringstab.certify.continuous"]
+    lib_cmd = [sys.executable, "-c", "import stringstab.certify.api"]
     cmd = [*_cli(), "certify", "1,0.5,0.5"]
     r = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if r.returncode != 0:
@@ -72,7 +72,7 @@ def bench_start(repeat: int) -> None:
     print("1. fast start: the command-line layer (lazy sub-commands, light io) adds the last "
           "line minus the middle one; the library's import chain is the middle one")
     for label, m, xs in (("baseline  python -c 'import numpy, scipy.linalg'", mb, base),
-                         ("library   python -c 'import stringstab.certify.continuous'", ml, lib),
+                         ("library   python -c 'import stringstab.certify.api'", ml, lib),
                          ("target    stringstab certify 1,0.5,0.5           ", mt, target)):
         print(f"   {label} median {m * 1e3:7.1f} ms (min {min(xs) * 1e3:.1f}, "
               f"max {max(xs) * 1e3:.1f}, n={repeat})")
@@ -86,7 +86,8 @@ def _triples(n: int, seed: int) -> np.ndarray:
 
 
 def bench_outputs(n: int, pade_n: int, formats: list[str], seed: int, repeat: int) -> None:
-    from stringstab.certify.continuous import certify_batch, certify_pade
+    from stringstab.certify.api import certify_batch
+    from stringstab.certify.pade import certify_pade
 
     K = _triples(n, seed)
     work = Path(tempfile.mkdtemp(prefix="bench_cli_"))

@@ -16,7 +16,7 @@ PNG figures included), against :func:`region_map` alone in this process on the s
 grid, ``--reps`` times, alternating, with the median ratio (target ≤ 1.5) and the
 load beside each pair; then where the command's time goes (phases timed in
 process: the map, the NPZ and CSV in this process, the figures in the forked one).
-For the exact maps it also times :func:`stringstab.certify.continuous.certify_batch`
+For the exact maps it also times :func:`stringstab.certify.api.certify_batch`
 alone, in this process, on a 20 000-point sample of the same grid: the
 certificate's own cost per point, which bounds what the map can reach.
 
@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.regions import region_map
 
 P = dict(tau=0.1, delta=0.2, headway=1.1)

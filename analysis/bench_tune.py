@@ -60,7 +60,7 @@ from typing import Any
 
 import numpy as np
 
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from stringstab.tuning import Projector, project, region_growing
 

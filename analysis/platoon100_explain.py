@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from stringstab.certify.continuous import check
+from stringstab.certify.api import check
 from stringstab.certify.sampled import check_sampled
 from stringstab.constants import DELTA, HEADWAY, STANDSTILL, TAU
 from stringstab.rl import load_policy

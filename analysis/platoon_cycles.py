@@ -5,7 +5,7 @@
    internal stability (k_x > 0 and k_v + (T* − τ) k_x > 0: Γ's denominator is a Hurwitz
    cubic), a fine sweep of |Γ(jω)| with the exact delay (:func:`stringstab.certify.frequency.gain` on
    ``--sweep`` log-spaced ω in [1e-4, 1e3] rad/s), and the exact certificate
-   (:func:`stringstab.certify.continuous.certify`): sup_ω |Γ(jω)| = 1, reached only at ω = 0.
+   (:func:`stringstab.certify.api.certify`): sup_ω |Γ(jω)| = 1, reached only at ω = 0.
 2. Platoons of 10 and 100 followers run behind UDDS, HWFET, US06 and WLTC 3b (Δt = 0.1 s,
    leader speed capped at 33.3 m/s) and behind the §5.1-style mixed leader, starting in
    equilibrium; the leader then holds its final speed for ``--settle`` s (300) so that the
@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from stringstab.certify.continuous import certify
+from stringstab.certify.api import certify
 from stringstab.certify.frequency import gain
 from stringstab.plots import plot_damping_ratios, plot_platoon
 from stringstab.traffic import (

@@ -6,10 +6,10 @@ Measured by the tool (issue 10, item 4); prints its tables, asserts nothing.
    each of k_x, k_v, k_a in [−2, 2]; default n = 41, step 0.1) at τ = 0.1 s, δ = 0.2 s,
    T* = 1.1 s: the share certified in continuous time, and the share of those that are
    *not* certified when every vehicle samples at Δt = 0.05, 0.1, 0.2 s with a
-   zero-order hold (:func:`stringstab.certify.continuous.certify_batch` with ``sample_time``), with the largest
+   zero-order hold (:func:`stringstab.certify.api.certify_batch` with ``sample_time``), with the largest
    sampled peak sup|H(e^{jθ})| among them and its gains.
 2. **Robustness.**  How the certified share shrinks as the τ and δ boxes widen
-   (:func:`stringstab.certify.continuous.certify_batch` with intervals): continuous time on the same grid,
+   (:func:`stringstab.certify.api.certify_batch` with intervals): continuous time on the same grid,
    and sampled at Δt = 0.1 s on a coarser grid (``--n-robust-sampled``, default 11³).
 3. **The paper's range and example gains.**  How much of the continuous-certified part
    of [−2, 2]³ survives at the paper's own step (Δt = 0.1 s: not printed, but its leaders
@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from stringstab import constants
-from stringstab.certify.continuous import certify, certify_batch, check
+from stringstab.certify.api import certify, certify_batch, check
 
 TAU, DELTA, HEADWAY = constants.TAU, constants.DELTA, constants.HEADWAY
 PERIODS = (0.05, constants.DT, 0.2)  # around the IDL paper's step; 0.2 s is HCFS's

@@ -77,7 +77,10 @@ class Params:
     headway: float = DEFAULT_HEADWAY
 
     def __post_init__(self) -> None:
-        check_params(self.tau, self.delta, self.headway)
+        # checked once, here, and kept as the floats checked (so Params("0.1", ...) holds 0.1)
+        for name, value in zip(("tau", "delta", "headway"),
+                               check_params(self.tau, self.delta, self.headway)):
+            object.__setattr__(self, name, value)
 
     def as_dict(self) -> dict[str, float]:
         """The parameters as a plain dict (for JSON and file metadata)."""
@@ -458,7 +461,12 @@ class Box:
         """
         if isinstance(p, Box):
             return p
-        return cls((p.tau, p.tau), (p.delta, p.delta), (p.headway, p.headway))
+        # the point box of parameters already checked (by Params): not checked again
+        box = object.__new__(cls)
+        for name in ("tau", "delta", "headway"):
+            v = getattr(p, name)
+            object.__setattr__(box, name, (v, v))
+        return box
 
 
 def check_box(tau: Any, delta: Any, headway: Any) -> Box:

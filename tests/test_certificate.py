@@ -13,8 +13,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certify.continuous import certify, certify_batch, certify_pade, tail_bound
+from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.frequency import margin_g, margin_g_coefficients
+from stringstab.certify.margin import tail_bound
+from stringstab.certify.pade import certify_pade
 from stringstab.errors import StringStabError
 
 W_SWEEP = np.unique(np.concatenate([
@@ -223,7 +225,7 @@ def test_witness_of_a_tiny_violation_is_reported():
 
 
 def test_check_gives_the_same_verdicts_as_certify_batch():
-    from stringstab.certify.continuous import check
+    from stringstab.certify.api import check
 
     rng = np.random.default_rng(11)
     K = rng.uniform(-2, 2, (500, 3))

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stringstab.certify.continuous import certify_batch, check
+from stringstab.certify.api import certify_batch, check
 from stringstab.certify.criteria import hurwitz, hurwitz_conditions
 from stringstab.certify.frequency import gain, margin_g
 from stringstab.certify.grid import certified, certified_lattice, lattice

@@ -175,7 +175,7 @@ def test_json_schema(capsys):
 
 
 def test_cli_matches_library(capsys):
-    from stringstab.certify.continuous import certify
+    from stringstab.certify.api import certify
 
     _, doc, _ = _json(capsys, BAD, "--delta", "0.25")
     ref = certify(0.9, -0.5, 1.1, tau=TAU, delta=0.25, headway=HEADWAY).as_dict()

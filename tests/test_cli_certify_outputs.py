@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.cli import main
 from stringstab.io import read_gains
 

@@ -119,12 +119,12 @@ def test_ctrl_c_while_writing_keeps_the_old_run_whole(capsys, tmp_path, monkeypa
 
 
 def test_memory_error_is_one_line(capsys, monkeypatch):
-    from stringstab.certify import continuous
+    from stringstab.certify.api import Loop
 
     def oom(*a, **k):
         raise MemoryError("Unable to allocate 74.5 GiB for an array")
 
-    monkeypatch.setattr(continuous, "certify_batch", oom)
+    monkeypatch.setattr(Loop, "certify_batch", oom)
     _one_line(capsys, ["certify", "1,1,1"], 2, "stringstab certify: error: out of memory (Unable "
               "to allocate 74.5 GiB for an array); expected a smaller request")
 

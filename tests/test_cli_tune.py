@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from stringstab.certify.continuous import certify
+from stringstab.certify.api import certify
 from stringstab.cli import main
 
 P = {"tau": 0.1, "delta": 0.2, "headway": 1.1}

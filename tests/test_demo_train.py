@@ -15,7 +15,7 @@ pytestmark = pytest.mark.torch
 
 @pytest.mark.slow  # ~13.5 s with -n 2 on 2 shared cores (CI runs it)
 def test_demo_train_step(tmp_path):
-    from stringstab.certify.continuous import check
+    from stringstab.certify.api import check
     from stringstab.cli import demo_steps as demo
 
     lines: list[str] = []

@@ -2,7 +2,7 @@
 
 import json
 
-from stringstab.certify.continuous import certify
+from stringstab.certify.api import certify
 from stringstab.cli import main
 
 

@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from stringstab import plots
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.errors import StringStabError
 from stringstab.regions import region_map
 from stringstab.tuning import TuneResults, project, region_growing
@@ -55,7 +55,7 @@ def test_trajectory_with_verdicts_computed_beforehand_runs_no_certificate(monkey
                    **P, methods="taylor")
     K = np.array([[1.5, 0.3, -0.1], [0.9, -0.5, 1.1]])
     batch = certify_batch(K[:, 0], K[:, 1], K[:, 2], **P)
-    from stringstab.certify import continuous as cert
+    from stringstab.certify import api as cert
 
     def boom(*a, **k):
         raise AssertionError("the plot ran a certificate")

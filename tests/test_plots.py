@@ -16,7 +16,7 @@ from matplotlib.legend import Legend
 from numpy.testing import assert_array_equal
 
 from stringstab import plots
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.errors import StringStabError
 from stringstab.io.gains import GainTable
 from stringstab.regions import EXACT_CLASSES, TYPE_CLASSES, region_map

@@ -9,7 +9,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 import stringstab
-from stringstab.certify.continuous import certify, certify_batch
+from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.criteria import TYPE_NAMES, hurwitz, taylor_criteria
 from stringstab.errors import StringStabError
 from stringstab.regions import (

@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.cli import main
 from stringstab.errors import StringStabError
 from stringstab.params import Box

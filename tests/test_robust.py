@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certify.continuous import certify, certify_batch
+from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.frequency import margin_g
 from stringstab.certify.robust import (
     Box,

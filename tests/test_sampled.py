@@ -18,8 +18,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from stringstab.certify import sampled as sampled_module
-from stringstab.certify.continuous import VERDICTS as CONTINUOUS_VERDICTS
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.certify.frequency import gain, margin_g
 from stringstab.certify.sampled import (
     VERDICTS,
@@ -32,6 +31,7 @@ from stringstab.certify.sampled import (
     spectral_radius,
     split_delay,
 )
+from stringstab.certify.verdicts import VERDICTS as CONTINUOUS_VERDICTS
 from stringstab.errors import StringStabError
 
 # (tau, delta, headway, sample_time, tau_prev): δ on and between multiples of H, δ < H,

@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certify.continuous import certify, certify_batch
+from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.frequency import gain
 from stringstab.errors import StringStabError
 from stringstab.plots import moves_projection, plot_moves

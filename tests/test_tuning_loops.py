@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certify.continuous import certify_batch
+from stringstab.certify.api import certify_batch
 from stringstab.certify.frequency import margin_g
 from stringstab.certify.sampled import sampled_margin, schur_margins
 from stringstab.cli import main

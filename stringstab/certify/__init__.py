@@ -1,16 +1,18 @@
 """The certificates: is a gain triple string stable, with the exact delay?
 
-One way in — :func:`certify` (one triple, the full report), :func:`certify_batch` (many
-triples, one row each) and :func:`check` (the verdict only, for inner loops) — chooses the
-certificate from the arguments: the continuous loop (:mod:`~stringstab.certify.continuous`),
-the sampled-data loop when a sample time is given (:mod:`~stringstab.certify.sampled`), or a
-box of parameters when τ, δ or T* is an interval (:mod:`~stringstab.certify.robust`).  Every
-certificate answers with the verdicts of :mod:`~stringstab.certify.verdicts` and is sound by
-construction: "certified" means internally stable and ‖Γ‖_H∞ ≤ 1 with the exact delay.
+One way in (:mod:`~stringstab.certify.api`) — :func:`certify` (one triple, the full
+report), :func:`certify_batch` (many triples, one row each) and :func:`check` (the verdict
+only, for inner loops) — checks the arguments once and chooses the certificate from them
+(:class:`~stringstab.certify.api.Loop`): the continuous loop
+(:mod:`~stringstab.certify.continuous`), the sampled-data loop when a sample time is given
+(:mod:`~stringstab.certify.sampled`), or a box of parameters when τ, δ or T* is an interval
+(:mod:`~stringstab.certify.robust`).  Every certificate answers with the verdicts of
+:mod:`~stringstab.certify.verdicts` and is sound by construction: "certified" means
+internally stable and ‖Γ‖_H∞ ≤ 1 with the exact delay.
 
-Also here: the Padé cross-check (:func:`certify_pade`, never a verdict), the branch and bound
-(:mod:`~stringstab.certify.branch_bound`), the margin g(ω) and its tail bound
-(:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
+Also here: the Padé cross-check (:mod:`~stringstab.certify.pade`, never a verdict), the
+branch and bound (:mod:`~stringstab.certify.branch_bound`), the margin g(ω) and its tail
+bound (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
 (:mod:`~stringstab.certify.criteria`), |Γ(jω)| (:mod:`~stringstab.certify.frequency`) and
 sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screen
 (:mod:`~stringstab.certify.screen`) and the certified points of a grid of gains
@@ -21,19 +23,14 @@ function (the façade binds it); import the modules with ``from stringstab.certi
 sampled``.
 """
 
-from .continuous import (
-    Certificate,
-    CertificateBatch,
-    PadeResult,
-    certify,
-    certify_batch,
-    certify_pade,
-    check,
-)
+from .api import Loop, certify, certify_batch, check
+from .continuous import Certificate, CertificateBatch
+from .pade import PadeResult, certify_pade
 
 __all__ = [
     "Certificate",
     "CertificateBatch",
+    "Loop",
     "PadeResult",
     "certify",
     "certify_batch",

@@ -45,67 +45,56 @@ algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, overload
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ..derive import generated as _gen
-from ..errors import StringStabError
 from ..io import TableColumn, columns_from_records
-from ..params import Box, Params, as_gains, parameter_model
-from ..params import sample_time as _sample_time
+from ..params import Params
 from . import margin as _margin
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
-from .criteria import TYPE_NAMES, TaylorCriteria, hurwitz_bands, hurwitz_margin, taylor_criteria
+from .criteria import (
+    TYPE_NAMES,
+    TaylorCriteria,
+    hurwitz_bands_kernel,
+    hurwitz_margin_kernel,
+    taylor_criteria_kernel,
+)
 from .excess import EXCESS_SEARCH, col
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
-from .margin import tail_bound
 from .verdicts import (
     CERTIFIED,
     INCONCLUSIVE,
     NOT_CERTIFIED,
     ROUNDOFF_SLACK,
     ROW_COLUMNS,
-    VERDICTS,
     BatchResult,
     Check,
     SingleResult,
     chunks,
     names,
     num,
-    one_triple,
 )
-
-if TYPE_CHECKING:
-    from .robust import RobustCertificate, RobustCertificateBatch
-    from .sampled import SampledCertificate, SampledCertificateBatch
 
 __all__ = [
     "TABLE_COLUMNS",
-    "VERDICTS",
     "Certificate",
     "CertificateBatch",
-    "Check",
-    "PadeResult",
-    "certify",
-    "certify_batch",
-    "certify_pade",
-    "check",
-    "tail_bound",
+    "certify_kernel",
+    "check_kernel",
 ]
 
 Array = npt.NDArray[np.float64]
 
-_CERT, _NOT, _INC = CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE
 _SLACK = ROUNDOFF_SLACK
 
 
 # ---------------------------------------------------------------------------
-# Step 1, the tail bound, is :func:`stringstab.certify.margin.tail_bound` (re-exported here).
+# Step 1, the tail bound, is :func:`stringstab.certify.margin.tail_bound`; step 3 the slack:
 # ---------------------------------------------------------------------------
 def _g_and_slack(w: Array, Q: Array) -> tuple[Array, Array]:
     """g on the grid ``w`` and its round-off slack (step 3).
@@ -143,7 +132,7 @@ def _exact_chunk(
                            *_gen.margin_coefficient_scales(kx, kv, ka, tau, delta, headway),
                            delta)):
         Q[i] = v
-    Om = tail_bound(*Q[:5])
+    Om = _margin.tail_bound(*Q[:5])
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
         Qt = Q[:, idx, None]
@@ -343,6 +332,18 @@ class CertificateBatch(BatchResult):
         return np.where(np.asarray(self.verdict) == "certified", 0.0, self.sup_gain - 1.0)
 
     # -- result rendering: the rows, columns and totals every output format is written from --
+    @classmethod
+    def table_columns(cls) -> list[TableColumn]:
+        """The columns of the human table of continuous certificates (:data:`TABLE_COLUMNS`).
+
+        Returns
+        -------
+        list of TableColumn
+            The gains, Hurwitz, verdict, type, sup|Γ| (and − 1), ω_peak, margin, the Taylor
+            verdicts and, with ``method="pade"``, python-control's.
+        """
+        return list(TABLE_COLUMNS)
+
     def columns(self) -> dict[str, Any]:
         """The result columns, in the order and with the keys of :meth:`Certificate.as_dict`.
 
@@ -352,6 +353,7 @@ class CertificateBatch(BatchResult):
 
         Examples
         --------
+        >>> from stringstab import certify_batch
         >>> b = certify_batch([1.5, -0.5], [0.3, 1.0], [-0.1, 1.0], tau=0.1, delta=0.2, headway=1.1)
         >>> b.columns()["sup_gain"].tolist(), b.columns()["taylor_printed"]["verdict"].tolist()
         ([1.0, inf], ['stable', 'unstable'])
@@ -405,240 +407,66 @@ TABLE_COLUMNS: list[TableColumn] = [
 
 
 # ---------------------------------------------------------------------------
-# The loop a caller asks for: continuous or sampled, point parameters or a box
+# The kernels: inputs already checked by stringstab.certify (the way in, stringstab.certify.api)
 # ---------------------------------------------------------------------------
-_LOOP_DOC = """tau, delta, headway : float, (lo, hi) or "LO:HI"
-        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
-        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
-        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.certify.robust`).
-    sample_time : float, optional
-        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
-    tau_prev : float, optional
-        Sampled, point parameters only: the predecessor's lag (default τ).
-    heterogeneous : bool
-        Sampled box only: the predecessor's lag ranges over the τ box independently of the
-        follower's (default; a platoon of different vehicles), or equals it."""
+def check_kernel(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64,
+                     max_rounds: int = 30, max_intervals: int = 1024) -> Check:
+    """The continuous-time verdicts alone (the kernel of :func:`stringstab.certify.check`).
 
-
-def _loop(tau: Any, delta: Any, headway: Any, sample_time: Any, tau_prev: Any,
-          method: str = "exact") -> tuple[Params | Box, float | None]:
-    """The parameters (a point or a box) and the sample time, checked."""
-    model = parameter_model(tau, delta, headway)
-    H = None if sample_time is None else _sample_time(sample_time)
-    if tau_prev is not None and (H is None or isinstance(model, Box)):
-        raise StringStabError(
-            "tau_prev (the predecessor's lag) is for the sampled loop at point parameters; "
-            f"got it with {'a box' if isinstance(model, Box) else 'sample_time=None'}")
-    if method not in ("exact", "pade"):
-        raise StringStabError(f"method must be 'exact' or 'pade'; got {method!r}")
-    if method == "pade" and (H is not None or isinstance(model, Box)):
-        raise StringStabError(
-            "method='pade' (python-control's cross-check) is for the continuous loop at one τ, δ, "
-            f"T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
-    return model, H
-
-
-def _gains(k_x: Any, k_v: Any, k_a: Any) -> tuple[Array, Array, Array]:
-    kx, kv, ka = as_gains(k_x, k_v, k_a)
-    return (np.ascontiguousarray(kx, dtype=float).ravel(),
-            np.ascontiguousarray(kv, dtype=float).ravel(),
-            np.ascontiguousarray(ka, dtype=float).ravel())
-
-
-def _continuous_check(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int,
-                      max_rounds: int, max_intervals: int) -> Check:
-    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
-    ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
-                      max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
-    v = ex.verdict.copy()
-    v[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
-    return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
-
-
-def check(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
-    tau_prev: float | None = None, heterogeneous: bool = True,
-    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-) -> Check:
-    """The certificate's verdicts alone, for inner loops (e.g. gain repair).
-
-    The same sound decision as :func:`certify_batch` (same branch and bound, same
-    verdicts) without the reporting extras — no peak search, no Taylor criteria, no pole
-    margins — so one triple costs a fraction of a millisecond in continuous time.
+    Inputs already checked by :func:`stringstab.certify.check` (the way in, which callers
+    use): nothing is validated again here.
 
     Parameters
     ----------
-    k_x, k_v, k_a : array_like
-        Gains, broadcast together and flattened.
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
-        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
-        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.certify.robust`).
-    sample_time : float, optional
-        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
-    tau_prev : float, optional
-        Sampled, point parameters only: the predecessor's lag (default τ).
-    heterogeneous : bool
-        Sampled box only: the predecessor's lag ranges over the τ box independently of the
-        follower's (default; a platoon of different vehicles), or equals it.
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    p : Params
+        τ, δ, T* (checked on construction).
     n_grid, max_rounds, max_intervals : int
-        As for :func:`certify_batch`.
+        As for :func:`certify_kernel`.
 
     Returns
     -------
     Check
-        With ``sample_time`` and ``witness_theta`` when sampled
-        (:class:`stringstab.certify.sampled.SampledCheck`), and the witness member
-        (``witness_tau``, ``witness_delta``, ...) over a box.
-
-    Examples
-    --------
-    >>> check([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
-    ['certified', 'not_certified']
-    >>> c = check([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2, headway=1.1,
-    ...           sample_time=0.1)
-    >>> c.verdict.tolist(), c.sample_time
-    (['certified', 'not_certified'], 0.1)
+        Verdicts, internal stability, min g found and where.
     """
-    model, H = _loop(tau, delta, headway, sample_time, tau_prev)
-    kx, kv, ka = _gains(k_x, k_v, k_a)
-    if isinstance(model, Box):
-        from .robust import check_robust
-
-        return check_robust(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
-                            sample_time=H, heterogeneous=heterogeneous, n_grid=n_grid,
-                            max_rounds=max_rounds, max_intervals=max_intervals)
-    if H is not None:
-        from .sampled import check_sampled
-
-        return check_sampled(kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway,
-                             sample_time=H, tau_prev=tau_prev, n_grid=n_grid,
-                             max_rounds=max_rounds, max_intervals=max_intervals)
-    return _continuous_check(kx, kv, ka, model, n_grid=n_grid or 64, max_rounds=max_rounds,
-                             max_intervals=max_intervals)
+    hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
+    ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
+                      max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
+    v = ex.verdict.copy()
+    v[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
+    return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
 
 
-@overload
-def certify_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: float, delta: float, headway: float, sample_time: None = None,
-    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
-    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: None = None, heterogeneous: bool = True,
-) -> CertificateBatch: ...
+def certify_kernel(
+    kx: Array, kv: Array, ka: Array, p: Params, *, progress: bool = False, chunk: int = 4096,
+    n_grid: int = 64, max_rounds: int = 30, max_intervals: int = 1024,
+) -> CertificateBatch:
+    """The continuous-time certificates of many triples (the kernel; module docstring).
 
-
-@overload
-def certify_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
-    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
-    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: float | None = None, heterogeneous: bool = True,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
-
-
-def certify_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
-    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
-    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: float | None = None, heterogeneous: bool = True,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
-    """Certify many gain triples at once (exact delay, sound; see the module docstring).
-
-    With point parameters and no sample time this is the continuous-time certificate of
-    this module; ``sample_time`` certifies the sampled-data loop
-    (:func:`stringstab.certify.sampled.certify_sampled_batch`) and any interval the whole box
-    (:func:`stringstab.certify.robust.certify_robust_batch`), with the same three verdicts.
+    Inputs already checked by :func:`stringstab.certify.certify_batch` (the way in, which
+    callers use): nothing is validated again here.
 
     Parameters
     ----------
-    k_x, k_v, k_a : array_like
-        Gains, broadcast together and flattened.
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
-        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
-        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.certify.robust`).
-    sample_time : float, optional
-        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
-    tau_prev : float, optional
-        Sampled, point parameters only: the predecessor's lag (default τ).
-    heterogeneous : bool
-        Sampled box only: the predecessor's lag ranges over the τ box independently of the
-        follower's (default; a platoon of different vehicles), or equals it.
-    method : {{"exact", "pade"}}
-        ``"pade"`` additionally runs the python-control cross-check
-        (:func:`certify_pade`) per triple and warns where it disagrees; the
-        verdict is always the exact one (continuous loop, point parameters only).
-    pade_order : int
-        Padé order for the cross-check.
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    p : Params
+        τ, δ, T* (checked on construction).
     progress : bool
         Show a tqdm progress bar over chunks.
     chunk : int
         Triples per vectorised chunk (bounds memory).
     n_grid, max_rounds, max_intervals : int
-        Initial intervals on [0, Ω] (default 64; sampled: on [0, π], 64 + 8m), refinement
-        rounds, and the cap on undecided intervals *per triple* beyond which that triple is
-        declared inconclusive (per triple, so a verdict never depends on the rest of the
-        batch).
+        Initial intervals on [0, Ω], refinement rounds, and the cap on undecided intervals
+        per triple beyond which that triple is inconclusive.
 
     Returns
     -------
-    CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
-        The last two carry ``sample_time`` and the parameter box in their columns, rows and
-        summary.
-
-    Raises
-    ------
-    StringStabError
-        On non-finite gains, parameters out of range, a malformed interval (lo > hi, a
-        negative end, τ reaching 0), or a sample time that is not a finite number > 0.
-
-    Examples
-    --------
-    >>> b = certify_batch([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1)
-    >>> b.verdict.tolist()
-    ['certified', 'not_certified']
-    >>> b.summary()["m_fss"]
-    0.5
-    >>> r = certify_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta="0.1:0.3",
-    ...                   headway=1.1)
-    >>> r.verdict.tolist(), r.summary()["box"]["tau"]
-    (['certified', 'not_certified'], [0.1, 0.3])
+    CertificateBatch
+        With ``method="exact"`` (the way in adds the Padé cross-check,
+        :func:`stringstab.certify.pade.cross_check`).
     """
-    model, H = _loop(tau, delta, headway, sample_time, tau_prev, method)
-    kx, kv, ka = _gains(k_x, k_v, k_a)
-    if isinstance(model, Box):
-        from .robust import certify_robust_batch
-
-        return certify_robust_batch(
-            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
-            heterogeneous=heterogeneous, progress=progress, chunk=chunk, n_grid=n_grid,
-            max_rounds=max_rounds, max_intervals=max_intervals)
-    if H is not None:
-        from .sampled import certify_sampled_batch
-
-        return certify_sampled_batch(
-            kx, kv, ka, tau=model.tau, delta=model.delta, headway=model.headway, sample_time=H,
-            tau_prev=tau_prev, progress=progress, chunk=chunk, n_grid=n_grid,
-            max_rounds=max_rounds, max_intervals=max_intervals)
-    return _continuous_batch(kx, kv, ka, model, method=method, pade_order=pade_order,
-                             progress=progress, chunk=chunk, n_grid=n_grid or 64,
-                             max_rounds=max_rounds, max_intervals=max_intervals)
-
-
-def _continuous_batch(
-    kx: Array, kv: Array, ka: Array, p: Params, *, method: str, pade_order: int, progress: bool,
-    chunk: int, n_grid: int, max_rounds: int, max_intervals: int,
-) -> CertificateBatch:
     n = kx.size
     verdict = np.empty(n, dtype=np.int8)
     margin = np.empty(n)
@@ -649,8 +477,8 @@ def _continuous_batch(
     worst_w = np.empty(n)
 
     # internal stability, with an inconclusive band around the boundary
-    hz_sure, hz_fail = hurwitz_bands(kx, kv, tau=p.tau, headway=p.headway)
-    hz_margin = hurwitz_margin(kx, kv, tau=p.tau, headway=p.headway)
+    hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
+    hz_margin = hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway)
 
     for sl in chunks(n, chunk, progress=progress):
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
@@ -659,7 +487,7 @@ def _continuous_batch(
         verdict[sl], margin[sl], omega_max[sl], n_evals[sl] = ex.verdict, ex.margin, ex.omega_max, ex.n_evals
         worst_w[sl] = ex.worst_omega
         # certified ⇒ sup |Γ| = 1 at ω = 0: only the others need a peak search
-        need = ex.verdict != _CERT
+        need = ex.verdict != CERTIFIED
         sup[sl], peak_w[sl] = 1.0, 0.0
         if need.any():
             idx = np.arange(sl.start, sl.stop)[need]
@@ -668,15 +496,15 @@ def _continuous_batch(
                 ex.grid_omega[need], ex.grid_g[need], ex.worst_omega[need],
             )
 
-    verdict[~hz_sure] = np.where(hz_fail[~hz_sure], _NOT, _INC)
+    verdict[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
     # certified ⇒ sup |Γ| = 1 exactly, at ω = 0 (Γ(0) = 1 for k_x ≠ 0)
-    cert = verdict == _CERT
+    cert = verdict == CERTIFIED
     sup[cert] = np.maximum(sup[cert], 1.0)
     # not certified and stable ⇒ |Γ| > 1 somewhere: sup|Γ| − 1 without cancellation, so a
     # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0;
     # searched only where the direct excess is below EXCESS_SEARCH (above it, it is exact enough)
     excess = np.where(cert, 0.0, sup - 1.0)
-    viol = np.flatnonzero((verdict == _NOT) & hz_sure & (excess < EXCESS_SEARCH))
+    viol = np.flatnonzero((verdict == NOT_CERTIFIED) & hz_sure & (excess < EXCESS_SEARCH))
     if viol.size:
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
@@ -689,191 +517,15 @@ def _continuous_batch(
         sup[viol] = np.where(take, 1.0 + e1, sup[viol])
     excess = np.where(hz_sure, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
-    td = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="derived")
-    tp = taylor_criteria(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway, source="printed")
+    td = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
+                                source="derived")
+    tp = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
+                                source="printed")
     vnames = names(verdict)
-    pade_rows = None
-    if method == "pade":
-        pade_rows = []
-        disagree = []
-        for i in range(n):
-            pr = certify_pade(kx[i], kv[i], ka[i], tau=p.tau, delta=p.delta, headway=p.headway,
-                              order=pade_order)
-            row = pr.as_dict()
-            row["agrees"] = pr.verdict == vnames[i] or vnames[i] == "inconclusive"
-            if not row["agrees"]:
-                disagree.append(
-                    f"K=({kx[i]:g}, {kv[i]:g}, {ka[i]:g}): exact {vnames[i]} (sup {hinf[i]:.9g}), "
-                    f"Padé {pr.verdict} (norm {pr.hinf:.9g})"
-                )
-            pade_rows.append(row)
-        if disagree:
-            more = f" and {len(disagree) - 3} more" if len(disagree) > 3 else ""
-            warnings.warn(
-                f"Padé({pade_order}) cross-check disagrees with the exact certificate on "
-                f"{len(disagree)} of {n} triples: " + "; ".join(disagree[:3]) + more,
-                stacklevel=3,
-            )
     return CertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, hurwitz=np.asarray(hz_sure),
         hurwitz_margin=hz_margin, verdict=vnames, type=np.array([TYPE_NAMES[int(t)] for t in td.type]) if n else np.array([], dtype=str),
         sup_gain=hinf, linf_gain=sup, peak_omega=peak_w, margin=margin, omega_max=omega_max,
-        n_evals=n_evals, taylor_derived=td, taylor_printed=tp, method=method, pade=pade_rows,
+        n_evals=n_evals, taylor_derived=td, taylor_printed=tp,
         sup_gain_excess=excess,
     )
-
-
-@overload
-def certify(
-    k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
-    sample_time: None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: None = None, heterogeneous: bool = True,
-) -> Certificate: ...
-
-
-@overload
-def certify(
-    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
-    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: float | None = None, heterogeneous: bool = True,
-) -> Certificate | SampledCertificate | RobustCertificate: ...
-
-
-def certify(
-    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
-    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: float | None = None, heterogeneous: bool = True,
-) -> Certificate | SampledCertificate | RobustCertificate:
-    """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : float
-        The gains.
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
-        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
-        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
-        box of every such member (:mod:`stringstab.certify.robust`).
-    sample_time : float, optional
-        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
-        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
-    tau_prev : float, optional
-        Sampled, point parameters only: the predecessor's lag (default τ).
-    heterogeneous : bool
-        Sampled box only: the predecessor's lag ranges over the τ box independently of the
-        follower's (default; a platoon of different vehicles), or equals it.
-    method, pade_order
-        As for :func:`certify_batch`.
-
-    Returns
-    -------
-    Certificate, SampledCertificate or RobustCertificate
-        The continuous, sampled-data or robust certificate of the triple.
-
-    Examples
-    --------
-    >>> c = certify(1.5, 0.3, -0.1, tau=0.1, delta=0.2, headway=1.1)
-    >>> c.verdict, c.sup_gain
-    ('certified', 1.0)
-    >>> c = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
-    >>> c.verdict, c.type, c.taylor_printed["verdict"]
-    ('not_certified', 'IV', 'stable')
-    >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
-    >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)
-    ('not_certified', 1.0911, 1.379, 0.1379)
-    """
-    one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
-    return certify_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
-                         sample_time=sample_time, method=method, pade_order=pade_order,
-                         tau_prev=tau_prev, heterogeneous=heterogeneous)[0]
-
-
-for _f in (check, certify_batch, certify):
-    _f.__doc__ = (_f.__doc__ or "").replace("{loop}", _LOOP_DOC).replace("{{", "{").replace("}}", "}")
-del _f
-
-
-# ---------------------------------------------------------------------------
-# python-control cross-check
-# ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class PadeResult:
-    """python-control's view: Padé(n) delay, own stability check, then ``norm(·, 'inf')``."""
-
-    order: int
-    stable: bool
-    hinf: float
-    linf: float
-    verdict: str
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return {"order": self.order, "stable": self.stable, "hinf": num(self.hinf),
-                "linf": num(self.linf), "verdict": self.verdict}
-
-
-def certify_pade(
-    k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
-    order: int = 5, tol: float = 1e-6, norm_tol: float = 1e-10,
-) -> PadeResult:
-    """The python-control cross-check of one triple.
-
-    The delay is replaced by ``control.pade(delta, order)``; stability is
-    checked on the poles *before* ``control.norm(sys, 'inf')`` is trusted
-    (that function returns the L∞ norm and never checks stability).  The
-    verdict is ``"certified"`` when stable and the norm ≤ 1 + ``tol``; it is an
-    approximation (Padé) and a cross-check only.  ``norm_tol`` is passed to
-    ``control.norm`` (its default, 1e-6, cannot resolve sup |Γ| = 1).
-
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : float
-        The gains.
-    tau, delta, headway : float
-        Actuator lag τ, delay δ, desired headway T*, s.
-    order : int
-        Order of the Padé approximant of e^{−δs}.
-    tol : float
-        Slack on the norm for the verdict.
-    norm_tol : float
-        Tolerance passed to ``control.norm``.
-
-    Returns
-    -------
-    PadeResult
-        ``stable``, ``hinf`` (the Padé model's H∞ norm) and ``verdict``.
-
-    Examples
-    --------
-    >>> r = certify_pade(1.5, 0.3, -0.1, tau=0.1, delta=0.2, headway=1.1)
-    >>> r.stable, r.verdict
-    (True, 'certified')
-    """
-    import control
-
-    p = Params(tau, delta, headway)
-    kx, kv, ka = (float(v) for v in as_gains(k_x, k_v, k_a))
-    if p.delta > 0:
-        num_d, den_d = control.pade(p.delta, order)
-        delay = control.tf(num_d, den_d)
-    else:
-        delay = control.tf([1.0], [1.0])
-    # N(s) = n0(s) + n1(s) e^{-δs} and D(s), generated from the derivation
-    d_co = [float(c) for c in _gen.denominator_coefficients(kx, kv, ka, p.tau, p.delta, p.headway)]
-    n_co = [float(c) for c in _gen.numerator_coefficients(kx, kv, ka, p.tau, p.delta, p.headway)]
-    n0, n1 = n_co[:_gen.NUMERATOR_SPLIT], n_co[_gen.NUMERATOR_SPLIT:]
-    den = control.tf(d_co, [1.0])
-    sys = (control.tf(n0, [1.0]) + control.tf(n1, [1.0]) * delay) / den
-    poles = np.concatenate([np.roots(d_co), np.asarray(control.poles(delay))])
-    stable = bool(np.all(poles.real < 0))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            linf = float(control.norm(sys, "inf", tol=norm_tol))
-        except Exception:  # python-control raises on poles on the imaginary axis
-            linf = float("inf")
-    hinf = linf if stable else float("inf")
-    verdict = "certified" if stable and hinf <= 1.0 + tol else "not_certified"
-    return PadeResult(order, stable, hinf, linf, verdict)

@@ -43,14 +43,17 @@ __all__ = [
     "TaylorCriteria",
     "hurwitz",
     "hurwitz_bands",
+    "hurwitz_bands_kernel",
     "hurwitz_conditions",
     "hurwitz_gradients",
     "hurwitz_margin",
+    "hurwitz_margin_kernel",
     "hurwitz_ok",
     "proposition1",
     "psi",
     "stability_type",
     "taylor_criteria",
+    "taylor_criteria_kernel",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -226,6 +229,12 @@ def hurwitz(
     array([ True, False, False])
     """
     kx, kv, ka = as_gains(k_x, k_v, k_a)
+    return _hurwitz(kx, kv, ka, tau, headway, rtol)
+
+
+def _hurwitz(kx: Array, kv: Array, ka: Array, tau: float, headway: float,
+             rtol: float) -> npt.NDArray[np.bool_]:
+    """:func:`hurwitz` of checked gains."""
     conds = _gen.hurwitz_conditions(kx, kv, ka, tau, 0.0, headway)
     if rtol:
         scales = _gen.hurwitz_scales(kx, kv, ka, tau, 0.0, headway)
@@ -268,8 +277,30 @@ def hurwitz_bands(
     >>> [v.tolist() for v in hurwitz_bands([1.0, -1.0, 0.0], 0.5, tau=0.1, headway=1.1)]
     [[True, False, False], [False, True, True]]
     """
-    sure = hurwitz(k_x, k_v, tau=tau, headway=headway, rtol=HURWITZ_RTOL)
-    fail = ~hurwitz(k_x, k_v, tau=tau, headway=headway, rtol=-HURWITZ_RTOL)
+    kx, kv, _ = as_gains(k_x, k_v, 0.0)
+    return hurwitz_bands_kernel(kx, kv, tau=tau, headway=headway)
+
+
+def hurwitz_bands_kernel(
+    kx: Array, kv: Array, *, tau: float, headway: float,
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+    """:func:`hurwitz_bands` of gains already checked by :mod:`stringstab.certify`'s way in.
+
+    Parameters
+    ----------
+    kx, kv : ndarray of float64
+        Position and velocity gains, finite, of one shape.
+    tau, headway : float
+        Actuator lag τ > 0 and desired headway T* ≥ 0, s (checked).
+
+    Returns
+    -------
+    sure, fail : ndarray of bool
+        As for :func:`hurwitz_bands`.
+    """
+    ka = np.zeros_like(kx)
+    sure = _hurwitz(kx, kv, ka, tau, headway, HURWITZ_RTOL)
+    fail = ~_hurwitz(kx, kv, ka, tau, headway, -HURWITZ_RTOL)
     return sure, fail
 
 
@@ -301,6 +332,24 @@ def hurwitz_margin(
     0.9016
     """
     kx, kv, _ = as_gains(k_x, k_v, 0.0)
+    return hurwitz_margin_kernel(kx, kv, tau=tau, headway=headway)
+
+
+def hurwitz_margin_kernel(kx: Array, kv: Array, *, tau: float, headway: float) -> Array:
+    """:func:`hurwitz_margin` of gains already checked by :mod:`stringstab.certify`'s way in.
+
+    Parameters
+    ----------
+    kx, kv : ndarray of float64
+        Position and velocity gains, finite, of one shape.
+    tau, headway : float
+        Actuator lag τ > 0 and desired headway T* ≥ 0, s (checked).
+
+    Returns
+    -------
+    ndarray
+        −max Re(p) over the poles of Γ, 1/s, of the gains' shape.
+    """
     shape = kx.shape
     kx, kv = kx.ravel(), kv.ravel()
     n = kx.size
@@ -408,6 +457,28 @@ def taylor_criteria(
     """
     tau, delta, headway = check_params(tau, delta, headway)
     kx, kv, ka = as_gains(k_x, k_v, k_a)
+    return taylor_criteria_kernel(kx, kv, ka, tau=tau, delta=delta, headway=headway, source=source)
+
+
+def taylor_criteria_kernel(
+    kx: Array, kv: Array, ka: Array, *, tau: float, delta: float, headway: float,
+    source: str = "derived",
+) -> TaylorCriteria:
+    """:func:`taylor_criteria` of inputs already checked by :mod:`stringstab.certify`'s way in.
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray of float64
+        Gains, finite, of one shape.
+    tau, delta, headway : float
+        τ > 0, δ ≥ 0, T* ≥ 0, s (checked).
+    source : {"derived", "printed"}
+        As for :func:`taylor_criteria`.
+
+    Returns
+    -------
+    TaylorCriteria
+    """
     psi1, psi2, psi3, lam = psi(kx, kv, ka, tau=tau, delta=delta, headway=headway, source=source)
     return TaylorCriteria(
         source, psi1, psi2, psi3, lam, proposition1(psi1, psi2, psi3, lam, source=source),

@@ -10,7 +10,7 @@ box of parameters — and :func:`certified_lattice` applies it to the lattice of
 
 * the continuous loop: the screen of :mod:`stringstab.certify.screen` (not Hurwitz, or
   |Γ(jω)| > 1 at a fixed frequency: a proof of failure) drops rows, then
-  :func:`stringstab.certify.continuous.check` decides the rest;
+  :func:`stringstab.certify.api.check` decides the rest;
 * a box: a gain certified for every member is string stable at the box's centre, so the
   centre's screen (continuous loop) drops rows soundly; then the centre's point certificate
   (of the same loop, far cheaper than the robust one) picks the rows the robust certificate
@@ -73,7 +73,7 @@ def lattice(lo: float, hi: float, n: int) -> Array:
 def _check_certified(K: Array, params: Params | Box, sample_time: float | None,
                      heterogeneous: bool) -> npt.NDArray[np.bool_]:
     """The certificate of the loop (point or box, continuous or sampled) on every row of K."""
-    from .continuous import check
+    from .api import check
 
     b = Box.of(params)
     if isinstance(params, Params):
@@ -114,7 +114,7 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
     Returns
     -------
     ndarray of bool, shape (n,)
-        True where certified: the rows whose :func:`stringstab.certify.continuous.check`
+        True where certified: the rows whose :func:`stringstab.certify.api.check`
         verdict (of that loop, and of the continuous loop with ``also_continuous``) is
         ``"certified"`` — the cheap steps of the module docstring only skip rows that cannot
         be (for a box, see there).

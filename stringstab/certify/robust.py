@@ -53,9 +53,11 @@ __all__ = [
     "RobustCertificate",
     "RobustCertificateBatch",
     "as_interval",
+    "certify_kernel",
     "certify_robust",
     "certify_robust_batch",
     "check_box",
+    "check_of",
     "check_robust",
     "parse_interval",
     "robust_margin",
@@ -166,6 +168,18 @@ class RobustCertificateBatch(BatchResult):
     n_evals: npt.NDArray[np.int64]
     sup_gain_excess: Array
 
+    @classmethod
+    def table_columns(cls) -> list[TableColumn]:
+        """The columns of the human table of these certificates (:data:`TABLE_COLUMNS`).
+
+        Returns
+        -------
+        list of TableColumn
+            The columns of the robust certificates: the gains, verdict, sup|Γ| (and − 1)
+            of the witness member, the witness member and frequency, margin.
+        """
+        return list(TABLE_COLUMNS)
+
     def __getitem__(self, i: int) -> RobustCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]
 
@@ -260,6 +274,37 @@ def certify_robust_batch(
     box = check_box(tau, delta, headway)
     H = None if sample_time is None else _sample_time(sample_time)
     kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
+    return certify_kernel(kx, kv, ka, box, H, heterogeneous=heterogeneous, chunk=chunk,
+                          n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals,
+                          max_splits=max_splits, max_cells=max_cells, progress=progress)
+
+
+def certify_kernel(
+    kx: Array, kv: Array, ka: Array, box: Box, H: float | None, *, heterogeneous: bool = True,
+    chunk: int = 4096, n_grid: int | None = None, max_rounds: int = 30,
+    max_intervals: int = 1024, max_splits: int = 48, max_cells: int = 4096,
+    progress: bool = False,
+) -> RobustCertificateBatch:
+    """The robust certificates of many triples: the kernel of :func:`certify_robust_batch`.
+
+    Inputs already checked by :func:`stringstab.certify.certify_batch` (the way in) or
+    :func:`certify_robust_batch`: nothing is validated again here.
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    box : Box
+        The box of τ, δ, T* (checked on construction).
+    H : float or None
+        Sampling period H > 0 (s), or None for continuous time.
+    heterogeneous, chunk, n_grid, max_rounds, max_intervals, max_splits, max_cells, progress
+        As for :func:`certify_robust_batch`.
+
+    Returns
+    -------
+    RobustCertificateBatch
+    """
     n = kx.size
     keys = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev", "delta",
             "headway", "n_evals", "sup_gain", "sup_gain_excess")
@@ -379,6 +424,22 @@ def check_robust(
     b = certify_robust_batch(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway,
                              sample_time=sample_time, heterogeneous=heterogeneous, n_grid=n_grid,
                              max_rounds=max_rounds, max_intervals=max_intervals)
+    return check_of(b)
+
+
+def check_of(b: RobustCertificateBatch) -> Check:
+    """The verdict-only answer of a robust batch (what :func:`check_robust` returns).
+
+    Parameters
+    ----------
+    b : RobustCertificateBatch
+        The robust certificates.
+
+    Returns
+    -------
+    Check
+        Verdict, stability, margin and witness (member and frequency) of each triple.
+    """
     return Check(b.verdict, b.stable, b.margin, b.witness_omega, sample_time=b.sample_time,
                  witness_theta=None if b.sample_time is None else b.witness_theta,
                  witness_tau=b.witness_tau, witness_tau_prev=b.witness_tau_prev,

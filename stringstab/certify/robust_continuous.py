@@ -39,7 +39,7 @@ import numpy.typing as npt
 
 from ..params import Box, as_gains, check_box
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
-from .criteria import hurwitz_bands
+from .criteria import hurwitz_bands_kernel
 from .excess import EXCESS_SEARCH, searched_excess, violation_peak
 from .frequency import gain_squared, margin_g_coefficients
 from .margin import curvature_bound, separable, tail_bound
@@ -181,7 +181,7 @@ def certify_box_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid:
     n = kx.size
     (t_lo, t_hi), (d_lo, d_hi), (h_lo, h_hi) = box.tau, box.delta, box.headway
     # internal stability: the worst member is (τ_hi, h_lo) (module docstring)
-    sure, fail = hurwitz_bands(kx, kv, tau=t_hi, headway=h_lo)
+    sure, fail = hurwitz_bands_kernel(kx, kv, tau=t_hi, headway=h_lo)
     a_min, a_absmax = _corner_values(kx, kv, ka, box)
     c_lo = np.minimum(kv + h_lo * kx, kv + h_hi * kx)
     c_hi = np.maximum(kv + h_lo * kx, kv + h_hi * kx)

@@ -81,8 +81,10 @@ __all__ = [
     "SampledCertificate",
     "SampledCertificateBatch",
     "SampledCheck",
+    "certify_kernel",
     "certify_sampled",
     "certify_sampled_batch",
+    "check_kernel",
     "check_sampled",
     "sampled_margin",
     "sampled_response",
@@ -197,6 +199,36 @@ def check_sampled(
     ['certified', 'not_certified']
     """
     kx, kv, ka, p, H, tp = _prepare(k_x, k_v, k_a, tau, delta, headway, sample_time, tau_prev)
+    return check_kernel(kx, kv, ka, p, H, tp, n_grid=n_grid, max_rounds=max_rounds,
+                        max_intervals=max_intervals)
+
+
+def check_kernel(
+    kx: Array, kv: Array, ka: Array, p: Params, H: float, tp: float, *,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+) -> SampledCheck:
+    """The sampled verdicts alone: the kernel of :func:`check_sampled`.
+
+    Inputs already checked by :func:`stringstab.certify.check` (the way in) or
+    :func:`check_sampled`: nothing is validated again here.
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    p : Params
+        τ, δ, T* (checked on construction).
+    H : float
+        Sampling period H > 0, s.
+    tp : float
+        The predecessor's lag τ_p > 0, s.
+    n_grid, max_rounds, max_intervals : int
+        As for :func:`check_sampled`.
+
+    Returns
+    -------
+    SampledCheck
+    """
     co, m = point_coefficients(kx, kv, ka, p, H, tp)
     sure, fail = schur_bands(co.delta)
     bb = _bnb_points(co, m, n_grid=n_grid or _default_grid(m), max_rounds=max_rounds,
@@ -303,6 +335,18 @@ class SampledCertificateBatch(BatchResult):
     n_evals: npt.NDArray[np.int64]
     sup_gain_excess: Array
 
+    @classmethod
+    def table_columns(cls) -> list[TableColumn]:
+        """The columns of the human table of these certificates (:data:`TABLE_COLUMNS`).
+
+        Returns
+        -------
+        list of TableColumn
+            The columns of the sampled-data certificates: the gains, Schur, verdict, sup|H|
+            (and − 1), ω_peak and θ_peak, margin, spectral radius.
+        """
+        return list(TABLE_COLUMNS)
+
     def __getitem__(self, i: int) -> SampledCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]
 
@@ -393,6 +437,37 @@ def certify_sampled_batch(
     (['certified', 'not_certified'], [1.0, 1.0911])
     """
     kx, kv, ka, p, H, tp = _prepare(k_x, k_v, k_a, tau, delta, headway, sample_time, tau_prev)
+    return certify_kernel(kx, kv, ka, p, H, tp, chunk=chunk, n_grid=n_grid,
+                          max_rounds=max_rounds, max_intervals=max_intervals, progress=progress)
+
+
+def certify_kernel(
+    kx: Array, kv: Array, ka: Array, p: Params, H: float, tp: float, *, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    progress: bool = False,
+) -> SampledCertificateBatch:
+    """The sampled-data certificates of many triples: the kernel of :func:`certify_sampled_batch`.
+
+    Inputs already checked by :func:`stringstab.certify.certify_batch` (the way in) or
+    :func:`certify_sampled_batch`: nothing is validated again here.
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    p : Params
+        τ, δ, T* (checked on construction).
+    H : float
+        Sampling period H > 0, s.
+    tp : float
+        The predecessor's lag τ_p > 0, s.
+    chunk, n_grid, max_rounds, max_intervals, progress
+        As for :func:`certify_sampled_batch`.
+
+    Returns
+    -------
+    SampledCertificateBatch
+    """
     n = kx.size
     verdict = np.empty(n, dtype=np.int8)
     margin = np.empty(n)

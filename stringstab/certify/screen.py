@@ -10,7 +10,7 @@ string stable when
   |Γ(jω)| > 1 there (IDL eq 10), whatever the rounding of g.
 
 Either is a proof that K fails, so a screen built on them is *sound*: it never drops a triple
-the certificate (:func:`stringstab.certify.continuous.check`) would certify — a certified
+the certificate (:func:`stringstab.certify.api.check`) would certify — a certified
 triple is Hurwitz and has g(ω) ≥ 0 at every ω, up to a rounding error many orders of magnitude
 below the screen's tolerance.  Which frequencies are tried is the caller's choice:
 :data:`SCREEN_OMEGA` (a fixed set, vectorised over many triples: :func:`surely_uncertifiable`)
@@ -74,7 +74,7 @@ def surely_uncertifiable(K: npt.ArrayLike, p: Params,
     """Which rows of K surely cannot be certified: not Hurwitz, or g(ω) < threshold at an ω.
 
     Sound (module docstring): a row flagged here is never certified by
-    :func:`stringstab.certify.continuous.check`; a row not flagged may still fail.
+    :func:`stringstab.certify.api.check`; a row not flagged may still fail.
 
     Parameters
     ----------

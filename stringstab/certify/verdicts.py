@@ -322,6 +322,21 @@ class BatchResult:
         return self.SINGLE(**values)
 
     @classmethod
+    def table_columns(cls) -> list[TableColumn]:
+        """The columns of this result's human table (``stringstab certify --format table``).
+
+        Each batch type names its own (the continuous, sampled and robust certificates report
+        different quantities), so a caller renders any result without asking which loop it
+        came from: ``write_results(b.columns(), ..., table=b.table_columns())``.
+
+        Returns
+        -------
+        list of TableColumn
+            Header, key into :meth:`columns` and format of each column, in order.
+        """
+        raise NotImplementedError(f"{cls.__name__} names no table columns")
+
+    @classmethod
     def of_single(cls, row: Any) -> Any:
         """The batch of one row (so that a single result renders through :meth:`columns`).
 
@@ -362,7 +377,7 @@ class BatchResult:
 class Check:
     """Verdicts only, with the witness of each triple that is not certified.
 
-    Returned by :func:`stringstab.certify.continuous.check` for every loop (continuous, sampled,
+    Returned by :func:`stringstab.certify.api.check` for every loop (continuous, sampled,
     robust); the sampled and robust forms fill the optional fields.
 
     Attributes

@@ -24,7 +24,6 @@ from ..params import (
     DEFAULT_TAU,
     Box,
     Params,
-    check_params,
     parameter_model,
     positive,
 )
@@ -172,7 +171,7 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     if any(":" in str(v) for v in values):
         model: Params | Box = parameter_model(*(str(v) for v in values))
     else:  # numbers: the point checks and messages ('tau ... must be ... > 0 s; got '0'')
-        model = Params(*check_params(*values))
+        model = Params(*values)
     H = None if args.sample_time is None else positive(
         "--sample-time (sampling period H)", args.sample_time, unit=" s")
     if H is not None:

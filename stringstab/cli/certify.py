@@ -1,10 +1,10 @@
 """``stringstab certify``: exact, delay-aware string-stability certificates for gain triples.
 
 Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
-certifies them with :func:`stringstab.certify.continuous.certify_batch` — the continuous-time loop,
+certifies them on the :class:`~stringstab.certify.api.Loop` they ask for — the continuous-time loop,
 the sampled-data loop (``--sample-time``) or every member of a box of parameters (``--tau``,
 ``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
-(:meth:`~stringstab.certify.continuous.CertificateBatch.columns`) as a table, JSON, CSV, Parquet or
+(``columns()``; the table's, ``table_columns()``) as a table, JSON, CSV, Parquet or
 NPZ (:func:`stringstab.io.write_results`).  Exit code 0
 when every triple is certified, 1 when any is not (``not_certified`` or
 ``inconclusive``), 2 on bad input (nothing printed, no file written).
@@ -18,7 +18,7 @@ import warnings
 from typing import Any
 
 from ..errors import StringStabError, show
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ._common import (
     add_gain_arguments,
     add_model_arguments,
@@ -159,10 +159,11 @@ def run(args: argparse.Namespace) -> int:
     """
     model, H = loop_params(args)
     order = _pade_order(args.pade_order)
-    if args.method == "pade" and (H is not None or isinstance(model, Box)):
-        raise StringStabError(
-            "--method pade (python-control's cross-check) is for the continuous loop at one τ, δ, "
-            f"T*; got {'--sample-time ' + args.sample_time if H is not None else 'an interval'}")
+    from ..certify.api import Loop
+
+    # the values are checked (with the flags' names); the library decides the loop's kind and
+    # refuses what no certificate answers (--method pade beyond the continuous point loop)
+    loop = Loop(model, H, method=args.method)
     out = check_output(args)
     if getattr(args, "from_identify", None):
         return _run_identified(args, out, H)
@@ -176,7 +177,6 @@ def run(args: argparse.Namespace) -> int:
                       f"expected at most about {int(max(_available() - BYTES_BASE, 0) // BYTES_PER_ROW)} "
                       "rows at once on this machine: split the file")
 
-    from ..certify.continuous import certify_batch
     from ..io import write_results
 
     n = len(table)
@@ -184,28 +184,19 @@ def run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings():
         # Padé disagreements are reported once, below, instead of per row.
         warnings.simplefilter("ignore")
-        batch = certify_batch(
-            table.k_x, table.k_v, table.k_a, tau=model.tau, delta=model.delta,
-            headway=model.headway, sample_time=H, method=args.method, pade_order=order,
-            progress=progress,
-        )
-    if H is None and not isinstance(model, Box):  # the continuous loop at one τ, δ, T*
-        from ..certify.continuous import TABLE_COLUMNS as columns
-
+        batch = loop.certify_batch(table.k_x, table.k_v, table.k_a, pade_order=order,
+                                   progress=progress)
+    if loop.kind == "continuous":
         params: dict[str, Any] = {"tau": model.tau, "delta": model.delta,
                                   "headway": model.headway, "method": args.method}
     else:
-        if isinstance(model, Box):
-            from ..certify.robust import TABLE_COLUMNS as columns
-        else:
-            from ..certify.sampled import TABLE_COLUMNS as columns
         params = {**shown_params(model, H), "method": args.method}
     if args.method == "pade":
         params["pade_order"] = order
     summary = batch.summary()
     write_results({**table.meta_columns(), **batch.columns()}, out, args.format,
                   params=_for_table(params) if args.format == "table" else params,
-                  summary=summary, table=columns, what="--out")
+                  summary=summary, table=batch.table_columns(), what="--out")
     if args.method == "pade":
         _warn_disagreements([{**table.meta(i), **r} for i, r in enumerate(batch.records())], order)
     if out is not None:
@@ -224,7 +215,7 @@ def _for_table(params: dict[str, Any]) -> dict[str, Any]:
 
 def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
-    from ..certify.continuous import certify_batch
+    from ..certify.api import Loop
     from ..identify.report import read_identified
     from ..io import TableColumn, columns_from_records, write_results
 
@@ -236,9 +227,8 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     for r in rows:
         from ..params import parameter_model
 
-        loop = parameter_model(*(given.get(k, r[k]) for k in ("tau", "delta", "headway")))
-        b = certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]], tau=loop.tau, delta=loop.delta,
-                          headway=loop.headway, sample_time=H)
+        loop = Loop(parameter_model(*(given.get(k, r[k]) for k in ("tau", "delta", "headway"))), H)
+        b = loop.certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]])
         c: dict[str, Any] = b.records()[0]
         rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
         for k in ("tau", "delta", "headway"):

@@ -56,7 +56,8 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     """Certify a few triples and a bundled gain time series (exact delay)."""
     import numpy as np
 
-    from ..certify.continuous import TABLE_COLUMNS, certify_batch
+    from ..certify.api import certify_batch
+    from ..certify.continuous import TABLE_COLUMNS
     from ..io import GainTable, parse_triple, read_gains, write_results
 
     params = {**PARAMS, "method": "exact"}

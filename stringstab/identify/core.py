@@ -26,7 +26,7 @@ Per follower (a vehicle whose predecessor and gap are in the log):
 
 The verdict is worded no more confidently than the bootstrap allows (:func:`statement`).
 The certificates are the façade's functions (``stringstab.certify``, ``stringstab.check``),
-imported from :mod:`stringstab.certify.continuous` because a sub-package does not import the root
+imported from :mod:`stringstab.certify.api` because a sub-package does not import the root
 package (``tests/test_house.py``).
 """
 
@@ -284,7 +284,7 @@ class _Progress:
 
 
 def _certify(p: dict[str, float], H: float | None) -> Any:
-    from ..certify import continuous as ss
+    from ..certify import api as ss
 
     return ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
                       headway=p["headway"], sample_time=H)
@@ -422,7 +422,7 @@ PROFILE_GRID = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
 def _profile(data: FollowerData, model: str, H: float | None, n_starts: int,
              seed: int) -> tuple[list[dict[str, Any]], list[FitResult]]:
     """Refit with T* held on :data:`PROFILE_GRID` and certify each refit."""
-    from ..certify import continuous as ss
+    from ..certify import api as ss
 
     v = np.concatenate([data.v[s.start:s.stop] for s in data.segments])
     g = np.concatenate([data.gap[s.start:s.stop] for s in data.segments])
@@ -461,7 +461,7 @@ def _profile_note(rows: list[dict[str, Any]], best: float) -> str:
 
 def _box(p: dict[str, float], bp: dict[str, Array], model: str, H: float | None) -> Any:
     """The robust certificate at the point gains over the 5-95 % bootstrap box of τ, T* (and δ)."""
-    from ..certify import continuous as ss
+    from ..certify import api as ss
 
     def iv(k: str) -> Any:
         lo, hi = (float(x) for x in np.percentile(bp[k], [5, 95]))

@@ -88,7 +88,7 @@ def trajectory_verdicts(rmap: RegionMap, gains: Any) -> list[str]:
     >>> trajectory_verdicts(m, [[1.5, 0.3, -0.1], [0.9, -0.5, 1.1]])
     ['certified', 'not_certified']
     """
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
 
     K, _ = gain_rows(gains)
     p = rmap.params
@@ -109,7 +109,7 @@ def plot_trajectory(
     vehicle are joined in order; the first point of each is labelled.
 
     Compute, then draw: the verdicts are computed beforehand, by :func:`trajectory_verdicts`
-    or :func:`stringstab.certify.continuous.certify_batch` of the triples (or its ``.verdict``).
+    or :func:`stringstab.certify.api.certify_batch` of the triples (or its ``.verdict``).
 
     Parameters
     ----------

@@ -12,7 +12,7 @@ all three, and returns a :class:`RegionMap` holding, per grid point,
 
   ``exact``
       the sound certificate with the exact delay
-      (:func:`stringstab.certify.continuous.certify_batch`): ``certified``,
+      (:func:`stringstab.certify.api.certify_batch`): ``certified``,
       ``not_certified`` or ``inconclusive``;
   ``taylor``
       Proposition 1 (IDL eqs 12-15) with the *derived* Ψ and the corrected

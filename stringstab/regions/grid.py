@@ -6,7 +6,7 @@ process or a pool of workers) and assembles a :class:`~stringstab.regions.Region
 block, the Taylor quantities are evaluated as polynomials in one gain with coefficients on
 the plane of the other two (Horner's rule, coefficients generated from the SymPy expressions,
 :func:`stringstab.derive.generated.psi_polynomials`), the exact verdicts by
-:func:`stringstab.certify.continuous.certify_batch` — of the continuous loop, of the sampled-data loop
+:func:`stringstab.certify.api.certify_batch` — of the continuous loop, of the sampled-data loop
 (``sample_time``) or over a box of parameters (intervals), with the continuous certificate
 beside a sampled one as the ``continuous`` method.
 """
@@ -92,7 +92,7 @@ class _Spec:
 
 def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, int]) -> dict[str, Any]:
     """A sampled or robust block: ``exact`` (and ``continuous``) with their stability."""
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
 
     p = spec.params
     out: dict[str, Any] = {}
@@ -139,7 +139,7 @@ def _eval_block(spec: _Spec, i0: int, i1: int, j0: int, j1: int) -> dict[str, An
             out[f"prop1_{method}"] = ok
             out[f"verdict_{method}"] = np.where(ok & hz, STABLE, UNSTABLE).astype(np.int8)
     if "exact" in spec.methods:
-        from ..certify.continuous import certify_batch
+        from ..certify.api import certify_batch
 
         full = [np.broadcast_to(gains[g], shape).ravel() for g in GAIN_NAMES]
         b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
@@ -176,7 +176,7 @@ def grid_blocks(n0: int, n1: int, n2: int, target: int) -> list[tuple[int, int, 
 def _warm(spec: _Spec) -> None:
     """Run the certificate once (imports and caches; forked workers inherit them)."""
     if "exact" in spec.methods:
-        from ..certify.continuous import certify_batch
+        from ..certify.api import certify_batch
 
         p = spec.params
         certify_batch([1.0], [0.5], [0.2], tau=p.tau, delta=p.delta, headway=p.headway,

@@ -2,7 +2,7 @@
 
 The agent proposes K = (k_x, k_v, k_a) for every environment at every step; before the eq-4 law
 acts, :class:`GainRepair` replaces each K that the exact certificate
-(:func:`stringstab.certify.continuous.check`) does not certify by a nearby certified triple.  The
+(:func:`stringstab.certify.api.check`) does not certify by a nearby certified triple.  The
 library's repairs (:func:`stringstab.tuning.project`, :func:`stringstab.tuning.region_growing`)
 take milliseconds per triple, and at the start of training about 90 % of the gain box is not
 certified (at τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, 9 % of a 0.05-spaced lattice over [−2, 2]³ is),
@@ -36,7 +36,7 @@ so calling them per environment step would dominate training.  The default metho
 ``"off"``
     no repair: the ablation (executed gains may be uncertified).
 
-Whatever the method, a triple is executed only if :func:`~stringstab.certify.continuous.check` returned
+Whatever the method, a triple is executed only if :func:`~stringstab.certify.api.check` returned
 ``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
 :func:`stringstab.certify.sampled.check_sampled` at H: the loop the simulator runs holds u over each
 control step, and gains on the continuous certificate's boundary need not be string stable in
@@ -72,7 +72,7 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
 
     The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
     ``also_continuous``): the screen of :mod:`stringstab.certify.screen` first, then the exact
-    certificate (:func:`stringstab.certify.continuous.check`) decides; with ``sample_time``,
+    certificate (:func:`stringstab.certify.api.check`) decides; with ``sample_time``,
     the sampled-data certificate at that step must certify the point too.  The grid has
     round((hi − lo)/resolution) + 1 points per axis, so its spacing is ``resolution`` only
     when that divides hi − lo.  Cached (8 entries).
@@ -150,7 +150,7 @@ class GainRepair:
     >>> K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])
     >>> K[0].tolist(), bool((K[1] != [0.9, -0.5, 1.1]).any())
     ([1.2, 0.5, 0.6], True)
-    >>> from stringstab.certify.continuous import check
+    >>> from stringstab.certify.api import check
     >>> check(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
     ['certified', 'certified']
     """

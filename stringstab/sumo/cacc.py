@@ -298,7 +298,7 @@ def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
     -------
     list of dict
         Per mode: the :class:`ModeLaw` fields, ``continuous`` and ``sampled`` (verdict and sup
-        gain of :func:`stringstab.certify.continuous.certify`), ``no_lag_closed_form`` (Hurwitz,
+        gain of :func:`stringstab.certify.api.certify`), ``no_lag_closed_form`` (Hurwitz,
         k_x T*² + 2 k_v T* ≥ 2) and ``sumo_discrete_sweep`` (:func:`discrete_sweep`).
 
     Raises
@@ -306,7 +306,7 @@ def certify_modes(vt: CACCType, dt: float) -> list[dict[str, Any]]:
     StringStabError
         When a mode is ill-posed (:func:`mode_laws`).
     """
-    from ..certify.continuous import certify
+    from ..certify.api import certify
 
     rows = []
     for law in mode_laws(vt, dt):

@@ -371,7 +371,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     """m_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
 
     m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
-    (:func:`stringstab.certify.continuous.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
+    (:func:`stringstab.certify.api.certify_batch`: internally stable and sup_ω |Γ(jω)| ≤ 1),
     else 0 ("inconclusive" counts as 0); the share is Σ m_fss / (N · T/Δt), eq 27's M_fss
     without its ×100 % (a fraction, as everywhere in the toolkit: docs/conventions.md).
     Identical triples are certified once.
@@ -398,7 +398,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     >>> fss_ratio([1.2, 0.1], [0.5, 0.58], [0.6, 1.0], tau=0.1, delta=0.2, headway=1.1)
     0.5
     """
-    from ..certify.continuous import certify_batch
+    from ..certify.api import certify_batch
     from ..params import as_gains
 
     kx, kv, ka = as_gains(k_x, k_v, k_a)

@@ -41,7 +41,7 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
                  ttc_star: float = TTC_STAR, warnings: Sequence[str] = ()) -> dict[str, Any]:
     """The ``metrics.json`` document of a run: its settings, the IDL metrics and a certificate.
 
-    ``certificate`` holds the exact certificate (:func:`stringstab.certify.continuous.certify`) of
+    ``certificate`` holds the exact certificate (:func:`stringstab.certify.api.certify`) of
     the controller's gains when they are fixed and of the eq-4 form, else None.
 
     Parameters
@@ -80,7 +80,7 @@ def _certificate(controller: Any, params: dict[str, Any]) -> dict[str, Any] | No
     taus = np.unique(np.asarray(params.get("tau"), dtype=np.float64))
     if K is None or controller.headway is None or np.ndim(K) != 1 or taus.size != 1:
         return None
-    from ..certify.continuous import certify
+    from ..certify.api import certify
 
     c = certify(float(K[0]), float(K[1]), float(K[2]), tau=float(taus[0]),
                 delta=params["delta"], headway=controller.headway)

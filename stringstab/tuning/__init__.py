@@ -4,8 +4,8 @@ In the IDL strategy every action K = [k_x, k_v, k_a] proposed by the agent goes
 through a *parameter tuning* step that replaces gains that are not string
 stable by nearby gains that are (IDL paper §3.3).  Two methods are offered;
 both report whether their output is certified by the exact certificate
-(:func:`stringstab.certify.continuous.certify`, or its verdict-only form
-:func:`stringstab.certify.continuous.check`: the same sound decision), never by a
+(:func:`stringstab.certify.api.certify`, or its verdict-only form
+:func:`stringstab.certify.api.check`: the same sound decision), never by a
 Taylor formula alone.
 
 :func:`region_growing`

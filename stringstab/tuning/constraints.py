@@ -20,7 +20,7 @@ by polarisation (:func:`quadratic_form`), so each constraint is evaluated by the
 the certificate it serves, and the NLP sees only the numbers (c, b, A) of each slot: one NLP for
 every loop.  :class:`Loop` says which member and frequency each constraint is taken at: a few
 fixed ones to start, then the certificate's witnesses (the exchange method), and decides every
-output with the certificate of that loop (:func:`stringstab.certify.continuous.check`).
+output with the certificate of that loop (:func:`stringstab.certify.api.check`).
 
 References
 ----------
@@ -357,14 +357,14 @@ class Loop:
         -------
         verdict : str
             ``"certified"``, ``"not_certified"`` or ``"inconclusive"``
-            (:func:`stringstab.certify.continuous.check`).
+            (:func:`stringstab.certify.api.check`).
         stable : bool
             Internally stable (every member of the box, for a box).
         witnesses : list of (Member, float)
             The witness, if its frequency is finite; the box's centre stands in for a member the
             certificate does not report.
         """
-        from ..certify.continuous import check
+        from ..certify.api import check
 
         b = self.box
         c = check(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
@@ -395,10 +395,10 @@ class Loop:
         Returns
         -------
         Certificate
-            :func:`stringstab.certify.continuous.certify` on this loop (point or box, continuous or
+            :func:`stringstab.certify.api.certify` on this loop (point or box, continuous or
             sampled).
         """
-        from ..certify.continuous import certify
+        from ..certify.api import certify
 
         b = self.box
         return certify(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,

@@ -224,7 +224,7 @@ def predict(k0: Array, pred: list[float], omegas: list[float], *, params: Params
         :func:`stringstab.certify.criteria.hurwitz_gradients`) ≥ m.
     check : callable
         ``check(K) -> (verdict, internally stable, witness frequency)``: the exact certificate
-        of K (:func:`stringstab.certify.continuous.check`).
+        of K (:func:`stringstab.certify.api.check`).
 
     Returns
     -------

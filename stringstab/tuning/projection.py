@@ -3,7 +3,7 @@
 :func:`project` (and the stateful :class:`Projector`, for a control loop) solves
 min ‖K − K0‖_W subject to the internal-stability conditions with a margin and the exact
 frequency condition g(ω_j; K) ≥ ε on a finite set of frequencies, refined by exchange until
-the exact certificate (:func:`stringstab.certify.continuous.check`) certifies; first, the Newton
+the exact certificate (:func:`stringstab.certify.api.check`) certifies; first, the Newton
 predictor of :mod:`stringstab.tuning.predictor` answers without IPOPT when it can.  The NLP's
 constraints are the generated Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
 and g (:func:`stringstab.certify.margin.casadi_g`).
@@ -91,7 +91,7 @@ def project(
     repaired gains (the dip of g at the nearest point of the linearised
     constraint, followed twice; each also at 0.98 and 1.02 times itself).  It
     is refined by *exchange*: after each solve the exact certificate
-    (:func:`stringstab.certify.continuous.check`) is asked; if it does not certify
+    (:func:`stringstab.certify.api.check`) is asked; if it does not certify
     K, its witness frequency (where |Γ(jω)| > 1) and the local minima of
     g(·; K) below 0 found by a dense scan are added, each with neighbours at
     ±5 %.  The loop ends when the certificate certifies K, when nothing new

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify.continuous import certify, check
+from ..certify.api import certify, check
 from ..certify.grid import certified_lattice
 from ..certify.screen import surely_uncertifiable
 from ..certify.screen import violating_dips as screen_dips
@@ -113,8 +113,8 @@ class Projector:
       over: along a trajectory that set grows and slows every later solve).
 
     Every output reported certified has been certified by the exact
-    certificate, :func:`stringstab.certify.continuous.check` (the verdicts of
-    :func:`~stringstab.certify.continuous.certify` without its reporting extras; a
+    certificate, :func:`stringstab.certify.api.check` (the verdicts of
+    :func:`~stringstab.certify.api.certify` without its reporting extras; a
     cache hit returns gains that were).
 
     Parameters
@@ -221,7 +221,7 @@ class Projector:
                                 eps=self.eps)
 
     def _check(self, K: Array) -> tuple[str, bool, float]:
-        """The exact certificate's verdict on K (:func:`stringstab.certify.continuous.check`).
+        """The exact certificate's verdict on K (:func:`stringstab.certify.api.check`).
 
         Returns (verdict, internally stable, witness frequency: where the
         smallest g(ω) was found; |Γ(jω)| > 1 there when K is internally stable

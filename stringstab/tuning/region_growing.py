@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from ..certify.continuous import certify
+from ..certify.api import certify
 from ..certify.criteria import TYPE_NAMES, hurwitz, taylor_criteria
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError

@@ -267,10 +267,10 @@ class VerdictAndGain:
     """What a :class:`TuneResult` reports of the exact certificate: verdict and sup |Γ|.
 
     Built from a full :class:`~stringstab.certify.continuous.Certificate` or, in the
-    projection's fast path, from :func:`stringstab.certify.continuous.check` (the same
+    projection's fast path, from :func:`stringstab.certify.api.check` (the same
     sound decision without the reporting extras).  A certified triple has
     ‖Γ‖_{H∞} = 1 exactly (Γ(0) = 1 and |Γ(jω)| ≤ 1), which is what
-    :func:`~stringstab.certify.continuous.certify` reports for it too, so no peak
+    :func:`~stringstab.certify.api.certify` reports for it too, so no peak
     search is needed; for any other verdict the full certificate is computed.
     """
 
@@ -300,7 +300,7 @@ class VerdictAndGain:
         return cls(verdicts.Verdict(cert.verdict), float(cert.sup_gain))
 
 
-#: What a triple that :func:`stringstab.certify.continuous.check` certified reports: certified,
+#: What a triple that :func:`stringstab.certify.api.check` certified reports: certified,
 #: and ‖Γ‖_H∞ = 1 (see :class:`VerdictAndGain`).
 CERTIFIED_BY_CHECK = VerdictAndGain(verdicts.Verdict.CERTIFIED, 1.0)
 

@@ -1,0 +1,490 @@
+"""The one way in to the certificates: :func:`certify`, :func:`certify_batch`, :func:`check`.
+
+Whatever the caller gives — gains as numbers or arrays, τ, δ, T* as numbers, ``(lo, hi)``
+pairs or ``"LO:HI"`` strings, a sample time or none — is checked and normalised here,
+*once*: :meth:`Loop.of` turns τ, δ, T*, the sample time and the predecessor's lag into a
+:class:`Loop` (point :class:`~stringstab.params.Params` or a :class:`~stringstab.params.Box`,
+the sample time H or None) and decides which certificate answers, :attr:`Loop.kind`:
+
+* ``"continuous"`` — point parameters, no sample time
+  (:mod:`stringstab.certify.continuous`);
+* ``"sampled"`` — point parameters and a sample time (:mod:`stringstab.certify.sampled`);
+* ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`).
+
+The gains are broadcast, checked finite and within range, and flattened once
+(:func:`gains`).  The kernels of the three certificates (``certify_kernel`` and
+``check_kernel`` of :mod:`~stringstab.certify.continuous`, :mod:`~stringstab.certify.sampled`
+and :mod:`~stringstab.certify.robust`) are then called with these arrays and checked values
+and check nothing again.  The command line builds its :class:`Loop` from
+the values it has already checked (with its own flag names in the messages) and asks it
+directly (:meth:`Loop.certify_batch`), so a parameter is checked once on every path.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Literal, overload
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import StringStabError
+from ..params import Box, Params, as_gains, parameter_model, positive
+from ..params import sample_time as checked_sample_time
+from . import continuous
+from .continuous import Certificate, CertificateBatch
+from .verdicts import Check, one_triple
+
+if TYPE_CHECKING:
+    from .robust import RobustCertificate, RobustCertificateBatch
+    from .sampled import SampledCertificate, SampledCertificateBatch
+
+__all__ = ["Loop", "LoopKind", "certify", "certify_batch", "check", "gains"]
+
+Array = npt.NDArray[np.float64]
+#: Which certificate answers: the continuous-time loop, the sampled-data loop, or a box.
+LoopKind = Literal["continuous", "sampled", "robust"]
+#: The methods of :func:`certify_batch`: the exact certificate, or it plus the Padé cross-check.
+METHODS = ("exact", "pade")
+
+
+def gains(k_x: Any, k_v: Any, k_a: Any) -> tuple[Array, Array, Array]:
+    """The gains broadcast, checked and flattened: what every kernel takes.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), broadcast together.
+
+    Returns
+    -------
+    k_x, k_v, k_a : ndarray of float64
+        One-dimensional, contiguous, finite, of one length.
+
+    Raises
+    ------
+    StringStabError
+        On non-numeric, non-broadcastable, non-finite or out-of-range gains
+        (:func:`stringstab.params.as_gains`).
+    """
+    kx, kv, ka = as_gains(k_x, k_v, k_a)
+    return (np.ascontiguousarray(kx, dtype=float).ravel(),
+            np.ascontiguousarray(kv, dtype=float).ravel(),
+            np.ascontiguousarray(ka, dtype=float).ravel())
+
+
+@dataclass(frozen=True)
+class Loop:
+    """The loop to certify, checked: parameters, sample time, and so which certificate.
+
+    Build it with :meth:`Loop.of` from what a caller gives (every value checked there), or
+    directly from values already checked (a :class:`~stringstab.params.Params` or
+    :class:`~stringstab.params.Box` is checked on construction; ``sample_time`` by
+    :func:`stringstab.params.sample_time` or the command line's own check).  Construction
+    refuses the combinations no certificate answers (``tau_prev`` without a sampled point
+    loop, ``method="pade"`` beyond the continuous point loop), so every :class:`Loop` can be
+    certified.
+
+    Attributes
+    ----------
+    model : Params or Box
+        τ, δ, T* (a point) or their box.
+    sample_time : float or None
+        The sampling period H (s) of the sampled-data loop; None for continuous time.
+    tau_prev : float or None
+        The predecessor's lag (s), sampled point loop only (None: τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently.
+    method : {"exact", "pade"}
+        ``"pade"`` adds python-control's cross-check (continuous point loop only).
+    """
+
+    model: Params | Box
+    sample_time: float | None = None
+    tau_prev: float | None = None
+    heterogeneous: bool = True
+    method: str = "exact"
+
+    def __post_init__(self) -> None:
+        box, H = isinstance(self.model, Box), self.sample_time
+        if self.tau_prev is not None and (H is None or box):
+            raise StringStabError(
+                "tau_prev (the predecessor's lag) is for the sampled loop at point parameters; "
+                f"got it with {'a box' if box else 'sample_time=None'}")
+        if self.method not in METHODS:
+            raise StringStabError(f"method must be 'exact' or 'pade'; got {self.method!r}")
+        if self.method == "pade" and (H is not None or box):
+            raise StringStabError(
+                "method='pade' (python-control's cross-check) is for the continuous loop at one "
+                f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
+
+    @classmethod
+    def of(cls, tau: Any, delta: Any, headway: Any, sample_time: Any = None,
+           tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact") -> Loop:
+        """The loop a caller asks for, every value checked (the one place they are).
+
+        Parameters
+        ----------
+        tau, delta, headway : float, (lo, hi) or "LO:HI"
+            τ > 0, δ ≥ 0, T* ≥ 0 (s): numbers make a point, any interval a box
+            (:func:`stringstab.params.parameter_model`).
+        sample_time : float, optional
+            H > 0 (s) for the sampled-data loop.
+        tau_prev : float, optional
+            The predecessor's lag (s), > 0; sampled point loop only.
+        heterogeneous : bool
+            Sampled box only: independent predecessor lag.
+        method : {"exact", "pade"}
+            The method of :func:`certify_batch`.
+
+        Returns
+        -------
+        Loop
+
+        Raises
+        ------
+        StringStabError
+            On a value out of its range or a malformed interval, or a combination no
+            certificate answers.
+
+        Examples
+        --------
+        >>> Loop.of(0.1, 0.2, 1.1, sample_time=0.1).kind
+        'sampled'
+        >>> Loop.of("0.1:0.3", 0.2, 1.1).kind
+        'robust'
+        """
+        model = parameter_model(tau, delta, headway)
+        H = None if sample_time is None else checked_sample_time(sample_time)
+        loop = cls(model, H, tau_prev, heterogeneous, method)
+        if tau_prev is None:
+            return loop
+        tp = positive("tau_prev (predecessor's actuator lag)", tau_prev, unit=" s")
+        return dataclasses.replace(loop, tau_prev=tp)
+
+    @property
+    def predecessor_lag(self) -> float:
+        """The predecessor's lag τ_p (s) of a sampled point loop: ``tau_prev``, or τ."""
+        if isinstance(self.model, Box):
+            raise StringStabError("a box of parameters has no single predecessor lag")
+        return self.model.tau if self.tau_prev is None else self.tau_prev
+
+    @property
+    def kind(self) -> LoopKind:
+        """Which certificate answers: ``"continuous"``, ``"sampled"`` or ``"robust"``."""
+        if isinstance(self.model, Box):
+            return "robust"
+        return "continuous" if self.sample_time is None else "sampled"
+
+    def certify_batch(
+        self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *, pade_order: int = 5,
+        progress: bool = False, chunk: int = 4096, n_grid: int | None = None,
+        max_rounds: int = 30, max_intervals: int = 1024,
+    ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+        """Certify many gain triples on this loop (:func:`certify_batch` with a checked loop).
+
+        Parameters
+        ----------
+        k_x, k_v, k_a : array_like
+            Gains, broadcast together and flattened (checked here, once).
+        pade_order, progress, chunk, n_grid, max_rounds, max_intervals
+            As for :func:`certify_batch`.
+
+        Returns
+        -------
+        CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
+            By :attr:`kind`.
+        """
+        return _certify(self, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
+                        chunk=chunk, n_grid=n_grid, max_rounds=max_rounds,
+                        max_intervals=max_intervals)
+
+    def check(
+        self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *,
+        n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    ) -> Check:
+        """The verdicts alone on this loop (:func:`check` with a checked loop).
+
+        Parameters
+        ----------
+        k_x, k_v, k_a : array_like
+            Gains, broadcast together and flattened (checked here, once).
+        n_grid, max_rounds, max_intervals : int
+            As for :func:`certify_batch`.
+
+        Returns
+        -------
+        Check
+            By :attr:`kind` (:class:`stringstab.certify.sampled.SampledCheck` when sampled).
+        """
+        return _check(self, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
+                      max_intervals=max_intervals)
+
+
+# ---------------------------------------------------------------------------
+# The dispatch: checked loop and gains in, the kernel of the loop's kind called
+# ---------------------------------------------------------------------------
+def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
+           max_rounds: int, max_intervals: int) -> Check:
+    model, H = loop.model, loop.sample_time
+    if isinstance(model, Box):
+        from . import robust
+
+        return robust.check_of(robust.certify_kernel(
+            kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals))
+    if H is not None:
+        from . import sampled
+
+        return sampled.check_kernel(kx, kv, ka, model, H, loop.predecessor_lag, n_grid=n_grid,
+                                    max_rounds=max_rounds, max_intervals=max_intervals)
+    return continuous.check_kernel(kx, kv, ka, model, n_grid=n_grid or 64,
+                                   max_rounds=max_rounds, max_intervals=max_intervals)
+
+
+def _certify(
+    loop: Loop, kx: Array, kv: Array, ka: Array, *, pade_order: int, progress: bool, chunk: int,
+    n_grid: int | None, max_rounds: int, max_intervals: int,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    model, H = loop.model, loop.sample_time
+    if isinstance(model, Box):
+        from . import robust
+
+        return robust.certify_kernel(
+            kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, progress=progress,
+            chunk=chunk, n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    if H is not None:
+        from . import sampled
+
+        return sampled.certify_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, progress=progress, chunk=chunk,
+            n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    batch = continuous.certify_kernel(kx, kv, ka, model, progress=progress, chunk=chunk,
+                                      n_grid=n_grid or 64, max_rounds=max_rounds,
+                                      max_intervals=max_intervals)
+    if loop.method == "pade":
+        from .pade import cross_check
+
+        # warn at the caller of certify_batch (or of Loop.certify_batch)
+        return cross_check(batch, pade_order, stacklevel=4)
+    return batch
+
+
+# ---------------------------------------------------------------------------
+# The façade's functions
+# ---------------------------------------------------------------------------
+def check(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+) -> Check:
+    """The certificate's verdicts alone, for inner loops (e.g. gain repair).
+
+    The same sound decision as :func:`certify_batch` (same branch and bound, same
+    verdicts) without the reporting extras — no peak search, no Taylor criteria, no pole
+    margins — so one triple costs a fraction of a millisecond in continuous time.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains, broadcast together and flattened.
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.certify.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
+    n_grid, max_rounds, max_intervals : int
+        As for :func:`certify_batch`.
+
+    Returns
+    -------
+    Check
+        With ``sample_time`` and ``witness_theta`` when sampled
+        (:class:`stringstab.certify.sampled.SampledCheck`), and the witness member
+        (``witness_tau``, ``witness_delta``, ...) over a box.
+
+    Examples
+    --------
+    >>> check([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
+    ['certified', 'not_certified']
+    >>> c = check([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2, headway=1.1,
+    ...           sample_time=0.1)
+    >>> c.verdict.tolist(), c.sample_time
+    (['certified', 'not_certified'], 0.1)
+    """
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous)
+    return _check(loop, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
+                  max_intervals=max_intervals)
+
+
+@overload
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: float, delta: float, headway: float, sample_time: None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: None = None, heterogeneous: bool = True,
+) -> CertificateBatch: ...
+
+
+@overload
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
+
+
+def certify_batch(
+    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
+    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
+    method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
+    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    """Certify many gain triples at once (exact delay, sound; see :mod:`stringstab.certify.continuous`).
+
+    With point parameters and no sample time this is the continuous-time certificate of
+    stringstab.certify.continuous; ``sample_time`` certifies the sampled-data loop
+    (:func:`stringstab.certify.sampled.certify_sampled_batch`) and any interval the whole box
+    (:func:`stringstab.certify.robust.certify_robust_batch`), with the same three verdicts.
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : array_like
+        Gains, broadcast together and flattened.
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.certify.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
+    method : {"exact", "pade"}
+        ``"pade"`` additionally runs the python-control cross-check
+        (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
+        verdict is always the exact one (continuous loop, point parameters only).
+    pade_order : int
+        Padé order for the cross-check.
+    progress : bool
+        Show a tqdm progress bar over chunks.
+    chunk : int
+        Triples per vectorised chunk (bounds memory).
+    n_grid, max_rounds, max_intervals : int
+        Initial intervals on [0, Ω] (default 64; sampled: on [0, π], 64 + 8m), refinement
+        rounds, and the cap on undecided intervals *per triple* beyond which that triple is
+        declared inconclusive (per triple, so a verdict never depends on the rest of the
+        batch).
+
+    Returns
+    -------
+    CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
+        The last two carry ``sample_time`` and the parameter box in their columns, rows and
+        summary.
+
+    Raises
+    ------
+    StringStabError
+        On non-finite gains, parameters out of range, a malformed interval (lo > hi, a
+        negative end, τ reaching 0), or a sample time that is not a finite number > 0.
+
+    Examples
+    --------
+    >>> b = certify_batch([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1)
+    >>> b.verdict.tolist()
+    ['certified', 'not_certified']
+    >>> b.summary()["m_fss"]
+    0.5
+    >>> r = certify_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta="0.1:0.3",
+    ...                   headway=1.1)
+    >>> r.verdict.tolist(), r.summary()["box"]["tau"]
+    (['certified', 'not_certified'], [0.1, 0.3])
+    """
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    return _certify(loop, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
+                    chunk=chunk, n_grid=n_grid, max_rounds=max_rounds,
+                    max_intervals=max_intervals)
+
+
+@overload
+def certify(
+    k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
+    sample_time: None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: None = None, heterogeneous: bool = True,
+) -> Certificate: ...
+
+
+@overload
+def certify(
+    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
+    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> Certificate | SampledCertificate | RobustCertificate: ...
+
+
+def certify(
+    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
+    sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
+    tau_prev: float | None = None, heterogeneous: bool = True,
+) -> Certificate | SampledCertificate | RobustCertificate:
+    """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
+
+    Parameters
+    ----------
+    k_x, k_v, k_a : float
+        The gains.
+    tau, delta, headway : float, (lo, hi) or "LO:HI"
+        Actuator lag τ > 0, delay δ ≥ 0, desired headway T* ≥ 0 (seconds).  A number is a
+        point; an interval (a ``(lo, hi)`` pair or a ``"LO:HI"`` string, see
+        :func:`stringstab.params.parameter_model`) asks for the robust certificate over the
+        box of every such member (:mod:`stringstab.certify.robust`).
+    sample_time : float, optional
+        H > 0 (s): certify the sampled-data loop (zero-order hold, every vehicle sampling
+        with period H; :mod:`stringstab.certify.sampled`) instead of the continuous-time one.
+    tau_prev : float, optional
+        Sampled, point parameters only: the predecessor's lag (default τ).
+    heterogeneous : bool
+        Sampled box only: the predecessor's lag ranges over the τ box independently of the
+        follower's (default; a platoon of different vehicles), or equals it.
+    method, pade_order
+        As for :func:`certify_batch`.
+
+    Returns
+    -------
+    Certificate, SampledCertificate or RobustCertificate
+        The continuous, sampled-data or robust certificate of the triple.
+
+    Examples
+    --------
+    >>> c = certify(1.5, 0.3, -0.1, tau=0.1, delta=0.2, headway=1.1)
+    >>> c.verdict, c.sup_gain
+    ('certified', 1.0)
+    >>> c = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
+    >>> c.verdict, c.type, c.taylor_printed["verdict"]
+    ('not_certified', 'IV', 'stable')
+    >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)
+    ('not_certified', 1.0911, 1.379, 0.1379)
+    """
+    one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    return _certify(loop, *gains([k_x], [k_v], [k_a]), pade_order=pade_order, progress=False,
+                    chunk=4096, n_grid=None, max_rounds=30, max_intervals=1024)[0]
