@@ -7,8 +7,10 @@ Prints, for the tree this script sits in:
 * import circles and upward arrows (the graph of ``tests/test_house.py``, lazy imports included);
 * underscored names imported from another module (``from .x import _private``);
 * the places that define the verdict vocabulary ("certified"): module- or class-level
-  assignments whose target is named like a verdict (``CERTIFIED``, ``VERDICTS``, ...) or whose
-  value holds the string ``"certified"``.
+  assignments that spell it out — a verdict word (``"certified"``, ``"not_certified"``,
+  ``"inconclusive"``) as a string literal, or integer codes given to a verdict-named target
+  (``CERTIFIED = 0``, ``_CERT, _NOT, _INC = ...`` of literals).  A heuristic: a column *named*
+  "certified" counts too.
 
 Run: ``python analysis/house_figures.py`` (add ``--json`` for a machine-readable line).
 """
@@ -44,8 +46,19 @@ def _private_imports() -> list[str]:
     return out
 
 
-def _has_certified_literal(node: ast.AST) -> bool:
-    return any(isinstance(n, ast.Constant) and n.value == "certified" for n in ast.walk(node))
+#: The words of the verdict vocabulary.
+VERDICT_WORDS = {"certified", "not_certified", "inconclusive"}
+
+
+def _defines_verdicts(names: list[str], value: ast.AST) -> bool:
+    """An assignment that spells the vocabulary out: a verdict word as a string literal, or a
+    verdict-named target given integer literals (the codes)."""
+    if "__all__" in names:  # lists function names, defines nothing
+        return False
+    if any(isinstance(n, ast.Constant) and n.value in VERDICT_WORDS for n in ast.walk(value)):
+        return True
+    ints = [n for n in ast.walk(value) if isinstance(n, ast.Constant) and type(n.value) is int]
+    return bool(ints) and any(VERDICT_NAME.search(n) for n in names)
 
 
 def _verdict_definitions() -> list[str]:
@@ -55,14 +68,10 @@ def _verdict_definitions() -> list[str]:
         bodies = [tree.body] + [c.body for c in tree.body if isinstance(c, ast.ClassDef)]
         for body in bodies:
             for node in body:
-                if isinstance(node, (ast.Assign, ast.AnnAssign)):
+                if isinstance(node, (ast.Assign, ast.AnnAssign)) and node.value is not None:
                     targets = node.targets if isinstance(node, ast.Assign) else [node.target]
                     names = [n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)]
-                    value = node.value
-                    if value is None:
-                        continue
-                    if any(VERDICT_NAME.search(n) for n in names) or \
-                            _has_certified_literal(value):
+                    if _defines_verdicts(names, node.value):
                         out.append(f"{mod}:{node.lineno} {', '.join(names)}")
     return out
 
