@@ -1,4 +1,4 @@
-"""The certificates: is a gain triple string stable, with the exact delay?
+"""The certificates: whether a gain triple is string stable, with the exact delay.
 
 One way in (:mod:`~stringstab.certify.api`) — :func:`certify` (one triple, the full
 report), :func:`certify_batch` (many triples, one row each) and :func:`check` (the verdict

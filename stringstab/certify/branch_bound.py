@@ -1,9 +1,9 @@
-"""A vectorised one-dimensional branch and bound: is f ≥ 0 on [0, Ω_i] for every item i?
+"""A vectorised one-dimensional branch and bound deciding f_i ≥ 0 on [0, Ω_i] for every item i.
 
 The one engine behind every certificate: continuous time (:mod:`stringstab.certify.continuous`),
-sampled data (:mod:`stringstab.certify.sampled`) and robust (:mod:`stringstab.certify.robust`).  Each item i (a gain triple, or a gain triple and a cell of
-uncertain parameters) has a function f_i on [0, Ω_i] that the caller can evaluate at any
-points, returning for each point
+sampled data (:mod:`stringstab.certify.sampled`) and robust (:mod:`stringstab.certify.robust`).
+Each item i (a gain triple, or a gain triple and a cell of uncertain parameters) has a
+function f_i on [0, Ω_i] that the caller can evaluate at any points, returning for each point
 
 * a *point value* f_i(x) at one admissible parameter value (used to prove a violation:
   f_i(x) < −slack is a witness),
@@ -101,11 +101,12 @@ _NO_POINTS.setflags(write=False)
 
 
 def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
-    """Item outcomes as verdict codes (:data:`stringstab.certify.verdicts.VERDICTS`): certified 0,
-    violated 1 (not certified), anything else 2 (inconclusive).
+    """Item outcomes of :func:`branch_and_bound` as verdict codes 0, 1, 2.
 
-    CERTIFIED, VIOLATED and INCONCLUSIVE *are* the verdict codes 0, 1, 2 (imported from
-    :mod:`stringstab.certify.verdicts`); only PENDING is mapped (to inconclusive).
+    Certified 0, violated 1 (not certified), anything else 2 (inconclusive): the codes of
+    :data:`stringstab.certify.verdicts.VERDICTS`.  CERTIFIED, VIOLATED and INCONCLUSIVE *are*
+    these codes (imported from :mod:`stringstab.certify.verdicts`); only PENDING is mapped (to
+    inconclusive).
 
     Parameters
     ----------

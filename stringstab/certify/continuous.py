@@ -1,17 +1,17 @@
-"""Exact, delay-aware, sound string-stability certificates for controller gains.
+r"""Exact, delay-aware, sound string-stability certificates for controller gains.
 
 The certificate decides whether ‖Γ‖_{H∞} ≤ 1 for the derived transfer function
 
 .. math::
-    Γ(s) = \\frac{k_x + k_v s + k_a s^2 e^{-δs}}{τs^3 + s^2 + (k_v + T^*k_x)s + k_x}
+    Γ(s) = \frac{k_x + k_v s + k_a s^2 e^{-δs}}{τs^3 + s^2 + (k_v + T^*k_x)s + k_x}
 
 with the *exact* delay (no Padé, no Taylor).  Since the denominator carries no
 delay, Γ is internally stable iff that cubic is Hurwitz; then
 ‖Γ‖_{H∞} = sup_{ω≥0} |Γ(jω)|, and |Γ(jω)| ≤ 1 iff
 
 .. math::
-    g(ω) = \\frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
-         = τ^2ω^4 + aω^2 + b + 2k_xk_a\\cos δω - 2k_vk_a ω\\sin δω \\ge 0 ,
+    g(ω) = \frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
+         = τ^2ω^4 + aω^2 + b + 2k_xk_a\cos δω - 2k_vk_a ω\sin δω \ge 0 ,
 
 (:func:`stringstab.certify.frequency.margin_g`).  The method is a branch and bound on g
 that is sound by construction:

@@ -202,12 +202,11 @@ def hurwitz(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike = 0.0,
     *, tau: float, headway: float, rtol: float = 0.0,
 ) -> npt.NDArray[np.bool_]:
-    """Internal stability of Γ: is τs³ + s² + (k_v + T*k_x)s + k_x Hurwitz?
+    """Internal stability of Γ: whether τs³ + s² + (k_v + T*k_x)s + k_x is Hurwitz.
 
     The conditions, derived by :func:`stringstab.derive.symbolic.hurwitz_conditions`, are
     k_x > 0 and k_v + (T* − τ)k_x > 0 (with τ > 0).  ``rtol`` demands each
     condition exceed ``rtol`` times the scale of its terms (a margin).
-
 
     Parameters
     ----------

@@ -51,13 +51,13 @@ def col(v: Array) -> Array:
 
 def excess_squared(omega: npt.ArrayLike, kx: npt.ArrayLike, kv: npt.ArrayLike, ka: npt.ArrayLike,
                    tau: npt.ArrayLike, delta: npt.ArrayLike, headway: npt.ArrayLike) -> Array:
-    """|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
+    r"""|Γ(jω)|² − 1 = −ω² g(ω)/|D(jω)|², without the cancellation of |N|²/|D|² − 1.
 
     g (:mod:`stringstab.certify.margin`) is evaluated from its coefficients, so an excess of 1e-20,
     which |Γ|² computed directly rounds to exactly 1, keeps its sign and its digits.  Near
     ω = 0, g(ω) = Ψ3 + g₂ω² + O(ω⁴) with g₂ = a − c_x δ²/2 − c_v δ and |D(0)|² = k_x², so
 
-    .. math:: |Γ(jω)|^2 = 1 − \\frac{Ψ_3}{k_x^2} ω^2 − \\frac{g_2 k_x^2 − Ψ_3 d_1}{k_x^4} ω^4 + …
+    .. math:: |Γ(jω)|^2 = 1 − \frac{Ψ_3}{k_x^2} ω^2 − \frac{g_2 k_x^2 − Ψ_3 d_1}{k_x^4} ω^4 + …
 
     (d₁ the ω² coefficient of |D|²): Ψ3 < 0 makes |Γ| > 1 on a neighbourhood of 0.
 

@@ -1,10 +1,10 @@
-"""Vectorised numeric frequency response of Γ(jω) with the exact delay.
+r"""Vectorised numeric frequency response of Γ(jω) with the exact delay.
 
 Direct NumPy evaluation of the derived transfer function (IDL eq 11, derived
 form, see :func:`stringstab.derive.symbolic.gamma`)
 
 .. math::
-    Γ(jω) = \\frac{k_x + k_v jω − k_a ω² e^{−jδω}}
+    Γ(jω) = \frac{k_x + k_v jω − k_a ω² e^{−jδω}}
                  {k_x − ω² + j ω (k_v + T^* k_x − τ ω²)}
 
 from the real and imaginary parts of N(jω) and D(jω) generated from the SymPy
@@ -33,7 +33,6 @@ def gamma_jw(
     *, tau: ArrayLike, delta: ArrayLike, headway: ArrayLike,
 ) -> npt.NDArray[np.complex128]:
     """Γ(jω) with the exact delay e^{−jδω} (IDL eq 11, derived form).
-
 
     Parameters
     ----------

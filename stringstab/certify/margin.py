@@ -1,11 +1,11 @@
-"""The frequency-domain margin g(ω) and everything computed from it: one home.
+r"""The frequency-domain margin g(ω) and everything computed from it: one home.
 
 For the derived transfer function Γ(s) = N(s)/D(s) (IDL eq 11, derived form,
 :func:`stringstab.derive.symbolic.gamma`), |Γ(jω)| ≤ 1 at ω > 0 iff
 
 .. math::
-    g(ω) = \\frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
-         = t_2 ω^4 + a ω^2 + b + c_x \\cos δω - c_v ω \\sin δω \\;\\ge\\; 0,
+    g(ω) = \frac{|D(jω)|^2 - |N(jω)|^2}{ω^2}
+         = t_2 ω^4 + a ω^2 + b + c_x \cos δω - c_v ω \sin δω \;\ge\; 0,
 
 with t₂ = τ², c = k_v + T*k_x, a = 1 − 2τc − k_a², b = c² − 2k_x − k_v²,
 c_x = 2k_xk_a, c_v = 2k_vk_a (g(0) = Ψ3).  Every formula here is *generated* from

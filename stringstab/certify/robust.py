@@ -184,10 +184,17 @@ class RobustCertificateBatch(BatchResult):
         return super().__getitem__(i)  # type: ignore[no-any-return]
 
     def columns(self) -> dict[str, Any]:
-        """The result columns: gains, stability over the box, verdict, sup gain and margin,
-        the ``witness`` group (``tau``, ``tau_prev``, ``delta``, ``headway``, ``omega``,
-        ``theta``), then ``sample_time`` (NaN in continuous time), ``heterogeneous`` (sampled
-        only) and the ``box`` group (``tau_lo``, ``tau_hi``, ...).
+        """The result columns, one row per triple, with the witness and box groups.
+
+        The gains, ``stable`` (over the box), ``verdict``, ``sup_gain``, ``sup_gain_excess``
+        and ``margin``; the ``witness`` group (``tau``, ``tau_prev``, ``delta``, ``headway``,
+        ``omega``, ``theta``); then ``sample_time`` (NaN in continuous time),
+        ``heterogeneous`` (sampled only) and the ``box`` group (``tau_lo``, ``tau_hi``, ...).
+
+        Returns
+        -------
+        dict
+            Column name to ndarray; ``witness`` and ``box`` map to dicts of ndarrays.
 
         Examples
         --------

@@ -1,10 +1,10 @@
-"""The robust certificate of the continuous loop over a box: the exact minimum over the box.
+r"""The robust certificate of the continuous loop over a box: the exact minimum over the box.
 
 The margin of :func:`stringstab.certify.frequency.margin_g` separates:
 
 .. math::
     g(ω) = (τω^2 - c)^2 + (1 - k_a^2)ω^2 - 2k_x - k_v^2
-           + 2k_xk_a\\cos δω - 2k_vk_a ω \\sin δω,\\qquad c = k_v + T^*k_x ,
+           + 2k_xk_a\cos δω - 2k_vk_a ω \sin δω,\qquad c = k_v + T^*k_x ,
 
 so at each ω the minimum over the box is a closed form (:func:`box_margin`,
 :func:`robust_margin`): e = τω² − k_v − T*k_x is affine in (τ, T*), its range over the box

@@ -1,4 +1,4 @@
-"""Sound string-stability certificates for the sampled-data (zero-order hold) loop.
+r"""Sound string-stability certificates for the sampled-data (zero-order hold) loop.
 
 Every vehicle samples synchronously with period H (``sample_time``), holds its command
 over the period and has the actuator lag τ; the delayed predecessor acceleration
@@ -11,8 +11,8 @@ as H → 0 in the interval arithmetic of :mod:`stringstab.certify.interval`.
 **The margin.**  On the unit circle z = e^{jθ}, |H(e^{jθ})| ≤ 1 iff
 
 .. math::
-    g_H(θ) = P(ρ) + \\cos(mθ)\\,Y_r(ρ) + \\sin(mθ)\\sin θ\\,Y_i(ρ) \\;\\ge 0,
-    \\qquad ρ = 4\\sin^2(θ/2),
+    g_H(θ) = P(ρ) + \cos(mθ)\,Y_r(ρ) + \sin(mθ)\sin θ\,Y_i(ρ) \;\ge 0,
+    \qquad ρ = 4\sin^2(θ/2),
 
 (:func:`sampled_margin`, :mod:`stringstab.certify.sampled_frequency`), the analogue of the
 continuous margin g; g_H(ωH) → g(ω) of :func:`stringstab.certify.frequency.margin_g` as
@@ -127,8 +127,10 @@ def _bnb_points(
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SampledCheck(Check):
-    """Verdicts only (see :func:`check_sampled`): a :class:`~stringstab.certify.verdicts.Check` whose
-    ``hurwitz`` is Schur stability of Δ(z), with ``sample_time`` and ``witness_theta``.
+    """The verdicts of the sampled certificate alone (see :func:`check_sampled`).
+
+    A :class:`~stringstab.certify.verdicts.Check` whose ``hurwitz`` is Schur stability of
+    Δ(z), with ``sample_time`` and ``witness_theta`` filled.
 
     Attributes
     ----------
@@ -361,10 +363,18 @@ class SampledCertificateBatch(BatchResult):
         return Box.of(self.params)
 
     def columns(self) -> dict[str, Any]:
-        """The result columns: gains, Schur stability, verdict, peak (ω and θ), margin, then
-        ``sample_time``, ``tau_prev`` and the ``box`` group (``tau_lo``, ``tau_hi``, ...).
+        """The result columns, one row per triple, with the (point) box group.
 
-        Non-finite numbers stay as they are (``sup_gain`` is ``inf`` when Δ is not Schur).
+        The gains, ``schur``, ``spectral_radius``, ``verdict``, ``sup_gain``,
+        ``sup_gain_excess``, ``linf_gain``, the peak (``peak_omega``, ``peak_theta``) and
+        ``margin``; then ``sample_time``, ``tau_prev`` and the ``box`` group (``tau_lo``,
+        ``tau_hi``, ...).  Non-finite numbers stay as they are (``sup_gain`` is ``inf`` when Δ
+        is not Schur).
+
+        Returns
+        -------
+        dict
+            Column name to ndarray; ``box`` maps to a dict of ndarrays.
 
         Examples
         --------

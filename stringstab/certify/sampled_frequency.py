@@ -1,11 +1,11 @@
-"""The sampled loop on the unit circle: H(e^{jθ}) and the margin g_H(θ), with its bounds.
+r"""The sampled loop on the unit circle: H(e^{jθ}) and the margin g_H(θ), with its bounds.
 
 On z = e^{jθ}, with ρ = |w|² = 4 sin²(θ/2) and w² = −ρz (w = z − 1), |H(e^{jθ})| ≤ 1 iff
 
 .. math::
-    g_H(θ) = \\frac{τ^2 τ_p^2}{H^6}\\,
-             \\frac{φ_{1p}^2|Δ|^2 - φ_1^2|n + z^{-(m+1)}k_a w^2\\ell|^2}{ρ}
-           = P(ρ) + \\cos(mθ)\\,Y_r(ρ) + \\sin(mθ)\\sin θ\\,Y_i(ρ) \\;\\ge 0,
+    g_H(θ) = \frac{τ^2 τ_p^2}{H^6}\,
+             \frac{φ_{1p}^2|Δ|^2 - φ_1^2|n + z^{-(m+1)}k_a w^2\ell|^2}{ρ}
+           = P(ρ) + \cos(mθ)\,Y_r(ρ) + \sin(mθ)\sin θ\,Y_i(ρ) \;\ge 0,
 
 with the coefficients of :mod:`stringstab.certify.zoh`.  The normalisation makes
 g_H(ωH) → g(ω) of :func:`stringstab.certify.frequency.margin_g` as H → 0.  This module

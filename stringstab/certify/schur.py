@@ -1,4 +1,4 @@
-"""Internal stability of the sampled loop: is Δ(z) Schur?
+"""Internal stability of the sampled loop: whether Δ(z) is Schur.
 
 The characteristic polynomial of the follower's sampled loop (:mod:`stringstab.certify.zoh`),
 in w = z − 1, is Δ = w³ + δ2 w² + δ1 w + δ0; it depends on k_x, k_v, τ, T* and H only (not
@@ -108,7 +108,7 @@ def _loop_delta(k_x: Any, k_v: Any, tau: Any, headway: Any,
 def schur(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, *, tau: float, headway: float, sample_time: float,
 ) -> npt.NDArray[np.bool_]:
-    """Internal stability of the sampled loop: is Δ(z) Schur (all roots inside |z| < 1)?
+    """Internal stability of the sampled loop: whether Δ(z) is Schur (all roots inside |z| < 1).
 
     Decided by the bilinear conditions (:func:`stringstab.derive.sampled_symbolic.schur_conditions`)
     in the w-form; True only outside a relative 10⁻¹² band around the boundary.  Δ does not

@@ -1,4 +1,4 @@
-"""The zero-order-hold discretisation of the loop: the coefficients of H(z) and of g_H.
+r"""The zero-order-hold discretisation of the loop: the coefficients of H(z) and of g_H.
 
 Every vehicle samples synchronously with period H, holds its command over the period and
 has the actuator lag τ; the delayed predecessor acceleration a_{i−1}(kH − δ) is exact for
@@ -7,7 +7,7 @@ predecessor's acceleration samples to the follower's, derived symbolically by
 :mod:`stringstab.derive.sampled_symbolic`, is in w = z − 1
 
 .. math::
-    H(z) = \\frac{φ_1}{φ_{1p}}\\,\\frac{n(w) + z^{-(m+1)} k_a w^2 \\ell(w)}{Δ(w)}
+    H(z) = \frac{φ_1}{φ_{1p}}\,\frac{n(w) + z^{-(m+1)} k_a w^2 \ell(w)}{Δ(w)}
 
 with Δ = w³ + δ2 w² + δ1 w + δ0, n = ν2 w² + ν1 w + ν0, ℓ = φ_{1p} + (1 − C) w and
 

@@ -233,8 +233,12 @@ def _check_axes(
 
 def _check_methods(methods: str | Sequence[str] | None, continuous_point: bool,
                    sampled: bool) -> tuple[str, ...]:
-    """The methods, checked against the loop: the Taylor criteria need the continuous loop at
-    one τ, δ, T*; ``continuous`` (the comparison) needs a sampled map."""
+    """The methods to evaluate, checked against the loop.
+
+    The Taylor criteria (``taylor``, ``printed``) need the continuous loop at one τ, δ, T*;
+    ``continuous`` (the comparison) needs a sampled map; a sampled or robust map must include
+    ``exact``.  None means every method at a continuous point, else ``("exact",)``.
+    """
     if methods is None:
         return METHODS if continuous_point else ("exact",)
     ms = tuple(m.strip() for m in methods.split(",")) if isinstance(methods, str) else tuple(methods)

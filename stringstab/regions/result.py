@@ -456,9 +456,11 @@ class RegionMap:
         return len(self._categorical_columns())
 
     def _categorical_columns(self) -> dict[str, Any]:
-        """:meth:`columns` with the grid coordinates and the labels as
-        :class:`~stringstab.io.Categorical` (codes into a few distinct values): what the CSV
-        writer formats fastest."""
+        """:meth:`columns` with the coordinates and labels as :class:`~stringstab.io.Categorical`.
+
+        Categorical columns are codes into a few distinct values: what the CSV writer formats
+        fastest.
+        """
         cached = self.__dict__.get("_categorical")
         if cached is not None:
             return dict(cached)

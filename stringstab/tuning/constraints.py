@@ -188,8 +188,16 @@ class Loop:
                                                              sorted(set(self.box.headway)))]
 
     def first_members(self) -> list[Member]:
-        """Members whose margins are constrained in the first solve: the corners of the box
-        (every τ, δ, T* end; τ_p = τ) and its centre (a point: the point)."""
+        """Members whose margins are constrained in the first solve: the box's corners and centre.
+
+        The corners take every end of τ, δ and T* (with τ_p = τ); for a point, the one member
+        is the point itself.
+
+        Returns
+        -------
+        list of Member
+            Sorted by τ, δ, T*.
+        """
         out = {self.centre()}
         for t, d, h in product(*(sorted(set(iv)) for iv in (self.box.tau, self.box.delta,
                                                              self.box.headway))):
@@ -197,8 +205,16 @@ class Loop:
         return sorted(out, key=lambda m: (m.tau, m.delta, m.headway))
 
     def extreme_members(self) -> list[Member]:
-        """Every corner of the box, with the predecessor's lag at either end of the τ box too
-        when sampled and heterogeneous (where a box's worst member usually is)."""
+        """Every corner of the box, where a box's worst member usually is.
+
+        Every end of τ, δ and T*; when sampled and heterogeneous, the predecessor's lag τ_p
+        also takes either end of the τ box independently (otherwise τ_p = τ).
+
+        Returns
+        -------
+        list of Member
+            The corners (8, or 16 when τ_p is free; fewer when an interval is a point).
+        """
         ends = [sorted(set(iv)) for iv in (self.box.tau, self.box.delta, self.box.headway)]
         tp_free = self.sampled and self.heterogeneous
         out = []
@@ -208,8 +224,10 @@ class Loop:
 
     # ------------------------------------------------------------------ the one homes
     def margin(self, member: Member, freq: Array, K: Array) -> Array:
-        """g (or g_H) at ``member`` on frequencies ``freq`` for the gains K (3,): from the one
-        home of each margin (:func:`stringstab.certify.margin.g`, :func:`stringstab.certify.sampled.sampled_margin`).
+        """The margin g (or g_H, sampled) at ``member`` on frequencies ``freq`` for the gains K.
+
+        Taken from the one home of each margin (:func:`stringstab.certify.margin.g`,
+        :func:`stringstab.certify.sampled.sampled_margin`).
 
         Parameters
         ----------
@@ -262,8 +280,9 @@ class Loop:
         return Slot("margin", member, float(freq), 0, form)
 
     def stability_slots(self, member: Member) -> list[Slot]:
-        """Internal stability at ``member``: the Hurwitz conditions (continuous) or the
-        normalised Schur conditions (sampled), each a quadratic form in K.
+        """Internal stability at ``member``, as constraints that are quadratic forms in K.
+
+        The Hurwitz conditions (continuous) or the normalised Schur conditions (sampled).
 
         Parameters
         ----------
@@ -273,8 +292,9 @@ class Loop:
         Returns
         -------
         list of Slot
-            Kind ``"stability"``: two Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
-            or five Schur conditions (:func:`stringstab.certify.sampled.schur_margins`), ``index`` 0, 1, ….
+            Kind ``"stability"``: two Hurwitz conditions
+            (:func:`stringstab.certify.criteria.hurwitz_conditions`) or five Schur conditions
+            (:func:`stringstab.certify.sampled.schur_margins`), ``index`` 0, 1, ….
         """
         def conditions(x: Array, v: Array, a: Array) -> Array:
             if not self.sampled:
@@ -293,8 +313,17 @@ class Loop:
 
     # ------------------------------------------------------------------ frequencies
     def ladder(self) -> list[float]:
-        """Fixed frequencies of the first solve: 0, 16 from 0.2 to 5 rad/s (geometric) and,
-        sampled, up to 10 rad/s and π rad/sample (θ = ωH)."""
+        """Fixed frequencies of the first solve.
+
+        Continuous: 0 and 16 frequencies from 0.2 to 5 rad/s (geometric).  Sampled: as θ = ωH
+        (rad/sample), 0, the same 16 and 3 more from 6 to 10 rad/s (geometric), each capped at
+        π, and π itself, without duplicates.
+
+        Returns
+        -------
+        list of float
+            ω (rad/s) or θ (rad/sample), increasing.
+        """
         w = np.geomspace(0.2, 5.0, 16)
         if not self.sampled:
             return [0.0, *w.tolist()]
@@ -302,8 +331,9 @@ class Loop:
         return [0.0, *sorted({float(min(t, math.pi)) for t in th} | {math.pi})]
 
     def dips(self, K: Array, member: Member, threshold: float, n: int = 384) -> list[float]:
-        """Local minima of the margin at ``member`` below ``threshold`` (a scan, zoomed): a
-        heuristic to pick frequencies, never a proof.
+        """Local minima of the margin at ``member`` below ``threshold`` (a scan, zoomed).
+
+        A heuristic to pick frequencies, never a proof.
 
         Parameters
         ----------

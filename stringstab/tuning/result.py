@@ -185,8 +185,14 @@ class TuneResults:
                 for i, r in enumerate(self.results)]
 
     def summary(self) -> dict[str, dict[str, Any]]:
-        """Per method: how many outputs, certified, repaired, unchanged, not certified, and the
-        median distance moved by the repaired ones."""
+        """Per-method counts of the outcomes and the median distance the repaired gains moved.
+
+        Returns
+        -------
+        dict of str to dict
+            For each method: ``n`` (outputs), ``certified``, ``repaired``, ``unchanged``,
+            ``not_certified`` and ``median_distance_moved`` (0.0 when none was repaired).
+        """
         out: dict[str, dict[str, Any]] = {}
         methods = self.methods or tuple(dict.fromkeys(r.method for r in self.results))
         for m in methods:
