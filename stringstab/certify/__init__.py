@@ -6,7 +6,13 @@ only, for inner loops) — checks the arguments once and chooses the certificate
 (:class:`~stringstab.certify.api.Loop`): the continuous loop
 (:mod:`~stringstab.certify.continuous`), the sampled-data loop when a sample time is given
 (:mod:`~stringstab.certify.sampled`), or a box of parameters when τ, δ or T* is an interval
-(:mod:`~stringstab.certify.robust`).  Every certificate answers with the verdicts of
+(:mod:`~stringstab.certify.robust`, with :mod:`~stringstab.certify.robust_continuous` and
+:mod:`~stringstab.certify.robust_sampled`).  The sampled-data loop is built from the ZOH
+discretisation (:mod:`~stringstab.certify.zoh`), the Schur test
+(:mod:`~stringstab.certify.schur`), H(e^{jθ}) and its margin
+(:mod:`~stringstab.certify.sampled_frequency`, :mod:`~stringstab.certify.sampled_excess`), on
+the interval arithmetic the robust boxes share (:mod:`~stringstab.certify.interval`).  Every
+certificate answers with the verdicts of
 :mod:`~stringstab.certify.verdicts` and is sound by construction: "certified" means
 internally stable and ‖Γ‖_H∞ ≤ 1 with the exact delay.
 
