@@ -60,7 +60,11 @@ def test_symbolic_H_equals_direct_construction(kx, kv, ka, tau, tp, H, d, h):
     n0, n1, den = f(kx, kv, ka, tau, d, h, H, tp, eps, z, m)
     ours = (n0 + z ** (-(m + 1)) * n1) / den
     truth = pair_response(th, kx, kv, ka, tau, d, h, H, tau_prev=tp)
-    assert_allclose(ours, truth, rtol=1e-8, atol=1e-10)
+    # near a pole on the unit circle (k_x = 0 puts one at z = 1, so den(e^{jθ}) ~ θ² at
+    # θ = 1e-3) both sides lose digits as ~1e-15/|den|: the tolerance says so, and stays 1e-8
+    # wherever |den| > 1e-6
+    rtol = 1e-8 + 1e-14 / np.abs(den)
+    assert np.all(np.abs(ours - truth) <= rtol * np.abs(truth) + 1e-10), (ours, truth, den)
 
 
 @given(kx=gain, kv=gain, ka=gain, tau=lag, tp=lag, H=period, d=delay, h=hw)
