@@ -288,3 +288,27 @@ def test_unevaluated_method_is_an_error(slice_map):
         m.classes("exact")
     with pytest.raises(StringStabError, match="3-D"):
         slice_map.slice("k_x", 0.0)
+
+
+@pytest.mark.parametrize("damage", ["not json", "missing methods", "missing array"])
+def test_load_npz_refuses_a_damaged_map_in_one_line(tmp_path, damage):
+    import json
+
+    rmap = region_map({"k_x": np.linspace(0.1, 2, 5), "k_v": np.linspace(-1, 1, 5)}, {"k_a": 0.5},
+                      **P)
+    good = tmp_path / "good.npz"
+    rmap.save_npz(good)
+    with np.load(good, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+    meta = json.loads(str(data["metadata"]))
+    if damage == "not json":
+        data["metadata"] = np.array("{not json")
+    elif damage == "missing methods":
+        del meta["methods"]
+        data["metadata"] = np.array(json.dumps(meta))
+    else:
+        del data["verdict_exact"]
+    bad = tmp_path / "bad.npz"
+    np.savez(bad, **data)
+    with pytest.raises(StringStabError, match=r"bad\.npz: expected"):
+        load_npz(bad)

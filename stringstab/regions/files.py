@@ -97,9 +97,14 @@ def read_npz(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np
         raise StringStabError(f"{path}: expected a region-map NPZ file; could not read it ({e})") from e
     if "metadata" not in data:
         raise StringStabError(f"{path}: expected a region-map NPZ with a 'metadata' entry; found {sorted(data)}")
-    meta = json.loads(str(data["metadata"]))
-    if meta.get("format") != FORMAT:
-        raise StringStabError(f"{path}: expected format {FORMAT!r}; found {meta.get('format')!r}")
+    try:
+        meta = json.loads(str(data["metadata"]))
+    except ValueError as e:
+        raise StringStabError(f"{path}: expected JSON in the 'metadata' entry of a region-map NPZ; "
+                              f"could not decode it ({e})") from e
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        found = meta.get("format") if isinstance(meta, dict) else type(meta).__name__
+        raise StringStabError(f"{path}: expected format {FORMAT!r}; found {found!r}")
     return meta, data
 
 

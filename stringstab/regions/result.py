@@ -591,6 +591,14 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
         If the file is not a stringstab region map.
     """
     meta, data = read_npz(path)
+    need = ("methods", "params", "axes", "fixed", "stringstab_version")
+    missing = [k for k in need if k not in meta]
+    arrays = ["hurwitz", *(f"axis_{n}" for n in meta.get("axes", ())),
+              *(f"verdict_{m}" for m in meta.get("methods", ()))]
+    missing += [k for k in arrays if k not in data]
+    if missing:
+        raise StringStabError(f"{path}: expected a region map with {', '.join(missing)}; "
+                              f"found metadata keys {sorted(meta)} and arrays {sorted(data)}")
     methods = tuple(meta["methods"])
     p = meta["params"]
     params: Params | Box = (Box(*(tuple(p[k]) for k in ("tau", "delta", "headway")))
