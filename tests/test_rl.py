@@ -649,3 +649,17 @@ def test_a_loaded_policy_repairs_as_training_did_and_missing_keys_are_refused(tm
     info = {k: v for k, v in pol.info.items() if k != "gain_rate"}
     with pytest.raises(StringStabError, match="expected key 'gain_rate' in policy info"):
         type(pol)(pol.actor, info)
+
+
+def test_replay_buffer_refuses_a_checkpoint_missing_a_key_or_an_array():
+    pytest.importorskip("torch")
+    from stringstab.rl.buffer import ReplayBuffer
+
+    buf = ReplayBuffer(8, obs_dim=3, act_dim=2, seed=0)
+    state, arrays = buf.state(), buf.arrays()
+    fresh = ReplayBuffer(8, obs_dim=3, act_dim=2, seed=0)
+    fresh.load_state(state, arrays)  # the round trip works
+    with pytest.raises(StringStabError, match=r"replay buffer: expected rng in the checkpoint"):
+        fresh.load_state({k: v for k, v in state.items() if k != "rng"}, arrays)
+    with pytest.raises(StringStabError, match=r"replay buffer: expected dones in the checkpoint"):
+        fresh.load_state(state, {k: v for k, v in arrays.items() if k != "dones"})

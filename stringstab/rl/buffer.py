@@ -125,8 +125,13 @@ class ReplayBuffer:
         Raises
         ------
         StringStabError
-            If the capacity differs or an array has another shape.
+            If a key or an array is missing, the capacity differs or an array has another shape.
         """
+        missing = [k for k in ("capacity", "pos", "size", "rng") if k not in state]
+        missing += [f for f in _FIELDS if f not in arrays]
+        if missing:
+            raise StringStabError(f"replay buffer: expected {', '.join(missing)} in the checkpoint; "
+                                  f"found state keys {sorted(state)} and arrays {sorted(arrays)}")
         size = int(state["size"])
         if int(state["capacity"]) != self.capacity or not 0 <= size <= self.capacity:
             raise StringStabError(
