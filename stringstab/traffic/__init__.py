@@ -27,7 +27,8 @@ from .controllers import (
     TimeVaryingLinearController,
     linear_law,
 )
-from .env import SCALES, BatchedCarFollowingEnv, CarFollowingEnv, state_vector
+from .dynamics import Platoon
+from .env import BatchedCarFollowingEnv, CarFollowingEnv
 from .leaders import (
     CYCLES,
     SYNTHETIC,
@@ -46,9 +47,12 @@ from .leaders import (
     stop_and_go,
     train_test_split,
 )
+from .limits import Limits, check_leader
 from .output import RUN_FILES, run_document, save_trajectories, write_run
-from .platoon import Limits, Platoon, PlatoonResult, check_leader, simulate
+from .platoon import simulate
+from .result import PlatoonResult
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
+from .state import SCALES, state_vector
 
 __all__ = [
     "CYCLES",
