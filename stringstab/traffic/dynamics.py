@@ -67,7 +67,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
-from .controllers import Observation
+from .controllers.base import Observation
 from .limits import DEFAULT_LENGTH, Limits
 
 __all__ = ["FractionalDelay", "Model", "Platoon", "PositionUpdate"]

@@ -58,7 +58,7 @@ from gymnasium.vector.utils import batch_space
 from ..constants import DT, GAIN_BOUNDS, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from .controllers import DEFAULT_STANDSTILL
+from .controllers.base import DEFAULT_STANDSTILL
 from .cycles import cycle
 from .dynamics import Model
 from .episodes import ActionMode, Episodes

@@ -18,7 +18,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
-from .controllers import Observation, linear_law
+from .controllers.base import Observation
+from .controllers.linear import linear_law
 from .dynamics import Model, Platoon
 from .limits import Limits
 from .loaders import FollowingPair

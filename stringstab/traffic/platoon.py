@@ -21,7 +21,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
-from .controllers import Controller
+from .controllers.base import Controller
 from .dynamics import FractionalDelay, Model, Platoon, PositionUpdate
 from .limits import DEFAULT_LENGTH, Limits, check_leader
 from .result import PlatoonResult

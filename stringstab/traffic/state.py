@@ -19,7 +19,7 @@ import numpy.typing as npt
 from ..constants import STATE_SCALES
 from ..errors import StringStabError
 from ..params import DEFAULT_HEADWAY
-from .controllers import DEFAULT_STANDSTILL, Observation
+from .controllers.base import DEFAULT_STANDSTILL, Observation
 
 __all__ = ["GAIN_SCALE", "OBSERVE", "SCALES", "extend_state", "state_dim", "state_vector"]
 
