@@ -1,4 +1,4 @@
-"""Platoon dynamics: the stepping core :class:`Platoon`, N followers behind a leader, many platoons at once.
+"""Platoon dynamics: the stepping core :class:`Platoon`, many platoons of N followers at once.
 
 Each follower i obeys the IDL paper's third-order model (eqs 5-7)
 

@@ -65,11 +65,12 @@ from .episodes import ActionMode, Episodes
 from .limits import DEFAULT_LENGTH, Limits
 from .loaders import FollowingPair
 from .rate import limit_rate
-from .state import OBSERVE, SCALES, extend_state, state_dim, state_vector
+from .state import GAIN_SCALE, OBSERVE, SCALES, extend_state, state_dim, state_vector
 from .trajectory import Trajectory
 
 __all__ = [
-    "OBSERVE",  # re-exported from stringstab.traffic.state (public here before the split)
+    "GAIN_SCALE",  # re-exported from stringstab.traffic.state (public here before the split)
+    "OBSERVE",  # re-exported from stringstab.traffic.state
     "SCALES",  # re-exported from stringstab.traffic.state
     "BatchedCarFollowingEnv",
     "CarFollowingEnv",

@@ -1,4 +1,4 @@
-"""The result of a platoon run: :class:`PlatoonResult` (what :func:`~stringstab.traffic.platoon.simulate` returns).
+"""The result of a platoon run: :class:`PlatoonResult`, what :func:`~stringstab.traffic.platoon.simulate` returns.
 
 Recorded trajectories or their summaries, the gains in force, collisions, and the IDL paper's
 evaluation metrics of the run (:mod:`stringstab.traffic.metrics`).

@@ -1,4 +1,4 @@
-"""The state the policy sees: IDL eq 16 and its extensions (:func:`state_vector`, :func:`extend_state`).
+"""The policy's state: IDL eq 16 (:func:`state_vector`) and its extensions (:func:`extend_state`).
 
 s = [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc] with Δp = gap − (T* v + l_0), α_p = 25,
 α_v = 2.5, α_acc = 4.5 (Table 2).  Optionally (``observe``, not in the paper) the follower's

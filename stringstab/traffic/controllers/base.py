@@ -1,4 +1,4 @@
-"""The controller interface: :class:`Observation` (what a follower knows) and :class:`Controller`.
+"""The controller interface: :class:`Observation`, what a follower knows, and :class:`Controller`.
 
 Every controller maps an :class:`Observation` of a batch of followers (arrays of any common
 shape, typically ``(n_platoons, n_followers)``) to desired accelerations u (m/s²); the
