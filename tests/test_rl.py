@@ -463,7 +463,7 @@ def test_contract_with_the_hcfs_environment(tmp_path):
 @given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 6), min_size=1, max_size=5),
        st.floats(0.001, 0.5))
 def test_limit_rate_clips_to_the_previous_gains(rows, rate):
-    from stringstab.traffic.env import limit_rate
+    from stringstab.traffic.rate import limit_rate
 
     A = np.array(rows)
     K, P = A[:, :3], A[:, 3:]
@@ -583,7 +583,7 @@ def test_wrapper_rate_limits_then_repairs_so_every_executed_gain_is_certified():
     rate-limited proposal is certified it is executed as is, every executed triple is certified
     by the independent sweep, and the repair does move some."""
     import stringstab as ss
-    from stringstab.traffic.env import limit_rate
+    from stringstab.traffic.rate import limit_rate
 
     rate = 0.05
     rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3)

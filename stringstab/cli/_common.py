@@ -491,7 +491,7 @@ def limits_from_args(args: Any) -> Any:
         A limit that is not a finite number, acc_min ≥ 0, acc_max ≤ 0, v_max ≤ 0, or a limit
         beyond any road vehicle (v_max > 70 m/s, |acc| > 15 m/s²).
     """
-    from ..traffic.platoon import Limits
+    from ..traffic.limits import Limits
 
     def number(option: str, text: Any) -> float:
         try:
@@ -535,7 +535,7 @@ def checked_leaders(args: Any, leaders: Any, limits: Any) -> list[str]:
     """
     import sys
 
-    from ..traffic.platoon import check_leader
+    from ..traffic.limits import check_leader
 
     out: list[str] = []
     for leader in leaders:

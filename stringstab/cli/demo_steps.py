@@ -104,8 +104,9 @@ def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
     """A 10-vehicle platoon behind the §5.1-style leader: certified gains vs the CACC baseline."""
     from ..traffic.controllers import CACCController, LinearController
     from ..traffic.leaders import leader_by_name
+    from ..traffic.limits import check_leader
     from ..traffic.output import run_document, write_run
-    from ..traffic.platoon import check_leader, simulate
+    from ..traffic.platoon import simulate
 
     leader = leader_by_name("mix")
     warnings = check_leader(leader, limits)

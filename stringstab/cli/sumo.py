@@ -161,7 +161,7 @@ def _case(args: argparse.Namespace) -> dict[str, Any]:
     from ..constants import DT
     from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
     from ..traffic.leaders import leader_by_name
-    from ..traffic.platoon import check_leader
+    from ..traffic.limits import check_leader
     from .simulate import parse_gains
 
     for name in ("standstill", "length", "dt", "duration", "tau", "delta", "headway", "hold"):

@@ -39,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import constants as _toolkit
-from ..traffic.platoon import DEFAULT_LENGTH
+from ..traffic.limits import DEFAULT_LENGTH
 
 __all__ = [
     "ACCEL_MAX",

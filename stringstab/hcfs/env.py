@@ -39,8 +39,9 @@ from gymnasium.vector.utils import batch_space
 
 from ..errors import StringStabError
 from ..params import positive
+from ..traffic.dynamics import Platoon
 from ..traffic.leaders import Trajectory
-from ..traffic.platoon import Limits, Platoon
+from ..traffic.limits import Limits
 from .constants import (
     ACCEL_MAX,
     ACCEL_MIN,

@@ -5,7 +5,7 @@ The set-up of HCFS §IV: every follower computes both candidates from its eq-3 s
 
     v_{k+1} = v_k + a_k T,   x_{k+1} = x_k + v_k T + ½ a_k T²
 
-(:class:`stringstab.traffic.platoon.Platoon` with ``model="kinematic"``, which also applies
+(:class:`stringstab.traffic.dynamics.Platoon` with ``model="kinematic"``, which also applies
 the acceleration bounds [a_min, a_max], the speed bounds [0, v_max] and detects collisions).
 Predecessor and leader data arrive 5 ms late (:func:`stringstab.hcfs.mdp.received`).
 
@@ -38,8 +38,9 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..params import count, positive
+from ..traffic.dynamics import Platoon
 from ..traffic.leaders import Trajectory
-from ..traffic.platoon import Limits, Platoon
+from ..traffic.limits import Limits
 from .cacc import CACC
 from .constants import (
     ACCEL_MAX,

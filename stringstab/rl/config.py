@@ -284,7 +284,7 @@ def _check(c: TD3Config) -> None:
     if len(w) != 3 or not all(math.isfinite(x) and x >= 0 for x in w):
         raise StringStabError(f"config field weights must be 3 numbers >= 0; got {show(c.weights)}")
     object.__setattr__(c, "weights", w)
-    from ..traffic.env import OBSERVE
+    from ..traffic.state import OBSERVE
 
     obs = tuple(c.observe) if isinstance(c.observe, (list, tuple)) else None
     if obs is None or not set(obs) <= set(OBSERVE) or len(set(obs)) != len(obs):

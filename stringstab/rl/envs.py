@@ -7,7 +7,7 @@ that turns the policy's *proposed* gains into the gains the vehicle *executes*:
 
 1. clip to the gain box (Table 2: [−2, 2]³);
 2. with ``gain_rate`` r > 0 (not in the paper), clip each gain to within r of the gain executed
-   at the previous step (:func:`~stringstab.traffic.env.limit_rate`; an episode's first step
+   at the previous step (:func:`~stringstab.traffic.rate.limit_rate`; an episode's first step
    is not limited);
 3. repair (§3.3, :class:`~stringstab.rl.repair.GainRepair`), so every executed triple is
    certified.
@@ -30,7 +30,8 @@ import numpy.typing as npt
 from gymnasium.vector import VectorActionWrapper, VectorEnv, VectorWrapper
 
 from ..errors import StringStabError, show
-from ..traffic.env import BatchedCarFollowingEnv, limit_rate
+from ..traffic.env import BatchedCarFollowingEnv
+from ..traffic.rate import limit_rate
 from .config import TD3Config
 from .repair import GainRepair, repair_for
 

@@ -143,7 +143,7 @@ def controller_for(strategy: Policy | str, *, headway: float,
         IDMController,
         TimeVaryingLinearController,
     )
-    from ..traffic.env import state_vector
+    from ..traffic.state import state_vector
 
     if isinstance(strategy, str):
         if strategy == "cacc":

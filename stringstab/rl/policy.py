@@ -130,7 +130,7 @@ class Policy:
         StringStabError
             If the policy outputs accelerations.
         """
-        from ..traffic.env import extend_state
+        from ..traffic.state import extend_state
         from .envs import executed_gains
 
         s = np.asarray(state, dtype=np.float64).reshape(-1, 3)
@@ -249,7 +249,7 @@ def load_policy(directory: str | os.PathLike[str]) -> Policy:
         _need(info, key, (int, float), where)
     if len(low) != act_dim or len(high) != act_dim:
         raise StringStabError(f"{where}: low/high must have act_dim={act_dim} entries")
-    from ..traffic.env import OBSERVE, state_dim
+    from ..traffic.state import OBSERVE, state_dim
 
     observe = info["observe"]
     if (not isinstance(observe, list) or not set(observe) <= set(OBSERVE)

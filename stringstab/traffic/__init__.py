@@ -5,11 +5,19 @@
   (synthetic profiles), :mod:`~stringstab.traffic.loaders` (CSV files, NGSIM pairs),
   :mod:`~stringstab.traffic.split` (a train/test split), and
   :mod:`~stringstab.traffic.leaders` (a leader by name; re-exports all of these);
-* :mod:`~stringstab.traffic.platoon` — vectorised platoon dynamics (IDL eqs 1-2, 5-7) and
-  :func:`simulate`;
-* :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM;
+* platoons: :mod:`~stringstab.traffic.limits` (acceleration and speed bounds, the leader
+  check, the vehicle length), :mod:`~stringstab.traffic.dynamics` (the vectorised stepping
+  core, IDL eqs 1-2, 5-7), :mod:`~stringstab.traffic.platoon` (:func:`simulate`) and
+  :mod:`~stringstab.traffic.result` (its :class:`PlatoonResult`);
+* :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM
+  (a subpackage, one module per controller);
+* :mod:`~stringstab.traffic.metrics` — the IDL evaluation metrics;
 * :mod:`~stringstab.traffic.reward` — the IDL reward (eqs 18-24);
-* :mod:`~stringstab.traffic.env` — a Gymnasium environment and a batched version for training.
+* environments: :mod:`~stringstab.traffic.state` (the eq-16 state and its extensions),
+  :mod:`~stringstab.traffic.rate` (the gain rate limit), :mod:`~stringstab.traffic.episodes`
+  (the episodes both environments step) and :mod:`~stringstab.traffic.env` (a Gymnasium
+  environment and a batched version for training);
+* :mod:`~stringstab.traffic.output` — run files.
 
 Their figures (like the IDL paper's Figs 7-8) are in :mod:`stringstab.plots.traffic`.
 """
@@ -27,7 +35,8 @@ from .controllers import (
     TimeVaryingLinearController,
     linear_law,
 )
-from .env import SCALES, BatchedCarFollowingEnv, CarFollowingEnv, state_vector
+from .dynamics import Platoon
+from .env import BatchedCarFollowingEnv, CarFollowingEnv
 from .leaders import (
     CYCLES,
     SYNTHETIC,
@@ -46,9 +55,12 @@ from .leaders import (
     stop_and_go,
     train_test_split,
 )
+from .limits import Limits, check_leader
 from .output import RUN_FILES, run_document, save_trajectories, write_run
-from .platoon import Limits, Platoon, PlatoonResult, check_leader, simulate
+from .platoon import simulate
+from .result import PlatoonResult
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
+from .state import SCALES, state_vector
 
 __all__ = [
     "CYCLES",

@@ -1,10 +1,11 @@
 """Gymnasium environments for one controlled follower (the IDL paper's training set-up, §3.2.2, §4.1.2).
 
 A controlled vehicle follows a recorded or synthetic leader.  Each step it observes the
-normalised state of eq 16, acts, and receives the reward of eqs 18-24
-(:mod:`~stringstab.traffic.reward`).  The vehicle obeys the platoon dynamics of
-:mod:`~stringstab.traffic.platoon` (third-order model with lag τ, delayed leader acceleration,
-limits and collision detection).
+normalised state of eq 16 (:mod:`~stringstab.traffic.state`), acts, and receives the reward
+of eqs 18-24 (:mod:`~stringstab.traffic.reward`).  The vehicle obeys the platoon dynamics of
+:mod:`~stringstab.traffic.dynamics` (third-order model with lag τ, delayed leader
+acceleration, limits and collision detection); both environments step the shared episodes of
+:mod:`~stringstab.traffic.episodes`.
 
 Two action modes:
 
@@ -17,12 +18,13 @@ Two action modes:
 State (eq 16): s = [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc] with Δp = gap − (T* v + l_0),
 α_p = 25, α_v = 2.5, α_acc = 4.5 (Table 2).  Optionally (``observe``, not in the paper) the
 follower's own acceleration a_i/α_acc and the gains it executed at the previous step
-(K_{t−1}/2, zero at an episode's first step) are appended (:func:`extend_state`): the eq-16
+(K_{t−1}/2, zero at an episode's first step) are appended
+(:func:`~stringstab.traffic.state.extend_state`): the eq-16
 state does not say what the vehicle is doing now, which the comfort reward (eq 21) penalises
 changes of, nor which gains it runs, which a gain rate limit makes part of the dynamics.
 
 The environment executes the gains it is given.  What turns a policy's *proposed* gains into
-executed ones — a gain rate limit (:func:`limit_rate`, not in the paper) and then the repair
+executed ones — a gain rate limit (:func:`~stringstab.traffic.rate.limit_rate`, not in the paper) and then the repair
 (§3.3), so every executed gain is certified — is an action wrapper around the environment
 (:class:`stringstab.rl.envs.RepairedGains`), which reads the previous step's executed gains
 (:attr:`BatchedCarFollowingEnv.prev_gains`) and the episode starts
@@ -44,7 +46,7 @@ the (simple) API.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Literal, TypeGuard
+from typing import Any, Literal
 
 import gymnasium as gym
 import numpy as np
@@ -53,325 +55,36 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..constants import DT, GAIN_BOUNDS, STATE_SCALES, TTC_STAR
+from ..constants import DT, GAIN_BOUNDS, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-from .controllers import DEFAULT_STANDSTILL, Observation, linear_law
+from .controllers.base import DEFAULT_STANDSTILL
 from .cycles import cycle
+from .dynamics import Model
+from .episodes import ActionMode, Episodes
+from .limits import DEFAULT_LENGTH, Limits
 from .loaders import FollowingPair
-from .metrics import time_headway, time_to_collision
-from .platoon import DEFAULT_LENGTH, Limits, Model, Platoon
-from .reward import reward
+from .rate import limit_rate
+from .state import GAIN_SCALE, OBSERVE, SCALES, extend_state, state_dim, state_vector
 from .trajectory import Trajectory
 
-__all__ = ["OBSERVE", "SCALES", "BatchedCarFollowingEnv", "CarFollowingEnv", "extend_state",
-           "limit_rate", "state_dim", "state_vector"]
+__all__ = [
+    "GAIN_SCALE",  # re-exported from stringstab.traffic.state (public here before the split)
+    "OBSERVE",  # re-exported from stringstab.traffic.state
+    "SCALES",  # re-exported from stringstab.traffic.state
+    "BatchedCarFollowingEnv",
+    "CarFollowingEnv",
+    "extend_state",  # re-exported from stringstab.traffic.state
+    "limit_rate",  # re-exported from stringstab.traffic.rate
+    "state_dim",  # re-exported from stringstab.traffic.state
+    "state_vector",  # re-exported from stringstab.traffic.state
+]
 
 #: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).
 _PLATOON_STATE = ("position", "speed", "accel", "_buf", "collided", "collision_events",
                   "first_collision_step", "_in_collision")
-#: What may be appended to the eq-16 state (``observe``): own acceleration, previous gains.
-OBSERVE = ("accel", "gains")
-#: Scale of the previous gains in the state (the half-range of Table 2's [−2, 2]).
-GAIN_SCALE = 2.0
 
 Array = npt.NDArray[np.float64]
-ActionMode = Literal["gains", "accel"]
-
-#: α_p, α_v, α_acc of eq 16 (Table 2).
-SCALES = STATE_SCALES
-
-
-def state_vector(obs: Observation, *, headway: float = DEFAULT_HEADWAY,
-                 standstill: float = DEFAULT_STANDSTILL,
-                 scales: tuple[float, float, float] = SCALES) -> Array:
-    """The IDL state (eq 16) of every follower in ``obs``, shape ``(*obs.gap.shape, 3)``.
-
-    s = [(gap − T* v − l_0)/α_p, (v_{i−1} − v)/α_v, a_{i−1}(t − δ)/α_acc].  Usable as the input
-    of a gain policy inside :class:`~stringstab.traffic.controllers.TimeVaryingLinearController`.
-
-    Parameters
-    ----------
-    obs : Observation
-        What the followers know at one step: gap Δx (m), own speed v (m/s), relative speed
-        Δv = v_{i−1} − v (m/s) and the delayed predecessor acceleration a_{i−1}(t − δ) (m/s²).
-    headway : float
-        Desired time headway T* (IDL eq 3), s.
-    standstill : float
-        Standstill distance l_0 (eq 3), m.
-    scales : (float, float, float)
-        α_p (m), α_v (m/s), α_acc (m/s²) of eq 16 (Table 2: 25, 2.5, 4.5).
-
-    Returns
-    -------
-    ndarray, shape ``(*obs.gap.shape, 3)``
-        The normalised state [Δp/α_p, Δv/α_v, a_{i−1}(t − δ)/α_acc], Δp the spacing error of
-        eq 3.
-    """
-    dp = obs.gap - headway * obs.speed - standstill
-    return np.stack([dp / scales[0], obs.rel_speed / scales[1],
-                     obs.pred_accel_delayed / scales[2]], axis=-1)
-
-
-def state_dim(observe: Sequence[str] = ()) -> int:
-    """Length of the state with the ``observe`` extras (:func:`extend_state`).
-
-    It is 3 (eq 16), 1 more for ``"accel"`` and 3 more for ``"gains"``.
-
-    Parameters
-    ----------
-    observe : sequence of str
-        Extras appended to the eq-16 state, some of :data:`OBSERVE` (``"accel"``, ``"gains"``).
-
-    Returns
-    -------
-    int
-        3, 4, 6 or 7.
-
-    Raises
-    ------
-    StringStabError
-        If ``observe`` names something other than ``"accel"`` or ``"gains"``.
-
-    Examples
-    --------
-    >>> state_dim(), state_dim(("accel", "gains"))
-    (3, 7)
-    """
-    unknown = sorted(set(observe) - set(OBSERVE))
-    if unknown:
-        raise StringStabError(f"observe must name some of {list(OBSERVE)}; got {unknown}")
-    return 3 + ("accel" in observe) + 3 * ("gains" in observe)
-
-
-def extend_state(state: npt.ArrayLike, *, observe: Sequence[str] = (),
-                 accel: npt.ArrayLike | None = None, prev_gains: npt.ArrayLike | None = None,
-                 scales: tuple[float, float, float] = SCALES) -> Array:
-    """The eq-16 ``state`` (..., 3) with the ``observe`` extras appended (not in the paper).
-
-    ``"accel"`` appends the follower's own acceleration a_i/α_acc (``accel``, shape ``(...)``),
-    ``"gains"`` the gains executed at the previous step K_{t−1}/2 (``prev_gains``, (..., 3)).
-
-    Parameters
-    ----------
-    state : array_like, shape (..., 3)
-        The normalised IDL state of eq 16 (:func:`state_vector`).
-    observe : sequence of str
-        Extras to append, some of :data:`OBSERVE`, always in the order accel, then gains.
-    accel : array_like, shape (...), optional
-        The follower's own acceleration a_i, m/s²; needed for ``"accel"``.
-    prev_gains : array_like, shape (..., 3), optional
-        The gains (k_x [1/s²], k_v [1/s], k_a [-]) executed at the previous step; needed for
-        ``"gains"`` (zeros at an episode's first step).
-    scales : (float, float, float)
-        α_p, α_v, α_acc of eq 16; only α_acc is used here.
-
-    Returns
-    -------
-    ndarray, shape (..., :func:`state_dim` (observe))
-        The extended state (``state`` itself, as floats, when ``observe`` is empty).
-
-    Raises
-    ------
-    StringStabError
-        If ``observe`` names an unknown extra, or an extra's input is missing.
-
-    Examples
-    --------
-    >>> extend_state([[0.1, 0.2, 0.3]], observe=("accel", "gains"), accel=[0.9],
-    ...              prev_gains=[[1.0, 0.5, -0.4]]).round(2).tolist()
-    [[0.1, 0.2, 0.3, 0.2, 0.5, 0.25, -0.2]]
-    """
-    s = np.asarray(state, dtype=np.float64)
-    state_dim(observe)  # checks the names
-    parts = [s]
-    if "accel" in observe:
-        if accel is None:
-            raise StringStabError("observe 'accel' needs the follower's acceleration")
-        parts.append(np.asarray(accel, dtype=np.float64)[..., None] / scales[2])
-    if "gains" in observe:
-        if prev_gains is None:
-            raise StringStabError("observe 'gains' needs the previous gains")
-        parts.append(np.asarray(prev_gains, dtype=np.float64) / GAIN_SCALE)
-    return np.concatenate(parts, axis=-1) if len(parts) > 1 else s
-
-
-def limit_rate(gains: npt.ArrayLike, prev_gains: npt.ArrayLike, rate: float, *,
-               fresh: npt.ArrayLike | bool = False) -> Array:
-    """Clip each gain to within ``rate`` of the previous step's (a gain rate limit; not in the paper).
-
-    Rows where ``fresh`` is true (an episode's first step: no previous gains) are left as
-    they are.  The result still needs the repair: the rate limit keeps the gains near a
-    certified triple, it does not certify them.
-
-    Parameters
-    ----------
-    gains : array_like, shape (..., 3)
-        The proposed gains (k_x, k_v, k_a) of IDL eq 4 (the policy's action, eq 17).
-    prev_gains : array_like, shape (..., 3)
-        The gains executed at the previous step.
-    rate : float
-        The largest change r of each gain per step (in the gain's unit per step).
-    fresh : array_like of bool, shape (...), or bool
-        True where there are no previous gains (the proposed gains pass unchanged).
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        clip(gains, prev_gains − r, prev_gains + r), or ``gains`` where ``fresh``.
-
-    Examples
-    --------
-    >>> limit_rate([[1.5, 0.0, 0.3]], [[1.0, 0.1, 0.3]], 0.2).tolist()
-    [[1.2, 0.0, 0.3]]
-    """
-    K = np.asarray(gains, dtype=np.float64)
-    P = np.asarray(prev_gains, dtype=np.float64)
-    out = np.clip(K, P - rate, P + rate)
-    f = np.asarray(fresh, dtype=bool)
-    return np.asarray(np.where(f[..., None] if f.ndim else f, K, out))
-
-
-def _is_pair(x: Any) -> TypeGuard[FollowingPair]:
-    # duck typing (see stringstab.traffic.platoon._is_trajectory)
-    return hasattr(x, "leader") and hasattr(x, "follower") and hasattr(x, "gap")
-
-
-class _Core:
-    """``n`` independent leader–follower episodes over a shared list of leaders."""
-
-    def __init__(self, leaders: Sequence[Trajectory | FollowingPair], n: int, *, action: ActionMode,
-                 tau: float, delta: float, headway: float, standstill: float, model: Model,
-                 limits: Limits | None, length: float, gain_bounds: tuple[float, float],
-                 weights: tuple[float, float, float], ttc_star: float,
-                 scales: tuple[float, float, float], terminate_on_collision: bool,
-                 observe: Sequence[str] = (), start_spread: tuple[float, float] = (0.0, 0.0)
-                 ) -> None:
-        items = list(leaders)
-        if not items:
-            raise StringStabError("the environment needs at least one leader trajectory or pair")
-        trs: list[Trajectory] = []
-        for it in items:
-            if _is_pair(it):
-                trs.append(it.leader)
-            elif hasattr(it, "speed") and hasattr(it, "dt"):
-                trs.append(it)  # type: ignore[arg-type]
-            else:
-                raise StringStabError(f"leaders must be Trajectory or FollowingPair; got {type(it).__name__}")
-        dts = {tr.dt for tr in trs}
-        if len(dts) != 1:
-            raise StringStabError(f"all leaders must share one step dt; got {sorted(dts)}")
-        if action not in ("gains", "accel"):
-            raise StringStabError(f"action must be 'gains' or 'accel'; got {show(action)}")
-        lo, hi = (float(b) for b in gain_bounds)
-        if not lo < hi:
-            raise StringStabError(f"gain_bounds must be (low, high) with low < high; got {show(gain_bounds)}")
-        self.items, self.n, self.dt = items, int(n), trs[0].dt
-        self.action, self.gain_bounds = action, (lo, hi)
-        self.headway, self.standstill = float(headway), float(standstill)
-        self.weights, self.ttc_star, self.scales = weights, float(ttc_star), scales
-        self.terminate_on_collision = terminate_on_collision
-        spread = tuple(float(x) for x in start_spread)
-        if len(spread) != 2 or not all(np.isfinite(x) and x >= 0 for x in spread):
-            raise StringStabError(f"start_spread must be (gap fraction, speed m/s) >= 0; got {show(start_spread)}")
-        state_dim(observe)  # checks the names
-        self.extras, self.start_spread = tuple(observe), spread
-        self.lengths = np.array([tr.n_steps for tr in trs])
-        T = int(self.lengths.max())
-        pad = [(tr.position, tr.speed, tr.accel) for tr in trs]
-        self.LX = np.zeros((len(trs), T))
-        self.LV = np.zeros((len(trs), T))
-        self.LA = np.zeros((len(trs), T))
-        for j, (x, v, a) in enumerate(pad):
-            m = x.shape[0]
-            self.LX[j, :m], self.LV[j, :m], self.LA[j, :m] = x, v, a
-            self.LX[j, m:], self.LV[j, m:] = x[-1], v[-1]
-        init_gap, init_speed = [], []
-        for it, tr in zip(items, trs):
-            if _is_pair(it):
-                init_gap.append(float(it.gap[0]))
-                init_speed.append(float(it.follower.speed[0]))
-            else:
-                init_gap.append(self.standstill + self.headway * float(tr.speed[0]))
-                init_speed.append(float(tr.speed[0]))
-        self.init_gap, self.init_speed = np.array(init_gap), np.array(init_speed)
-        self.platoon = Platoon(self.n, 1, dt=self.dt, tau=tau, delta=delta, model=model,
-                               limits=limits, length=length)
-        self.which = np.zeros(self.n, dtype=np.int64)
-        self.k = np.zeros(self.n, dtype=np.int64)
-        #: Gains executed at the previous step (zero, and not rate limited, at an episode start).
-        self.prev_gains = np.zeros((self.n, 3))
-        self.obs: Observation | None = None
-        self.ret = np.zeros(self.n)
-
-    def leader_now(self) -> tuple[Array, Array, Array]:
-        kk = np.minimum(self.k, self.lengths[self.which] - 1)
-        return self.LX[self.which, kk], self.LV[self.which, kk], self.LA[self.which, kk]
-
-    def reset_rows(self, rows: npt.NDArray[np.int64], which: npt.NDArray[np.int64],
-                   rng: np.random.Generator | None = None) -> None:
-        self.which[rows] = which
-        self.k[rows] = 0
-        self.ret[rows] = 0.0
-        self.prev_gains[rows] = 0.0
-        gap, speed = self.init_gap[which], self.init_speed[which]
-        if rng is not None and any(self.start_spread):
-            u = rng.uniform(-1.0, 1.0, size=(2, len(rows)))
-            free = np.array([not _is_pair(self.items[j]) for j in which])  # NGSIM: as recorded
-            gap = np.where(free, gap * (1.0 + self.start_spread[0] * u[0]), gap)
-            speed = np.where(free, np.maximum(speed + self.start_spread[1] * u[1], 0.0), speed)
-        self.platoon.reset(self.LX[which, 0], self.LV[which, 0], self.LA[which, 0],
-                           gap=gap[:, None], speed=speed[:, None], accel=0.0, rows=rows)
-
-    def observe(self) -> Observation:
-        self.obs = self.platoon.observe(*self.leader_now())
-        return self.obs
-
-    def state(self) -> npt.NDArray[np.float32]:
-        assert self.obs is not None
-        s = state_vector(self.obs, headway=self.headway, standstill=self.standstill,
-                         scales=self.scales)[:, 0, :]
-        if self.extras:
-            s = extend_state(s, observe=self.extras, accel=self.obs.accel[:, 0],
-                             prev_gains=self.prev_gains, scales=self.scales)
-        return s.astype(np.float32)
-
-    def command(self, actions: npt.ArrayLike) -> tuple[Array, Array | None]:
-        assert self.obs is not None
-        a = np.asarray(actions, dtype=np.float64).reshape(self.n, -1)
-        if self.action == "accel":
-            if a.shape[1] != 1:
-                raise StringStabError(f"accel actions must have 1 value per env; got shape {a.shape}")
-            return a[:, :1], None
-        if a.shape[1] != 3:
-            raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
-        K = np.clip(a, *self.gain_bounds)
-        self.prev_gains = K.copy()
-        u = linear_law(K[:, None, :], self.obs, headway=self.headway, standstill=self.standstill)
-        return u, K
-
-    def step(self, actions: npt.ArrayLike) -> tuple[Array, npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]]:
-        u, K = self.command(actions)
-        prev_accel = self.platoon.accel[:, 1].copy()
-        u_lim = self.platoon.advance(u)
-        self.k += 1
-        o = self.observe()
-        gap, spd, pspd = o.gap[:, 0], o.speed[:, 0], o.pred_speed[:, 0]
-        r, r_f, r_j, r_e = reward(gap, spd, pspd, o.accel[:, 0], prev_accel, weights=self.weights,
-                                  ttc_star=self.ttc_star)
-        collision = gap <= 0
-        terminated = collision & self.terminate_on_collision
-        truncated = (self.k >= self.lengths[self.which] - 1) & ~terminated
-        self.ret += r
-        info: dict[str, Any] = {
-            "gap": gap.copy(), "speed": spd.copy(), "accel": o.accel[:, 0].copy(),
-            "command": u_lim[:, 0].copy(), "ttc": time_to_collision(gap, spd, pspd),
-            "headway": time_headway(gap, spd), "r_f": r_f, "r_j": r_j, "r_e": r_e,
-            "collision": collision, "leader_index": self.which.copy(), "t": self.k * self.dt,
-        }
-        if K is not None:
-            info["gains"] = K
-        return np.asarray(r, dtype=np.float64), terminated, truncated, info
 
 
 def _spaces(action: ActionMode, gain_bounds: tuple[float, float],
@@ -401,7 +114,7 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
     tau, delta, headway, standstill : float
         τ (s), δ (s), T* (s), l_0 (m).
     model : {"lag", "kinematic"}
-        Vehicle update (see :mod:`stringstab.traffic.platoon`).
+        Vehicle update (see :mod:`stringstab.traffic.dynamics`).
     limits : Limits, optional
         Acceleration and speed bounds (Table 2).
     length : float
@@ -444,7 +157,7 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                  order: Literal["random", "sequential"] = "random") -> None:
         if order not in ("random", "sequential"):
             raise StringStabError(f"order must be 'random' or 'sequential'; got {show(order)}")
-        self._core = _Core(leaders if leaders is not None else _default_leaders(), 1, action=action,
+        self._core = Episodes(leaders if leaders is not None else _default_leaders(), 1, action=action,
                            tau=tau, delta=delta, headway=headway, standstill=standstill, model=model,
                            limits=limits, length=length, gain_bounds=gain_bounds, weights=weights,
                            ttc_star=ttc_star, scales=scales,
@@ -580,7 +293,7 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         if int(num_envs) < 1:
             raise StringStabError(f"num_envs must be >= 1; got {show(num_envs)}")
         self.num_envs = int(num_envs)
-        self._core = _Core(leaders if leaders is not None else _default_leaders(), self.num_envs,
+        self._core = Episodes(leaders if leaders is not None else _default_leaders(), self.num_envs,
                            action=action, tau=tau, delta=delta, headway=headway,
                            standstill=standstill, model=model, limits=limits, length=length,
                            gain_bounds=gain_bounds, weights=weights, ttc_star=ttc_star,

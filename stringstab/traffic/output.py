@@ -18,7 +18,7 @@ import numpy as np
 from ..constants import TTC_STAR
 from ..errors import StringStabError, show
 from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
-from .platoon import PlatoonResult
+from .result import PlatoonResult
 
 __all__ = ["RUN_FILES", "UNITS", "run_document", "save_trajectories", "write_run"]
 
@@ -57,7 +57,7 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
     ttc_star : float
         TTC* of the safety metrics, s.
     warnings : sequence of str
-        Warnings about the run (e.g. from :func:`~stringstab.traffic.platoon.check_leader`).
+        Warnings about the run (e.g. from :func:`~stringstab.traffic.limits.check_leader`).
 
     Returns
     -------
