@@ -282,6 +282,24 @@ def test_every_subpackage_says_what_lives_there():
         assert doc and len(doc) > 80, f"{init.relative_to(PKG.parent)} has no docstring saying what lives there"
 
 
+#: "No module over ~500 lines doing more than one job": a module over :data:`LONG` lines is
+#: listed here with its one job (the test fails when one is added unlisted, or shrinks).
+LONG = 600
+LONG_MODULES = {
+    "stringstab/io/gains.py": "reading gain triples K = [k_x, k_v, k_a]: every format, one reader",
+    "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
+    "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
+}
+
+
+def test_long_modules_do_one_job():
+    long = {str(p.relative_to(PKG.parent)) for p in PKG.rglob("*.py")
+            if len(p.read_text(encoding="utf-8").splitlines()) > LONG
+            and p.name != "generated.py"}  # written by stringstab.derive.codegen
+    assert long - set(LONG_MODULES) == set(), f"modules over {LONG} lines: split them by job"
+    assert set(LONG_MODULES) - long == set(), "no longer long: remove them from LONG_MODULES"
+
+
 def _private_imports() -> set[tuple[str, str]]:
     """(importer, "module.name") for every underscored name imported from another module."""
     out = set()
