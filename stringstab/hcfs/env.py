@@ -40,8 +40,8 @@ from gymnasium.vector.utils import batch_space
 from ..errors import StringStabError
 from ..params import positive
 from ..traffic.dynamics import Platoon
-from ..traffic.leaders import Trajectory
 from ..traffic.limits import Limits
+from ..traffic.trajectory import Trajectory
 from .constants import (
     ACCEL_MAX,
     ACCEL_MIN,

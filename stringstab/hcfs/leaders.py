@@ -37,7 +37,9 @@ import dataclasses
 import math
 
 from ..errors import StringStabError, show
-from ..traffic.leaders import Trajectory, cycle, leader_by_name
+from ..traffic.cycles import cycle
+from ..traffic.leaders import leader_by_name
+from ..traffic.trajectory import Trajectory
 from .constants import DT
 
 __all__ = [

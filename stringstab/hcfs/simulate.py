@@ -39,8 +39,8 @@ import numpy.typing as npt
 from ..errors import StringStabError
 from ..params import count, positive
 from ..traffic.dynamics import Platoon
-from ..traffic.leaders import Trajectory
 from ..traffic.limits import Limits
+from ..traffic.trajectory import Trajectory
 from .cacc import CACC
 from .constants import (
     ACCEL_MAX,

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError
-from ..traffic.leaders import Trajectory
+from ..traffic.trajectory import Trajectory
 from .constants import BETA
 from .policy import AccelerationPolicy
 from .simulate import MODES, HCFSRun, RunConfig, simulate_hcfs
