@@ -270,7 +270,7 @@ def simulate_hcfs(
 
     Examples
     --------
-    >>> from stringstab.traffic.leaders import sinusoid
+    >>> from stringstab.traffic import sinusoid
     >>> from stringstab.hcfs.policy import LeaderSpeedMatcher
     >>> lead = sinusoid(omega=0.5, amplitude=2.0, speed=10.0, duration=10.0, dt=0.2)
     >>> run = simulate_hcfs(lead, LeaderSpeedMatcher(), n_followers=2,
