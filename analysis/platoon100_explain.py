@@ -32,10 +32,10 @@ from stringstab.constants import DELTA, HEADWAY, STANDSTILL, TAU
 from stringstab.rl import load_policy
 from stringstab.rl.evaluate import controller_for
 from stringstab.traffic.controllers import LinearController
-from stringstab.traffic.leaders import paper_mix
 from stringstab.traffic.limits import Limits
 from stringstab.traffic.metrics import platoon_metrics
 from stringstab.traffic.platoon import simulate
+from stringstab.traffic.synthetic import paper_mix
 
 N = 100
 WIDE = Limits(accel_min=-1e3, accel_max=1e3, speed_min=0.0, speed_max=1e3)

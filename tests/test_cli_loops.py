@@ -14,7 +14,8 @@ import sympy as sp
 from _sampled_truth import THETA, pair_response, pair_roots
 from numpy.testing import assert_allclose
 
-from stringstab.certify.sampled import sampled_response, schur_margins
+from stringstab.certify.sampled_frequency import sampled_response
+from stringstab.certify.schur import schur_margins
 from stringstab.cli import main
 
 ISSUE = ["1.2,0.5,0.6", "--sample-time", "0.1", "--tau", "0.1", "--delta", "0.2", "--headway", "1.1"]

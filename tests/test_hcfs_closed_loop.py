@@ -13,7 +13,8 @@ from stringstab.hcfs.policy import LeaderSpeedMatcher
 from stringstab.hcfs.report import write_report
 from stringstab.hcfs.simulate import simulate_hcfs
 from stringstab.hcfs.verify import verify
-from stringstab.traffic.leaders import leader_by_name, stop_and_go
+from stringstab.traffic.leaders import leader_by_name
+from stringstab.traffic.synthetic import stop_and_go
 
 JS = (2.5, 5.0)
 

@@ -69,7 +69,7 @@ def test_training_is_seeded_and_checkpoints_are_evaluated(tmp_path):
     _torch()
     from stringstab.hcfs.ddpg import train_hcfs_ddpg
     from stringstab.hcfs.env import HCFSVectorEnv
-    from stringstab.traffic.leaders import stop_and_go
+    from stringstab.traffic.synthetic import stop_and_go
 
     def env():
         return HCFSVectorEnv(1, [stop_and_go(dt=C.DT)], n_followers=2, episode_seconds=4.0)

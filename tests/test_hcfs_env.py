@@ -17,7 +17,8 @@ from stringstab.hcfs.env import HCFSVectorEnv
 from stringstab.hcfs.mdp import STATE_SCALES
 from stringstab.hcfs.policy import LeaderSpeedMatcher
 from stringstab.hcfs.simulate import simulate_hcfs
-from stringstab.traffic.leaders import leader_by_name, stop_and_go
+from stringstab.traffic.leaders import leader_by_name
+from stringstab.traffic.synthetic import stop_and_go
 
 
 def test_spaces_and_autoreset_contract():

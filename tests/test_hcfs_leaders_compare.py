@@ -18,7 +18,8 @@ from stringstab.hcfs.leaders import (
 )
 from stringstab.hcfs.policy import LeaderSpeedMatcher
 from stringstab.hcfs.simulate import simulate_hcfs
-from stringstab.traffic.leaders import cycle, stop_and_go
+from stringstab.traffic.cycles import cycle
+from stringstab.traffic.synthetic import stop_and_go
 
 
 def _kinematics_residual(tr):

@@ -19,7 +19,7 @@ from stringstab.hcfs.switching import (
     predicted_rewards,
     switch_weights,
 )
-from stringstab.traffic.leaders import from_accel_segments
+from stringstab.traffic.trajectory import from_accel_segments
 
 
 @given(x=st.floats(-1e3, 1e3), v=st.floats(0, 40), a=st.floats(-3, 3),

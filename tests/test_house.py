@@ -347,3 +347,53 @@ def test_no_source_reaches_certify_modules_through_the_function():
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
             if bad.search(line) and p.name != "test_house.py"]
     assert hits == []
+
+
+def _defined_names(tree: ast.Module) -> set[str]:
+    """Names a module defines at module level: def, class, assignment (also inside ``if``/``try``)."""
+    names: set[str] = set()
+
+    def visit(body: list[ast.stmt]) -> None:
+        for node in body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                names.add(node.name)
+            elif isinstance(node, ast.Assign):
+                names.update(n.id for t in node.targets for n in ast.walk(t) if isinstance(n, ast.Name))
+            elif isinstance(node, (ast.AnnAssign, ast.AugAssign)) and isinstance(node.target, ast.Name):
+                names.add(node.target.id)
+            elif isinstance(node, ast.If):
+                visit(node.body)
+                visit(node.orelse)
+            elif isinstance(node, ast.Try):
+                for part in (node.body, node.orelse, node.finalbody, *(h.body for h in node.handlers)):
+                    visit(part)
+
+    visit(tree.body)
+    return names
+
+
+def _reexports(source: str) -> list[str]:
+    """Names in a module's ``__all__`` that it does not define (imports it re-exports)."""
+    tree = ast.parse(source)
+    listed: list[str] = []
+    for node in tree.body:
+        targets = node.targets if isinstance(node, ast.Assign) else (
+            [node.target] if isinstance(node, ast.AnnAssign) else [])
+        if any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets):
+            assert node.value is not None
+            listed = list(ast.literal_eval(node.value))
+    return [name for name in listed if name not in _defined_names(tree)]
+
+
+def test_a_module_exports_only_what_it_defines():
+    # one home per name: a module (not a package ``__init__``, which re-exports its modules
+    # by design) lists in ``__all__`` only names it defines, so no module is a re-export shim
+    shims = {mod: names for mod, path in MODULES.items()
+             if path.name != "__init__.py" and (names := _reexports(path.read_text(encoding="utf-8")))}
+    assert shims == {}, "modules re-exporting names defined elsewhere"
+    # the check can fail: a made-up shim is found; definitions in if/try and assignments count
+    fake = ("from .limits import Limits\nimport numpy as np\n"
+            "__all__ = ['Limits', 'np', 'simulate', 'A', 'B', 'C', 'D']\n"
+            "def simulate(): ...\nA: int = 1\nif True:\n    B = 2\nelse:\n    C = 3\n"
+            "try:\n    from x import D\nexcept ImportError:\n    D = None\n")
+    assert _reexports(fake) == ["Limits", "np"]

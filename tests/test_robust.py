@@ -17,18 +17,11 @@ from numpy.testing import assert_allclose
 
 from stringstab.certify.api import certify, certify_batch
 from stringstab.certify.frequency import margin_g
-from stringstab.certify.robust import (
-    Box,
-    as_interval,
-    certify_robust,
-    certify_robust_batch,
-    check_box,
-    parse_interval,
-    robust_margin,
-)
-from stringstab.certify.robust_continuous import box_margin
+from stringstab.certify.robust import certify_robust, certify_robust_batch
+from stringstab.certify.robust_continuous import box_margin, robust_margin
 from stringstab.certify.sampled import certify_sampled, check_sampled
 from stringstab.errors import StringStabError
+from stringstab.params import Box, as_interval, check_box, parse_interval
 
 gain = st.floats(-2, 2, allow_nan=False)
 

@@ -17,7 +17,8 @@ from numpy.testing import assert_allclose
 
 from stringstab.certify.api import certify_batch
 from stringstab.certify.frequency import margin_g
-from stringstab.certify.sampled import sampled_margin, schur_margins
+from stringstab.certify.sampled_frequency import sampled_margin
+from stringstab.certify.schur import schur_margins
 from stringstab.cli import main
 from stringstab.errors import StringStabError
 from stringstab.tuning import Projector, project, tune

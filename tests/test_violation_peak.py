@@ -14,7 +14,7 @@ from scipy.optimize import brentq
 import stringstab as ss
 from stringstab.certify.frequency import gain_squared
 from stringstab.certify.margin import coefficients
-from stringstab.certify.sampled import split_delay
+from stringstab.certify.zoh import split_delay
 
 TAU, DELTA, T = 0.1, 0.2, 1.1
 mpmath.mp.dps = 60

@@ -17,7 +17,7 @@ import pytest
 from scipy.optimize import brentq
 
 import stringstab as ss
-from stringstab.certify import sampled
+from stringstab.certify import sampled, sampled_frequency
 from stringstab.certify.margin import coefficients
 
 TAU, DELTA, T = 0.1, 0.2, 1.1
@@ -67,8 +67,8 @@ def _just_below_psi3_zero(kv, ka, rel):
 def test_the_truth_agrees_with_the_direct_double_precision_response():
     # a check of the 60-digit truth itself, away from |H| = 1
     th = np.array([0.05, 0.7, 2.0])
-    h = sampled.sampled_response(th, 0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T,
-                                    sample_time=0.1)
+    h = sampled_frequency.sampled_response(th, 0.9, -0.5, 1.1, tau=TAU, delta=DELTA, headway=T,
+                                             sample_time=0.1)
     for t, v in zip(th, h):
         assert _excess_mp(t, 0.9, -0.5, 1.1, 0.1) == pytest.approx(abs(v) ** 2 - 1, rel=1e-9)
 

@@ -36,18 +36,23 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from .verdicts import CERTIFIED, INCONCLUSIVE, VERDICTS
-from .verdicts import NOT_CERTIFIED as VIOLATED
+from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, VERDICTS
 
-__all__ = ["CERTIFIED", "INCONCLUSIVE", "PENDING", "VIOLATED", "BranchAndBound", "branch_and_bound",
-           "verdict_codes", "zoom_max"]
+__all__ = [
+    "PENDING",
+    "BranchAndBound",
+    "branch_and_bound",
+    "verdict_codes",
+    "zoom_max",
+]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
 
-#: Item outcomes: :data:`CERTIFIED`, :data:`VIOLATED` and :data:`INCONCLUSIVE` *are* the verdict
-#: codes of :mod:`stringstab.certify.verdicts` (imported above: a violated item is not certified);
-#: PENDING, the engine's own fourth outcome (intervals handed back), is the first code after them.
+#: Item outcomes: certified, violated and inconclusive items carry the verdict codes
+#: CERTIFIED, NOT_CERTIFIED and INCONCLUSIVE of :mod:`stringstab.certify.verdicts` (a violated
+#: item is not certified); PENDING, the engine's own fourth outcome (intervals handed back), is
+#: the first code after them.
 PENDING = len(VERDICTS)
 
 #: ``evaluate(idx, X)`` with X of shape (len(idx), k + 1), sorted along axis 1, returns
@@ -68,7 +73,8 @@ class BranchAndBound:
     Attributes
     ----------
     status : ndarray of int8
-        :data:`CERTIFIED`, :data:`VIOLATED`, :data:`INCONCLUSIVE` or :data:`PENDING`.
+        :data:`~stringstab.certify.verdicts.CERTIFIED`, :data:`~stringstab.certify.verdicts.NOT_CERTIFIED`
+        (violated), :data:`~stringstab.certify.verdicts.INCONCLUSIVE` or :data:`PENDING`.
     minimum : ndarray
         Smallest point value found (an upper bound on min f).
     argmin : ndarray
@@ -104,14 +110,14 @@ def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
     """Item outcomes of :func:`branch_and_bound` as verdict codes 0, 1, 2.
 
     Certified 0, violated 1 (not certified), anything else 2 (inconclusive): the codes of
-    :data:`stringstab.certify.verdicts.VERDICTS`.  CERTIFIED, VIOLATED and INCONCLUSIVE *are*
-    these codes (imported from :mod:`stringstab.certify.verdicts`); only PENDING is mapped (to
-    inconclusive).
+    :data:`stringstab.certify.verdicts.VERDICTS`.  Certified, violated and inconclusive items
+    already carry these codes (CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE); only PENDING is mapped
+    (to inconclusive).
 
     Parameters
     ----------
     status : ndarray of int8
-        Item outcomes of :func:`branch_and_bound` (CERTIFIED, VIOLATED, INCONCLUSIVE, PENDING).
+        Item outcomes of :func:`branch_and_bound` (CERTIFIED, NOT_CERTIFIED, INCONCLUSIVE, PENDING).
 
     Returns
     -------
@@ -267,7 +273,7 @@ def branch_and_bound(
     else:
         pi, pl, ph = _NO_ITEMS, _NO_POINTS, _NO_POINTS
     status[inconclusive] = INCONCLUSIVE
-    status[violated] = VIOLATED
+    status[violated] = NOT_CERTIFIED
     return BranchAndBound(status, minimum, argmin, n_evals, grid_x, grid_f, pi, pl, ph)
 
 

@@ -33,9 +33,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ..io import TableColumn
-from ..params import Box, Interval, as_gains, as_interval, check_box, parse_interval
+from ..params import Box, as_gains, check_box
 from ..params import sample_time as _sample_time
-from .robust_continuous import certify_box_continuous, robust_margin
+from .robust_continuous import certify_box_continuous
 from .verdicts import (
     ROW_COLUMNS,
     BatchResult,
@@ -48,19 +48,13 @@ from .verdicts import (
 
 __all__ = [
     "TABLE_COLUMNS",
-    "Box",
-    "Interval",
     "RobustCertificate",
     "RobustCertificateBatch",
-    "as_interval",
     "certify_kernel",
     "certify_robust",
     "certify_robust_batch",
-    "check_box",
     "check_of",
     "check_robust",
-    "parse_interval",
-    "robust_margin",
 ]
 
 Array = npt.NDArray[np.float64]

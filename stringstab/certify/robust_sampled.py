@@ -1,6 +1,6 @@
 """The robust certificate of the sampled-data loop over a box: bisection of parameter cells.
 
-g_H of :func:`stringstab.certify.sampled.sampled_margin` has no closed-form minimum over a
+g_H of :func:`stringstab.certify.sampled_frequency.sampled_margin` has no closed-form minimum over a
 box of τ, δ, T* (and the predecessor's lag τ_p), so the branch and bound of
 :mod:`stringstab.certify.branch_bound` also splits the parameters: each item is a cell
 (τ, τ_p, ε, T* intervals) whose coefficients are enclosed with derivative enclosures
@@ -283,10 +283,10 @@ def certify_box_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *,
         wit["m"][o] = cells.m[b]
         for k in ("t", "tp", "e", "h"):
             wit[k][o] = getattr(cells, k)[b].mean(axis=1)
-        viol = np.unique(cells.owner[bb.status == branch_bound.VIOLATED])
+        viol = np.unique(cells.owner[bb.status == NOT_CERTIFIED])
         status[viol] = NOT_CERTIFIED
         active[viol] = False
-        decided = (branch_bound.CERTIFIED, branch_bound.VIOLATED, branch_bound.PENDING)
+        decided = (CERTIFIED, NOT_CERTIFIED, branch_bound.PENDING)
         inc = np.unique(cells.owner[np.isin(bb.status, decided, invert=True)])
         inc = inc[status[inc] != NOT_CERTIFIED]
         status[inc] = INCONCLUSIVE

@@ -58,14 +58,13 @@ from ..params import Box, Params, as_gains
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes
 from .excess import EXCESS_SEARCH, searched_excess
 from .sampled_excess import peak_gain, violation_peak
-from .sampled_frequency import margin_bound, margin_curvature, sampled_margin, sampled_response
-from .schur import schur, schur_bands, schur_margins, spectral_radius, spectral_radius_of
+from .sampled_frequency import margin_bound, margin_curvature
+from .schur import schur_bands, spectral_radius_of
 from .verdicts import (
     CERTIFIED,
     INCONCLUSIVE,
     NOT_CERTIFIED,
     ROW_COLUMNS,
-    VERDICTS,
     BatchResult,
     Check,
     SingleResult,
@@ -73,11 +72,10 @@ from .verdicts import (
     names,
     one_triple,
 )
-from .zoh import Coefficients, loop_parameters, point_coefficients, split_delay
+from .zoh import Coefficients, loop_parameters, point_coefficients
 
 __all__ = [
     "TABLE_COLUMNS",
-    "VERDICTS",
     "SampledCertificate",
     "SampledCertificateBatch",
     "SampledCheck",
@@ -86,12 +84,6 @@ __all__ = [
     "certify_sampled_batch",
     "check_kernel",
     "check_sampled",
-    "sampled_margin",
-    "sampled_response",
-    "schur",
-    "schur_margins",
-    "spectral_radius",
-    "split_delay",
 ]
 
 Array = npt.NDArray[np.float64]

@@ -31,7 +31,6 @@ from ..ranges import check_magnitude, sensible_warning
 
 __all__ = [
     "NEGATIVE_NUMBER",
-    "RESULT_FORMATS",
     "add_gain_arguments",
     "add_limit_arguments",
     "add_model_arguments",

@@ -80,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     leaders, desc = test_leaders(args.leaders, dt=dt)
     limits = limits_from_args(args)
     out = OutputDir(args.out, command="compare")
-    from ..traffic.leaders import paper_mix
+    from ..traffic.synthetic import paper_mix
 
     checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits)
     groups: dict[str, list[Any]] = {}

@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     out = OutputDir(Path(args.out) if args.out else Path(args.run) / "evaluation",
                     command="evaluate")
     policy_doc = _policy_of(Path(args.run), out)
-    from ..traffic.leaders import paper_mix
+    from ..traffic.synthetic import paper_mix
 
     warnings = checked_leaders(args, [*leaders, *([paper_mix(dt=p["dt"])] if sizes else [])],
                                limits)

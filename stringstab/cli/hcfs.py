@@ -27,7 +27,8 @@ def add_parser(sub: Any) -> None:
         added sets ``func`` to :func:`run`.
     """
     from ..hcfs.constants import BETA, PAPER_JERK_LIMIT
-    from ..traffic.leaders import CYCLES, SYNTHETIC
+    from ..traffic.cycles import CYCLES
+    from ..traffic.synthetic import SYNTHETIC
 
     p = sub.add_parser(
         "hcfs",

@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..traffic.leaders import Trajectory
+from ..traffic.trajectory import Trajectory
 from .constants import BETA, PAPER_JERK_LIMIT
 from .policy import AccelerationPolicy
 from .verify import verify

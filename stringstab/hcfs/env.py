@@ -40,8 +40,8 @@ from gymnasium.vector.utils import batch_space
 from ..errors import StringStabError
 from ..params import positive
 from ..traffic.dynamics import Platoon
-from ..traffic.leaders import Trajectory
 from ..traffic.limits import Limits
+from ..traffic.trajectory import Trajectory
 from .constants import (
     ACCEL_MAX,
     ACCEL_MIN,
@@ -110,7 +110,7 @@ class HCFSVectorEnv(VectorEnv[Obs, Obs, npt.NDArray[Any]]):
 
     Examples
     --------
-    >>> from stringstab.traffic.leaders import stop_and_go
+    >>> from stringstab.traffic import stop_and_go
     >>> env = HCFSVectorEnv(2, [stop_and_go(dt=0.2)], n_followers=3, episode_seconds=2.0)
     >>> obs, _ = env.reset(seed=0)
     >>> obs.shape, env.single_action_space.shape

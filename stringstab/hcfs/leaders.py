@@ -37,7 +37,9 @@ import dataclasses
 import math
 
 from ..errors import StringStabError, show
-from ..traffic.leaders import Trajectory, cycle, leader_by_name
+from ..traffic.cycles import cycle
+from ..traffic.leaders import leader_by_name
+from ..traffic.trajectory import Trajectory
 from .constants import DT
 
 __all__ = [
@@ -93,7 +95,7 @@ def half_speed(tr: Trajectory, *, factor: float = HALF_SPEED, name: str | None =
 
     Examples
     --------
-    >>> from stringstab.traffic.leaders import from_speed
+    >>> from stringstab.traffic import from_speed
     >>> half_speed(from_speed([0, 1], [10.0, 12.0], dt=0.5)).speed.tolist()
     [5.0, 5.5, 6.0]
     """

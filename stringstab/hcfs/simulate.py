@@ -39,8 +39,8 @@ import numpy.typing as npt
 from ..errors import StringStabError
 from ..params import count, positive
 from ..traffic.dynamics import Platoon
-from ..traffic.leaders import Trajectory
 from ..traffic.limits import Limits
+from ..traffic.trajectory import Trajectory
 from .cacc import CACC
 from .constants import (
     ACCEL_MAX,
@@ -270,7 +270,7 @@ def simulate_hcfs(
 
     Examples
     --------
-    >>> from stringstab.traffic.leaders import sinusoid
+    >>> from stringstab.traffic import sinusoid
     >>> from stringstab.hcfs.policy import LeaderSpeedMatcher
     >>> lead = sinusoid(omega=0.5, amplitude=2.0, speed=10.0, duration=10.0, dt=0.2)
     >>> run = simulate_hcfs(lead, LeaderSpeedMatcher(), n_followers=2,

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError
-from ..traffic.leaders import Trajectory
+from ..traffic.trajectory import Trajectory
 from .constants import BETA
 from .policy import AccelerationPolicy
 from .simulate import MODES, HCFSRun, RunConfig, simulate_hcfs
@@ -221,7 +221,7 @@ def verify(
 
     Examples
     --------
-    >>> from stringstab.traffic.leaders import stop_and_go
+    >>> from stringstab.traffic import stop_and_go
     >>> from stringstab.hcfs.policy import LeaderSpeedMatcher
     >>> v = verify([stop_and_go(waves=1, dt=0.2)], LeaderSpeedMatcher(), jerk_limits=[2.5],
     ...            n_followers=2)

@@ -30,7 +30,6 @@ __all__ = [
     "CONTINUOUS",
     "EXACT_CLASSES",
     "GAIN_NAMES",
-    "INCONCLUSIVE",
     "METHODS",
     "STABLE",
     "TYPE_CLASSES",

@@ -24,19 +24,11 @@ from pathlib import Path
 from typing import Literal
 
 from ..errors import StringStabError
-from ..traffic.leaders import (
-    CYCLES,
-    FollowingPair,
-    Trajectory,
-    cycle,
-    hard_acceleration,
-    hard_braking,
-    load_csv,
-    load_ngsim_pairs,
-    sinusoid,
-    stop_and_go,
-    train_test_split,
-)
+from ..traffic.cycles import CYCLES, cycle
+from ..traffic.loaders import FollowingPair, load_csv, load_ngsim_pairs
+from ..traffic.split import train_test_split
+from ..traffic.synthetic import hard_acceleration, hard_braking, sinusoid, stop_and_go
+from ..traffic.trajectory import Trajectory
 
 __all__ = ["Split", "cut", "default_leaders", "leaders_from_files"]
 

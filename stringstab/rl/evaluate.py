@@ -377,9 +377,9 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
         ``"m_fss_sampled"`` (:func:`fss` of every vehicle's executed gains at every step;
         None otherwise).
     """
-    from ..traffic.leaders import paper_mix
     from ..traffic.metrics import platoon_metrics
     from ..traffic.platoon import simulate
+    from ..traffic.synthetic import paper_mix
 
     leader = paper_mix(dt=dt).hold(hold)
     ctrl = controller_for(strategy, headway=headway, standstill=standstill)

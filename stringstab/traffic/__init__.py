@@ -4,7 +4,7 @@
   :mod:`~stringstab.traffic.cycles` (driving cycles), :mod:`~stringstab.traffic.synthetic`
   (synthetic profiles), :mod:`~stringstab.traffic.loaders` (CSV files, NGSIM pairs),
   :mod:`~stringstab.traffic.split` (a train/test split), and
-  :mod:`~stringstab.traffic.leaders` (a leader by name; re-exports all of these);
+  :mod:`~stringstab.traffic.leaders` (a leader by name from a command-line spec);
 * platoons: :mod:`~stringstab.traffic.limits` (acceleration and speed bounds, the leader
   check, the vehicle length), :mod:`~stringstab.traffic.dynamics` (the vectorised stepping
   core, IDL eqs 1-2, 5-7), :mod:`~stringstab.traffic.platoon` (:func:`simulate`) and
@@ -35,32 +35,20 @@ from .controllers import (
     TimeVaryingLinearController,
     linear_law,
 )
+from .cycles import CYCLES, cycle
 from .dynamics import Platoon
 from .env import BatchedCarFollowingEnv, CarFollowingEnv
-from .leaders import (
-    CYCLES,
-    SYNTHETIC,
-    FollowingPair,
-    Trajectory,
-    cycle,
-    from_accel_segments,
-    from_speed,
-    hard_acceleration,
-    hard_braking,
-    leader_by_name,
-    load_csv,
-    load_ngsim_pairs,
-    paper_mix,
-    sinusoid,
-    stop_and_go,
-    train_test_split,
-)
+from .leaders import leader_by_name
 from .limits import Limits, check_leader
+from .loaders import FollowingPair, load_csv, load_ngsim_pairs
 from .output import RUN_FILES, run_document, save_trajectories, write_run
 from .platoon import simulate
 from .result import PlatoonResult
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
+from .split import train_test_split
 from .state import SCALES, state_vector
+from .synthetic import SYNTHETIC, hard_acceleration, hard_braking, paper_mix, sinusoid, stop_and_go
+from .trajectory import Trajectory, from_accel_segments, from_speed
 
 __all__ = [
     "CYCLES",

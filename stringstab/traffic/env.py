@@ -32,8 +32,8 @@ executed ones — a gain rate limit (:func:`~stringstab.traffic.rate.limit_rate`
 (``start_spread``, not in the paper): the initial gap scaled by 1 + s_g·U(−1, 1) and the speed
 offset by s_v·U(−1, 1) m/s, so that closing situations are met in training.
 
-An episode runs over one leader (a :class:`~stringstab.traffic.leaders.Trajectory`, started in
-equilibrium, or a :class:`~stringstab.traffic.leaders.FollowingPair`, started where the recorded
+An episode runs over one leader (a :class:`~stringstab.traffic.trajectory.Trajectory`, started in
+equilibrium, or a :class:`~stringstab.traffic.loaders.FollowingPair`, started where the recorded
 human follower was, as in the paper §4.1.2) until its last sample (``truncated``) or a
 collision (``terminated``, when ``terminate_on_collision``; the paper ends training events at a
 collision and lets test events continue).
@@ -64,20 +64,12 @@ from .dynamics import Model
 from .episodes import ActionMode, Episodes
 from .limits import DEFAULT_LENGTH, Limits
 from .loaders import FollowingPair
-from .rate import limit_rate
-from .state import GAIN_SCALE, OBSERVE, SCALES, extend_state, state_dim, state_vector
+from .state import SCALES, state_dim
 from .trajectory import Trajectory
 
 __all__ = [
-    "GAIN_SCALE",  # re-exported from stringstab.traffic.state (public here before the split)
-    "OBSERVE",  # re-exported from stringstab.traffic.state
-    "SCALES",  # re-exported from stringstab.traffic.state
     "BatchedCarFollowingEnv",
     "CarFollowingEnv",
-    "extend_state",  # re-exported from stringstab.traffic.state
-    "limit_rate",  # re-exported from stringstab.traffic.rate
-    "state_dim",  # re-exported from stringstab.traffic.state
-    "state_vector",  # re-exported from stringstab.traffic.state
 ]
 
 #: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).

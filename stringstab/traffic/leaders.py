@@ -1,11 +1,12 @@
-"""Lead-vehicle trajectories by name, and the leader API in one place.
+"""Lead-vehicle trajectories by name.
 
-:func:`leader_by_name` turns a command-line spec into a :class:`Trajectory`: a bundled driving
-cycle (:mod:`~stringstab.traffic.cycles`), a synthetic profile with parameters
+:func:`leader_by_name` turns a command-line spec into a
+:class:`~stringstab.traffic.trajectory.Trajectory`: a bundled driving cycle
+(:mod:`~stringstab.traffic.cycles`), a synthetic profile with parameters
 (:mod:`~stringstab.traffic.synthetic`) or a ``t, v[, a]`` CSV file
-(:mod:`~stringstab.traffic.loaders`).  The leader API of those modules — the trajectory type
-(:mod:`~stringstab.traffic.trajectory`), NGSIM pairs and the train/test split
-(:mod:`~stringstab.traffic.split`) — is re-exported here.
+(:mod:`~stringstab.traffic.loaders`).  The leader API itself lives in those modules and in
+:mod:`~stringstab.traffic.trajectory` and :mod:`~stringstab.traffic.split`; the package
+:mod:`stringstab.traffic` exports its public names.
 """
 
 from __future__ import annotations
@@ -15,44 +16,16 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..constants import DT, SPEED_MAX
+from ..constants import DT
 from ..errors import StringStabError, show
 from .cycles import CYCLE_ALIASES, CYCLES, cycle
-from .loaders import FEET, FollowingPair, load_csv, load_ngsim_pairs
-from .split import train_test_split
+from .loaders import load_csv
 from .synthetic import (
-    PAPER_MIX_SEGMENTS,
     SYNTHETIC,
-    hard_acceleration,
-    hard_braking,
-    paper_mix,
-    sinusoid,
-    stop_and_go,
 )
-from .trajectory import Trajectory, from_accel_segments, from_speed
+from .trajectory import Trajectory
 
-__all__ = [
-    "CYCLES",
-    "CYCLE_ALIASES",
-    "FEET",
-    "PAPER_MIX_SEGMENTS",
-    "SPEED_MAX",
-    "SYNTHETIC",
-    "FollowingPair",
-    "Trajectory",
-    "cycle",
-    "from_accel_segments",
-    "from_speed",
-    "hard_acceleration",
-    "hard_braking",
-    "leader_by_name",
-    "load_csv",
-    "load_ngsim_pairs",
-    "paper_mix",
-    "sinusoid",
-    "stop_and_go",
-    "train_test_split",
-]
+__all__ = ["leader_by_name"]
 
 
 def _parse_kwargs(spec: str, fn: Callable[..., Any], what: str) -> dict[str, Any]:

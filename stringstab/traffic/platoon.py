@@ -5,10 +5,6 @@ third-order model, eqs 5-7, or the kinematic one, eqs 1-2; discretisation, delay
 collisions are described in :mod:`stringstab.traffic.dynamics`) with a controller
 (:mod:`~stringstab.traffic.controllers`) behind each leader and returns a
 :class:`~stringstab.traffic.result.PlatoonResult`.
-
-``DEFAULT_LENGTH``, ``Limits`` and ``check_leader`` (homes :mod:`stringstab.traffic.limits`),
-``Platoon`` (:mod:`stringstab.traffic.dynamics`) and ``PlatoonResult``
-(:mod:`stringstab.traffic.result`) are re-exported here, where they were public before.
 """
 
 from __future__ import annotations
@@ -23,20 +19,11 @@ from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from .controllers.base import Controller
 from .dynamics import FractionalDelay, Model, Platoon, PositionUpdate
-from .limits import DEFAULT_LENGTH, Limits, check_leader
+from .limits import DEFAULT_LENGTH, Limits
 from .result import PlatoonResult
 from .trajectory import Trajectory
 
-__all__ = [
-    # re-exported from their homes (public here before the split)
-    "DEFAULT_LENGTH",
-    "Limits",
-    "Platoon",
-    "PlatoonResult",
-    "check_leader",
-    # defined here
-    "simulate",
-]
+__all__ = ["simulate"]
 
 Array = npt.NDArray[np.float64]
 

@@ -25,10 +25,6 @@ from ..constants import ACCEL_MAX, ACCEL_MIN, HEADWAY_MU, HEADWAY_SIGMA, TTC_STA
 from .metrics import time_headway, time_to_collision
 
 __all__ = [
-    "ACCEL_MAX",
-    "ACCEL_MIN",
-    "HEADWAY_MU",
-    "HEADWAY_SIGMA",
     "comfort_reward",
     "efficiency_reward",
     "headway_density",
@@ -39,7 +35,7 @@ __all__ = [
 Array = npt.NDArray[np.float64]
 
 # acc_max, acc_min (Table 2) and the μ, σ of the log-normal headway density (eq 23, Zhu et al.
-# 2020) are the toolkit's constants, re-exported here.
+# 2020) are the toolkit's constants (:mod:`stringstab.constants`).
 
 
 def safety_reward(ttc: npt.ArrayLike, *, ttc_star: float = TTC_STAR,

@@ -166,7 +166,7 @@ class Trajectory:
 
         Examples
         --------
-        >>> from stringstab.traffic.leaders import cycle
+        >>> from stringstab.traffic import cycle
         >>> cycle("udds").head(10.0).duration
         10.0
         """

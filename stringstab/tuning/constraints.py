@@ -9,11 +9,11 @@ constraint of the NLP is a *quadratic form in the gains*:
 * the continuous margin g(ω; K) (:func:`stringstab.certify.margin.g`) at one member (τ, δ, T*) and one
   frequency ω is a polynomial of degree 2 in K = (k_x, k_v, k_a): t2 does not depend on K,
   a is affine, b, c_x, c_v are quadratic;
-* the sampled margin g_H(θ; K) (:func:`stringstab.certify.sampled.sampled_margin`) is one too: every
+* the sampled margin g_H(θ; K) (:func:`stringstab.certify.sampled_frequency.sampled_margin`) is one too: every
   w-coefficient of Δ(w) and n(w) is affine in K, and g_H is a sum of products of two of them;
 * so are the internal-stability conditions: the Hurwitz conditions (linear,
   :func:`stringstab.certify.criteria.hurwitz_conditions`) and the normalised Schur conditions of the
-  sampled loop (:func:`stringstab.certify.sampled.schur_margins`).
+  sampled loop (:func:`stringstab.certify.schur.schur_margins`).
 
 A quadratic q(K) = c + bᵀK + KᵀAK is recovered *exactly* (up to round-off) from ten evaluations
 by polarisation (:func:`quadratic_form`), so each constraint is evaluated by the same code as
@@ -227,7 +227,7 @@ class Loop:
         """The margin g (or g_H, sampled) at ``member`` on frequencies ``freq`` for the gains K.
 
         Taken from the one home of each margin (:func:`stringstab.certify.margin.g`,
-        :func:`stringstab.certify.sampled.sampled_margin`).
+        :func:`stringstab.certify.sampled_frequency.sampled_margin`).
 
         Parameters
         ----------
@@ -247,7 +247,7 @@ class Loop:
         if not self.sampled:
             return _margin.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                              headway=member.headway)
-        from ..certify.sampled import sampled_margin
+        from ..certify.sampled_frequency import sampled_margin
 
         return sampled_margin(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                               headway=member.headway, sample_time=self.H,
@@ -272,7 +272,7 @@ class Loop:
             form = quadratic_form(lambda x, v, a: _margin.g(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway))
         else:
-            from ..certify.sampled import sampled_margin
+            from ..certify.sampled_frequency import sampled_margin
 
             form = quadratic_form(lambda x, v, a: sampled_margin(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway,
@@ -294,13 +294,13 @@ class Loop:
         list of Slot
             Kind ``"stability"``: two Hurwitz conditions
             (:func:`stringstab.certify.criteria.hurwitz_conditions`) or five Schur conditions
-            (:func:`stringstab.certify.sampled.schur_margins`), ``index`` 0, 1, ….
+            (:func:`stringstab.certify.schur.schur_margins`), ``index`` 0, 1, ….
         """
         def conditions(x: Array, v: Array, a: Array) -> Array:
             if not self.sampled:
                 return np.asarray(hurwitz_conditions(x, v, a, tau=member.tau,
                                                      headway=member.headway))
-            from ..certify.sampled import schur_margins
+            from ..certify.schur import schur_margins
 
             return schur_margins(x, v, tau=member.tau, headway=member.headway, sample_time=self.H)
 

@@ -148,7 +148,7 @@ def project(
     hurwitz_margin : float
         m in k_x ≥ m and k_v + (T* − τ)k_x ≥ m (internal stability with a margin); sampled,
         m in each Schur condition normalised to these as H → 0
-        (:func:`stringstab.certify.sampled.schur_margins`).
+        (:func:`stringstab.certify.schur.schur_margins`).
     eps : float
         ε > 0 of the frequency constraints.
     warm_start : sequence of 3 floats, optional
