@@ -241,3 +241,39 @@ def test_fractional_delay_option_is_checked():
     lead = sinusoid(omega=2.0, duration=2.0)
     with pytest.raises(StringStabError, match="fractional_delay must be 'linear' or 'exact'"):
         simulate(lead, LinearController(1.2, 0.5, 0.6), 2, fractional_delay="cubic")
+
+
+@pytest.mark.parametrize("fractional_delay", ["linear", "exact"])
+def test_platoon_state_round_trip_continues_bit_for_bit(fractional_delay):
+    from stringstab.traffic.dynamics import Platoon
+
+    dt, n = 0.1, 60
+    t = np.arange(2 * n + 1) * dt
+    lv = 15 + 2 * np.sin(0.8 * t)
+    la = 1.6 * np.cos(0.8 * t)
+    lx = np.cumsum(np.r_[0.0, lv[:-1] * dt])
+
+    def make():
+        # δ = 0.25 s is 2.5 steps: the fractional part of the delay is used
+        p = Platoon(2, 3, dt=dt, tau=0.3, delta=0.25, fractional_delay=fractional_delay)
+        p.reset(lx[0], lv[0], la[0], gap=np.full((2, 3), 20.0), speed=np.full((2, 3), 15.0),
+                accel=0.0)
+        return p
+
+    def run(p, k0, k1):
+        out = []
+        for k in range(k0, k1):
+            obs = p.observe(lx[k], lv[k], la[k])
+            u = 0.4 * (obs.gap - 5 - 1.1 * obs.speed) + 0.6 * obs.rel_speed + 0.3 * obs.pred_accel_delayed
+            out.append(p.advance(u).copy())
+        return np.array(out)
+
+    a = make()
+    run(a, 0, n)
+    meta, arrays = a.state()
+    tail = run(a, n, 2 * n)
+    b = make()
+    b.load_state(meta, arrays)
+    assert np.array_equal(run(b, n, 2 * n), tail)
+    with pytest.raises(StringStabError, match="platoon state: expected _buf"):
+        make().load_state(meta, {k: v for k, v in arrays.items() if k != "_buf"})

@@ -304,6 +304,53 @@ class Platoon:
         return Observation(k, k * self.dt, self.dt, gap, V[:, 1:], A[:, 1:], V[:, :-1], rel,
                            A[:, :-1], ad)
 
+    #: The arrays that hold the platoon's state between two steps (with :attr:`step`).
+    STATE_ARRAYS: tuple[str, ...] = ("position", "speed", "accel", "_buf", "_ubuf", "collided",
+                                     "collision_events", "first_collision_step", "_in_collision")
+
+    def state(self) -> tuple[dict[str, Any], dict[str, Array]]:
+        """The platoon's state between two steps, to continue bit for bit (a checkpoint).
+
+        Returns
+        -------
+        meta : dict
+            ``step`` and ``any_in_collision`` (JSON-ready).
+        arrays : dict of str to ndarray
+            Copies of the arrays named in :attr:`STATE_ARRAYS` (positions, speeds,
+            accelerations, the delay buffers and the collision records).
+        """
+        meta = {"step": int(self.step), "any_in_collision": bool(self._any_in_collision)}
+        return meta, {a: np.array(getattr(self, a), copy=True) for a in self.STATE_ARRAYS}
+
+    def load_state(self, meta: dict[str, Any], arrays: dict[str, Any]) -> None:
+        """Restore :meth:`state` output into this platoon (same shape; checked).
+
+        Parameters
+        ----------
+        meta : dict
+            ``step`` and ``any_in_collision``, as :meth:`state` returns them.
+        arrays : dict of str to array_like
+            The arrays of :meth:`state`, by name.
+
+        Raises
+        ------
+        StringStabError
+            If a key or an array is missing, or an array has another shape.
+        """
+        missing = [k for k in ("step", "any_in_collision") if k not in meta]
+        missing += [a for a in self.STATE_ARRAYS if a not in arrays]
+        if missing:
+            raise StringStabError(f"platoon state: expected {', '.join(missing)}; found "
+                                  f"{sorted(meta)} and arrays {sorted(arrays)}")
+        for a in self.STATE_ARRAYS:
+            dst, src = getattr(self, a), np.asarray(arrays[a])
+            if src.shape != dst.shape:
+                raise StringStabError(f"platoon state {a}: expected shape {dst.shape}; "
+                                      f"found {src.shape}")
+            dst[...] = src
+        self.step = int(meta["step"])
+        self._any_in_collision = bool(meta["any_in_collision"])
+
     def advance(self, command: npt.ArrayLike) -> Array:
         """Apply desired accelerations u (P, N) over one step; returns the limited u.
 

@@ -73,8 +73,6 @@ __all__ = [
 ]
 
 #: Platoon arrays that make up the state of a :class:`BatchedCarFollowingEnv` (with the step).
-_PLATOON_STATE = ("position", "speed", "accel", "_buf", "collided", "collision_events",
-                  "first_collision_step", "_in_collision")
 
 Array = npt.NDArray[np.float64]
 
@@ -363,9 +361,9 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
             raise StringStabError("call reset() before state_dict()")
         c, p = self._core, self._core.platoon
         arrays = {"which": c.which, "k": c.k, "ret": c.ret, "prev_gains": c.prev_gains}
-        arrays.update({f"platoon.{a}": getattr(p, a) for a in _PLATOON_STATE})
-        meta = {"num_envs": self.num_envs, "n_leaders": len(c.items), "step": int(p.step),
-                "any_in_collision": bool(p._any_in_collision),
+        platoon_meta, platoon_arrays = p.state()
+        arrays.update({f"platoon.{a}": v for a, v in platoon_arrays.items()})
+        meta = {"num_envs": self.num_envs, "n_leaders": len(c.items), **platoon_meta,
                 "rng": self.np_random.bit_generator.state}
         return meta, {k: np.array(v, copy=True) for k, v in arrays.items()}
 
@@ -394,17 +392,14 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
             if key not in meta:
                 raise StringStabError(f"environment state: expected key {key!r} in the "
                                       f"environment's meta data, found keys {sorted(meta)}")
-        names = ["which", "k", "ret", "prev_gains", *(f"platoon.{a}" for a in _PLATOON_STATE)]
+        names = ["which", "k", "ret", "prev_gains", *(f"platoon.{a}" for a in p.STATE_ARRAYS)]
         for name in names:
             if name not in arrays:
                 raise StringStabError(f"environment state: expected key {name!r} in the "
                                       f"environment's arrays, found keys {sorted(arrays)}")
         for name in ("which", "k", "ret", "prev_gains"):
             self._restore(getattr(c, name), arrays[name], name)
-        for a in _PLATOON_STATE:
-            self._restore(getattr(p, a), arrays[f"platoon.{a}"], f"platoon.{a}")
-        p.step = int(meta["step"])
-        p._any_in_collision = bool(meta["any_in_collision"])
+        p.load_state(meta, {a: arrays[f"platoon.{a}"] for a in p.STATE_ARRAYS})
         self.np_random.bit_generator.state = meta["rng"]
         c.observe()
 
