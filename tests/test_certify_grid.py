@@ -178,8 +178,8 @@ def test_same_points_as_the_projection_certified_map(p):
 
 
 def _loop_certified_points(K, params, sample_time, heterogeneous=True):
-    """tuning/constraints.py's ``Loop.certified_points`` before it called the helper (verbatim,
-    with the box's centre of ``Loop.centre``)."""
+    """tuning/constraints.py's ``LoopConstraints.certified_points`` before it called the helper (verbatim,
+    with the box's centre of ``LoopConstraints.centre``)."""
     b = Box.of(params)
     (t0, t1), (d0, d1), (h0, h1) = b.tau, b.delta, b.headway
     ct, cd, ch = 0.5 * (t0 + t1), 0.5 * (d0 + d1), 0.5 * (h0 + h1)
@@ -201,7 +201,7 @@ LOOPS = [(P, None, 9), (P, 0.1, 9), (BOX, None, 9), (BOX, 0.1, 4)]
 
 @pytest.mark.parametrize(("params", "sample_time", "n"), LOOPS)
 def test_same_points_as_the_tuning_loop(params, sample_time, n):
-    from stringstab.tuning.constraints import Loop
+    from stringstab.tuning.constraints import LoopConstraints as Loop
 
     K = lattice(-2.0, 2.0, n)
     old = _loop_certified_points(K, params, sample_time)

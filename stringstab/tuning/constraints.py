@@ -18,8 +18,8 @@ constraint of the NLP is a *quadratic form in the gains*:
 A quadratic q(K) = c + bᵀK + KᵀAK is recovered *exactly* (up to round-off) from ten evaluations
 by polarisation (:func:`quadratic_form`), so each constraint is evaluated by the same code as
 the certificate it serves, and the NLP sees only the numbers (c, b, A) of each slot: one NLP for
-every loop.  :class:`Loop` says which member and frequency each constraint is taken at: a few
-fixed ones to start, then the certificate's witnesses (the exchange method), and decides every
+every loop.  :class:`LoopConstraints` says which member and frequency each constraint is taken
+at: a few fixed ones to start, then the certificate's witnesses (the exchange method), and decides every
 output with the certificate of that loop (:func:`stringstab.certify.api.check`).
 
 References
@@ -44,7 +44,7 @@ from ..certify.criteria import hurwitz_conditions
 from ..certify.grid import certified
 from ..params import Box, Params
 
-__all__ = ["FORM_SIZE", "Loop", "Member", "Slot", "quadratic_form"]
+__all__ = ["FORM_SIZE", "LoopConstraints", "Member", "Slot", "quadratic_form"]
 
 Array = npt.NDArray[np.float64]
 
@@ -143,7 +143,7 @@ class Slot:
     form: Array
 
 
-class Loop:
+class LoopConstraints:
     """The loop to repair gains for, its constraints and its certificate.
 
     Parameters

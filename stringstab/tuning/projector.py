@@ -27,7 +27,7 @@ from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model, positive
 from ..params import sample_time as _sample_time
-from .constraints import Loop, Member, Slot, evaluate_forms
+from .constraints import LoopConstraints, Member, Slot, evaluate_forms
 from .exchange import (
     CLUSTER,
     dedupe_frequencies,
@@ -85,7 +85,7 @@ def _loop_map(box: Box, sample_time: float | None, heterogeneous: bool, lo: floa
     Only points whose stability conditions (at the box's corners) are ≥ ``margin`` are kept;
     they serve as starting points and fallbacks.
     """
-    loop = Loop(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0]),
+    loop = LoopConstraints(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0]),
                 sample_time, heterogeneous)
     g = np.linspace(lo, hi, n)
     K = np.stack([a.ravel() for a in np.meshgrid(g, g, g, indexing="ij")], axis=1)
@@ -174,7 +174,7 @@ class Projector:
         self.sample_time = None if sample_time is None else _sample_time(sample_time)
         #: The sampled or robust loop (None: the continuous loop at one τ, δ, T*).
         self.loop = (None if self.sample_time is None and isinstance(self.params, Params)
-                     else Loop(self.params, self.sample_time, heterogeneous))
+                     else LoopConstraints(self.params, self.sample_time, heterogeneous))
         self.weights = as_weights(weights)
         self.bounds = as_bounds(bounds)
         self.hurwitz_margin = positive("hurwitz_margin", hurwitz_margin, allow_zero=True)
@@ -366,7 +366,7 @@ class Projector:
         return solve_quadratic(K0, x0, slots, weights=self.weights, bounds=self.bounds,
                                hurwitz_margin=self.hurwitz_margin, eps=eps)
 
-    def _first_slots(self, loop: Loop, k0: Array, witnesses: list[tuple[Member, float]]) -> list[Slot]:
+    def _first_slots(self, loop: LoopConstraints, k0: Array, witnesses: list[tuple[Member, float]]) -> list[Slot]:
         """The exchange's first constraint slots for ``loop`` (duplicates removed).
 
         They are stability at the corners of the (τ, T*) box (sampled loop) or at its member with
@@ -389,12 +389,12 @@ class Projector:
             slots += [loop.margin_slot(m, f * r) for r in _K0_CLUSTER if f > 0]
         return dedupe_slots(slots)
 
-    def _repair_loop(self, loop: Loop, k0: Array, key: tuple[float, ...], use_state: bool,
+    def _repair_loop(self, loop: LoopConstraints, k0: Array, key: tuple[float, ...], use_state: bool,
                      warm_start: Sequence[float] | None, t0: float) -> TuneResult:
         """Repair K0 for the sampled or robust loop.
 
         The exchange runs on :func:`~stringstab.tuning.nlp.quadratic_nlp`; every output is
-        decided by that loop's certificate (:meth:`Loop.check`).
+        decided by that loop's certificate (:meth:`LoopConstraints.check`).
         """
         method, w = "projection", self.weights
         verdict0, _, wit0 = loop.check(k0)
