@@ -162,9 +162,11 @@ def count(name: str, value: Any) -> int:
     ...
     stringstab.errors.StringStabError: n_followers must be an integer >= 1; got 2.5
     """
+    if isinstance(value, bool):  # True == 1, but a flag is not a count
+        raise StringStabError(f"{name} must be an integer >= 1; got {show(value)}")
     try:
         n = int(value)
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError, OverflowError) as e:
         raise StringStabError(f"{name} must be an integer >= 1; got {show(value)}") from e
     if n < 1 or n != value:
         raise StringStabError(f"{name} must be an integer >= 1; got {show(value)}")

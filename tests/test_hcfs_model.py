@@ -162,3 +162,23 @@ def test_rate_limit_and_policy_seam():
         accelerations(lambda z: np.full(len(z), np.nan), s)
     p = ScaledPolicy(lambda z: z[:, :1], scales=[2, 1, 1, 1, 1, 1])
     np.testing.assert_allclose(accelerations(p, np.ones((1, 6))), [0.5])
+
+
+def test_a_torch_policy_with_the_wrong_input_size_is_refused_in_one_line():
+    torch = pytest.importorskip("torch")
+    net = torch.nn.Linear(5, 1)  # expects 5 inputs; the HCFS state has 6
+
+    def policy(s):
+        with torch.no_grad():
+            return net(torch.as_tensor(s, dtype=torch.float32)).numpy()
+
+    with pytest.raises(StringStabError, match="failed on a state batch"):
+        accelerations(policy, np.zeros((3, 6)))
+
+
+@pytest.mark.parametrize("value", [True, False, float("inf"), 2.5, "x", 0])
+def test_count_refuses_what_is_not_a_count(value):
+    from stringstab.params import count
+
+    with pytest.raises(StringStabError, match="must be an integer >= 1"):
+        count("n_followers", value)

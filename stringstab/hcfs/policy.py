@@ -95,8 +95,9 @@ def accelerations(policy: AccelerationPolicy, state: npt.ArrayLike) -> Array:
     Raises
     ------
     StringStabError
-        If the state does not have 6 components, the policy raises a TypeError or
-        ValueError, returns the wrong number of values or a NaN/inf.
+        If the state does not have 6 components, the policy raises a TypeError,
+        ValueError or RuntimeError (torch's error for a wrong input shape), returns the wrong
+        number of values or a NaN/inf.
 
     Examples
     --------
@@ -109,7 +110,7 @@ def accelerations(policy: AccelerationPolicy, state: npt.ArrayLike) -> Array:
     flat = s.reshape(-1, 6)
     try:
         out = np.asarray(policy(flat), dtype=np.float64)
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError, RuntimeError) as e:  # RuntimeError: torch's shape errors
         raise StringStabError(f"the acceleration policy {policy_label(policy)!r} failed on a state batch: {e}") from e
     if out.size != flat.shape[0]:
         raise StringStabError(
