@@ -663,3 +663,21 @@ def test_replay_buffer_refuses_a_checkpoint_missing_a_key_or_an_array():
         fresh.load_state({k: v for k, v in state.items() if k != "rng"}, arrays)
     with pytest.raises(StringStabError, match=r"replay buffer: expected dones in the checkpoint"):
         fresh.load_state(state, {k: v for k, v in arrays.items() if k != "dones"})
+
+
+def test_replay_buffer_batch_larger_than_capacity_keeps_its_newest_transitions():
+    pytest.importorskip("torch")
+    from stringstab.rl.buffer import ReplayBuffer
+
+    big = ReplayBuffer(4, obs_dim=1, act_dim=1, seed=0)
+    one = ReplayBuffer(4, obs_dim=1, act_dim=1, seed=0)
+    big.add([[1.0]], [[0.0]], [0.0], [[0.0]], [0.0])  # pos 1 before the big batch
+    one.add([[1.0]], [[0.0]], [0.0], [[0.0]], [0.0])
+    x = np.arange(10, dtype=np.float32)[:, None]
+    big.add(x, x, x[:, 0], x, np.zeros(10))
+    for i in range(10):  # the same transitions one at a time: the reference
+        one.add(x[i:i + 1], x[i:i + 1], x[i:i + 1, 0], x[i:i + 1], np.zeros(1))
+    for f in ("obs", "actions", "rewards", "next_obs", "dones"):
+        assert np.array_equal(getattr(big, f), getattr(one, f)), f
+    assert (big.pos, big.size) == (one.pos, one.size) == (3, 4)
+    assert sorted(big.obs[:, 0]) == [6.0, 7.0, 8.0, 9.0]

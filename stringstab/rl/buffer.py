@@ -69,12 +69,20 @@ class ReplayBuffer:
         """
         o = np.asarray(obs, dtype=np.float32)
         n = o.shape[0]
-        idx = (self.pos + np.arange(n)) % self.capacity
-        self.obs[idx] = o
-        self.actions[idx] = np.asarray(actions, dtype=np.float32).reshape(n, -1)
-        self.rewards[idx, 0] = np.asarray(rewards, dtype=np.float32).reshape(n)
-        self.next_obs[idx] = np.asarray(next_obs, dtype=np.float32)
-        self.dones[idx, 0] = np.asarray(dones, dtype=np.float32).reshape(n)
+        a = np.asarray(actions, dtype=np.float32).reshape(n, -1)
+        r = np.asarray(rewards, dtype=np.float32).reshape(n)
+        o2 = np.asarray(next_obs, dtype=np.float32)
+        d = np.asarray(dones, dtype=np.float32).reshape(n)
+        # a batch larger than the buffer: only its newest ``capacity`` transitions remain
+        # (written once each, as if the batch had been added one transition at a time)
+        keep = slice(max(0, n - self.capacity), n)
+        m = n - keep.start
+        idx = (self.pos + keep.start + np.arange(m)) % self.capacity
+        self.obs[idx] = o[keep]
+        self.actions[idx] = a[keep]
+        self.rewards[idx, 0] = r[keep]
+        self.next_obs[idx] = o2[keep]
+        self.dones[idx, 0] = d[keep]
         self.pos = int((self.pos + n) % self.capacity)
         self.size = int(min(self.size + n, self.capacity))
 
