@@ -310,6 +310,13 @@ def _private_imports() -> set[tuple[str, str]]:
                 if base.startswith(ROOT) and base != mod:
                     out |= {(mod, f"{base}.{a.name}") for a in node.names
                             if a.name.startswith("_") and not a.name.startswith("__")}
+                    # a private module of another package (its own package's are its business;
+                    # _version is the version's one home, below every layer)
+                    parent, _, last = base.rpartition(".")
+                    if (last.startswith("_") and not last.startswith("__")
+                            and base != f"{ROOT}._version" and mod != parent
+                            and not mod.startswith(parent + ".")):
+                        out.add((mod, base))
     return out
 
 

@@ -184,7 +184,7 @@ def test_gamma_parts_and_polynomial_coefficients():
     d = D_jw(*POINT, 1j * OMEGA)
     close(gen.gamma_parts(OMEGA, *POINT), [n.real, n.imag, d.real, d.imag])
     close(gen.denominator_coefficients(*POINT), ref(sp.Poly(gam.denominator, S.s).all_coeffs()))
-    n0, n1 = S._split_delay(gam.numerator)
+    n0, n1 = S.delay_parts(gam.numerator)
     co = gen.numerator_coefficients(*POINT)
     k = gen.NUMERATOR_SPLIT
     close(co[:k], ref(sp.Poly(n0, S.s).all_coeffs()))

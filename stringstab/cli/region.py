@@ -229,7 +229,7 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
 
 def _warm_up_outputs() -> None:
     from ..io.text_formats import warm_up as warm_up_writer
-    from ..plots._common import warm_up as warm_up_plots
+    from ..plots import warm_up as warm_up_plots
 
     warm_up_plots()
     warm_up_writer()

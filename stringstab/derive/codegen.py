@@ -483,7 +483,7 @@ def _source() -> str:
         "denominator_coefficients", gain_args, sp.Poly(gam.denominator, S.s).all_coeffs(),
         "Coefficients of D(s), highest power of s first.",
     ))
-    n0, n1 = S._split_delay(gam.numerator)
+    n0, n1 = S.delay_parts(gam.numerator)
     blocks.append(f"#: How many of :func:`numerator_coefficients` belong to the delay-free part n0(s).\n"
                   f"NUMERATOR_SPLIT = {sp.Poly(n0, S.s).degree() + 1}\n")
     blocks.append(_function(

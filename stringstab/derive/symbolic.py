@@ -34,6 +34,7 @@ __all__ = [
     "SUBSTITUTABLE",
     "TransferFunction",
     "VehicleModel",
+    "delay_parts",
     "delta",
     "derive_all",
     "derived_psi",
@@ -195,8 +196,19 @@ def gamma() -> TransferFunction:
     return TransferFunction(num, den)
 
 
-def _split_delay(num: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
-    """Write N(s) = n0(s) + n1(s) e^{−δs}."""
+def delay_parts(num: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """The parts of a numerator N(s) = n0(s) + n1(s) e^{−δs} (IDL eq 11's delayed term apart).
+
+    Parameters
+    ----------
+    num : sympy.Expr
+        A numerator in s holding ``exp(-delta*s)`` (e.g. ``gamma().numerator``).
+
+    Returns
+    -------
+    n0, n1 : sympy.Expr
+        The undelayed part and the coefficient of e^{−δs}.
+    """
     e = sp.exp(-delta * s)
     expr = sp.expand(num.subs(e, _E))
     n1 = expr.coeff(_E, 1)
@@ -224,7 +236,7 @@ def margin_exact() -> sp.Expr:
     jw = sp.I * omega
     d = sp.expand(g.denominator.subs(s, jw))
     d_re, d_im = d.as_real_imag()
-    n0, n1 = _split_delay(g.numerator)
+    n0, n1 = delay_parts(g.numerator)
     n = sp.expand(
         n0.subs(s, jw) + n1.subs(s, jw) * (sp.cos(delta * omega) - sp.I * sp.sin(delta * omega))
     )
@@ -263,7 +275,7 @@ def margin_series(omega_order: int = 6, delay_order: int | None = None) -> sp.Ex
     if delay_order < 0:
         raise StringStabError(f"delay_order must be >= 0 or None; got {delay_order!r}")
     g = gamma()
-    n0, n1 = _split_delay(g.numerator)
+    n0, n1 = delay_parts(g.numerator)
     taylor = sum((-delta * s) ** k / sp.factorial(k) for k in range(delay_order + 1))
     jw = sp.I * omega
     n = sp.expand((n0 + n1 * taylor).subs(s, jw))

@@ -38,7 +38,7 @@ matplotlib is imported on first use.
 from __future__ import annotations
 
 from ..io.figures import FIGURE_FORMATS
-from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult
+from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
 from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
 from .region_sets import plot_boundaries, plot_facets
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
@@ -72,4 +72,5 @@ __all__ = [
     "save_figures",
     "save_region_outputs",
     "trajectory_verdicts",
+    "warm_up",
 ]
