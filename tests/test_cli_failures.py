@@ -118,6 +118,32 @@ def test_ctrl_c_while_writing_keeps_the_old_run_whole(capsys, tmp_path, monkeypa
     assert after == before
 
 
+def test_sigterm_while_writing_stops_like_ctrl_c_and_keeps_the_old_run_whole(capsys, tmp_path,
+                                                                             monkeypatch):
+    """SIGTERM (a scheduler's time limit) is handled as Ctrl-C: one line, exit 130, no partial run."""
+    previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        out = tmp_path / "sim"
+        argv = ["simulate", "--followers", "2", "--duration", "10", "--no-figures", "--out",
+                str(out)]
+        assert main(argv) == 0
+        before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+        capsys.readouterr()
+        import stringstab.traffic.output as output
+
+        def terminated(*a, **k):
+            signal.raise_signal(signal.SIGTERM)  # without the handler: the process dies here
+
+        monkeypatch.setattr(output, "write_run", terminated)
+        _one_line(capsys, [*argv[:-3], "--gains", "1,1,0.5", *argv[-3:]], 130,
+                  "stringstab simulate: interrupted")
+        after = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+        assert after == before
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # handler restored
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def test_memory_error_is_one_line(capsys, monkeypatch):
     from stringstab.certify.api import Loop
 

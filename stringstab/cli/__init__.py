@@ -4,8 +4,8 @@ Each sub-command lives in its own module of this package and exposes
 ``add_parser(subparsers)`` (which registers it and sets ``func``) and a
 ``run(args) -> int``.  Bad input (:class:`~stringstab.errors.StringStabError`)
 becomes a one-line message on stderr and exit code 2; no verdict is printed.  The
-entry point is the one place that also turns Ctrl-C (``KeyboardInterrupt``: one line,
-exit 130) and ``MemoryError`` (one line, exit 2) into a sentence.
+entry point is the one place that also turns Ctrl-C and SIGTERM (``KeyboardInterrupt``: one
+line, exit 130) and ``MemoryError`` (one line, exit 2) into a sentence.
 
 Sub-commands are registered lazily: ``stringstab --help`` lists them from
 :data:`HELP` and ``stringstab NAME ...`` imports only ``stringstab.cli.NAME``,
@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -138,7 +140,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     int
         The sub-command's exit code (0 when it returns None); 2 after a
         :class:`~stringstab.errors.StringStabError` or running out of memory (one line on
-        stderr); 130 when interrupted; 0 when the output pipe closes early. argparse itself
+        stderr); 130 when interrupted (Ctrl-C or SIGTERM); 0 when the output pipe closes early. argparse itself
         exits with 2 on a malformed command line.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -160,6 +162,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             hook(u)
 
     sys.unraisablehook = quiet_interrupt
+    # SIGTERM (a batch scheduler's time limit, ``kill``) stops a command as Ctrl-C does: one
+    # line, outputs complete or absent, a resumable training run; only where nobody else
+    # (an embedding program) handles it, and only in the main thread, where Python runs handlers
+    term = None
+    if (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL):
+        term = signal.signal(signal.SIGTERM, _terminate)
     try:
         with invocation(lambda: provenance(args, argv)):
             return int(args.func(args) or 0)
@@ -182,6 +191,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     finally:
         sys.unraisablehook = hook
+        if term is not None:
+            signal.signal(signal.SIGTERM, term)
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    """SIGTERM as Ctrl-C: raise KeyboardInterrupt where the command is (see :func:`main`)."""
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":  # pragma: no cover
