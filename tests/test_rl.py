@@ -681,3 +681,23 @@ def test_replay_buffer_batch_larger_than_capacity_keeps_its_newest_transitions()
         assert np.array_equal(getattr(big, f), getattr(one, f)), f
     assert (big.pos, big.size) == (one.pos, one.size) == (3, 4)
     assert sorted(big.obs[:, 0]) == [6.0, 7.0, 8.0, 9.0]
+
+
+def test_fss_certifies_each_triple_at_the_step_it_ran_at():
+    from stringstab.certify.sampled import check_sampled
+    from stringstab.rl.evaluate import fss
+
+    rng = np.random.default_rng(3)
+    K = rng.uniform([0.05, -1, -1], [2, 2, 1.5], size=(300, 3))
+    steps = np.where(np.arange(300) < 120, 0.1, 0.4)
+    p = dict(tau=0.3, delta=0.2, headway=1.0)
+    f = fss(K, **p, dt=steps)
+    # the reference: the sampled certificate of each group at its own step, pooled by count
+    want = sum(int(np.sum(check_sampled(*K[steps == h].T, **p, sample_time=h).verdict
+                          == "certified")) for h in (0.1, 0.4)) / 300
+    assert f["m_fss_sampled"] == want and f["dt"] == [0.1, 0.4]
+    # a scalar step is the same as that step for every row; min(dt) for all would differ here
+    assert fss(K, **p, dt=0.1)["m_fss_sampled"] == fss(K, **p, dt=np.full(300, 0.1))["m_fss_sampled"]
+    assert fss(K, **p, dt=0.1)["m_fss_sampled"] != want
+    with pytest.raises(StringStabError, match="one per gain triple"):
+        fss(K, **p, dt=[0.1, 0.2])

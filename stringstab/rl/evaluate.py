@@ -55,7 +55,7 @@ BASELINES = ("cacc", "idm")
 
 
 def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
-        dt: float) -> dict[str, Any]:
+        dt: float | npt.ArrayLike) -> dict[str, Any]:
     """m_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
 
     The continuous certificate is what the repair guarantees (and what the exit code of
@@ -73,8 +73,9 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         Communication delay δ (eq 4), s.
     headway : float
         Time headway T* (eq 3), s.
-    dt : float
-        Control step, s: the sampling period H of the sampled-data certificate.
+    dt : float or array_like of float
+        Control step, s: the sampling period H of the sampled-data certificate; one per triple
+        when the triples ran at different steps (episodes of leaders sampled differently).
 
     Returns
     -------
@@ -82,28 +83,37 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         ``"m_fss"``: the fraction in [0, 1] of triples certified by the exact continuous-time
         certificate (IDL eqs 27-28 without the ×100 %, :func:`stringstab.traffic.metrics.fss_ratio`);
         ``"m_fss_sampled"``: the fraction certified by the
-        sampled-data certificate of the zero-order-hold loop at ``dt``
+        sampled-data certificate of the zero-order-hold loop at each triple's own ``dt``
         (:func:`stringstab.certify.sampled.check_sampled`); ``"n"``: the number of triples;
-        ``"certificate"``, ``"dt"``: what was checked.
+        ``"certificate"``, ``"dt"``: what was checked (the step, or the sorted list of steps).
 
     Raises
     ------
     StringStabError
-        If there is no gain triple.
+        If there is no gain triple, or ``dt`` is an array of another length.
     """
     from ..certify.sampled import check_sampled
 
     K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
     if not K.shape[0]:
         raise StringStabError("m_fss needs at least one executed gain triple")
-    uniq, inverse = np.unique(K, axis=0, return_inverse=True)
-    cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
-                       headway=headway, sample_time=dt)
-    ok_s = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
+    step = np.asarray(dt, dtype=np.float64)
+    if step.ndim and step.size != K.shape[0]:
+        raise StringStabError(f"dt: expected one step or one per gain triple ({K.shape[0]}); "
+                              f"found {step.size}")
+    steps = np.broadcast_to(step.reshape(-1) if step.ndim else step, K.shape[:1])
+    ok_s = np.zeros(K.shape[0], dtype=bool)
+    for h in np.unique(steps):  # each triple at the step it ran at
+        rows = np.flatnonzero(steps == h)
+        uniq, inverse = np.unique(K[rows], axis=0, return_inverse=True)
+        cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
+                           headway=headway, sample_time=float(h))
+        ok_s[rows] = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
+    hs = sorted(float(h) for h in np.unique(steps))
     return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
             "m_fss_sampled": float(ok_s.mean()), "n": int(K.shape[0]),
             "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",
-            "dt": dt}
+            "dt": hs[0] if len(hs) == 1 else hs}
 
 
 def controller_for(strategy: Policy | str, *, headway: float,
@@ -275,15 +285,13 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
     for i, (tr, _, _) in enumerate(starts):
         groups.setdefault((tr.n_steps, tr.dt), []).append(i)
     episodes: list[dict[str, Any]] = [{} for _ in leaders]
-    ttc_all, jerk_all, hw_all, gains_rows = [], [], [], []
-    dts: set[float] = set()
+    ttc_all, jerk_all, hw_all, gains_rows, gains_dt = [], [], [], [], []
     for (_, dt), idx in groups.items():
         trs = [starts[i][0] for i in idx]
         gap0 = np.array([[starts[i][1]] for i in idx])
         v0 = np.array([[starts[i][2]] for i in idx])
         res = simulate(trs, ctrl, 1, tau=tau, delta=delta, initial_gap=gap0, initial_speed=v0,
                        limits=limits)
-        dts.add(dt)
         assert res.speed is not None and res.accel is not None
         gap = res.gap[:, 0, :]
         spd = res.speed
@@ -307,6 +315,7 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
                 f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt)
                 episodes[i]["m_fss"] = f["m_fss"]
                 gains_rows.append(np.column_stack([res.t, np.full(res.t.size, i), G[j]]))
+                gains_dt.append(np.full(res.t.size, dt))
         if progress is not None:
             progress(len(idx))
     mps = np.array([np.nan if e["m_p"] is None else e["m_p"] for e in episodes])
@@ -334,7 +343,7 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
     gains = None
     if gains_rows:
         gains = np.concatenate(gains_rows)
-        f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=min(dts))
+        f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=np.concatenate(gains_dt))
         summary["m_fss"], summary["n_gains"] = f["m_fss"], f["n"]
         summary["m_fss_sampled"] = f["m_fss_sampled"]
         summary["certificate"] = f["certificate"]
