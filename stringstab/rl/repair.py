@@ -235,7 +235,9 @@ class GainRepair:
             else:
                 r = region_growing(k, tau=p.tau, delta=p.delta, headway=p.headway,
                                    bounds=self.bounds)
-            kr = np.asarray(r.k, dtype=np.float64)
+            # a solver may return a point a rounding error outside its bounds: the env would
+            # clip it before executing it, so the point certified is the clipped one
+            kr = np.clip(np.asarray(r.k, dtype=np.float64), *self.bounds)
             if r.certified and grid.certified(kr[None], p)[0]:
                 out[i] = kr
             else:
