@@ -45,8 +45,9 @@ algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import numpy.typing as npt
@@ -283,9 +284,28 @@ class Certificate(SingleResult):
         return d
 
 
+#: The columns of the human table of certificates (``stringstab certify``).
+TABLE_COLUMNS: list[TableColumn] = [
+    *ROW_COLUMNS,
+    TableColumn("hurwitz", "hurwitz"),
+    TableColumn("verdict", "verdict"),
+    TableColumn("type", "type"),
+    TableColumn("sup|Γ|", "sup_gain", "%.6g", missing="inf"),
+    TableColumn("sup|Γ|-1", "sup_gain_excess", "%.3g", missing="inf"),
+    TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
+    TableColumn("margin", "margin", "%.3g"),
+    TableColumn("taylor(derived)", "taylor_derived.verdict"),
+    TableColumn("taylor(printed)", "taylor_printed.verdict"),
+    TableColumn("pade", "pade.verdict"),
+    TableColumn("pade ‖Γ‖∞", "pade.hinf", "%.6g", missing="inf"),
+]
+
+
 @dataclass(frozen=True)
 class CertificateBatch(BatchResult):
     """Certificates of many triples, as arrays (see :class:`Certificate` for fields)."""
+
+    TABLE: ClassVar[Sequence[TableColumn]] = TABLE_COLUMNS
 
     k_x: Array
     k_v: Array
@@ -332,17 +352,6 @@ class CertificateBatch(BatchResult):
         return np.where(np.asarray(self.verdict) == "certified", 0.0, self.sup_gain - 1.0)
 
     # -- result rendering: the rows, columns and totals every output format is written from --
-    @classmethod
-    def table_columns(cls) -> list[TableColumn]:
-        """The columns of the human table of continuous certificates (:data:`TABLE_COLUMNS`).
-
-        Returns
-        -------
-        list of TableColumn
-            The gains, Hurwitz, verdict, type, sup|Γ| (and − 1), ω_peak, margin, the Taylor
-            verdicts and, with ``method="pade"``, python-control's.
-        """
-        return list(TABLE_COLUMNS)
 
     def columns(self) -> dict[str, Any]:
         """The result columns, in the order and with the keys of :meth:`Certificate.as_dict`.
@@ -389,21 +398,6 @@ def _taylor_columns(tc: TaylorCriteria) -> dict[str, Any]:
             "type": names[np.asarray(tc.type, dtype=np.intp)]}
 
 
-#: The columns of the human table of certificates (``stringstab certify``).
-TABLE_COLUMNS: list[TableColumn] = [
-    *ROW_COLUMNS,
-    TableColumn("hurwitz", "hurwitz"),
-    TableColumn("verdict", "verdict"),
-    TableColumn("type", "type"),
-    TableColumn("sup|Γ|", "sup_gain", "%.6g", missing="inf"),
-    TableColumn("sup|Γ|-1", "sup_gain_excess", "%.3g", missing="inf"),
-    TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
-    TableColumn("margin", "margin", "%.3g"),
-    TableColumn("taylor(derived)", "taylor_derived.verdict"),
-    TableColumn("taylor(printed)", "taylor_printed.verdict"),
-    TableColumn("pade", "pade.verdict"),
-    TableColumn("pade ‖Γ‖∞", "pade.hinf", "%.6g", missing="inf"),
-]
 
 
 # ---------------------------------------------------------------------------

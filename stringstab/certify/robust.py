@@ -26,6 +26,7 @@ R. E. Moore, R. B. Kearfott, M. J. Cloud, *Introduction to Interval Analysis*, S
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -142,6 +143,7 @@ class RobustCertificateBatch(BatchResult):
 
     SINGLE: ClassVar[type[RobustCertificate]] = RobustCertificate
     SHARED: ClassVar[tuple[str, ...]] = ("box", "sample_time", "heterogeneous")
+    TABLE: ClassVar[Sequence[TableColumn]] = TABLE_COLUMNS
 
     k_x: Array
     k_v: Array
@@ -162,17 +164,6 @@ class RobustCertificateBatch(BatchResult):
     n_evals: npt.NDArray[np.int64]
     sup_gain_excess: Array
 
-    @classmethod
-    def table_columns(cls) -> list[TableColumn]:
-        """The columns of the human table of these certificates (:data:`TABLE_COLUMNS`).
-
-        Returns
-        -------
-        list of TableColumn
-            The columns of the robust certificates: the gains, verdict, sup|Γ| (and − 1)
-            of the witness member, the witness member and frequency, margin.
-        """
-        return list(TABLE_COLUMNS)
 
     def __getitem__(self, i: int) -> RobustCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]

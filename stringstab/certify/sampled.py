@@ -47,6 +47,7 @@ N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -311,6 +312,7 @@ class SampledCertificateBatch(BatchResult):
 
     SINGLE: ClassVar[type[SampledCertificate]] = SampledCertificate
     SHARED: ClassVar[tuple[str, ...]] = ("params", "sample_time", "tau_prev")
+    TABLE: ClassVar[Sequence[TableColumn]] = TABLE_COLUMNS
 
     k_x: Array
     k_v: Array
@@ -329,17 +331,6 @@ class SampledCertificateBatch(BatchResult):
     n_evals: npt.NDArray[np.int64]
     sup_gain_excess: Array
 
-    @classmethod
-    def table_columns(cls) -> list[TableColumn]:
-        """The columns of the human table of these certificates (:data:`TABLE_COLUMNS`).
-
-        Returns
-        -------
-        list of TableColumn
-            The columns of the sampled-data certificates: the gains, Schur, verdict, sup|H|
-            (and − 1), ω_peak and θ_peak, margin, spectral radius.
-        """
-        return list(TABLE_COLUMNS)
 
     def __getitem__(self, i: int) -> SampledCertificate:
         return super().__getitem__(i)  # type: ignore[no-any-return]

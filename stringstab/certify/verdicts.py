@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -296,7 +296,8 @@ class BatchResult:
 
     A subclass is a frozen dataclass whose fields are per-triple arrays, except those named in
     ``SHARED`` (the same for every triple: parameters, sample time, box); ``SINGLE`` is the
-    class of one row.  It defines :meth:`columns`; the rows and the totals follow.
+    class of one row and ``TABLE`` the columns of its human table.  It defines
+    :meth:`columns`; the rows and the totals follow.
     """
 
     k_x: Array
@@ -305,6 +306,8 @@ class BatchResult:
     stable: npt.NDArray[np.bool_]
     SINGLE: ClassVar[type[Any]]
     SHARED: ClassVar[tuple[str, ...]] = ()
+    #: The columns of the batch type's human table (:meth:`table_columns`).
+    TABLE: ClassVar[Sequence[TableColumn]] = ()
 
     def __len__(self) -> int:
         return int(self.k_x.size)
@@ -332,9 +335,12 @@ class BatchResult:
         Returns
         -------
         list of TableColumn
-            Header, key into :meth:`columns` and format of each column, in order.
+            Header, key into :meth:`columns` and format of each column, in order
+            (``cls.TABLE``).
         """
-        raise NotImplementedError(f"{cls.__name__} names no table columns")
+        if not cls.TABLE:
+            raise NotImplementedError(f"{cls.__name__} names no table columns")
+        return list(cls.TABLE)
 
     @classmethod
     def of_single(cls, row: Any) -> Any:
