@@ -427,6 +427,17 @@ class Box:
         """Every interval is a single value."""
         return all(lo == hi for lo, hi in (self.tau, self.delta, self.headway))
 
+    def centre(self) -> Params:
+        """The member at the box's centre: each parameter at the middle of its interval.
+
+        Returns
+        -------
+        Params
+            τ, δ, T* at (lo + hi)/2 (the point itself for a point box).
+        """
+        (t0, t1), (d0, d1), (h0, h1) = self.tau, self.delta, self.headway
+        return Params(0.5 * (t0 + t1), 0.5 * (d0 + d1), 0.5 * (h0 + h1))
+
     def as_dict(self) -> dict[str, list[float]]:
         """``{"tau": [lo, hi], "delta": [lo, hi], "headway": [lo, hi]}`` (for JSON)."""
         return {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}

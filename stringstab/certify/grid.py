@@ -85,12 +85,6 @@ def _check_certified(K: Array, params: Params | Box, sample_time: float | None,
     return np.asarray(c.verdict == Verdict.CERTIFIED.value)
 
 
-def _centre(box: Box) -> Params:
-    """The centre of a box of τ, δ, T* (a member of it)."""
-    (t0, t1), (d0, d1), (h0, h1) = box.tau, box.delta, box.headway
-    return Params(0.5 * (t0 + t1), 0.5 * (d0 + d1), 0.5 * (h0 + h1))
-
-
 def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | None = None,
               heterogeneous: bool = True, also_continuous: bool = False
               ) -> npt.NDArray[np.bool_]:
@@ -135,7 +129,7 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
         ok[idx] = certified(K[idx], params, sample_time=sample_time,
                             heterogeneous=heterogeneous)
         return ok
-    point = params if isinstance(params, Params) else _centre(params)
+    point = params if isinstance(params, Params) else params.centre()
     cand = ~surely_uncertifiable(K, point) if sample_time is None else np.ones(len(K), bool)
     idx = np.flatnonzero(cand)
     if not isinstance(params, Params) and idx.size:

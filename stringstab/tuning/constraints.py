@@ -177,9 +177,8 @@ class LoopConstraints:
     # ------------------------------------------------------------------ members
     def centre(self) -> Member:
         """The box's centre (the point itself for a point)."""
-        (t0, t1), (d0, d1), (h0, h1) = self.box.tau, self.box.delta, self.box.headway
-        t = 0.5 * (t0 + t1)
-        return Member(t, t, 0.5 * (d0 + d1), 0.5 * (h0 + h1))
+        c = self.box.centre()
+        return Member(c.tau, c.tau, c.delta, c.headway)
 
     def corners(self) -> list[Member]:
         """The corners of the (τ, T*) box with δ at its centre (where stability is worst)."""
