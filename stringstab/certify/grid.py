@@ -33,6 +33,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..params import Box, Params
+from ..params import sample_time as checked_sample_time
 from .criteria import hurwitz_conditions
 from .screen import surely_uncertifiable
 from .verdicts import Verdict
@@ -72,16 +73,15 @@ def lattice(lo: float, hi: float, n: int) -> Array:
 
 def _check_certified(K: Array, params: Params | Box, sample_time: float | None,
                      heterogeneous: bool) -> npt.NDArray[np.bool_]:
-    """The certificate of the loop (point or box, continuous or sampled) on every row of K."""
-    from .api import check
+    """The certificate of the loop (point or box, continuous or sampled) on every row of K.
 
-    b = Box.of(params)
-    if isinstance(params, Params):
-        c = check(K[:, 0], K[:, 1], K[:, 2], tau=params.tau, delta=params.delta,
-                  headway=params.headway, sample_time=sample_time)
-    else:
-        c = check(K[:, 0], K[:, 1], K[:, 2], tau=b.tau, delta=b.delta, headway=b.headway,
-                  sample_time=sample_time, heterogeneous=heterogeneous)
+    ``params`` is checked already (a :class:`Params` or :class:`Box`), so the loop is built
+    from it directly (:class:`stringstab.certify.api.Loop`), not checked again per call.
+    """
+    from .api import Loop
+
+    H = None if sample_time is None else checked_sample_time(sample_time)
+    c = Loop(params, H, heterogeneous=heterogeneous).check(K[:, 0], K[:, 1], K[:, 2])
     return np.asarray(c.verdict == Verdict.CERTIFIED.value)
 
 
