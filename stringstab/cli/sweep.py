@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import signal
 import time
 from typing import Any
 
@@ -62,10 +61,6 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _terminate(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
     """Run ``sweep``; 0 when every point is done, 1 when some failed, 130 when interrupted.
 
@@ -97,8 +92,7 @@ def run(args: argparse.Namespace) -> int:
     workers = None if args.workers is None else _int("--workers", args.workers, 1)
     retries = _int("--retries", args.retries, 0)
     check_output_dir(args.out, what="--out")
-    old = signal.signal(signal.SIGTERM, _terminate)
-    try:
+    try:  # SIGTERM arrives as KeyboardInterrupt too (stringstab.cli.main)
         with dask_client(args.scheduler, workers) as client:
             dash = dashboard_address(client)
             if dash is not None and importlib.util.find_spec("bokeh") is None:
@@ -114,8 +108,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"interrupted: {n} of {len(spec)} points are finished in {args.out}; run the same "
               "command again to resume", flush=True)
         return 130
-    finally:
-        signal.signal(signal.SIGTERM, old)
     from ..report import command_line
     from ..report.commands import sweep_report
     from ..sweep.report import sweep_table
