@@ -52,14 +52,20 @@ from .interval import Interval, IntervalAD, interval, poly_add, poly_scale
 __all__ = [
     "WHOLE_SAMPLE_RTOL",
     "Coefficients",
+    "abs2_over_rho",
     "build",
     "cell_coefficients",
     "coefficients",
+    "cross_terms",
+    "delta_cells",
+    "exp_neg_ad",
     "loop_parameters",
     "phi",
+    "phi_ad",
     "phi_interval",
     "point_coefficients",
     "primitives",
+    "ratio_ad",
     "split_delay",
 ]
 
@@ -169,47 +175,70 @@ _R = {0: [1.0], 1: [0.0, -0.5], 2: [0.0, -1.0, 0.5], 3: [0.0, 0.0, 1.5, -0.5]}
 _T = {0: [0.0], 1: [1.0], 2: [0.0, -1.0], 3: [0.0, -1.0, 1.0]}
 
 
-def _const_poly(c: list[float], like: Any) -> list[Any]:
-    """Constant coefficients as points shaped as ``like``."""
-    return [like.const(v) for v in c]
+def _scaled(c: Any, coefs: list[float]) -> list[Any]:
+    """c times each constant of ``coefs`` (None for a zero: adding it would change nothing)."""
+    return [None if v == 0.0 else c * v for v in coefs]
 
 
-def _abs2_over_rho(p: list[Interval]) -> list[Interval]:
+def _filled(p: list[Any], like: Any) -> list[Any]:
+    """``p`` with every missing (None) coefficient a zero constant shaped as ``like``."""
+    return [like.const(0.0) if v is None else v for v in p]
+
+
+def abs2_over_rho(p: list[Any]) -> list[Any]:
     """(|Σ p_k w^k|² − p_0²)/ρ on the unit circle, as a polynomial in ρ.
 
     |Σp_k w^k|² = Σ_k p_k² ρ^k + 2 Σ_{k<l} p_k p_l ρ^k R_{l−k}(ρ); every term but p_0²
     carries a factor ρ (R_j(0) = 0 for j ≥ 1), divided out exactly.
+
+    Parameters
+    ----------
+    p : list of Interval or IntervalAD
+        The coefficients p_0, p_1, ... of a polynomial in w = z − 1 (at least two).
+
+    Returns
+    -------
+    list
+        The coefficients in ρ = |w|² = 4 sin²(θ/2), constant term first, in the arithmetic
+        of ``p``.
     """
-    out: list[Interval] = []
-    like = p[0]
+    out: list[Any] = []
     for k in range(1, len(p)):
-        out = poly_add(out, [like.const(0.0)] * (k - 1) + [p[k] * p[k]])
+        out = poly_add(out, [None] * (k - 1) + [p[k] * p[k]])
     for k in range(len(p)):
         for l_ in range(k + 1, len(p)):
             r = _R[l_ - k]
             # ρ^k R_j / ρ = ρ^{k-1} R_j  (k ≥ 1) or R_j/ρ (k = 0: drop R_j's zero constant)
             rr = ([0.0] * (k - 1) + r) if k >= 1 else r[1:]
-            term = poly_scale(2.0 * (p[k] * p[l_]), _const_poly(rr, like))
-            out = poly_add(out, term)
-    return out
+            out = poly_add(out, _scaled(2.0 * (p[k] * p[l_]), rr))
+    return _filled(out, p[0])
 
 
-def _cross(ell: list[Interval], nu: list[Interval]) -> tuple[list[Interval], list[Interval]]:
-    """Y = ℓ(w)·conj(n(w)) = Y_r(ρ) + j sin θ · Y_i(ρ)."""
-    like = ell[0]
-    yr: list[Interval] = []
-    yi: list[Interval] = []
+def cross_terms(ell: list[Any], nu: list[Any]) -> tuple[list[Any], list[Any]]:
+    """Y = ℓ(w)·conj(n(w)) = Y_r(ρ) + j sin θ · Y_i(ρ) on the unit circle.
+
+    Parameters
+    ----------
+    ell, nu : list of Interval or IntervalAD
+        The coefficients of ℓ(w) and n(w) in w = z − 1, constant term first.
+
+    Returns
+    -------
+    (list, list)
+        The coefficients of Y_r and Y_i in ρ = 4 sin²(θ/2), constant term first.
+    """
+    yr: list[Any] = []
+    yi: list[Any] = []
     for a, la in enumerate(ell):
         for b, nb in enumerate(nu):
             c = la * nb
             lo_, d = min(a, b), abs(a - b)
             shift = [0.0] * lo_
-            yr = poly_add(yr, poly_scale(c, _const_poly(shift + _R[d], like)))
+            yr = poly_add(yr, _scaled(c, shift + _R[d]))
             if d:
                 sgn = 1.0 if a > b else -1.0
-                yi = poly_add(yi, poly_scale(c, _const_poly(shift + [sgn * t for t in _T[d]],
-                                                             like)))
-    return yr, yi
+                yi = poly_add(yi, _scaled(c, shift + [sgn * t for t in _T[d]]))
+    return _filled(yr, ell[0]), _filled(yi, ell[0])
 
 
 def primitives(
@@ -290,13 +319,13 @@ def build(q: dict[str, Any], H: float) -> Coefficients:
     A = kap * f1p
     B = kap * f1
     A2, B2 = A * A, B * B
-    Ad = _abs2_over_rho([d0, d1, d2, d0.const(1.0)])
-    An = _abs2_over_rho(nu)
+    Ad = abs2_over_rho([d0, d1, d2, d0.const(1.0)])
+    An = abs2_over_rho(nu)
     # |ℓ|² = ℓ0² − ℓ1 (ℓ0 − ℓ1) ρ, with ℓ0 − ℓ1 = C − E_p = C (1 − e^{−εH/τ_p}) ≥ 0
     L = [f1p * f1p, -(ell1 * cm)]
     kaL = poly_scale(B2 * K_a * K_a, [d0.const(0.0), *L])
     P = poly_add(poly_add(poly_scale(A2, Ad), poly_scale(B2, An), -1.0), kaL, -1.0)
-    yr, yi = _cross(ell, nu)
+    yr, yi = cross_terms(ell, nu)
     k2 = 2.0 * (B2 * K_a)
     return Coefficients([d0, d1, d2], nu, ell, f1, f1p, P, poly_scale(k2, yr), poly_scale(k2, yi))
 
@@ -329,15 +358,39 @@ def coefficients(
 # ---------------------------------------------------------------------------
 # Parameter cells: the mean-value form
 # ---------------------------------------------------------------------------
-def _recip_ad(t: IntervalAD, H: float) -> IntervalAD:
-    """H/t for t > 0: decreasing, derivative −H/t² ∈ [−H/t_lo², −H/t_hi²]."""
+def ratio_ad(t: IntervalAD, H: float) -> IntervalAD:
+    """x = H/t for t > 0 (a lag): decreasing, derivative −H/t² ∈ [−H/t_lo², −H/t_hi²].
+
+    Parameters
+    ----------
+    t : IntervalAD
+        A lag over the cells (τ or τ_p), s, > 0.
+    H : float
+        Sample time, s.
+
+    Returns
+    -------
+    IntervalAD
+        H/t with its derivative enclosures.
+    """
     lo, hi = t.r.lo, t.r.hi
     dr = Interval(-H / (lo * lo), -H / (hi * hi))
     return IntervalAD(Interval(H / t.c.lo), Interval(H / hi, H / lo), tuple(dr * gi for gi in t.g))
 
 
-def _phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
-    """φ1, ψ2, ψ3 of x ≥ 0: increasing, with φ1' = 1 − φ1, ψ2' = φ1, ψ3' = ψ2."""
+def phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
+    """φ1, ψ2, ψ3 of x ≥ 0 (:func:`phi`): increasing, with φ1' = 1 − φ1, ψ2' = φ1, ψ3' = ψ2.
+
+    Parameters
+    ----------
+    x : IntervalAD
+        x ≥ 0 over the cells (e.g. H/τ of :func:`ratio_ad`).
+
+    Returns
+    -------
+    (IntervalAD, IntervalAD, IntervalAD)
+        φ1, ψ2 and ψ3 with their derivative enclosures.
+    """
     c = tuple(Interval(v) for v in phi(x.c.lo))
     r = phi_interval(x.r.lo, x.r.hi)
     ders = (1.0 - r[0], r[0], r[1])
@@ -345,8 +398,19 @@ def _phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
                  for ci, ri, dk in zip(c, r, ders))
 
 
-def _exp_neg_ad(y: IntervalAD) -> IntervalAD:
-    """e^{−y}: decreasing, derivative −e^{−y}."""
+def exp_neg_ad(y: IntervalAD) -> IntervalAD:
+    """e^{−y}: decreasing, derivative −e^{−y}.
+
+    Parameters
+    ----------
+    y : IntervalAD
+        The exponent over the cells.
+
+    Returns
+    -------
+    IntervalAD
+        e^{−y} with its derivative enclosures.
+    """
     r = Interval(np.exp(-y.r.hi), np.exp(-y.r.lo))
     return IntervalAD(Interval(np.exp(-y.c.lo)), r, tuple(-(r * gi) for gi in y.g))
 
@@ -380,15 +444,50 @@ def cell_coefficients(
     E = IntervalAD.variable(eps[:, 0], eps[:, 1], d - 2, d)
     Th = IntervalAD.variable(headway[:, 0], headway[:, 1], d - 1, d)
     K_x, K_v, K_a = T.const(kx), T.const(kv), T.const(ka)
-    f1, p2, p3 = _phi_ad(_recip_ad(T, H))
-    xp = _recip_ad(Tp, H)
-    f1p, p2p, p3p = _phi_ad(xp)
+    f1, p2, p3 = phi_ad(ratio_ad(T, H))
+    xp = ratio_ad(Tp, H)
+    f1p, p2p, p3p = phi_ad(xp)
     y = (1.0 - E) * xp
-    cm = _exp_neg_ad(y) * _phi_ad(E * xp)[0]
+    cm = exp_neg_ad(y) * phi_ad(E * xp)[0]
     q = {"K_x": K_x, "K_v": K_v, "K_a": K_a, "T": T, "Tp": Tp, "Cc": K_v + Th * K_x,
          "f1": f1, "p2": p2, "p3": p3, "f1p": f1p, "p2p": p2p, "p3p": p3p,
-         "ell1": _phi_ad(y)[0], "cm": cm}
+         "ell1": phi_ad(y)[0], "cm": cm}
     return build(q, H)
+
+
+def delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) -> list[IntervalAD]:
+    """δ0, δ1, δ2 of Δ(w) with derivative enclosures over cells of (τ, T*) alone.
+
+    The characteristic polynomial depends on τ and T* only (not on δ, k_a or the
+    predecessor's lag), so the Schur test over a box needs these three coefficients, not the
+    whole :func:`cell_coefficients`; the numbers are the ones :func:`build` computes for
+    them (the same operations; the derivatives along τ and T* of a cell of
+    :func:`cell_coefficients` with ``tau_p=None``).
+
+    Parameters
+    ----------
+    kx, kv : ndarray
+        The gains, one per cell.
+    H : float
+        Sample time, s.
+    tau, headway : ndarray, shape (n, 2)
+        The cells' bounds of τ and T*.
+
+    Returns
+    -------
+    list of IntervalAD
+        [δ0, δ1, δ2], derivatives in the order (τ, T*).
+    """
+    T = IntervalAD.variable(tau[:, 0], tau[:, 1], 0, 2)
+    Th = IntervalAD.variable(headway[:, 0], headway[:, 1], 1, 2)
+    K_x, K_v = T.const(kx), T.const(kv)
+    Cc = K_v + Th * K_x
+    f1, p2, p3 = phi_ad(ratio_ad(T, H))
+    Hs = float(H)
+    d0 = K_x * (Hs * Hs) * f1
+    d1 = Hs * (Cc * f1 + K_x * (T * p2 + (0.5 * Hs) * f1))
+    d2 = f1 + Cc * T * p2 + K_x * T * T * p3
+    return [d0, d1, d2]
 
 
 
