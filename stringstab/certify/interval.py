@@ -65,6 +65,13 @@ class Interval:
         self.hi = self.lo if hi is None else np.asarray(hi, dtype=float)
         self.mag = np.maximum(np.abs(self.lo), np.abs(self.hi)) if mag is None else mag
 
+    @classmethod
+    def _new(cls, lo: Any, hi: Any, mag: Any) -> Interval:
+        """The result of an operation (arrays already): no conversion, ``hi is lo`` for points."""
+        out = object.__new__(cls)
+        out.lo, out.hi, out.mag = lo, hi, mag
+        return out
+
     @property
     def point(self) -> bool:
         """True for a point (``hi is lo``): the fast path, one array for both ends."""
@@ -76,17 +83,20 @@ class Interval:
         return v if isinstance(v, Interval) else Interval(np.asarray(v, dtype=float))
 
     def __add__(self, o: Any) -> Interval:
-        o = Interval.of(o)
-        if self.point and o.point:
-            return Interval(self.lo + o.lo, None, self.mag + o.mag)
-        return Interval(self.lo + o.lo, self.hi + o.hi, self.mag + o.mag)
+        if not isinstance(o, Interval):
+            o = Interval(np.asarray(o, dtype=float))
+        if self.hi is self.lo and o.hi is o.lo:
+            lo = self.lo + o.lo
+            return Interval._new(lo, lo, self.mag + o.mag)
+        return Interval._new(self.lo + o.lo, self.hi + o.hi, self.mag + o.mag)
 
     __radd__ = __add__
 
     def __neg__(self) -> Interval:
-        if self.point:
-            return Interval(-self.lo, None, self.mag)
-        return Interval(-self.hi, -self.lo, self.mag)
+        if self.hi is self.lo:
+            lo = -self.lo
+            return Interval._new(lo, lo, self.mag)
+        return Interval._new(-self.hi, -self.lo, self.mag)
 
     def __sub__(self, o: Any) -> Interval:
         return self + (-Interval.of(o))
@@ -95,14 +105,22 @@ class Interval:
         return Interval.of(o) + (-self)
 
     def __mul__(self, o: Any) -> Interval:
-        o = Interval.of(o)
-        if self.point and o.point:
-            return Interval(self.lo * o.lo, None, self.mag * o.mag)
+        if type(o) is float:  # a constant: the products with the one number, no conversion
+            if self.hi is self.lo:
+                lo = self.lo * o
+                return Interval._new(lo, lo, self.mag * abs(o))
+            a, c = self.lo * o, self.hi * o
+            return Interval._new(np.minimum(a, c), np.maximum(a, c), self.mag * abs(o))
+        if not isinstance(o, Interval):
+            o = Interval(np.asarray(o, dtype=float))
+        if self.hi is self.lo and o.hi is o.lo:
+            lo = self.lo * o.lo
+            return Interval._new(lo, lo, self.mag * o.mag)
         a, b, c, d = self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi
         # pairwise min/max: the same end points as a reduction over the four, without
         # stacking them into one array first
-        return Interval(np.minimum(np.minimum(a, b), np.minimum(c, d)),
-                        np.maximum(np.maximum(a, b), np.maximum(c, d)), self.mag * o.mag)
+        return Interval._new(np.minimum(np.minimum(a, b), np.minimum(c, d)),
+                             np.maximum(np.maximum(a, b), np.maximum(c, d)), self.mag * o.mag)
 
     __rmul__ = __mul__
 

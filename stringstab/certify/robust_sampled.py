@@ -17,7 +17,7 @@ m = ⌊δ/H⌋: the δ interval is split at the multiples of H into pieces of fr
 ε ∈ [ε_lo, ε_hi] ⊂ [0, 1] (continuous at the joins: ε = 1 at m equals ε = 0 at m + 1).  Schur
 stability over (τ, T*) is decided by a two-dimensional bisection on the interval-evaluated Schur
 conditions (:func:`stringstab.certify.schur.schur_terms` of
-:func:`stringstab.certify.zoh.delta_cells`).  A box left inconclusive is not certified when one
+:func:`_delta_cells`).  A box left inconclusive is not certified when one
 of its members — a corner, or the member where the search came closest — is not certified by
 its own point certificate (:func:`stringstab.certify.sampled.check_members`): that member is
 the witness.
@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 from ..params import Box
 from .excess import EXCESS_SEARCH, searched_excess
+from .interval import IntervalAD
 from .robust_split import split_search
 from .sampled import check_members
 from .sampled_excess import peak_gain, violation_peak
@@ -45,7 +46,7 @@ from .sampled_frequency import margin_bound
 from .sampled_split import delay_ends
 from .schur import SCHUR_RTOL, schur_terms
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
-from .zoh import Coefficients, coefficients, delta_cells, split_delay
+from .zoh import Coefficients, coefficients, phi_ad, ratio_ad, split_delay
 
 __all__ = ["certify_box_sampled"]
 
@@ -68,6 +69,42 @@ def _delay_pieces(d_lo: float, d_hi: float, H: float) -> list[tuple[int, float, 
     return out
 
 
+def _delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) -> list[IntervalAD]:
+    """δ0, δ1, δ2 of Δ(w) with derivative enclosures over cells of (τ, T*) alone.
+
+    The characteristic polynomial depends on τ and T* only (not on δ, k_a or the
+    predecessor's lag), so the Schur test over a box needs these three coefficients, not the
+    whole :func:`cell_coefficients`; the numbers are the ones :func:`build` computes for
+    them (the same operations; the derivatives along τ and T* of a cell of
+    :func:`cell_coefficients` with ``tau_p=None``).
+
+    Parameters
+    ----------
+    kx, kv : ndarray
+        The gains, one per cell.
+    H : float
+        Sample time, s.
+    tau, headway : ndarray, shape (n, 2)
+        The cells' bounds of τ and T*.
+
+    Returns
+    -------
+    list of IntervalAD
+        [δ0, δ1, δ2], derivatives in the order (τ, T*).
+    """
+    T = IntervalAD.variable(tau[:, 0], tau[:, 1], 0, 2)
+    Th = IntervalAD.variable(headway[:, 0], headway[:, 1], 1, 2)
+    K_x, K_v = T.const(kx), T.const(kv)
+    Cc = K_v + Th * K_x
+    f1, p2, p3 = phi_ad(ratio_ad(T, H))
+    Hs = float(H)
+    d0 = K_x * (Hs * Hs) * f1
+    d1 = Hs * (Cc * f1 + K_x * (T * p2 + (0.5 * Hs) * f1))
+    d2 = f1 + Cc * T * p2 + K_x * T * T * p3
+    return [d0, d1, d2]
+
+
+
 def _schur_box(kx: Array, kv: Array, box: Box, H: float, max_depth: int = 14) -> tuple[
         npt.NDArray[np.bool_], npt.NDArray[np.bool_], Array, Array]:
     """Schur stability of Δ over (τ, T*) ∈ box by bisection: (sure, fail, witness τ, T*).
@@ -87,7 +124,7 @@ def _schur_box(kx: Array, kv: Array, box: Box, H: float, max_depth: int = 14) ->
     for depth in range(max_depth + 1):
         if owner.size == 0:
             break
-        delta = delta_cells(kx[owner], kv[owner], H=H, tau=t, headway=h)
+        delta = _delta_cells(kx[owner], kv[owner], H=H, tau=t, headway=h)
         hw = np.stack([0.5 * (t[:, 1] - t[:, 0]), 0.5 * (h[:, 1] - h[:, 0])], axis=1)
         ok = np.ones(owner.size, dtype=bool)
         bad = np.zeros(owner.size, dtype=bool)

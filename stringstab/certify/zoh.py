@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -57,7 +58,6 @@ __all__ = [
     "cell_coefficients",
     "coefficients",
     "cross_terms",
-    "delta_cells",
     "exp_neg_ad",
     "loop_parameters",
     "phi",
@@ -455,42 +455,6 @@ def cell_coefficients(
     return build(q, H)
 
 
-def delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) -> list[IntervalAD]:
-    """δ0, δ1, δ2 of Δ(w) with derivative enclosures over cells of (τ, T*) alone.
-
-    The characteristic polynomial depends on τ and T* only (not on δ, k_a or the
-    predecessor's lag), so the Schur test over a box needs these three coefficients, not the
-    whole :func:`cell_coefficients`; the numbers are the ones :func:`build` computes for
-    them (the same operations; the derivatives along τ and T* of a cell of
-    :func:`cell_coefficients` with ``tau_p=None``).
-
-    Parameters
-    ----------
-    kx, kv : ndarray
-        The gains, one per cell.
-    H : float
-        Sample time, s.
-    tau, headway : ndarray, shape (n, 2)
-        The cells' bounds of τ and T*.
-
-    Returns
-    -------
-    list of IntervalAD
-        [δ0, δ1, δ2], derivatives in the order (τ, T*).
-    """
-    T = IntervalAD.variable(tau[:, 0], tau[:, 1], 0, 2)
-    Th = IntervalAD.variable(headway[:, 0], headway[:, 1], 1, 2)
-    K_x, K_v = T.const(kx), T.const(kv)
-    Cc = K_v + Th * K_x
-    f1, p2, p3 = phi_ad(ratio_ad(T, H))
-    Hs = float(H)
-    d0 = K_x * (Hs * Hs) * f1
-    d1 = Hs * (Cc * f1 + K_x * (T * p2 + (0.5 * Hs) * f1))
-    d2 = f1 + Cc * T * p2 + K_x * T * T * p3
-    return [d0, d1, d2]
-
-
-
 # ---------------------------------------------------------------------------
 # The delay in samples, the parameters and the point coefficients
 # ---------------------------------------------------------------------------
@@ -588,8 +552,20 @@ def point_coefficients(kx: Array, kv: Array, ka: Array, p: Params, H: float,
     """
     m, eps = split_delay(p.delta, H)
     n = kx.size
-    t = np.full(n, p.tau)
-    t_p = np.full(n, tp)
-    e = np.full(n, eps)
+    # the parameters' quantities once per parameter set, on one element: each row's numbers
+    # are those of the full arrays (the same operations on the same values, broadcast)
+    q = dict(_parameter_primitives(float(p.tau), float(tp), float(eps), float(H)))
     c = kv + p.headway * kx
-    return coefficients(kx, kv, ka, H=H, tau=(t, t), tau_p=(t_p, t_p), eps=(e, e), c=(c, c)), m
+    q.update(K_x=Interval(kx), K_v=Interval(kv), K_a=Interval(ka), Cc=Interval(c))
+    co = build(q, H)
+    one = np.ones(n)
+    return co.map(lambda v: v if v.lo.shape == (n,) else
+                  Interval(v.lo * one, None, np.asarray(v.mag) * one)), m
+
+
+@lru_cache(maxsize=64)
+def _parameter_primitives(tau: float, tau_p: float, eps: float, H: float) -> dict[str, Interval]:
+    """The parameter-only primitives of :func:`primitives` at one point (one element)."""
+    t, t_p, e, one = np.array([tau]), np.array([tau_p]), np.array([eps]), np.ones(1)
+    q = primitives(one, one, one, H=H, tau=(t, t), tau_p=(t_p, t_p), eps=(e, e), c=(one, one))
+    return {k: v for k, v in q.items() if k not in ("K_x", "K_v", "K_a", "Cc")}
