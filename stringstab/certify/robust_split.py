@@ -45,6 +45,7 @@ Array = npt.NDArray[np.float64]
 #: certificate's grid, 64 + 8m).
 _FIRST_CELLS = 4
 _BOUND_GRID = 32
+_HEADWAY_DIV = 1
 _LOOSE = 0.5
 
 
@@ -252,7 +253,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
     gx, gv, ga = kx[items], kv[items], ka[items]
     def initial(own: npt.NDArray[np.intp], k: int) -> _Split:
         """k × k follower cells and k cells of τ_p per end of the delay, for the items ``own``."""
-        nt, nh = (k if t_w > 0 else 1), (k if h_w > 0 else 1)
+        nt, nh = (k if t_w > 0 else 1), (max(1, k // _HEADWAY_DIV) if h_w > 0 else 1)
         tc, hc = _grid(t_lo, t_hi, nt), _grid(h_lo, h_hi, nh)
         F = FollowerCells.of(np.repeat(own, nt * nh), gx, gv, H=H,
                              tau=np.tile(np.repeat(tc, nh, axis=0), (own.size, 1)),
@@ -465,12 +466,14 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
         pmin, low = np.minimum.reduceat(pp, off), np.minimum.reduceat(lp, off)
         loose = pmin - low
         split_f[pc[(lp < (low + _LOOSE * loose)[pr]) & (loose > 0)[pr]]] = True
-    t_w, h_w = widths
-    # follower cells: halve along the side that is wider relative to the box
-    rel_t = (F.tau[:, 1] - F.tau[:, 0]) / (t_w or 1.0)
-    rel_h = (F.headway[:, 1] - F.headway[:, 0]) / (h_w or 1.0)
-    along_t = rel_t >= rel_h
-    sf = np.flatnonzero(split_f & ((rel_t > 0) | (rel_h > 0)))
+    # follower cells: halve along the parameter whose width costs the bound most where it
+    # was loose (the larger mean-value spread at the held points)
+    sp = F.spreads(pc, Z[pr])[:, :, 0]  # (pairs, 2)
+    cost = np.zeros((len(F), 2))
+    np.maximum.at(cost, pc, sp)
+    wt, wh = F.tau[:, 1] - F.tau[:, 0], F.headway[:, 1] - F.headway[:, 0]
+    along_t = (cost[:, 0] >= cost[:, 1]) & (wt > 0) | (wh <= 0)
+    sf = np.flatnonzero(split_f & ((wt > 0) | (wh > 0)))
     tau_a, tau_b = F.tau[sf].copy(), F.tau[sf].copy()
     hd_a, hd_b = F.headway[sf].copy(), F.headway[sf].copy()
     at = along_t[sf]

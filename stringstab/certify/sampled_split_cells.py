@@ -158,6 +158,26 @@ class FollowerCells:
         Fc = V[:, 0]
         return Fc, np.maximum(V[:, 1], Fc - spread), ROUNDOFF_SLACK * mags[:, 0]
 
+    def spreads(self, cell: npt.NDArray[np.intp], Z: Array) -> Array:
+        """max |∂F/∂p| × half-width along τ and T* over each cell, shape (r, 2, k).
+
+        Parameters
+        ----------
+        cell : ndarray of int, shape (r,)
+            The cells, one per row.
+        Z : ndarray, shape (r, 3, k)
+            :func:`vander` of each row's frequencies.
+
+        Returns
+        -------
+        ndarray, shape (r, 2, k)
+            How much each parameter's width costs the mean-value bound (where to halve).
+        """
+        V = np.matmul(self.V[cell][:, 2:6], Z)
+        hw = self.hw[cell]
+        return np.stack([np.maximum(np.abs(V[:, 0]), np.abs(V[:, 1])) * hw[:, 0, None],
+                         np.maximum(np.abs(V[:, 2]), np.abs(V[:, 3])) * hw[:, 1, None]], axis=1)
+
 
 @dataclass
 class PredecessorCells:
