@@ -45,7 +45,8 @@ Array = npt.NDArray[np.float64]
 #: certificate's grid, 64 + 8m).
 _FIRST_CELLS = 4
 _BOUND_GRID = 32
-_HEADWAY_DIV = 1
+#: A cell is halved when its bound lies in this (lower) share of the gap between the best
+#: bound and the best centre value of its side, at the end of a held interval.
 _LOOSE = 0.5
 
 
@@ -253,7 +254,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
     gx, gv, ga = kx[items], kv[items], ka[items]
     def initial(own: npt.NDArray[np.intp], k: int) -> _Split:
         """k × k follower cells and k cells of τ_p per end of the delay, for the items ``own``."""
-        nt, nh = (k if t_w > 0 else 1), (max(1, k // _HEADWAY_DIV) if h_w > 0 else 1)
+        nt, nh = (k if t_w > 0 else 1), (k if h_w > 0 else 1)
         tc, hc = _grid(t_lo, t_hi, nt), _grid(h_lo, h_hi, nh)
         F = FollowerCells.of(np.repeat(own, nt * nh), gx, gv, H=H,
                              tau=np.tile(np.repeat(tc, nh, axis=0), (own.size, 1)),
