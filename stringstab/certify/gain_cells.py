@@ -34,6 +34,7 @@ IDL paper, Definition 1 (eq 10), eq 11; R. E. Moore, R. B. Kearfott, M. J. Cloud
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import numpy as np
@@ -344,6 +345,8 @@ class CertifiedCells:
     ----------
     proven, refused, blocks : int
         Cells proven and tried without success, and blocks done, so far.
+    seconds : float
+        Wall time spent proving, so far.
 
     Examples
     --------
@@ -366,6 +369,7 @@ class CertifiedCells:
         b = -(-m // BLOCK_SIDE)
         self.done = np.zeros(b**3, dtype=bool)
         self.proven = self.refused = self.blocks = 0
+        self.seconds = 0.0
 
     def cells_of(self, K: npt.ArrayLike) -> tuple[npt.NDArray[np.intp], npt.NDArray[np.bool_]]:
         """The (i, j, k) of the cell of each row of K, and whether the row is in the box.
@@ -388,6 +392,7 @@ class CertifiedCells:
 
     def _prove_block(self, block: int) -> None:
         """Prove the candidate cells of one block (a call of its own)."""
+        t0 = time.perf_counter()
         m, b = self.n - 1, -(-(self.n - 1) // BLOCK_SIDE)
         bi = np.array(np.unravel_index(block, (b, b, b)))
         r = [np.arange(x * BLOCK_SIDE, min((x + 1) * BLOCK_SIDE, m)) for x in bi]
@@ -397,16 +402,16 @@ class CertifiedCells:
         ijk, flat = ijk[keep], flat[keep]
         self.done[block] = True
         self.blocks += 1
-        if not flat.size:
-            return
-        K_lo, K_hi = self.g[ijk], self.g[ijk + 1]
-        ok = continuous_cells(K_lo, K_hi, self.params)
-        if self.sample_time is not None and ok.any():
-            j = np.flatnonzero(ok)
-            ok[j] = sampled_cells(K_lo[j], K_hi[j], self.params, self.sample_time)
-        self.proven_cells[flat] = ok
-        self.proven += int(ok.sum())
-        self.refused += int((~ok).sum())
+        if flat.size:
+            K_lo, K_hi = self.g[ijk], self.g[ijk + 1]
+            ok = continuous_cells(K_lo, K_hi, self.params)
+            if self.sample_time is not None and ok.any():
+                j = np.flatnonzero(ok)
+                ok[j] = sampled_cells(K_lo[j], K_hi[j], self.params, self.sample_time)
+            self.proven_cells[flat] = ok
+            self.proven += int(ok.sum())
+            self.refused += int((~ok).sum())
+        self.seconds += time.perf_counter() - t0
 
     def contains(self, K: npt.ArrayLike) -> npt.NDArray[np.bool_]:
         """Which rows of K lie in a proven cell (certified by the cell's proof).

@@ -114,13 +114,19 @@ def _schur_box(kx: Array, kv: Array, box: Box, H: float, max_depth: int = 14) ->
     below −band at a cell's centre is a witness member that is not Schur.
     """
     n = kx.size
-    owner = np.arange(n)
-    t = np.tile(np.array(box.tau, dtype=float), (n, 1))
-    h = np.tile(np.array(box.headway, dtype=float), (n, 1))
     fail = np.zeros(n, dtype=bool)
     undecided = np.zeros(n, dtype=bool)
     wt = np.full(n, np.nan)
     wh = np.full(n, np.nan)
+    # k_x ≤ 0: δ0 = k_x H² φ1 ≤ 0, the first condition fails at every member (the bisection
+    # would find it at the box's centre, its first cell: the same witness, without the work)
+    neg = kx <= 0
+    fail[neg] = True
+    wt[neg] = np.array(box.tau, dtype=float)[None, :].mean(axis=1)[0]
+    wh[neg] = np.array(box.headway, dtype=float)[None, :].mean(axis=1)[0]
+    owner = np.flatnonzero(~neg)
+    t = np.tile(np.array(box.tau, dtype=float), (owner.size, 1))
+    h = np.tile(np.array(box.headway, dtype=float), (owner.size, 1))
     for depth in range(max_depth + 1):
         if owner.size == 0:
             break

@@ -11,7 +11,7 @@ the lower bound min F over the follower cells minus max G over the predecessor c
 minus the maximum of G over its own τ — and the point value of the member made of the
 centres where F is smallest and G largest.  A frequency interval the cells' width, not its
 own, leaves undecided is handed back; the cells whose bounds are in the looser half of the
-gap at its ends are halved, and the triple goes on with its undecided intervals.
+gap at its midpoint are halved, and the triple goes on with its undecided intervals.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ Array = npt.NDArray[np.float64]
 #: Cells per side of (τ, T*) (and of τ_p) the split search's bounds start from, and the
 #: frequency intervals of its first pass on [0, π] (the screen of the cells' centres uses the
 #: certificate's grid, 64 + 8m).
-_FIRST_CELLS = 4
+_FIRST_CELLS = 3
 _BOUND_GRID = 32
 #: A cell is halved when its bound lies in this (lower) share of the gap between the best
 #: bound and the best centre value of its side, at the end of a held interval.
@@ -201,13 +201,14 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
                  max_splits: int, max_cells: int) -> dict[str, Array]:
     """The branch and bound of F − G ≥ 0 over cells refined where they limit the bound.
 
-    :func:`screen_members` first; then, for the triples that pass it, 4 × 4 follower cells
-    of (τ, T*) (one along a dimension of no width) and the 4 cells of τ_p at each end of a
+    :func:`screen_members` first; then, for the triples that pass it, 3 × 3 follower cells
+    of (τ, T*) (one along a dimension of no width) and the 3 cells of τ_p at each end of a
     piece of the delay (with τ_p = τ, each follower cell has its own predecessor cells over
     its τ), and the branch and bound on θ (module docstring).  A frequency interval the cells'
     width, not its own, leaves undecided is handed back; the cells whose bounds are in the
-    looser half of the gap at its ends are halved (follower cells along their relatively
-    wider side), and the triple goes on with its undecided intervals.
+    looser half of the gap at its midpoint are halved (follower cells along the parameter
+    whose width costs the bound most there), and the triple goes on with its undecided
+    intervals.
 
     Parameters
     ----------
@@ -275,7 +276,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
         wit[key][items] = w0[:, j]
     code[items[viol]] = NOT_CERTIFIED
     act = np.flatnonzero(~viol)  # the items of this pass (the branch and bound's items)
-    # the bounds need finer cells than 2 × 2 to say anything: start from 4 × 4
+    # the bounds need finer cells than 2 × 2 to say anything: start from 3 × 3
     cells = initial(act, _FIRST_CELLS)
     intervals: tuple[npt.NDArray[np.intp], Array, Array] | None = None
     can_split = (t_w > 0) or (h_w > 0)
@@ -293,6 +294,11 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
         np.maximum.at(aG, g_item, G.a)
         mG = np.zeros(ni)
         np.maximum.at(mG, g_item, G.m)
+        # and the largest magnitudes (the round-off slacks, per item rather than per cell)
+        env = [np.zeros((ni, *x.shape[1:])) for x in (F.mag, F.gmag, G.mag, G.gmag)]
+        for e_, own_, x in zip(env, (F.owner, F.owner, g_item, g_item),
+                               (F.mag, F.gmag, G.mag, G.gmag)):
+            np.maximum.at(e_, own_, x)
         refine = can_split and split_round < max_splits
         lbest = np.full(act.size, np.inf)
         lwit = np.full((act.size, 5), np.nan)  # θ, τ, T*, τ_p, δ
@@ -301,7 +307,8 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
                      G: PredecessorCells = G, f_start: Any = f_start, f_count: Any = f_count,
                      g_start: Any = g_start, g_count: Any = g_count, aF: Array = aF,
                      aG: Array = aG, mG: Array = mG, lbest: Array = lbest,
-                     lwit: Array = lwit, act: Any = act) -> tuple[Array, Array, Array, Array]:
+                     lwit: Array = lwit, act: Any = act,
+                     env: list[Array] = env) -> tuple[Array, Array, Array, Array]:
             it = act[idx]
             point, low, slack = (np.empty_like(X) for _ in range(3))
             wrow = np.empty((X.shape[0], 5))
@@ -315,7 +322,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
                 sl = slice(s, e)
                 _evaluate_rows(it[sl], X[sl], F, G, f_start, f_count, g_start, g_count,
                                heterogeneous, E, e_delta, point[sl], low[sl], slack[sl],
-                               wrow[sl])
+                               wrow[sl], [x[it[sl]] for x in env] + [mG[it[sl]]])
                 s = e
             v = point[np.arange(X.shape[0]), point.argmin(axis=1)]
             order = np.lexsort((v, idx))
@@ -368,19 +375,33 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
     return {"code": code, "value": best, **wit, "n_evals": n_evals}
 
 
+def _trig(X: Array, rows: npt.NDArray[np.intp], m: Array) -> tuple[Array, Array]:
+    """cos(mθ) and sin(mθ) sin θ for pairs (row of X, m), computed once per row and m."""
+    ms, inv = np.unique(m, return_inverse=True)
+    mX = ms[None, :, None] * X[:, None, :]  # (r, distinct m, k)
+    return np.cos(mX)[rows, inv], (np.sin(mX) * np.sin(X)[:, None, :])[rows, inv]
+
+
 def _evaluate_rows(it: npt.NDArray[np.intp], X: Array, F: FollowerCells, G: PredecessorCells,
                    f_start: Any, f_count: Any, g_start: Any, g_count: Any, heterogeneous: bool,
                    E: int, e_delta: Array, point: Array, low: Array, slack: Array,
-                   wrow: Array) -> None:
-    """Point values, lower bounds, slacks and the best members of rows of items ``it`` at X."""
+                   wrow: Array, env: list[Array]) -> None:
+    """Point values, lower bounds, slacks and the best members of rows of items ``it`` at X.
+
+    ``env``: per row, the largest magnitudes over the item's cells (F's value and gradients,
+    G's value and gradient) and the largest m: the round-off slacks, once per row.
+    """
     pr, pc, off = _pairs(f_start, f_count, it)
     r, k = X.shape
     rr = np.arange(r)
     Z = vander(X)
-    FC, FL, FE = F.bounds(pc, Z[pr])
+    fs = FollowerCells.slacks(env[0], env[1], Z)
+    gs = PredecessorCells.slacks(env[2], env[3], env[4], X, Z)
+    FC, FL, FE = F.bounds(pc, Z[pr], slack=(fs[0][pr], fs[1][pr]))
     if heterogeneous:
         qr, qc, qoff = _pairs(g_start, g_count, it)
-        GC, GU, GE = G.bounds(qc, X[qr], Z[qr])
+        GC, GU, GE = G.bounds(qc, X[qr], Z[qr], trig=_trig(X, qr, G.m[qc]),
+                              slack=(gs[0][qr], gs[1][qr]))
         low[:] = np.minimum.reduceat(FL, off, axis=0) - np.maximum.reduceat(GU, qoff, axis=0)
         fmin = np.minimum.reduceat(FC, off, axis=0)
         gmax = np.maximum.reduceat(GC, qoff, axis=0)
@@ -391,8 +412,10 @@ def _evaluate_rows(it: npt.NDArray[np.intp], X: Array, F: FollowerCells, G: Pred
         jg = qc[_first_min(-GC[np.arange(qc.size), kk[qr]], -gmax[rr, kk], qr, qoff)]
     else:  # each follower cell with the predecessor cells of its own τ
         gc = (g_start[pc][:, None] + np.arange(E)[None, :]).ravel()
+        rows = np.repeat(pr, E)
         GC, GU, GE = (v.reshape(pc.size, E, k) for v in G.bounds(
-            gc, np.repeat(X[pr], E, axis=0), np.repeat(Z[pr], E, axis=0)))
+            gc, X[rows], Z[rows], trig=_trig(X, rows, G.m[gc]),
+            slack=(gs[0][rows], gs[1][rows])))
         low[:] = np.minimum.reduceat(FL - GU.max(axis=1), off, axis=0)
         gmax = GC.max(axis=1)
         pp = FC - gmax
@@ -429,7 +452,7 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
             ka: Array, H: float, ends: list[tuple[int, float]], heterogeneous: bool,
             widths: tuple[float, float], max_cells: int,
             e_delta: Array) -> tuple[_Split, npt.NDArray[np.bool_]]:
-    """Halve the cells whose bounds are in the looser half at the ends of the held intervals.
+    """Halve the cells whose bounds are in the looser half at the held intervals' midpoints.
 
     Returns the new cells and, per item of ``act``, whether it now has more than
     ``max_cells`` cells (it is then inconclusive).
@@ -438,17 +461,20 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
     ni = int(max(F.owner.max(initial=-1), act.max(initial=-1))) + 1
     f_start, f_count = _csr(F.owner, ni)
     g_start, g_count = _csr(G.owner, ni if heterogeneous else len(F))
-    th = np.concatenate([bb.pending_lo, bb.pending_hi])[:, None]
-    it = act[np.concatenate([bb.pending_item, bb.pending_item])]
+    # the cells' bounds at the held intervals' midpoints decide which cells to halve
+    th = (0.5 * (bb.pending_lo + bb.pending_hi))[:, None]
+    it = act[bb.pending_item]
     pr, pc, off = _pairs(f_start, f_count, it)
     Z = vander(th)
-    FC, FL, _ = F.bounds(pc, Z[pr])
+    nil = (0.0, 0.0)  # the round-off slacks do not enter which cells to halve
+    FC, FL, _ = F.bounds(pc, Z[pr], slack=nil)  # type: ignore[arg-type]
     FC, FL = FC[:, 0], FL[:, 0]
     split_f = np.zeros(len(F), dtype=bool)
     split_g = np.zeros(len(G), dtype=bool)
+    bad_pairs: Any = None
     if heterogeneous:
         qr, qc, qoff = _pairs(g_start, g_count, it)
-        GC, GU, _ = G.bounds(qc, th[qr], Z[qr])
+        GC, GU, _ = G.bounds(qc, th[qr], Z[qr], slack=nil)  # type: ignore[arg-type]
         GC, GU = GC[:, 0], GU[:, 0]
         fmin, L = np.minimum.reduceat(FC, off), np.minimum.reduceat(FL, off)
         gmax, U = np.maximum.reduceat(GC, qoff), np.maximum.reduceat(GU, qoff)
@@ -458,20 +484,24 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
         bad_g = (GU > (U - _LOOSE * lg)[qr]) & (lg >= 0.3 * tot)[qr] & (lg > 0)[qr]
         split_f[pc[bad_f]] = True
         split_g[qc[bad_g]] = True
+        bad_pairs = bad_f
     else:
         E = len(ends)
         gc = (g_start[pc][:, None] + np.arange(E)[None, :]).ravel()
-        GC, GU, _ = G.bounds(gc, np.repeat(th[pr], E, axis=0), np.repeat(Z[pr], E, axis=0))
+        GC, GU, _ = G.bounds(gc, np.repeat(th[pr], E, axis=0), np.repeat(Z[pr], E, axis=0),
+                             slack=nil)  # type: ignore[arg-type]
         GC, GU = GC.reshape(pc.size, E).max(axis=1), GU.reshape(pc.size, E).max(axis=1)
         pp, lp = FC - GC, FL - GU
         pmin, low = np.minimum.reduceat(pp, off), np.minimum.reduceat(lp, off)
         loose = pmin - low
-        split_f[pc[(lp < (low + _LOOSE * loose)[pr]) & (loose > 0)[pr]]] = True
+        bad_pairs = (lp < (low + _LOOSE * loose)[pr]) & (loose > 0)[pr]
+        split_f[pc[bad_pairs]] = True
     # follower cells: halve along the parameter whose width costs the bound most where it
     # was loose (the larger mean-value spread at the held points)
-    sp = F.spreads(pc, Z[pr])[:, :, 0]  # (pairs, 2)
+    bp = np.flatnonzero(bad_pairs)
+    sp = F.spreads(pc[bp], Z[pr[bp]])[:, :, 0]  # (bad pairs, 2)
     cost = np.zeros((len(F), 2))
-    np.maximum.at(cost, pc, sp)
+    np.maximum.at(cost, pc[bp], sp)
     wt, wh = F.tau[:, 1] - F.tau[:, 0], F.headway[:, 1] - F.headway[:, 0]
     along_t = (cost[:, 0] >= cost[:, 1]) & (wt > 0) | (wh <= 0)
     sf = np.flatnonzero(split_f & ((wt > 0) | (wh > 0)))

@@ -372,9 +372,12 @@ def predecessor_margins(G: Array, Gmag: Array, m: Array,
     Z = vander(theta[None, :])[0]
     st = np.sin(theta)
     gv, gm = G @ Z, Gmag @ Z
-    mm = np.asarray(m, dtype=float)[..., None]
-    m1 = 1.0 + mm
-    g = gv[..., 0, :] + np.cos(mm * theta) * gv[..., 1, :] + np.sin(mm * theta) * st * gv[..., 2, :]
+    mm = np.asarray(m, dtype=float)
+    ms, inv = np.unique(mm, return_inverse=True)  # cos mθ, sin mθ once per distinct m
+    cm = np.cos(ms[:, None] * theta)[inv.reshape(mm.shape)]
+    sm = (np.sin(ms[:, None] * theta) * st)[inv.reshape(mm.shape)]
+    m1 = 1.0 + mm[..., None]
+    g = gv[..., 0, :] + cm * gv[..., 1, :] + sm * gv[..., 2, :]
     gs = ROUNDOFF_SLACK * m1 * (gm[..., 0, :] + m1 * (gm[..., 1, :] + np.abs(st) * gm[..., 2, :]))
     return g, gs
 

@@ -133,7 +133,28 @@ class FollowerCells:
         return FollowerCells(self.owner[idx], self.tau[idx], self.headway[idx], self.V[idx],
                              self.a[idx], self.mag[idx], self.gmag[idx])
 
-    def bounds(self, cell: npt.NDArray[np.intp], Z: Array) -> tuple[Array, Array, Array]:
+    @staticmethod
+    def slacks(mag: Array, gmag: Array, Z: Array) -> tuple[Array, Array]:
+        """The round-off slacks of F and of its gradients from magnitudes (r, 3) at θ.
+
+        Parameters
+        ----------
+        mag, gmag : ndarray, shape (r, 3)
+            Magnitudes of F's coefficients and of their gradients (of a cell, or the largest
+            over an item's cells: a bound for each of them).
+        Z : ndarray, shape (r, 3, k)
+            :func:`vander` of each row's frequencies.
+
+        Returns
+        -------
+        (ndarray, ndarray)
+            The slacks of the value and of each gradient, shape (r, k).
+        """
+        mags = np.matmul(np.stack([mag, gmag], axis=1), Z)
+        return ROUNDOFF_SLACK * mags[:, 0], ROUNDOFF_SLACK * mags[:, 1]
+
+    def bounds(self, cell: npt.NDArray[np.intp], Z: Array,
+               slack: tuple[Array, Array] | None = None) -> tuple[Array, Array, Array]:
         """F at the centres, a lower bound over the cells, and the slack, at θ.
 
         Parameters
@@ -142,6 +163,9 @@ class FollowerCells:
             The cells, one per row.
         Z : ndarray, shape (r, 3, k)
             :func:`vander` of each row's frequencies.
+        slack : (ndarray, ndarray), optional
+            The slacks of :meth:`slacks` for each row, when the caller has them (from
+            magnitudes at least the cells'); computed from the cells' own otherwise.
 
         Returns
         -------
@@ -150,13 +174,12 @@ class FollowerCells:
             extension and the mean-value form) and the round-off slack of both.
         """
         V = np.matmul(self.V[cell], Z)
-        mags = np.matmul(np.stack([self.mag[cell], self.gmag[cell]], axis=1), Z)
-        gmag = ROUNDOFF_SLACK * mags[:, 1]
+        E, gmag = self.slacks(self.mag[cell], self.gmag[cell], Z) if slack is None else slack
         hw = self.hw[cell]
         spread = ((np.maximum(np.abs(V[:, 2]), np.abs(V[:, 3])) + gmag) * hw[:, 0, None]
                   + (np.maximum(np.abs(V[:, 4]), np.abs(V[:, 5])) + gmag) * hw[:, 1, None])
         Fc = V[:, 0]
-        return Fc, np.maximum(V[:, 1], Fc - spread), ROUNDOFF_SLACK * mags[:, 0]
+        return Fc, np.maximum(V[:, 1], Fc - spread), E
 
     def spreads(self, cell: npt.NDArray[np.intp], Z: Array) -> Array:
         """max |∂F/∂p| × half-width along τ and T* over each cell, shape (r, 2, k).
@@ -254,8 +277,38 @@ class PredecessorCells:
         return PredecessorCells(self.owner[idx], self.tau_p[idx], self.end[idx], self.m[idx],
                                 self.V[idx], self.a[idx], self.mag[idx], self.gmag[idx])
 
-    def bounds(self, cell: npt.NDArray[np.intp], theta: Array,
-               Z: Array) -> tuple[Array, Array, Array]:
+    @staticmethod
+    def slacks(mag: Array, gmag: Array, m: Array, theta: Array,
+               Z: Array) -> tuple[Array, Array]:
+        """The round-off slacks of G and of its gradient from magnitudes (r, 3, 3) at θ.
+
+        Parameters
+        ----------
+        mag, gmag : ndarray, shape (r, 3, 3)
+            Magnitudes of P_G, Y_r, Y_i's coefficients and of their gradients (of a cell, or
+            the largest over an item's cells).
+        m : ndarray, shape (r,)
+            Whole samples of delay (the largest of the cells').
+        theta : ndarray, shape (r, k)
+            Frequencies, rad/sample.
+        Z : ndarray, shape (r, 3, k)
+            :func:`vander` of ``theta``.
+
+        Returns
+        -------
+        (ndarray, ndarray)
+            The slacks of the value and of the gradient, shape (r, k).
+        """
+        m1 = (1.0 + m)[:, None, None]
+        ast = np.abs(np.sin(theta))[:, None]
+        mags = np.matmul(np.concatenate([mag, gmag], axis=1), Z)
+        sl = ROUNDOFF_SLACK * m1 * (mags[:, [0, 3]] + m1 * (mags[:, [1, 4]]
+                                                            + ast * mags[:, [2, 5]]))
+        return sl[:, 0], sl[:, 1]
+
+    def bounds(self, cell: npt.NDArray[np.intp], theta: Array, Z: Array,
+               trig: tuple[Array, Array] | None = None,
+               slack: tuple[Array, Array] | None = None) -> tuple[Array, Array, Array]:
         """G at the centres, an upper bound over the cells, and the slack, at θ.
 
         Parameters
@@ -266,6 +319,12 @@ class PredecessorCells:
             Frequencies, rad/sample.
         Z : ndarray, shape (r, 3, k)
             :func:`vander` of ``theta``.
+        trig : (ndarray, ndarray), optional
+            cos(mθ) and sin(mθ) sin θ of each row, shape (r, k), when the caller has them
+            (computed here otherwise).
+        slack : (ndarray, ndarray), optional
+            The slacks of :meth:`slacks` for each row, when the caller has them (from
+            magnitudes and m at least the cells'); computed from the cells' own otherwise.
 
         Returns
         -------
@@ -273,9 +332,11 @@ class PredecessorCells:
             Of shape (r, k): G at the centre, the upper bound (the better of the interval
             extension and the mean-value form) and the round-off slack of both.
         """
-        st = np.sin(theta)
-        m = self.m[cell][:, None]
-        cm, f = np.cos(m * theta), np.sin(m * theta) * st
+        if trig is None:
+            m = self.m[cell][:, None]
+            cm, f = np.cos(m * theta), np.sin(m * theta) * np.sin(theta)
+        else:
+            cm, f = trig
         V = np.matmul(self.V[cell], Z)
         Pc, Phi, Pglo, Pghi = V[:, 0], V[:, 1], V[:, 2], V[:, 3]
         Rc, Rlo, Rhi, Rglo, Rghi = (V[:, 4 + i] for i in range(5))
@@ -286,11 +347,8 @@ class PredecessorCells:
         a, b, c, e = cm * Rglo, cm * Rghi, f * Iglo, f * Ighi
         dlo = Pglo + np.minimum(a, b) + np.minimum(c, e)
         dhi = Pghi + np.maximum(a, b) + np.maximum(c, e)
-        m1 = (1.0 + m)[:, None]
-        ast = np.abs(st)[:, None]
-        mags = np.matmul(np.concatenate([self.mag[cell], self.gmag[cell]], axis=1), Z)
-        sl = ROUNDOFF_SLACK * m1 * (mags[:, [0, 3]] + m1 * (mags[:, [1, 4]]
-                                                            + ast * mags[:, [2, 5]]))
+        E, Eg = (self.slacks(self.mag[cell], self.gmag[cell], self.m[cell], theta, Z)
+                 if slack is None else slack)
         hw = 0.5 * (self.tau_p[cell, 1] - self.tau_p[cell, 0])
-        spread = (np.maximum(np.abs(dlo), np.abs(dhi)) + sl[:, 1]) * hw[:, None]
-        return Gc, np.minimum(Gn, Gc + spread), sl[:, 0]
+        spread = (np.maximum(np.abs(dlo), np.abs(dhi)) + Eg) * hw[:, None]
+        return Gc, np.minimum(Gn, Gc + spread), E

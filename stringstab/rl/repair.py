@@ -10,18 +10,22 @@ so calling them per environment step would dominate training.  The default metho
 *certified lookup*:
 
 ``"projection"`` (default)
-    1. a cheap screen drops triples that surely fail
+    1. a proposal inside a *proven cell* of the lattice below — a cell on which both
+       certificates hold for every gain (:mod:`stringstab.certify.gain_cells`, proven by blocks
+       the first time a proposal comes near: :func:`certified_cells`) — is executed unchanged,
+       without a certificate call;
+    2. for the others, cheap screens drop triples that surely fail
        (:func:`stringstab.certify.screen.surely_uncertifiable`: not internally stable, or g(ω)
        below its round-off threshold at one of 48 fixed frequencies, where g is the margin of
-       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there);
-    2. the rest are checked by the exact certificate in one vectorised call; certified triples
-       are executed unchanged;
+       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there; with a sample time, the sampled
+       loop's :class:`~stringstab.certify.screen.SampledScreen`), and the rest are checked by
+       the exact certificates in one vectorised call each; certified triples are executed
+       unchanged;
     3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
-       points of a grid of spacing ``resolution`` over the gain box that the exact certificate
-       certifies (built once per process and parameter set, one vectorised call, about 10 s for
-       the default 81³ grid);
+       points of a grid of spacing ``resolution`` over the gain box that the exact certificates
+       certify (built once per process and parameter set, one vectorised call);
     4. ``refine`` bisection steps along the segment from that point towards the proposed K keep
-       the farthest point the exact certificate certifies (one vectorised call per step).
+       the farthest point in a proven cell (no certificate call).
 
     The result is within about one lattice spacing of the true projection (the nearest certified
     triple); ``analysis/bench_train.py`` measures the difference against
@@ -36,11 +40,12 @@ so calling them per environment step would dominate training.  The default metho
 ``"off"``
     no repair: the ablation (executed gains may be uncertified).
 
-Whatever the method, a triple is executed only if :func:`~stringstab.certify.api.check` returned
-``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
-:func:`stringstab.certify.sampled.check_sampled` at H: the loop the simulator runs holds u over each
-control step, and gains on the continuous certificate's boundary need not be string stable in
-that sampled loop.
+Whatever the method, a triple is executed only if it is certified (``"off"`` excepted): by
+:func:`~stringstab.certify.api.check` for exactly that triple, or by the proof of a proven cell
+that contains it — and, with ``sample_time`` H, also by the sampled-data certificate
+(:func:`stringstab.certify.sampled.check_sampled` at H, or the cell's proof): the loop the
+simulator runs holds u over each control step, and gains on the continuous certificate's
+boundary need not be string stable in that sampled loop.
 """
 
 from __future__ import annotations
