@@ -449,9 +449,56 @@ def main(argv=None):
         print("\n| set | triples | decided verdicts changed | inconclusive before | now decided "
               "| inconclusive after |\n|---|---|---|---|---|---|")
         print("\n".join(compare(v["before"], v["after"])))
+        print(verify_new_decisions(inputs, v["before"], v["after"]))
         if args.write_fixture:
             write_fixture(args.write_fixture, inputs, v["before"], rng)
     print("\n# load at the end {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
+
+
+def verify_new_decisions(inputs: dict, before: dict, after: dict) -> str:
+    """Check every verdict that was inconclusive before and is decided now (this checkout).
+
+    A certified box: the point certificate certifies every member of a grid over it
+    (τ, τ_p, T* at their ends, δ at 5 points); a not-certified box: its witness member's own
+    point certificate says not certified.
+    """
+    from stringstab.certify.api import certify, certify_batch
+    from stringstab.certify.sampled import check_members
+
+    ok = bad = 0
+    for name, b in sorted(before.items()):
+        kind = name.split("_")[1]
+        idx = np.flatnonzero((b == "inconclusive") & (after[name] != "inconclusive"))
+        if not idx.size or kind == "check":
+            continue
+        K = inputs[name][idx]
+        sk = {} if kind == "robust" else {"sample_time": H,
+                                          "heterogeneous": kind == "sampled"}
+        r = certify_batch(*K.T, **BOX, **sk)
+        for i, k in enumerate(K):
+            if r.verdict[i] == "certified":
+                taus = BOX["tau"]
+                M = np.array([(t, tp, d, h) for t in taus for tp in taus
+                              for d in np.linspace(*BOX["delta"], 5) for h in BOX["headway"]
+                              if kind != "sampledhom" or t == tp])
+                if kind == "robust":
+                    good = all(certify(*k, tau=t, delta=d, headway=h).verdict == "certified"
+                               for t, _, d, h in M)
+                else:
+                    kk = np.repeat(k[None], len(M), axis=0)
+                    v, _, _ = check_members(*kk.T.copy(), tau=M[:, 0], tau_prev=M[:, 1],
+                                            delta=M[:, 2], headway=M[:, 3], H=H)
+                    good = bool(np.all(v == 0))
+            else:
+                w = dict(tau=r.witness_tau[i], delta=r.witness_delta[i],
+                         headway=r.witness_headway[i])
+                if kind != "robust":
+                    w.update(tau_prev=r.witness_tau_prev[i], sample_time=H)
+                good = certify(*k, **w).verdict == "not_certified"
+            ok += good
+            bad += not good
+    return (f"# newly decided verdicts checked: {ok} agree with their members' point "
+            f"certificates, {bad} do not")
 
 
 def write_fixture(path: str, inputs: dict, before: dict, rng: np.random.Generator) -> None:
