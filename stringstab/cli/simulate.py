@@ -20,13 +20,8 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import check_params
-from ._common import (
-    add_limit_arguments,
-    add_vehicle_arguments,
-    checked_leaders,
-    collision_status,
-    limits_from_args,
-)
+from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, limits_from_args
+from ._outcome import collision_status
 
 __all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "run"]
 

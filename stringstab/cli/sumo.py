@@ -312,7 +312,7 @@ def run_platoon(args: argparse.Namespace) -> int:
     """
     from ..io import OutputDir
     from ..traffic.output import RUN_FILES, run_document, write_run
-    from ._common import collision_status
+    from ._outcome import collision_status
     from .simulate import first_collision
 
     if (args.sumocfg is None) != (args.controlled is None):
@@ -387,7 +387,7 @@ def _run_scenario(args: argparse.Namespace) -> int:
 
     from ..io import OutputDir, write_results
     from ..sumo.inscenario import run_scenario
-    from ._common import collision_status
+    from ._outcome import collision_status
 
     t0 = time.perf_counter()
     if args.steps is not None and args.steps < 1:
@@ -431,7 +431,7 @@ def _run_scenario(args: argparse.Namespace) -> int:
 def _without_leader(args: argparse.Namespace, summary: dict[str, Any]) -> int:
     """1 with a warning per controlled vehicle that never had a leader (never driven), else 0."""
     from ..sumo.inscenario import LOOKAHEAD
-    from ._common import command_name
+    from ._outcome import command_name
 
     steps = {v["vehicle"]: v["steps_present"] for v in summary["vehicles"]}
     for vid in summary["without_leader"]:
