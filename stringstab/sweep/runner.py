@@ -21,10 +21,12 @@ take.
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..errors import StringStabError
@@ -88,6 +90,22 @@ def _lost_record(point: dict[str, Any], error: str) -> dict[str, Any]:
             "error": error, "seconds": float("nan"), "worker": None, "pid": None}
 
 
+@contextlib.contextmanager
+def _quiet_scheduler() -> Iterator[None]:
+    """An in-process scheduler (a local cluster) does not log the workers a Ctrl-C already ended.
+
+    A terminal's Ctrl-C reaches the local cluster's workers too; the scheduler then logs an
+    ERROR for each worker ``Client.run`` cannot reach, which is expected here.
+    """
+    logger = logging.getLogger("distributed.scheduler")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+
+
 def cancel_points(client: Any, futures: list[Any], root: str, *,
                   log: Callable[[str], None] = print, wait: float = STOP_WAIT) -> int:
     """Cancel a sweep's tasks on the scheduler and stop those running; see the module.
@@ -120,7 +138,8 @@ def cancel_points(client: Any, futures: list[Any], root: str, *,
     running = 0
     while True:
         try:
-            counts = client.run(interrupt_points, root, ids, on_error="return")
+            with _quiet_scheduler():
+                counts = client.run(interrupt_points, root, ids, on_error="return")
         except Exception as e:  # the scheduler is gone: nothing more to stop from here
             log(f"sweep: could not reach the workers to stop the running points ({e})")
             return 0
