@@ -185,3 +185,18 @@ def test_id_due_but_not_inserted_stops_the_run_at_once(tmp_path, capsys, monkeyp
                    "insert it (it departs before the configuration's begin, t = 4 s, and SUMO "
                    "skips it); expected a vehicle the scenario inserts"]
     assert len(steps) == 1 and not out.exists()  # stopped at the first step, not the run's end
+
+
+def test_schedule_is_when_sumo_inserts_the_vehicles():
+    from stringstab.sumo.routes import scheduled_departures
+
+    sched = scheduled_departures(SCENARIO)
+    departed = {}
+    with SumoSession(["-c", SCENARIO], dt=0.1, scenario=True) as s:
+        for _ in range(700):
+            s.step()
+            for vid in s.simulation.getDepartedIDList():
+                departed[vid] = float(s.simulation.getTime())
+    assert len(departed) == 11 and {"ramp.0", "ramp.4"} <= departed.keys()
+    for vid, t in departed.items():  # inserted in the step that starts at its depart time
+        assert sched.depart(vid) == pytest.approx(t - 0.1, abs=1e-9), vid

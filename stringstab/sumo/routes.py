@@ -2,7 +2,7 @@
 
 :func:`scheduled_departures` reads the ``route-files`` and ``additional-files`` of a
 ``.sumocfg`` (SUMO's XML: ``<vehicle>`` and ``<trip>`` with ``depart``, ``<flow>`` with
-``begin``, ``end`` and ``period``/``vehsPerHour``/``number``) so that
+``begin`` and ``period``/``vehsPerHour``) so that
 :func:`~stringstab.sumo.inscenario.run_scenario` can refuse a ``--controlled`` id that no file
 defines before SUMO starts, and one that does not appear when it is due at the step it was due
 (SUMO's own flow vehicles are named ``FLOW.INDEX``, the k-th departing at ``begin + k·period``).
@@ -12,7 +12,6 @@ then nothing is refused up front and the ids are checked as the run goes and at 
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -131,16 +130,18 @@ def _files(root: ET.Element, option: str, base: Path) -> list[Path]:
     return out
 
 
-def _flow_period(el: ET.Element, begin: float) -> float | None:
+def _flow_period(el: ET.Element) -> float | None:
+    """The fixed time between a flow's vehicles (``period``, or 3600/``vehsPerHour``), s.
+
+    None when it is random (``period="exp(...)"``, ``probability``) or left to SUMO
+    (``number`` alone): such a flow's vehicles are checked at the run's end only.
+    """
     period = _seconds(el.get("period"))  # None for a random "exp(rate)" period
     if period is not None:
         return period if period > 0 else None
     vph = _seconds(el.get("vehsPerHour"))
     if vph is not None and vph > 0:
         return 3600.0 / vph
-    number, end = _seconds(el.get("number")), _seconds(el.get("end"))
-    if number is not None and number > 0 and end is not None and math.isfinite(end):
-        return (end - begin) / number
     return None
 
 
@@ -186,5 +187,5 @@ def scheduled_departures(sumocfg: str | os.PathLike[str]) -> Schedule:
             elif el.tag == "flow":
                 begin = _seconds(el.get("begin"))
                 b = sched.begin if begin is None else begin
-                sched.flows[vid] = (b, _flow_period(el, b))
+                sched.flows[vid] = (b, _flow_period(el))
     return sched
