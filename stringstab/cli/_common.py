@@ -28,6 +28,7 @@ from ..params import (
     positive,
 )
 from ..ranges import check_magnitude, sensible_warning
+from ._outcome import command_name
 
 __all__ = [
     "NEGATIVE_NUMBER",
@@ -542,8 +543,6 @@ def checked_leaders(args: Any, leaders: Any, limits: Any) -> list[str]:
             text = w if len(leaders) == 1 else f"{leader.name}: {w}"
             if text not in out:
                 out.append(text)
-    command = getattr(args, "command", "")
-    sub = getattr(args, "hcfs_command", None)
     for w in out:
-        print(f"stringstab {command}{' ' + sub if sub else ''}: warning: {w}", file=sys.stderr)
+        print(f"{command_name(args)}: warning: {w}", file=sys.stderr)
     return out
