@@ -192,9 +192,9 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     summary: dict[str, Any] = {}
     for method in dict.fromkeys(r["method"] for r in records):
         rs = [r for r in records if r["method"] == method]
-        moved = [r["distance"] for r in rs if r["status"] == "repaired"]
+        moved = [r["distance"] for r in rs if r["status"] in ("repaired", "moved_not_certified")]
         summary[method] = {"n": len(rs), "certified": sum(r["certified"] for r in rs),
-                           "repaired": len(moved),
+                           "repaired": sum(r["status"] == "repaired" for r in rs),
                            "median_distance_moved": float(np.median(moved)) if moved else 0.0}
     params = {**PARAMS, "method": "both"}
     columns = columns_from_records(records)

@@ -30,7 +30,8 @@ MARKDOWN = """\
 {% endfor %}{% endfor %}
 """
 
-#: The HTML page: inline CSS, a contents list, the converted Markdown; nothing loaded from outside.
+#: The HTML page: inline CSS, a contents list, the converted Markdown (formulas already typeset as
+#: embedded SVG images, :mod:`stringstab.report.maths`); nothing loaded from outside.
 HTML = """\
 <!DOCTYPE html>
 <html lang="en">
@@ -52,6 +53,8 @@ code, pre { font-family: ui-monospace, "DejaVu Sans Mono", monospace; font-size:
 pre { background: #f5f5f5; padding: .6rem; overflow-x: auto; }
 img { max-width: 100%; height: auto; display: block; margin: 1rem auto .3rem;
       border: 1px solid #e3e3e3; }
+img.math { display: inline; margin: 0; border: 0; max-width: none; }
+p.math { text-align: center; margin: .8rem 0; }
 p > em:only-child { color: #444; }
 td.yes { background: #e6f4ea !important; color: #1b5e20; }
 td.no { background: #fde8e8 !important; color: #b71c1c; }
