@@ -1,14 +1,14 @@
-"""Maths typeset at build time: TeX in ``$…$`` / ``$$…$$`` rendered to SVG by matplotlib's mathtext.
+r"""Maths typeset at build time: TeX in ``$…$`` / ``$$…$$`` rendered to SVG by matplotlib's mathtext.
 
-The report's Markdown keeps the TeX (``$\\Gamma(s)$``; GitHub and most Markdown viewers typeset
+The report's Markdown keeps the TeX (``$\Gamma(s)$``; GitHub and most Markdown viewers typeset
 it); the HTML page gets each formula as an SVG image embedded as a ``data:`` URI, drawn by
 matplotlib's own TeX subset (:mod:`matplotlib.mathtext`, Computer Modern fonts shipped with
 matplotlib, glyphs as paths). Nothing is loaded at reading time: no script, no font, no
 network, and the page stays one file. The same renderer typesets the ``.. math::`` blocks of the
 docstrings on the documentation site (``docs/griffe_rst.py``).
 
-Only mathtext's subset of TeX is available (fractions, sub/superscripts, Greek, ``\\left(``,
-``\\sup``, ``\\Vert``, ``\\mathcal``…); environments such as ``align`` are not.  A formula it
+Only mathtext's subset of TeX is available (fractions, sub/superscripts, Greek, ``\left(``,
+``\sup``, ``\Vert``, ``\mathcal``…); environments such as ``align`` are not.  A formula it
 cannot parse raises :class:`~stringstab.errors.StringStabError` naming the formula.
 """
 
@@ -20,13 +20,15 @@ import re
 from dataclasses import dataclass
 from functools import lru_cache
 
-__all__ = ["MATH", "Formula", "split_maths", "typeset", "typeset_html"]
+__all__ = ["MATH", "Formula", "inline_tex", "split_maths", "typeset", "typeset_html"]
 
 #: Inline ``$x$`` (no space inside the dollars, as pandoc reads them) or display ``$$x$$``.
 MATH = re.compile(r"\$\$(?P<display>.+?)\$\$|(?<![\\$\w])\$(?P<inline>[^\s$](?:[^$\n]*?[^\s$\\])?)\$(?![\w$])",
                   re.DOTALL)
 
 _CODE = re.compile(r"(```.*?```|`[^`\n]+`)", re.DOTALL)
+#: A word written with TeX's braced sub- or superscripts (``e^{-δs}``, ``a_{i−1}``).
+_BRACED = re.compile(r"(?<![\w$\\])([^\s$(){}\[\],;]*?[_^]\{[^{}$]*\}(?:[_^]\{[^{}$]*\})*)")
 
 
 @dataclass(frozen=True)
@@ -70,7 +72,7 @@ class Formula:
 
 
 @lru_cache(maxsize=512)
-def typeset(tex: str, *, display: bool = False, size: float = 12.0) -> Formula:
+def typeset(tex: str, *, display: bool = False, size: float = 13.5) -> Formula:
     r"""Render one formula to SVG with matplotlib's mathtext (Computer Modern).
 
     Parameters
@@ -78,9 +80,10 @@ def typeset(tex: str, *, display: bool = False, size: float = 12.0) -> Formula:
     tex : str
         The formula without dollars, e.g. ``r"\Vert\Gamma\Vert_{\mathcal{H}_\infty} \leq 1"``.
     display : bool, optional
-        A display formula (drawn 15 % larger, shown on its own line).
+        A display formula (drawn 40 % larger: mathtext sets fractions small; on its own line).
     size : float, optional
-        Font size of an inline formula, points (the report's text is 12 pt).
+        Font size of an inline formula, points (the report's text is 12 pt; Computer Modern
+        reads smaller than its sans-serif at one size).
 
     Returns
     -------
@@ -108,7 +111,7 @@ def typeset(tex: str, *, display: bool = False, size: float = 12.0) -> Formula:
 
     from ..errors import StringStabError
 
-    pts = size * (1.15 if display else 1.0)
+    pts = size * (1.4 if display else 1.0)
     with matplotlib.rc_context({"mathtext.fontset": "cm", "svg.fonttype": "path",
                                 "svg.hashsalt": "stringstab"}):
         prop = FontProperties(size=pts)
@@ -126,6 +129,30 @@ def typeset(tex: str, *, display: bool = False, size: float = 12.0) -> Formula:
         buf = io.BytesIO()
         fig.savefig(buf, format="svg", dpi=72, transparent=True, metadata={"Date": None})
     return Formula(tex, buf.getvalue(), width + 2 * pad, height + 2 * pad, depth + pad, display)
+
+
+def inline_tex(text: str) -> str:
+    """Mark the words of plain text written in TeX (``e^{-δs}``, ``a_{i−1}``) as formulas.
+
+    Text written elsewhere in the toolkit (an erratum's explanation) uses TeX's braces for
+    sub- and superscripts; wrapped in dollars they are typeset instead of shown as source.
+
+    Parameters
+    ----------
+    text : str
+        Plain text.
+
+    Returns
+    -------
+    str
+        The text with each such word in ``$…$``.
+
+    Examples
+    --------
+    >>> inline_tex("with e^{-δs} replaced; k_x stays")
+    'with $e^{-δs}$ replaced; k_x stays'
+    """
+    return _BRACED.sub(lambda m: f"${m.group(1)}$", text)
 
 
 def split_maths(text: str) -> list[tuple[str, str | None, bool]]:
