@@ -284,7 +284,9 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
         for r, J, names in figs:
             for kind, name in names.items():
                 n_panels = 4 if kind != "switching" else 2
-                fig = Figure(figsize=(11, 2.4 * n_panels + 0.6), layout="constrained")
+                n = ver.runs[r].n_followers  # jerk: a panel per follower and mode
+                height = 1.25 * n + 1.6 if kind == "jerk" and n > 1 else 2.4 * n_panels + 0.6
+                fig = Figure(figsize=(11, height), layout="constrained")
                 plot_figure(ver.runs[r], J, kind, fig=fig)
                 fig.savefig(out.path(name), dpi=90)
                 files[name] = name

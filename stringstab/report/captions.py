@@ -72,16 +72,23 @@ CAPTIONS: list[tuple[str, str]] = [
      "(its theorem needs a1 = a2); the jerk-safe variant stays within it."),
     ("switching_*", "Which controller (DDPG or CACC) each follower uses over time, per mode."),
     # train / evaluate / compare
-    ("rolling_reward.png", "Training curve: rolling mean episode reward over environment steps."),
-    ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode and follower with its CDF; "
-     "mass left of 1 means disturbances shrink."),
+    ("rolling_reward.png", "Training curve (IDL Fig. 3): the return of each training episode (grey "
+     "dots) and its rolling mean over training episodes, with the paper's window of 10 and a "
+     "window of 100; a mean is drawn only where its window is full, and a window longer than the "
+     "run is named on the figure instead of drawn."),
+    ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode (orange bars) with its CDF "
+     "(blue line, right axis), every episode drawn (the axis holds all values, so each CDF ends "
+     "at 1); mass left of the dashed line at 1 means disturbances shrink."),
     ("fig9_ttc.png", "IDL paper Fig. 9: distribution of the time to collision at closing "
-     "moments, on a log axis; the shaded range below TTC* is the safety-relevant one (counted "
-     "in TIT), and the legend gives each strategy's share there."),
-    ("fig11_jerk.png", "IDL paper Fig. 11: share of squared-jerk samples in each range per "
-     "strategy, counts on the bars (comfort: more mass in the low ranges is better)."),
-    ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy, with the "
-     "desired headway T*."),
+     "moments, on a log axis, as shares of all closing moments; the shaded range below TTC* is "
+     "the safety-relevant one (counted in TIT), and the legend gives each strategy's share there "
+     "and the share beyond the axis."),
+    ("fig11_jerk.png", "IDL paper Fig. 11: share of all squared-jerk samples in each of the "
+     "paper's ranges per strategy, and above its last range (> 60 m²/s⁶), counts on the bars, "
+     "so every sample is counted (comfort: more mass in the low ranges is better)."),
+    ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy over all "
+     "samples, drawn from 0 to 3 s, with the desired headway T*; the legend gives the shares off "
+     "the axis."),
     ("gains_region.png", "The gains each strategy executed (coloured by strategy) over the "
      "certified region projected over the executed k_a values (certified at every one, at some, "
      "at none); the axes extend past the ±2 gain bounds so gains on a bound are visible."),
