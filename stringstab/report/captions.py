@@ -54,13 +54,14 @@ CAPTIONS: list[tuple[str, str]] = [
      "speed, on each clean segment; the title gives the fitted parameters and the RMSE. The "
      "dashed curves tracking the black ones means the model explains the data."),
     ("transfer_*", "The fitted model's |Γ(jω)| (string stable where it stays below the dotted line "
-     "at 1) beside the data's own speed transfer |Ĝ(jω)| with its coherence; only coherent "
-     "points (black) below the grey band count for the data's verdict (above it common-mode GPS "
-     "error dominates). Agreement of the curve and the points means the verdict is the data's, "
-     "not only the model's."),
+     "at 1; its peak marked, the curve drawn from a decade below it) beside the data's own speed "
+     "transfer |Ĝ(jω)| with ± two standard errors and its coherence; only coherent points "
+     "(black) left of the grey band count for the data's verdict (in it common-mode GPS error "
+     "dominates), and the log holds no frequency below its first point (light band). Agreement "
+     "of the curve and the points means the verdict is the data's, not only the model's."),
     ("sup_gain.png", "Along the identified platoon: the model's sup|Γ| per follower with its 5-95 % "
-     "bootstrap interval, and the data's own amplification (max |Ĝ| and the energy ratio); "
-     "points above the dotted line at 1 amplify disturbances."),
+     "bootstrap interval, and the data's own amplification (max |Ĝ| ± two standard errors, and "
+     "the energy ratio); points above the dotted line at 1 amplify disturbances."),
     # tune
     ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
      "(square: certified, cross: not), over the certified region projected over the repaired "

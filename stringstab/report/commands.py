@@ -8,6 +8,7 @@ verification.  A command calls one function and writes the result::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -316,8 +317,35 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
         rep.section("Notes").text("\n".join(f"- {n}" for n in notes))
     figs = _pngs(Path(str(f)).name for f in files)
     if figs:
-        rep.section("Figures").figures(figs)
+        sec = rep.section("Figures")
+        for f in figs:
+            sec.figure(f, _identify_caption(res, f))
     return rep
+
+
+def _identify_caption(res: Any, name: str) -> str:
+    """The caption of one identify figure: whose it is and its numbers, then what to see."""
+    from .captions import caption_for
+
+    for v in res.vehicles:
+        tag = f"{v.platoon}_{v.position}" if len(res.sources) > 1 else f"{v.position}"
+        if name in (f"fit_{tag}.png", f"transfer_{tag}.png"):
+            c = v.certificate
+            who = f"Follower {v.position} ({v.name}"
+            who += f", {v.platoon})" if len(res.sources) > 1 else ")"
+            if name.startswith("fit_"):
+                head = (f"{who}: speed RMSE {v.fit.rmse_speed:.2g} m/s, gap RMSE "
+                        f"{v.fit.rmse_gap:.2g} m over {len(v.segments)} clean segment"
+                        f"{'' if len(v.segments) == 1 else 's'}. ")
+            else:
+                e = v.empirical
+                data = (f"the data's max |Ĝ| = {e.gain:.3g} ± {2 * e.gain_error * e.gain:.2g} at "
+                        f"{e.gain_omega:.2g} rad/s (amplifies: {e.amplifies})"
+                        if math.isfinite(e.gain) else "no coherent frequency in the data")
+                head = (f"{who}: the model's sup|Γ| = {float(c.sup_gain):.3g} at "
+                        f"{float(c.peak_omega):.2g} rad/s ({c.verdict}); {data}. ")
+            return head + caption_for(name)
+    return caption_for(name)
 
 
 def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[str],
