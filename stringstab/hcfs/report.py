@@ -285,10 +285,11 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
             for kind, name in names.items():
                 n_panels = 4 if kind != "switching" else 2
                 n = ver.runs[r].n_followers  # jerk: a panel per follower and mode
-                height = 1.25 * n + 1.6 if kind == "jerk" and n > 1 else 2.4 * n_panels + 0.6
-                fig = Figure(figsize=(11, height), layout="constrained")
+                height = 1.25 * n + 1.6 if kind == "jerk" and n > 1 else 2.2 * n_panels + 0.6
+                # 9 in at 110 dpi: 990 px, shown at full size in the report (text ≥ 8 pt)
+                fig = Figure(figsize=(9, height), layout="constrained")
                 plot_figure(ver.runs[r], J, kind, fig=fig)
-                fig.savefig(out.path(name), dpi=90)
+                fig.savefig(out.path(name), dpi=110)
                 files[name] = name
     out.write_json("report.json", report_dict(ver, command=command))
     files["json"] = "report.json"

@@ -124,7 +124,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     hw = pick(result.headway)
     N = gap.shape[0]
     if fig is None:
-        fig = plt.figure(figsize=(12, 7.5), layout="constrained")
+        fig = plt.figure(figsize=(9, 6.5), layout="constrained")
     axes = np.asarray(fig.subplots(2, 2, sharex=True)).ravel()
     panels = [
         (spd, 0, "speed v (m/s)"),
@@ -153,7 +153,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
             axes[3].annotate(f"clipped: h up to {float(finite.max()):.3g} s "
                              f"(vehicle {k[0] + 1}, t = {float(result.t[k[1]]):.4g} s)",
                              xy=(0.01, 0.97), xycoords="axes fraction", ha="left", va="top",
-                             fontsize=8, color="0.25",
+                             fontsize=9, color="0.25",
                              bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9})
     cb = fig.colorbar(lc, ax=list(axes), shrink=0.8, pad=0.01)
     cb.set_label("position in platoon (0 = leader)")
