@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..ranges import metric_caveat
 from .render import Report
 
 __all__ = ["compare_report", "evaluate_report", "identify_report", "region_report",
@@ -132,8 +133,11 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
     for w in doc.get("warnings", []):
         sec.verdict("leader", None, f"warning: {w}")
     m = rep.section("Metrics")
-    m.table([{"metric": k, "value": doc.get(k), "unit": u or "–", "meaning": what}
-             for k, what, u in METRICS if k in doc], caption="The IDL paper's metrics of this run.")
+    m.table([{"metric": k, "value": doc.get(k), "unit": u or "–",
+              "meaning": f"{what} {metric_caveat(k, doc.get(k))}".strip()}
+             for k, what, u in METRICS if k in doc],
+            caption="The IDL paper's metrics of this run (a value outside its sensible range "
+                    "says so in its meaning).")
     if doc.get("m_p"):
         m.table([["m_p", *doc["m_p"]]],
                 columns=["follower"] + [str(i + 1) for i in range(len(doc["m_p"]))],

@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..ranges import metric_caveat
 from .maths import inline_tex
 from .render import Report, Section
 
@@ -181,6 +182,11 @@ def _simulate(rep: Report, s: Mapping[str, Any], root: Path) -> None:
     if rows:
         sec.table(rows, caption="Platoon metrics (lower is better except m_fss).",
                   units={label: u for _, label, u in _SIM_METRICS if u})
+    for name in ("certified", "cacc"):
+        for k, label, _ in _SIM_METRICS:
+            caveat = metric_caveat(k, s.get(name, {}).get(k))
+            if caveat:
+                sec.verdict(f"{name}: {label} = {s[name][k]:.3g}", None, caveat.strip("()"))
     for name in ("certified", "cacc"):
         if name in s:
             mp = s[name]["max_m_p"]
