@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass
 from functools import lru_cache
 
-__all__ = ["MATH", "Formula", "inline_tex", "split_maths", "typeset", "typeset_html"]
+__all__ = ["MATH", "Formula", "inline_tex", "mathtext_tex", "split_maths", "typeset", "typeset_html"]
 
 #: Inline ``$x$`` (no space inside the dollars, as pandoc reads them) or display ``$$x$$``.
 MATH = re.compile(r"\$\$(?P<display>.+?)\$\$|(?<![\\$\w])\$(?P<inline>[^\s$](?:[^$\n]*?[^\s$\\])?)\$(?![\w$])",
@@ -71,6 +71,40 @@ class Formula:
                 f'src="data:image/svg+xml;base64,{data}">')
 
 
+#: TeX that mathtext does not know, and what it does know that draws the same.
+_COMPAT = [(re.compile(p), r) for p, r in (
+    (r"\\ge(?![a-zA-Z])", r"\\geq"), (r"\\le(?![a-zA-Z])", r"\\leq"),
+    (r"\\ne(?![a-zA-Z])", r"\\neq"),
+    (r"\\(?:text|textrm|operatorname)\{", r"\\mathrm{"), (r"\\[dt]frac", r"\\frac"),
+    (r"\\lvert|\\rvert", "|"), (r"\\lVert|\\rVert", r"\\Vert "),
+    (r"\\(?:big|Big|bigg|Bigg)[lr]?(?![a-zA-Z])", ""), (r"\\displaystyle", ""),
+    (r"\\limits", ""), (r"\\!", ""),
+)]
+
+
+def mathtext_tex(tex: str) -> str:
+    r"""The formula in mathtext's dialect of TeX (``\ge`` → ``\geq``, ``\text`` → ``\mathrm``…).
+
+    Parameters
+    ----------
+    tex : str
+        TeX as written in a docstring or a report.
+
+    Returns
+    -------
+    str
+        The same formula, in commands mathtext knows.
+
+    Examples
+    --------
+    >>> mathtext_tex(r"g \ge 0, \text{if } \tfrac{a}{b} \le 1")
+    'g \\geq 0, \\mathrm{if } \\frac{a}{b} \\leq 1'
+    """
+    for pattern, repl in _COMPAT:
+        tex = pattern.sub(repl, tex)
+    return tex
+
+
 @lru_cache(maxsize=512)
 def typeset(tex: str, *, display: bool = False, size: float = 13.5) -> Formula:
     r"""Render one formula to SVG with matplotlib's mathtext (Computer Modern).
@@ -111,12 +145,13 @@ def typeset(tex: str, *, display: bool = False, size: float = 13.5) -> Formula:
 
     from ..errors import StringStabError
 
+    src = mathtext_tex(tex)
     pts = size * (1.4 if display else 1.0)
     with matplotlib.rc_context({"mathtext.fontset": "cm", "svg.fonttype": "path",
                                 "svg.hashsalt": "stringstab"}):
         prop = FontProperties(size=pts)
         try:
-            box = MathTextParser("path").parse(f"${tex}$", dpi=72, prop=prop)
+            box = MathTextParser("path").parse(f"${src}$", dpi=72, prop=prop)
         except ValueError as e:
             raise StringStabError(f"cannot typeset the formula ${tex}$ with matplotlib's mathtext: "
                                   f"{str(e).splitlines()[-1]}") from e
@@ -124,7 +159,7 @@ def typeset(tex: str, *, display: bool = False, size: float = 13.5) -> Formula:
         pad = 1.0  # points around the ink, so no glyph touches the edge
         fig = Figure(figsize=((width + 2 * pad) / 72.0, (height + 2 * pad) / 72.0))
         FigureCanvasSVG(fig)
-        fig.text(pad / (width + 2 * pad), (depth + pad) / (height + 2 * pad), f"${tex}$",
+        fig.text(pad / (width + 2 * pad), (depth + pad) / (height + 2 * pad), f"${src}$",
                  fontproperties=prop)
         buf = io.BytesIO()
         fig.savefig(buf, format="svg", dpi=72, transparent=True, metadata={"Date": None})
