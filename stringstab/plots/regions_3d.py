@@ -102,7 +102,7 @@ def _corner_ticks(ax: Any, a0: Any, a1: Any, a2: Any) -> None:
 
     for k, (axis, a) in enumerate(((ax.xaxis, a0), (ax.yaxis, a1), (ax.zaxis, a2))):
         lo, hi = float(a[0]), float(a[-1])
-        ticks = MaxNLocator(4, steps=[1, 2, 5, 10]).tick_values(lo, hi)
+        ticks = np.asarray(MaxNLocator(4, steps=[1, 2, 5, 10]).tick_values(lo, hi), dtype=float)
         span = 1e-9 * max(abs(lo), abs(hi), 1.0)
         ticks = ticks[(ticks >= lo - span) & (ticks <= hi + span)]
         if k == 1:
