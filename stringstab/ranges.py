@@ -127,9 +127,8 @@ def _range(kind: str) -> str:
 #: The sensible range of each reported metric: name -> (lo, hi, unit, what a value outside means).
 #: A number outside is printed with :func:`metric_caveat` beside it (docs/conventions.md).
 METRIC_RANGES: dict[str, tuple[float, float, str, str]] = {
-    "M_effi": (0.0, 10.0, "s", "a negative mean time headway means some moment has a negative "
-               "gap (a collision or an overlap), so it is no efficiency; above 10 s the platoon "
-               "drifted apart"),
+    "M_effi": (0.0, math.inf, "s", "a negative mean time headway means some moment has a "
+               "negative gap (a collision or an overlap), so it measures no efficiency"),
     "max_m_p": (0.0, 10.0, "", "a predecessor that barely accelerates makes the energy ratio "
                 "meaningless"),
     "M_lss": (0.0, 10.0, "", "a predecessor that barely accelerates makes the energy ratio "
@@ -162,7 +161,7 @@ def metric_caveat(name: str, value: Any) -> str:
     >>> metric_caveat("M_effi", 1.47)
     ''
     >>> metric_caveat("M_effi", -20.1)[:46]
-    '(outside the sensible range [0, 10] s: a negat'
+    '(outside the sensible range [0, ∞] s: a negati'
     """
     if name not in METRIC_RANGES or isinstance(value, bool):
         return ""

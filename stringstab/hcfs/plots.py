@@ -129,14 +129,18 @@ def _jerk_limits(ax: Any, run: HCFSRun, i: int, peak: float) -> list[Any]:
     return lines
 
 
-def _jerk_note(ax: Any, run: HCFSRun, i: int, jerk: Any, *, short: bool = False) -> None:
-    """Say the largest |jerk| and the frames above J in the panel's right-hand title."""
+def _jerk_note(ax: Any, run: HCFSRun, i: int, jerk: Any, *, short: bool = False,
+               head: str = "") -> None:
+    """Say the largest |jerk| and the frames above J in the panel's title (under ``head``)."""
     J = run.configs[i].jerk_limit
     above = int(np.count_nonzero(np.abs(jerk) > J * (1 + 1e-9)))
     peak = float(np.abs(jerk).max())
-    text = (f"max {peak:.3g}; {above:,} frames > J" if short
+    text = (f"max {peak:.3g} m/s³; {above:,} frames > J" if short
             else f"max |jerk| {peak:.3g} m/s³; {above:,} of {jerk.size:,} frames above J")
-    ax.set_title(text, fontsize=8, loc="right", color="#B00000" if above else "0.25")
+    if head:
+        ax.set_title(f"{head}\n{text}", fontsize=8, loc="left")
+    else:
+        ax.set_title(text, fontsize=8, loc="right", color="#B00000" if above else "0.25")
 
 
 def plot_jerk_grid(run: HCFSRun, idx: Sequence[int], *, fig: Any) -> list[Any]:
@@ -160,6 +164,8 @@ def plot_jerk_grid(run: HCFSRun, idx: Sequence[int], *, fig: Any) -> list[Any]:
     list of Axes
         The panels, row by row.
     """
+    import textwrap
+
     N = run.n_followers
     axes = np.atleast_2d(fig.subplots(N, len(idx), sharex=True, sharey="col", squeeze=False))
     for col, i in enumerate(idx):
@@ -169,16 +175,12 @@ def plot_jerk_grid(run: HCFSRun, idx: Sequence[int], *, fig: Any) -> list[Any]:
             ax = axes[row, col]
             ax.plot(run.t, jerk[row], color="#0072B2", lw=0.6)
             _jerk_limits(ax, run, i, peak)
-            _jerk_note(ax, run, i, jerk[row:row + 1], short=True)
+            _jerk_note(ax, run, i, jerk[row:row + 1], short=True,
+                       head=textwrap.fill(_title(run, i), 40) if row == 0 else "")
             ax.grid(alpha=0.3)
             ax.tick_params(labelsize=8)
             if col == 0:
                 ax.set_ylabel(f"follower {row + 1}", fontsize=8)
-        import textwrap
-
-        axes[0, col].annotate(textwrap.fill(_title(run, i), 34), xy=(0, 1), xycoords="axes fraction",
-                              xytext=(0, 14), textcoords="offset points", ha="left", va="bottom",
-                              fontsize=9, fontweight="bold")
         axes[-1, col].set_xlabel("time t (s)", fontsize=9)
     axes[0, 0].legend(loc="lower right", fontsize=8, framealpha=0.9)
     fig.supylabel("jerk (m/s³), one panel per follower", fontsize=9)

@@ -139,6 +139,11 @@ def _num(x: float, name: str, at_bound: Sequence[str], unit: str = "") -> str:
     return text + (" (at its bound)" if name in at_bound else "")
 
 
+def _small(x: float, unit: str) -> str:
+    """An error as a title shows it: two digits, and "< 0.01" below the resolution of a log."""
+    return f"< 0.01 {unit}" if x < 0.01 else f"{x:.2g} {unit}"
+
+
 def _fig_fit(v: VehicleResult) -> Any:
     fig = _figure(9, 5.5)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
@@ -163,7 +168,8 @@ def _fig_fit(v: VehicleResult) -> Any:
                   f"k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, τ = {_num(p['tau'], 'tau', b, 's')}, "
                   f"T* = {_num(p['headway'], 'headway', b, 's')}, "
                   f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}\n"
-                  f"fit error (RMSE): speed {v.fit.rmse_speed:.2g} m/s, gap {v.fit.rmse_gap:.2g} m",
+                  f"fit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
+                  f"{_small(v.fit.rmse_gap, 'm')}",
                   fontsize=9)
     return fig
 

@@ -187,6 +187,9 @@ def plot_damping_ratios(m_p: npt.ArrayLike, *, ax: Any = None, label: str | None
     pos = np.arange(1, mp.size + 1)
     (line,) = ax.plot(pos, mp, marker=marker, ms=3 if mp.size > 30 else 5, label=label)
     ref = ax.axhline(1.0, color="k", ls="--", lw=0.8)
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # positions are whole numbers
     ax.set_xlabel("follower position i")
     ax.set_ylabel("damping ratio m_p (follower / predecessor)")
     ax.grid(alpha=0.3)

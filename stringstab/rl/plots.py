@@ -146,13 +146,12 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
         lo, hi = 0.0, 2.0
     if x.size:
         lo, hi = min(lo, float(x.min())), max(hi, float(x.max()))
-    _, _, patches = ax.hist(x, bins=bins, range=(lo, hi), color="tab:orange", alpha=0.85,
-                            label="episodes per bin")
+    _, _, patches = ax.hist(x, bins=bins, range=(lo, hi), color="tab:orange", alpha=0.85)
     ax.set_xlim(lo, hi)
     ax2 = ax.twinx()
     xs = np.sort(x)
     (cdf,) = ax2.step(np.r_[lo, xs, hi], np.r_[0.0, np.arange(1, xs.size + 1), xs.size]
-                      / max(xs.size, 1), where="post", color="tab:blue", lw=1.5, label="CDF")
+                      / max(xs.size, 1), where="post", color="tab:blue", lw=1.5)
     ax2.set_ylim(0, 1.02)
     ax2.set_ylabel("CDF (share of episodes ≤ m_p)")
     ax.axvline(1.0, color="k", ls="--", lw=1)
