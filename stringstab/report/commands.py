@@ -294,8 +294,9 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     rows = []
     for v in res.vehicles:
         r = v.row()
-        rows.append({"pos": r["position"], "name": r["name"], "k_x": r["k_x"], "k_v": r["k_v"],
-                     "k_a": r["k_a"], "τ": r["tau"], "T*": r["headway"], "l0": r["standstill"],
+        rows.append({"pos": r["position"], "name": r["name"], "k_x": _denoise(r["k_x"]),
+                     "k_v": _denoise(r["k_v"]), "k_a": _denoise(r["k_a"]), "τ": _denoise(r["tau"]),
+                     "T*": _denoise(r["headway"]), "l0": _denoise(r["standstill"]),
                      "RMSE v": r["rmse_speed"], "RMSE gap": r["rmse_gap"], "sup|Γ|": r["sup_gain"],
                      "sup|Γ| 5 %": r["sup_gain_lo"], "sup|Γ| 95 %": r["sup_gain_hi"],
                      "verdict": r["verdict"], "certified share (%)": 100 * r["certified_share"],
@@ -317,14 +318,22 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
         units={"at ω": "rad/s"})
     notes = [f"{v.position} {v.name}: {n}" for v in res.vehicles for n in v.fit.notes + v.notes]
     notes += [f"skipped: {s}" for s in res.skipped]
-    if notes:
-        rep.section("Notes").text("\n".join(f"- {n}" for n in notes))
+    if notes:  # plain text: T* is a name, not emphasis
+        rep.section("Notes").text("\n".join(f"- {n}".replace("*", "\\*") for n in notes))
     figs = _pngs(Path(str(f)).name for f in files)
     if figs:
         sec = rep.section("Figures")
         for f in figs:
             sec.figure(f, _identify_caption(res, f))
     return rep
+
+
+def _denoise(x: Any) -> Any:
+    """Show a fitted value as a table should: within 1e-6 of 0, it is 0.
+
+    A fit run onto the bound T* ≥ 0 returns 8.9e-08, which is solver noise, not a headway.
+    """
+    return 0.0 if isinstance(x, float) and abs(x) < 1e-6 else x
 
 
 def _identify_caption(res: Any, name: str) -> str:

@@ -45,7 +45,8 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans",
        max-width: 64rem; margin: 2rem auto; padding: 0 1.2rem; line-height: 1.5; color: #1b1b1b; }
 h1 { border-bottom: 2px solid #3f51b5; padding-bottom: .3rem; }
 h2 { border-bottom: 1px solid #ccc; padding-bottom: .2rem; margin-top: 2.4rem; }
-table { border-collapse: collapse; margin: .6rem 0 1.2rem; font-size: .92rem; }
+table { border-collapse: collapse; margin: .6rem 0 1.2rem; font-size: .92rem; display: block;
+        max-width: 100%; overflow-x: auto; }
 th, td { border: 1px solid #c8c8c8; padding: .25rem .55rem; text-align: left; vertical-align: top; }
 th { background: #eef0f8; }
 tr:nth-child(even) td { background: #fafafa; }
