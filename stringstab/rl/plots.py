@@ -100,7 +100,7 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
     ax.set_xlabel("training episode")
     ax.set_ylabel("episode return")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="best")
     return out
 
 
