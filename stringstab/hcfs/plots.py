@@ -135,7 +135,8 @@ def _jerk_note(ax: Any, run: HCFSRun, i: int, jerk: Any, *, short: bool = False,
     J = run.configs[i].jerk_limit
     above = int(np.count_nonzero(np.abs(jerk) > J * (1 + 1e-9)))
     peak = float(np.abs(jerk).max())
-    text = (f"max {peak:.3g} m/s³; {above:,} frames > J" if short
+    frames = "frame" if above == 1 else "frames"
+    text = (f"max {peak:.3g} m/s³; {above:,} {frames} > J" if short
             else f"max |jerk| {peak:.3g} m/s³; {above:,} of {jerk.size:,} frames above J")
     if head:
         ax.set_title(f"{head}\n{text}", fontsize=8, loc="left")

@@ -143,7 +143,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     hdw = result.params.get("headway")
     if hdw is not None:
         axes[3].axhline(hdw, color="k", ls="--", lw=0.8, label=f"T* = {hdw:g} s")
-        axes[3].legend(loc="upper right")
+        axes[3].legend(loc="lower right")  # the clipping note takes the top
     finite = hw[np.isfinite(hw)]
     if finite.size:
         top = min(float(np.percentile(finite, 99.5)) * 1.1, 10.0)
