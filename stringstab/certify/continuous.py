@@ -53,6 +53,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..derive import generated as _gen
+from ..errors import StringStabError
 from ..io import TableColumn, columns_from_records
 from ..params import Params
 from . import margin as _margin
@@ -424,12 +425,41 @@ def check_kernel(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64
     Check
         Verdicts, internal stability, min g found and where.
     """
+    _theta_zero(p)
     hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
     ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
                       max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
     v = ex.verdict.copy()
-    v[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
+    v[~hz_sure] = _unsure_verdict(v[~hz_sure], hz_fail[~hz_sure])
     return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
+
+
+def _theta_zero(p: Params) -> None:
+    """Refuse θ_r > 0: this is the θ_r = 0 kernel (the way in sends θ_r > 0 to ``reaction``)."""
+    if p.reaction_delay:
+        raise StringStabError(
+            "stringstab.certify.continuous certifies reaction_delay = 0 only; expected "
+            f"stringstab.certify.reaction (chosen by stringstab.certify.api) for {p!r}")
+
+
+def _unsure_verdict(v: npt.NDArray[np.int8], fail: npt.NDArray[np.bool_]) -> npt.NDArray[np.int8]:
+    """The verdict of rows not surely Hurwitz.
+
+    Not certified when surely not Hurwitz, and also within the Hurwitz band when the branch
+    and bound proved g(ω) < 0 somewhere (issue 29 item 7: ‖Γ‖∞ ≥ |Γ(jω)| > 1, or ∞, so not
+    string stable either way); else inconclusive.
+    """
+    return np.where(fail | (v == NOT_CERTIFIED), NOT_CERTIFIED, INCONCLUSIVE).astype(np.int8)
+
+
+def _agreeing_margin(hm: Array, sure: npt.NDArray[np.bool_]) -> Array:
+    """``hurwitz_margin`` in sign agreement with ``hurwitz`` (issue 29 item 7).
+
+    > 0 only where surely Hurwitz (NaN there if the eigenvalues say otherwise), else ≤ 0 (a
+    root on the axis within round-off, 2e-16 from the eigenvalues, is reported as 0).
+    """
+    with np.errstate(invalid="ignore"):
+        return np.where(sure, np.where(hm > 0, hm, np.nan), np.where(hm > 0, 0.0, hm))
 
 
 def certify_kernel(
@@ -470,9 +500,11 @@ def certify_kernel(
     peak_w = np.empty(n)
     worst_w = np.empty(n)
 
+    _theta_zero(p)
     # internal stability, with an inconclusive band around the boundary
     hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
-    hz_margin = hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway)
+    hz_margin = _agreeing_margin(hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway),
+                                 hz_sure)
 
     for sl in chunks(n, chunk, progress=progress):
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
@@ -490,7 +522,9 @@ def certify_kernel(
                 ex.grid_omega[need], ex.grid_g[need], ex.worst_omega[need],
             )
 
-    verdict[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
+    verdict[~hz_sure] = _unsure_verdict(verdict[~hz_sure], hz_fail[~hz_sure])
+    # rows in the Hurwitz band proven not string stable by g < 0 (their excess is reported)
+    band_viol = ~hz_sure & ~hz_fail & (verdict == NOT_CERTIFIED)
     # certified ⇒ sup |Γ| = 1 exactly, at ω = 0 (Γ(0) = 1 for k_x ≠ 0)
     cert = verdict == CERTIFIED
     sup[cert] = np.maximum(sup[cert], 1.0)
@@ -498,7 +532,8 @@ def certify_kernel(
     # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0;
     # searched only where the direct excess is below EXCESS_SEARCH (above it, it is exact enough)
     excess = np.where(cert, 0.0, sup - 1.0)
-    viol = np.flatnonzero((verdict == NOT_CERTIFIED) & hz_sure & (excess < EXCESS_SEARCH))
+    viol = np.flatnonzero((verdict == NOT_CERTIFIED) & (hz_sure | band_viol)
+                          & (excess < EXCESS_SEARCH))
     if viol.size:
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
@@ -509,7 +544,7 @@ def certify_kernel(
         excess[viol] = np.where(take, e1, excess[viol])
         peak_w[viol] = np.where(take, w_e, peak_w[viol])
         sup[viol] = np.where(take, 1.0 + e1, sup[viol])
-    excess = np.where(hz_sure, excess, np.inf)
+    excess = np.where(hz_sure | band_viol, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
                                 source="derived")
