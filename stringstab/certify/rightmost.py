@@ -55,12 +55,15 @@ def _newton(s: CArray, tau: Array, c: Array, kx: Array, theta: Array,
     """Newton on the exact D from the starts ``s`` (columns); (roots, converged)."""
     tau, c, kx, theta = (v[:, None] for v in (tau, c, kx, theta))
     with np.errstate(all="ignore"):
-        for _ in range(steps):
+        for i in range(steps):
             e = np.exp(-theta * s)
             q = c * s + kx
             d = (tau * s + 1.0) * s * s + e * q
             dd = (3.0 * tau * s + 2.0) * s + e * (c - theta * q)
-            s = s - d / dd
+            step = d / dd
+            s = s - step
+            if i % 4 == 3 and not np.any(np.abs(step) > 1e-13 * np.abs(s)):
+                break
         e = np.exp(-theta * s)
         d = (tau * s + 1.0) * s * s + e * (c * s + kx)
         size = np.abs(tau * s**3) + np.abs(s * s) + np.abs(e) * (np.abs(c * s) + np.abs(kx))
@@ -70,7 +73,7 @@ def _newton(s: CArray, tau: Array, c: Array, kx: Array, theta: Array,
 
 def rightmost_root(kx: Array, kv: Array, tau: Array | float, headway: Array | float,
                    theta: Array | float, *,
-                   order: int = 6, starts: int = 4, steps: int = 30,
+                   order: int = 4, starts: int = 3, steps: int = 24,
                    extra: Array | None = None) -> CArray:
     """Estimate the rightmost root of D(s) = τs³ + s² + e^{−θ_r s}((k_v + T*k_x)s + k_x).
 
