@@ -65,7 +65,7 @@ from .criteria import (
     hurwitz_margin_kernel,
     taylor_criteria_kernel,
 )
-from .excess import EXCESS_SEARCH, col
+from .excess import EXCESS_SEARCH, col, excess_squared
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
 from .verdicts import (
@@ -452,6 +452,25 @@ def _unsure_verdict(v: npt.NDArray[np.int8], fail: npt.NDArray[np.bool_]) -> npt
     return np.where(fail | (v == NOT_CERTIFIED), NOT_CERTIFIED, INCONCLUSIVE).astype(np.int8)
 
 
+def _band_excess(kx: Array, kv: Array, ka: Array, p: Params, witness: Array,
+                 Om: Array) -> tuple[Array, Array]:
+    """|Γ(jω)| − 1 > 0 where g(ω) < 0 was proven, for rows in the Hurwitz band (issue 29 item 7).
+
+    The largest finite excess (cancellation-free, :func:`stringstab.certify.excess.excess_squared`)
+    at the branch and bound's witness and on a short logarithmic grid near ω = 0 (a witness at
+    ω = 0 is Ψ3 < 0: the excess lives at small ω); the L∞ peak itself may be a pole on the axis.
+    """
+    W = np.concatenate([witness[:, None], Om[:, None] * np.logspace(-8.0, -1.0, 57)[None, :]],
+                       axis=1)
+    e2 = excess_squared(W, col(kx), col(kv), col(ka), p.tau, p.delta, p.headway)
+    e2 = np.where(np.isfinite(e2), e2, -np.inf)
+    j = np.argmax(e2, axis=1)
+    rows = np.arange(kx.size)
+    best = e2[rows, j]
+    e1 = best / (1.0 + np.sqrt(1.0 + np.maximum(best, 0.0)))
+    return np.where(np.isfinite(e1), e1, np.inf), W[rows, j]
+
+
 def _agreeing_margin(hm: Array, sure: npt.NDArray[np.bool_]) -> Array:
     """``hurwitz_margin`` in sign agreement with ``hurwitz`` (issue 29 item 7).
 
@@ -532,8 +551,7 @@ def certify_kernel(
     # violation of 1e-20 (Ψ3 just below 0) is reported as such, at its frequency, not as 1 at 0;
     # searched only where the direct excess is below EXCESS_SEARCH (above it, it is exact enough)
     excess = np.where(cert, 0.0, sup - 1.0)
-    viol = np.flatnonzero((verdict == NOT_CERTIFIED) & (hz_sure | band_viol)
-                          & (excess < EXCESS_SEARCH))
+    viol = np.flatnonzero((verdict == NOT_CERTIFIED) & hz_sure & (excess < EXCESS_SEARCH))
     if viol.size:
         e2, w_e = _violation_peak(kx[viol], kv[viol], ka[viol], p.tau, p.delta, p.headway,
                                   omega_max[viol], np.stack([peak_w[viol], worst_w[viol]], axis=1))
@@ -544,6 +562,10 @@ def certify_kernel(
         excess[viol] = np.where(take, e1, excess[viol])
         peak_w[viol] = np.where(take, w_e, peak_w[viol])
         sup[viol] = np.where(take, 1.0 + e1, sup[viol])
+    bv = np.flatnonzero(band_viol)
+    if bv.size:  # a pole may sit on the axis: the excess at the proven witness of g < 0
+        excess[bv], peak_w[bv] = _band_excess(kx[bv], kv[bv], ka[bv], p, worst_w[bv],
+                                              omega_max[bv])
     excess = np.where(hz_sure | band_viol, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,

@@ -176,16 +176,19 @@ def approximation_verdicts(kx: Array, kv: Array, p: Params) -> dict[str, npt.NDA
 
     Examples
     --------
-    >>> v = approximation_verdicts(np.array([1.0]), np.array([0.5]),
-    ...                            Params(0.1, 0.2, 1.1, reaction_delay=1.5))
+    >>> v = approximation_verdicts(np.array([1.56]), np.array([-1.03]),
+    ...                            Params(0.1, 0.2, 1.1, reaction_delay=0.3))
     >>> bool(v["taylor1"][0]), bool(v["pade11"][0])  # both wrong: 2 roots in Re s > 0
-    (False, True)
+    (True, True)
     """
     out = {}
     args = (kx, kv, 0.0, p.tau, p.delta, p.headway, p.reaction_delay)
     for kind, fn in (("taylor1", _gen.reaction_taylor1_hurwitz),
                      ("pade11", _gen.reaction_pade11_hurwitz)):
-        out[kind] = np.logical_and.reduce([np.asarray(c) > 0 for c in fn(*args)]) & np.ones(kx.shape, bool)
+        ok = np.ones(kx.shape, dtype=bool)
+        for cond in fn(*args):
+            ok &= np.asarray(cond) > 0
+        out[kind] = ok
     return out
 
 
