@@ -63,9 +63,9 @@ from typing import Any
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-import stringstab as ss  # noqa: E402
+import stringstab as ss
 
 #: Cases whose two spectral resolutions differ by more than this are left out (unresolved).
 RESOLVED = 1e-6
@@ -309,7 +309,7 @@ def run(n: int, seed: int = 0, progress: bool = False) -> dict[str, Any]:
     args = (c["k_x"], c["k_v"], c["tau"], c["headway"], c["theta"])
     re, diff, cnt_spec, near_spec = spectral_rightmost(*args)
     cnt_pade, near_pade = pade_count(*args)
-    sup, w_sup, marg = sweep(c["k_x"], c["k_v"], c["k_a"], c["tau"], c["delta"], c["headway"],
+    sup, _w_sup, marg = sweep(c["k_x"], c["k_v"], c["k_a"], c["tau"], c["delta"], c["headway"],
                              c["theta"])
     resolved = diff <= RESOLVED
     stable = resolved & (re < -STAB_TOL)

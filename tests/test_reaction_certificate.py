@@ -83,7 +83,7 @@ def test_the_sampled_and_robust_certificates_refuse_theta_so_far(kw, found):
 
 
 def test_the_pade_cross_check_refuses_theta():
-    with pytest.raises(StringStabError, match="method='pade'.*reaction_delay=0.2"):
+    with pytest.raises(StringStabError, match=r"method='pade'.*reaction_delay=0\.2"):
         ss.certify(1.0, 0.5, 0.2, **P, reaction_delay=0.2, method="pade")
 
 
