@@ -21,8 +21,15 @@
    at θ_r = 0 and at each θ_r: the share of the θ_r = 0 certified set no longer certified, and
    what is certified that was not.
 
-    python analysis/reaction_findings.py                       # both, ~10 min on 2 busy cores
+3. **What the Taylor route gets wrong** (internal stability only): e^{−θ_r s} ≈ 1 − θ_r s or
+   Padé(1,1) in the denominator turns it into a cubic or quartic Hurwitz test
+   (:func:`stringstab.certify.reaction.approximation_verdicts`); on a 0.01 grid of
+   (k_x, k_v) ∈ [−2, 2]² at τ = 0.1 s, T* = 1.1 s, the share where it says stable and the exact
+   root count finds roots in Re s > 0, and the reverse.
+
+    python analysis/reaction_findings.py                       # all three, ~15 min on 2 busy cores
     python analysis/reaction_findings.py --only region --n 41  # the region part on 41³
+    python analysis/reaction_findings.py --only taylor
 
 Prints markdown tables and the machine load; ``--out`` writes the figures as JSON.
 """
@@ -147,9 +154,39 @@ def region_part(n: int, thetas) -> dict:
     return out
 
 
+def taylor_part(thetas) -> list[dict]:
+    from stringstab.certify.quasipolynomial import count_unstable_roots
+    from stringstab.certify.reaction import approximation_verdicts
+
+    g = np.round(np.arange(-2.0, 2.0 + 1e-9, 0.01), 2)
+    kx, kv = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    rows = []
+    print(f"\n## The Taylor route against the exact root count ({kx.size} (k_x, k_v) on a 0.01 "
+          "grid of [−2, 2]², τ = 0.1 s, T* = 1.1 s)")
+    print("| θ_r (s) | exact: stable | taylor1 says stable, exact unstable | taylor1 says unstable, "
+          "exact stable | pade11 says stable, exact unstable | pade11 says unstable, exact stable |")
+    print("|---|---|---|---|---|---|")
+    for th in thetas:
+        p = ss.Params(0.1, 0.2, 1.1, reaction_delay=th)
+        rc = count_unstable_roots(kx, kv, 0.1, 1.1, th)
+        av = approximation_verdicts(kx, kv, p)
+        row = {"theta": th, "stable": float(rc.stable.mean()),
+               "undecided": int((~rc.stable & ~rc.unstable).sum())}
+        cells = []
+        for k in ("taylor1", "pade11"):
+            for name, m in (("false_stable", av[k] & rc.unstable), ("false_unstable", ~av[k] & rc.stable)):
+                row[f"{k}_{name}"] = float(m.mean())
+                i = np.flatnonzero(m)
+                ex = f" e.g. ({kx[i[len(i) // 2]]:g}, {kv[i[len(i) // 2]]:g})" if i.size else ""
+                cells.append(f"{100 * m.mean():.2f} %{ex}")
+        rows.append(row)
+        print(f"| {th:g} | {100 * row['stable']:.2f} % | " + " | ".join(cells) + " |", flush=True)
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--only", choices=("headway", "region"), help="one part only")
+    ap.add_argument("--only", choices=("headway", "region", "taylor"), help="one part only")
     ap.add_argument("--n", type=int, default=81, help="region grid per axis (default 81)")
     ap.add_argument("--step", type=float, default=0.1, help="T* scan step, s (default 0.1)")
     ap.add_argument("--out", help="write the figures as JSON here")
@@ -160,6 +197,8 @@ def main(argv: list[str] | None = None) -> int:
         res["headway"] = headway_part((0.1, 0.5), THETAS, args.step)
     if args.only in (None, "region"):
         res["region"] = region_part(args.n, (0.1, 0.2, 0.3))
+    if args.only in (None, "taylor"):
+        res["taylor"] = taylor_part((0.1, 0.2, 0.3, 0.5))
     print(f"\n# load after {os.getloadavg()}")
     if args.out:
         with open(args.out, "w", encoding="utf-8") as f:
