@@ -158,8 +158,10 @@ def reasons(verdict: npt.NDArray[np.int8], unstable: npt.NDArray[np.bool_],
                 parts.append(f"unstable: a real root at s = {_g(real_root[i])} (k_x < 0)")
             else:
                 parts.append("unstable: a root at s = 0 (k_x = 0)")
-        if violated[i]:
+        if violated[i] and witness[i] > 0:
             parts.append(f"|Γ(jω)| > 1 at ω = {_g(witness[i])} rad/s (g_θ = {_g(margin[i])})")
+        elif violated[i]:  # g_θ(0) = Ψ3 < 0: |Γ(jω)|² ≈ 1 − Ψ3ω²/k_x² > 1 for small ω
+            parts.append(f"|Γ(jω)| > 1 near ω = 0 (Ψ3 = g_θ(0) = {_g(margin[i])})")
         if verdict[i] != NOT_CERTIFIED:
             if not np.isfinite(roots[i]):
                 parts.append(f"undecided: stability, |D(jω)| down to {_g(min_abs[i])} at "

@@ -3,7 +3,8 @@ r"""The rightmost root of D(s) = τs³ + s² + e^{−θ_r s}(cs + k_x), estimate
 ``hurwitz_margin`` of a loop with a reaction delay θ_r > 0 is −Re s* for the rightmost root s*
 of the quasi-polynomial (the slowest decay rate, 1/s).  It is *estimated*, never proven: the
 roots of a Padé(m, m) approximant of e^{−θ_r s} (a polynomial of degree 3 + m, all roots from
-one companion matrix per item) start Newton's method on the exact D, and the converged root
+one companion matrix per item) and of the cubic at θ_r = 0 start Newton's method on the exact
+D, and the converged root
 with the largest real part is reported (plus the real root of :func:`stringstab.certify.
 quasipolynomial.real_root` where k_x < 0).  The proven statement is the root count of
 :mod:`stringstab.certify.quasipolynomial`; :mod:`stringstab.certify.reaction` reports this
@@ -123,7 +124,8 @@ def rightmost_root(kx: Array, kv: Array, tau: Array | float, headway: Array | fl
     poly[:, 1:order + 2] += c[:, None] * num  # c s num
     lead = poly[:, -1]
     C = np.zeros((n, deg, deg))
-    C[:, 0, :] = -poly[:, -2::-1] / lead[:, None]
+    with np.errstate(all="ignore"):  # θ_r → 0 makes the leading coefficient vanish: no start
+        C[:, 0, :] = -poly[:, -2::-1] / lead[:, None]
     C[:, np.arange(1, deg), np.arange(deg - 1)] = 1.0
     with np.errstate(all="ignore"):
         ok_rows = np.all(np.isfinite(C), axis=(1, 2))
@@ -132,6 +134,11 @@ def rightmost_root(kx: Array, kv: Array, tau: Array | float, headway: Array | fl
             ev[ok_rows] = np.linalg.eigvals(C[ok_rows])
     order_re = np.argsort(-np.nan_to_num(ev.real, nan=-np.inf), axis=1)[:, :starts]
     s0 = np.take_along_axis(ev, order_re, axis=1)
+    # and the roots of the cubic at θ_r = 0 (the starts that matter as θ_r → 0)
+    C3 = np.zeros((n, 3, 3))
+    C3[:, 0, :] = -np.stack([np.ones(n), c, kx], axis=1) / tau[:, None]
+    C3[:, 1, 0] = C3[:, 2, 1] = 1.0
+    s0 = np.concatenate([s0, np.linalg.eigvals(C3) if n else np.zeros((0, 3), complex)], axis=1)
     if extra is not None:
         s0 = np.concatenate([s0, np.asarray(extra, dtype=complex)[:, None]], axis=1)
     s, ok = _newton(s0, tau, c, kx, theta, steps)
