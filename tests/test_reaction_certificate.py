@@ -205,7 +205,7 @@ def test_derive_shows_the_theta_forms():
 def test_the_tuning_refuses_theta_instead_of_dropping_it():
     from stringstab.tuning.constraints import LoopConstraints
 
-    with pytest.raises(StringStabError, match="tuning certifies reaction_delay = 0 only so far; "
-                                              "got reaction_delay=0.2"):
+    with pytest.raises(StringStabError, match=r"tuning certifies reaction_delay = 0 only so far; "
+                                              r"got reaction_delay=0\.2"):
         LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), None)
     assert LoopConstraints(ss.Params(0.1, 0.2, 1.1), None).box.reaction_delay == (0.0, 0.0)
