@@ -209,3 +209,27 @@ def test_the_tuning_refuses_theta_instead_of_dropping_it():
                                               r"got reaction_delay=0\.2"):
         LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), None)
     assert LoopConstraints(ss.Params(0.1, 0.2, 1.1), None).box.reaction_delay == (0.0, 0.0)
+
+
+def test_theta_is_checked_once_on_the_way_in():
+    import sys
+
+    from stringstab import params
+
+    seen: list[str] = []
+
+    def prof(frame, event, arg):
+        if (event == "call" and frame.f_code.co_filename == params.__file__
+                and frame.f_code.co_name in ("check_reaction_delay", "check_params")):
+            seen.append(frame.f_code.co_name)
+
+    ss.certify_batch([1.0], [0.5], [0.2], **P, reaction_delay=0.2)  # import everything first
+    for fn in (lambda: ss.certify_batch([1.0, 0.9], [0.5, -0.5], [0.2, 1.1], **P, reaction_delay=0.2),
+               lambda: ss.check([1.0, 0.9], [0.5, -0.5], [0.2, 1.1], **P, reaction_delay=0.2)):
+        seen.clear()
+        sys.setprofile(prof)
+        try:
+            fn()
+        finally:
+            sys.setprofile(None)
+        assert sorted(seen) == ["check_params", "check_reaction_delay"]
