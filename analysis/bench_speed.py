@@ -9,15 +9,22 @@ load (``os.getloadavg()``), and the table keeps, per side, the round whose figur
 1. robust sampled ``certify_batch`` per triple over continuous ``certify_batch`` per triple,
    on the same random triples K ~ U[−2, 2]³ (box τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25],
    T* ∈ [1.0, 1.2], H = 0.1 s, heterogeneous; τ = 0.1, δ = 0.2, T* = 1.1 for the continuous
-   baseline: ``--n-time`` triples, the robust sampled one on the first ``--n-rs``), both timed
+   baseline: ``--n-time`` triples, the robust sampled one on the first ``--n-rs``, default
+   all; and both on the first 500 triples, a smaller call, the docs' figure of the base), timed
    in the same process, best of ``--repeat``, in CPU time of the process (``time.process_time``:
    on a shared machine the wall time of a single-threaded computation also counts the other
    jobs' time slices);
 2. robust continuous ``certify_batch`` over continuous ``certify_batch`` (same triples, box);
-3. ``check`` over ``certify_batch`` (continuous, the same triples);
+3. ``check`` over ``certify_batch`` (continuous, the same triples), and the same with one
+   triple per call (the first ``n_single`` = 300 triples: an inner loop's use);
 4. the repair's share of IDL training time (``config_for("idl")``, defaults, both checks,
-   ``--train-steps`` steps, seed 0; the certified lattice built before the run, as in
-   ``analysis/bench_train.py``), and training env steps/s;
+   seed 0; the certified lattice built before the run, as in ``analysis/bench_train.py``):
+   part ``train`` runs ``--train-steps`` steps without the episodes rule (mostly the early,
+   exploring phase of training), part ``trainfull`` the default training to its end (its
+   700-clean-episodes rule; about 211,000 steps).  The share is the repair's CPU time (this
+   process; ``GainRepair.__call__`` wrapped in the worker, the same wrapper before and after)
+   over the run's, and train's own wall-clock ``repair_share`` next to it; the training env
+   steps/s (wall);
 5. IDL environment steps/s with one environment: ``make_env(config_for("idl", num_envs=1))``
    (the car-following env in the repair wrapper) stepped with the last ``--env-steps``
    proposals recorded from a training run of this checkout (past its random first 2,000
@@ -34,7 +41,8 @@ Prints the table (before, after, ratio after/before, target) and the loads; asse
 about time.  ``--write-fixture PATH`` writes a sample of the inputs with the base verdicts
 (the fixture of ``tests/test_speed_verdicts.py``).  Examples::
 
-    python analysis/bench_speed.py                                  # everything, ~30-60 min
+    python analysis/bench_speed.py                                  # everything, ~1.5-2 h
+    python analysis/bench_speed.py --parts certify,env,train,verdicts   # without trainfull
     python analysis/bench_speed.py --parts certify --n-verdicts 2000 --n-time 2000
     python analysis/bench_speed.py --parts verdicts --write-fixture tests/data/speed_verdicts.csv
 """
@@ -200,11 +208,28 @@ def work_certify(inp: dict, out: dict) -> None:
     t_rs = _best(lambda: certify_batch(kx[:n_rs], kv[:n_rs], ka[:n_rs], **BOX, sample_time=H),
                  max(1, r - 1),
                  warm=lambda: certify_batch(kx[:20], kv[:20], ka[:20], **BOX, sample_time=H))
+    # a smaller batch (the first 500 triples, as the docs' figure of the base): the search's
+    # rounds cost about the same for few triples as for many, so the cost per triple grows
+    n5 = min(500, len(K))
+    t_rs5 = _best(lambda: certify_batch(kx[:n5], kv[:n5], ka[:n5], **BOX, sample_time=H),
+                  max(1, r - 1), warm=lambda: None)
+    t_c5 = _best(lambda: certify_batch(kx[:n5], kv[:n5], ka[:n5], **POINT), r)
     t_c4 = _best(lambda: certify_batch(kx, kv, ka, **POINT), r)
     base = min(t_c, t_c2, t_c3, t_c4)
+    # one triple per call (an inner loop's use): the first n_single triples
+    ns = min(inp.get("n_single", 300), len(K))
+    rows = [([a], [b], [c]) for a, b, c in zip(kx[:ns], kv[:ns], ka[:ns])]
+
+    def each(f):
+        return lambda: [f(*row, **POINT) for row in rows]
+
+    t1_chk = _best(each(check), r)
+    t1_c = _best(each(certify_batch), r)
     # per triple: robust sampled on the first n_rs triples, scaled to the n of the others
     out.update(n=len(K), n_rs=n_rs, continuous=base, check=t_chk, robust_continuous=t_rc,
-               robust_sampled=t_rs * len(K) / n_rs, load=[load0, os.getloadavg()])
+               single_check=t1_chk, single_continuous=t1_c, n_single=ns,
+               robust_sampled=t_rs * len(K) / n_rs, robust_sampled_500=t_rs5,
+               continuous_500=t_c5, load=[load0, os.getloadavg()])
 
 
 def work_verdicts(inp: dict, out: dict) -> None:
@@ -233,24 +258,39 @@ def work_verdicts(inp: dict, out: dict) -> None:
 
 def work_train(inp: dict, out: dict) -> None:
     from stringstab.rl import config_for, train
-    from stringstab.rl.repair import GainRepair
+    from stringstab.rl import repair as rp
 
-    GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
-    cfg = config_for("idl", total_steps=inp["train_steps"], seed=0, stop_episodes=0)
+    rp.GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
+    steps = inp["train_steps"]
+    if steps:  # a short run without the episodes rule
+        cfg = config_for("idl", total_steps=steps, seed=0, stop_episodes=0)
+    else:  # the default training: config_for("idl") as it is (its episodes rule included)
+        cfg = config_for("idl", seed=0)
+    # the repair's CPU time (this process), next to train's own wall-clock share: on a
+    # shared machine the wall time of each part also counts the other jobs' time slices
+    cpu = [0.0]
+    orig = rp.GainRepair.__call__
+
+    def call(self, K):
+        c = time.process_time()
+        try:
+            return orig(self, K)
+        finally:
+            cpu[0] += time.process_time() - c
+
+    rp.GainRepair.__call__ = call  # type: ignore[method-assign]
     load0 = os.getloadavg()
     c0 = time.process_time()
     res = train(cfg, progress=False)
+    c_total = time.process_time() - c0
     t = res.timing
     cells = 0.0
-    try:  # the proofs of the repair's cells (after only), paid once per process and region
-        from stringstab.rl.repair import certified_cells
-
-        cells = certified_cells(0.1, 0.2, 1.1, -2.0, 2.0, 0.05, 0.1).seconds
-    except ImportError:
-        pass
+    if hasattr(rp, "certified_cells"):  # the proofs of the repair's cells (after only)
+        cells = rp.certified_cells(0.1, 0.2, 1.1, -2.0, 2.0, 0.05, 0.1).seconds
     out.update(repair_share=t["repair_share"], steps_per_second=t["steps_per_second"],
                total_seconds=t["total_seconds"], repair_seconds=t["repair_seconds"],
-               cells_seconds=cells, cpu_seconds=time.process_time() - c0,
+               cells_seconds=cells, cpu_seconds=c_total, repair_cpu_seconds=cpu[0],
+               repair_cpu_share=cpu[0] / c_total, steps=res.steps,
                load=[load0, os.getloadavg()])
 
 
@@ -346,10 +386,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--base", default="f6db69e", help="the base commit (default f6db69e)")
-    ap.add_argument("--parts", default="certify,train,env,verdicts")
+    ap.add_argument("--parts", default="certify,env,train,trainfull,verdicts",
+                    help="certify, env, train (--train-steps), trainfull (the default "
+                         "training, about 211,000 steps each side), verdicts")
     ap.add_argument("--n-time", type=int, default=5000, help="triples timed (default 5000)")
-    ap.add_argument("--n-rs", type=int, default=2000,
-                    help="of them, timed by the robust sampled certificate (default 2000)")
+    ap.add_argument("--n-rs", type=int, default=None,
+                    help="of them, timed by the robust sampled certificate (default all)")
     ap.add_argument("--n-verdicts", type=int, default=20000,
                     help="random triples compared before/after (default 20000)")
     ap.add_argument("--n-adversarial", type=int, default=300,
@@ -388,14 +430,18 @@ def main(argv=None):
     path = os.path.join(tmp, "inputs.npz")
     np.savez(path, **inputs)
     spec0 = {"inputs": path, "repeat": args.repeat, "train_steps": args.train_steps,
-             "env_steps": args.env_steps, "n_rs": args.n_rs}
+             "env_steps": args.env_steps,
+             "n_rs": args.n_time if args.n_rs is None else args.n_rs}
     res: dict[str, dict[str, list[dict]]] = {"before": {}, "after": {}}
-    for part in ("certify", "env", "train"):
+    for part in ("certify", "env", "train", "trainfull"):
         if part not in parts:
             continue
-        for _ in range(args.rounds if part != "train" else 1):
+        spec = {**spec0, "part": part}
+        if part == "trainfull":  # the default training, its own length
+            spec.update(part="train", train_steps=0)
+        for _ in range(args.rounds if not part.startswith("train") else 1):
             for side in ("before", "after"):
-                r = run_worker(side, base_dir, {**spec0, "part": part})
+                r = run_worker(side, base_dir, spec)
                 res[side].setdefault(part, []).append(r)
                 print(f"# {part} {side}: {json.dumps(r)}", flush=True)
     rows = []
@@ -406,26 +452,49 @@ def main(argv=None):
         for key, name, target in (
                 ("robust_sampled", "robust sampled certify_batch / continuous certify_batch, per triple", "≤ 10×"),
                 ("robust_continuous", "robust continuous / continuous certify_batch", "≤ 2×"),
-                ("check", "check / certify_batch (continuous)", "≤ 0.7×")):
+                ("check", "check / certify_batch (continuous), per triple", "≤ 0.7×")):
             b, a = best("before", key), best("after", key)
             rb, ra = b[key] / b["continuous"], a[key] / a["continuous"]
             rows.append(f"| {name} | {rb:.2f}× (load {b['load'][0][0]:.1f}) | {ra:.2f}× "
                         f"(load {a['load'][0][0]:.1f}) | {ra / rb:.3f} | {target} |")
+        b = min(res["before"]["certify"], key=lambda r: r["robust_sampled_500"] / r["continuous_500"])
+        a = min(res["after"]["certify"], key=lambda r: r["robust_sampled_500"] / r["continuous_500"])
+        rb, ra = (x["robust_sampled_500"] / x["continuous_500"] for x in (b, a))
+        rows.insert(1, f"| the same on the first 500 triples (one call of 500) | {rb:.2f}× (load "
+                    f"{b['load'][0][0]:.1f}) | {ra:.2f}× (load {a['load'][0][0]:.1f}) | "
+                    f"{ra / rb:.3f} | ≤ 10× |")
+        b = min(res["before"]["certify"], key=lambda r: r["single_check"] / r["single_continuous"])
+        a = min(res["after"]["certify"], key=lambda r: r["single_check"] / r["single_continuous"])
+        rb, ra = (x["single_check"] / x["single_continuous"] for x in (b, a))
+        rows.append(f"| check / certify_batch, one triple per call ({a['n_single']} calls) | "
+                    f"{rb:.2f}× (load {b['load'][0][0]:.1f}) | {ra:.2f}× "
+                    f"(load {a['load'][0][0]:.1f}) | {ra / rb:.3f} | ≤ 0.7× |")
         for side in ("before", "after"):
             r = res[side]["certify"][0]
+            print(f"# {side}: check one triple per call {1e3 * r['single_check'] / r['n_single']:.3f} "
+                  f"ms, certify_batch one triple per call "
+                  f"{1e3 * r['single_continuous'] / r['n_single']:.3f} ms")
             print(f"# {side}: continuous certify_batch {1e6 * r['continuous'] / r['n']:.1f} "
                   f"µs/triple, robust sampled {1e3 * r['robust_sampled'] / r['n']:.3f} ms/triple")
-    if "train" in parts:
-        b, a = res["before"]["train"][0], res["after"]["train"][0]
-        rows.append(f"| repair share of IDL training time ({args.train_steps} steps) | "
-                    f"{100 * b['repair_share']:.1f} % (load {b['load'][0][0]:.1f}) | "
-                    f"{100 * a['repair_share']:.1f} % (load {a['load'][0][0]:.1f}) | "
+    for part in ("train", "trainfull"):
+        if part not in parts:
+            continue
+        b, a = res["before"][part][0], res["after"][part][0]
+        what = (f"{args.train_steps} steps" if part == "train" else
+                f"the default training: {b['steps']} / {a['steps']} steps")
+        rows.append(f"| repair share of IDL training time, CPU ({what}) | "
+                    f"{100 * b['repair_cpu_share']:.1f} % (load {b['load'][0][0]:.1f}) | "
+                    f"{100 * a['repair_cpu_share']:.1f} % (load {a['load'][0][0]:.1f}) | "
+                    f"{a['repair_cpu_share'] / b['repair_cpu_share']:.2f} | < 15 % |")
+        rows.append(f"| the same, wall clock (train's own timing) | "
+                    f"{100 * b['repair_share']:.1f} % | {100 * a['repair_share']:.1f} % | "
                     f"{a['repair_share'] / b['repair_share']:.2f} | < 15 % |")
         c = a.get("cells_seconds", 0.0)
-        rows.append(f"| of which the proofs of the repair's cells (once per process) | – | "
+        rows.append(f"| of which the proofs of the repair's cells (wall) | – | "
                     f"{100 * c / a['total_seconds']:.1f} % of the time | | |")
-        rows.append(f"| IDL training env steps/s | {b['steps_per_second']:.0f} | "
-                    f"{a['steps_per_second']:.0f} | "
+        rows.append(f"| IDL training env steps/s (wall; CPU s of the run) | "
+                    f"{b['steps_per_second']:.0f} ({b['cpu_seconds']:.0f} s) | "
+                    f"{a['steps_per_second']:.0f} ({a['cpu_seconds']:.0f} s) | "
                     f"{a['steps_per_second'] / b['steps_per_second']:.2f} | (reported) |")
     if "env" in parts:
         b = max(res["before"]["env"], key=lambda r: r["steps_per_second"])
@@ -455,21 +524,47 @@ def main(argv=None):
     print("\n# load at the end {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
 
 
+def _g_exact(w: float, K, tau=POINT["tau"], delta=POINT["delta"],
+             headway=POINT["headway"]) -> float:
+    """(|D(jω)|² − |N(jω)|²)/ω² of Γ (IDL eq 11) in extended precision, no toolkit code."""
+    kx, kv, ka = (np.longdouble(k) for k in K)
+    w = np.longdouble(w)
+    c = kv + np.longdouble(headway) * kx
+    dr, di = kx - w * w, w * (c - np.longdouble(tau) * w * w)
+    dw = np.longdouble(delta) * w
+    nr = kx - ka * w * w * np.cos(dw)
+    ni = kv * w + ka * w * w * np.sin(dw)
+    return float((dr * dr + di * di - nr * nr - ni * ni) / (w * w))
+
+
 def verify_new_decisions(inputs: dict, before: dict, after: dict) -> str:
     """Check every verdict that was inconclusive before and is decided now (this checkout).
 
     A certified box: the point certificate certifies every member of a grid over it
     (τ, τ_p, T* at their ends, δ at 5 points); a not-certified box: its witness member's own
-    point certificate says not certified.
+    point certificate says not certified.  ``check`` (a point): only main's issue 29 item 7
+    decides rows the base left inconclusive (on the Hurwitz boundary k_v + (T* − τ)k_x = 0,
+    a proven g(ω) < 0): such a row must be on that boundary with g < 0 at its witness
+    frequency, g recomputed from Γ here (:func:`_g_exact`).
     """
-    from stringstab.certify.api import certify, certify_batch
+    from stringstab.certify.api import certify, certify_batch, check
     from stringstab.certify.sampled import check_members
 
     ok = bad = 0
     for name, b in sorted(before.items()):
         kind = name.split("_")[1]
         idx = np.flatnonzero((b == "inconclusive") & (after[name] != "inconclusive"))
-        if not idx.size or kind == "check":
+        if not idx.size:
+            continue
+        if kind == "check":
+            K = inputs[name][idx]
+            c = check(*K.T, **POINT)
+            for i, k in enumerate(K):
+                on = abs(k[1] + (POINT["headway"] - POINT["tau"]) * k[0]) <= 1e-12 * (1 + abs(k[1]))
+                g = _g_exact(max(float(c.witness_omega[i]), 1e-5), k)
+                good = bool(c.verdict[i] == "not_certified" and on and g < 0)
+                ok += good
+                bad += not good
             continue
         K = inputs[name][idx]
         sk = {} if kind == "robust" else {"sample_time": H,

@@ -101,12 +101,16 @@ def phi(x: npt.ArrayLike) -> tuple[Array, Array, Array]:
     """
     x = np.asarray(x, dtype=float)
     xs = np.minimum(x, 1.0)
+    neg = -xs
     acc = np.zeros_like(xs)
-    for k in range(26, 2, -1):  # Horner on x³ Σ (−x)^{k−3}/k!
-        acc = acc * (-xs) + _INV_FACT[k]
+    for k in range(26, 2, -1):  # Horner on x³ Σ (−x)^{k−3}/k! (in place: the same numbers)
+        acc *= neg
+        acc += _INV_FACT[k]
     p3s = acc * xs * xs * xs
     p2s = 0.5 * xs * xs - p3s
     p1s = xs - p2s
+    if acc.ndim and bool(np.all(x <= 1.0)):  # every x on the series (H ≤ τ): no direct forms
+        return p1s, p2s, p3s
     p1l = -np.expm1(-x)
     p2l = x - p1l
     p3l = 0.5 * x * x - p2l
