@@ -68,6 +68,7 @@ def simulate(
     progress: bool | None = None,
     fractional_delay: FractionalDelay = "linear",
     position_update: PositionUpdate = "exact",
+    reaction_delay: npt.ArrayLike = 0.0,
 ) -> PlatoonResult:
     """Simulate platoons of ``n_followers`` behind prescribed leaders.
 
@@ -106,6 +107,12 @@ def simulate(
     position_update : {"exact", "trapezoid"}
         Positions by the exact integral of the lag model (default) or by the trapezoid rule,
         Eclipse SUMO's ballistic update (module docstring; recorded in ``params`` then).
+    reaction_delay : float or array
+        Reaction delay θ_r, s (≥ 0, issue 25): every follower applies its command θ_r late,
+        τ ȧ = u(t − θ_r) − a, integrated exactly for any θ_r (:mod:`stringstab.traffic.dynamics`);
+        an array of shape (N,) or (P, N) gives each vehicle its own.  The commands before
+        t = 0 are the equilibrium command.  ``command`` records u as computed (applied θ_r
+        later).  Recorded in ``params`` when > 0; 0 (default) changes nothing, bit for bit.
 
     Returns
     -------
@@ -132,7 +139,8 @@ def simulate(
     N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length,
-                   fractional_delay=fractional_delay, position_update=position_update)
+                   fractional_delay=fractional_delay, position_update=position_update,
+                   reaction_delay=reaction_delay)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
     LV = np.ascontiguousarray(np.stack([tr.speed for tr in leaders], axis=1))
     LA = np.ascontiguousarray(np.stack([tr.accel for tr in leaders], axis=1))
@@ -208,6 +216,8 @@ def simulate(
         params["fractional_delay"] = fractional_delay
     if position_update != "exact":
         params["position_update"] = position_update
+    if plat.reaction_delay.any():
+        params["reaction_delay"] = plat.reaction_delay.tolist()
     sq = (lambda a: a) if batched else (lambda a: a[0])
     return PlatoonResult(
         dt=dt,
