@@ -40,11 +40,12 @@ TAU, DELTA, HEADWAY, L0, LENGTH = 0.1, 0.2, 1.1, 2.0, 5.0
 K = (1.2, 0.5, 0.6)
 
 
-def dde_reference(leader, gains, n, *, tau, theta, sub):
+def dde_reference(leader, gains, n, *, tau, theta, sub, delta=DELTA):
     """RK4 at step Δt/sub of x' = v, v' = a, τa' = u(t − θ_r) − a, u computed every Δt and held.
 
     Independent of the simulator: the controller (IDL eq 4 with eq 3) and the delayed link
-    (δ = 2Δt, whole steps) are written out here, and the applied command at any time t is the
+    (the predecessor's acceleration at t − δ read off this integration's own fine grid, which
+    must contain t − δ; the leader's interpolated between its samples) are written out here, and the applied command at any time t is the
     command of step ⌊(t − θ_r)/Δt⌋ (0 before t = 0, the equilibrium command), taken constant
     over each Runge-Kutta step at its value in the step's middle.
     """
@@ -52,11 +53,13 @@ def dde_reference(leader, gains, n, *, tau, theta, sub):
     tau = np.broadcast_to(np.asarray(tau, float), (n,))
     theta = np.broadcast_to(np.asarray(theta, float), (n,))
     kx, kv, ka = gains
-    nd = round(DELTA / dt)
+    nd = round(delta / (dt / sub))  # δ in fine steps
+    assert abs(nd * dt / sub - delta) < 1e-12
     v0 = leader.speed[0]
     x = leader.position[0] - np.cumsum(np.full(n, L0 + HEADWAY * v0 + LENGTH))
     v, a = np.full(n, v0), np.zeros(n)
     X, V, A, U = (np.zeros((T, n)) for _ in range(4))
+    fine_a = np.zeros((T * sub + 1, n))  # a on the fine grid, 0 before t = 0
     h = dt / sub
     cols = np.arange(n)
 
@@ -71,7 +74,11 @@ def dde_reference(leader, gains, n, *, tau, theta, sub):
         X[k], V[k], A[k] = x, v, a
         xp = np.concatenate([[leader.position[k]], x[:-1]])
         vp = np.concatenate([[leader.speed[k]], v[:-1]])
-        ad = np.concatenate([[leader.accel[k - nd]], A[k - nd, :-1]]) if k >= nd else np.zeros(n)
+        m0 = k * sub - nd  # t_k − δ on the fine grid
+        ad = np.zeros(n)
+        if m0 >= 0:
+            ad[1:] = fine_a[m0, :-1]
+            ad[0] = np.interp(m0 * h, leader.t, leader.accel)
         U[k] = np.clip(kx * (xp - x - LENGTH - HEADWAY * v - L0) + kv * (vp - v) + ka * ad, -7.6, 3.0)
         y = np.array([x, v, a])
         for m in range(sub):
@@ -81,6 +88,7 @@ def dde_reference(leader, gains, n, *, tau, theta, sub):
             k3 = rhs(u, y + h / 2 * k2)
             k4 = rhs(u, y + h * k3)
             y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            fine_a[k * sub + m + 1] = y[2]
         x, v, a = y
     return X.T, V.T, A.T
 
@@ -95,12 +103,17 @@ TAUS = [0.1, 0.3, 0.5]
 
 
 @pytest.mark.parametrize("theta", [0.2375, [0.05, 0.2375, 0.3125]], ids=["uniform", "per-vehicle"])
-def test_dde_reference_on_a_grid_through_the_switches_agrees(theta):
-    # Δt/40 = 2.5 ms: every switching instant kΔt + θ_r lies on the reference's grid, so RK4
-    # integrates smooth pieces and agrees to its own O(h⁴) error
+@pytest.mark.parametrize("delta", [0.2, 0.25], ids=["delta=2dt", "delta=2.5dt-exact"])
+def test_dde_reference_on_a_grid_through_the_switches_agrees(theta, delta):
+    # Δt/40 = 2.5 ms: every switching instant kΔt + θ_r and every t_k − δ lies on the
+    # reference's grid, so RK4 integrates smooth pieces and agrees to its own O(h⁴) error
     lead = sinusoid(omega=2.0, amplitude=0.5, speed=20.0, duration=6.0, dt=0.1)
-    res = simulate(lead, LinearController(*K), 3, tau=TAUS, delta=DELTA, reaction_delay=theta)
-    ref = dde_reference(lead, K, 3, tau=TAUS, theta=theta, sub=40)
+    res = simulate(lead, LinearController(*K), 3, tau=TAUS, delta=delta, reaction_delay=theta,
+                   fractional_delay="exact")
+    if delta == 0.25:  # the received value inside the step, not the interpolation: check it
+        lin = simulate(lead, LinearController(*K), 3, tau=TAUS, delta=delta, reaction_delay=theta)
+        assert np.abs(lin.accel - res.accel).max() > 1e-4
+    ref = dde_reference(lead, K, 3, tau=TAUS, theta=theta, sub=40, delta=delta)
     assert _errors(res, ref) < 1e-8
 
 
