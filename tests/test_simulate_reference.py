@@ -14,7 +14,11 @@ import importlib.util
 import json
 from pathlib import Path
 
+import numpy as np
+
 import pytest
+
+from stringstab.traffic import Radio, SensorNoise
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "analysis" / "simulate_reference.py"
@@ -29,6 +33,9 @@ CASES = ref.cases()
 NEUTRAL = {
     "none": {},
     "reaction_delay=0": {"reaction_delay": 0.0},
+    # a message every step, no loss, no staleness; sensors with σ = 0 and no filter
+    "radio": {"radio": Radio()},
+    "radio+sensors": {"radio": Radio(message_phase=0, loss=0.0, seed=7), "sensors": SensorNoise(seed=3)},
 }
 
 
@@ -39,7 +46,18 @@ def test_the_reference_covers_every_case():
 @pytest.mark.parametrize("extra", list(NEUTRAL), ids=list(NEUTRAL))
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_outputs_are_unchanged_bit_for_bit(name, extra):
-    got = ref.fingerprint(CASES[name](**NEUTRAL[extra]))
+    res = CASES[name](**NEUTRAL[extra])
+    given = [k for k in ("radio", "sensors") if k in NEUTRAL[extra]]
+    for k in given:  # recorded in params; the rest of params is what it was
+        assert res.params.pop(k) == NEUTRAL[extra][k].describe()
+    got = ref.fingerprint(res)
     want = RECORDED[name]
     diff = [k for k in want if got[k] != want[k]]
     assert diff == [], {k: (got[k], want[k]) for k in diff}
+    if "radio" in given:  # every message received, none lost, no fallback
+        steps = res.t.size
+        np.testing.assert_array_equal(res.radio["messages_received"], steps)
+        np.testing.assert_array_equal(res.radio["messages_lost"], 0)
+        np.testing.assert_array_equal(res.radio["fallback_time"], 0.0)
+    else:
+        assert res.radio is None
