@@ -367,7 +367,7 @@ def test_bad_schedule_against_the_step():
     lead = sinusoid(omega=1.0, amplitude=1.0, speed=20.0, duration=2.0, dt=0.01)
     with pytest.raises(StringStabError, match=r"whole multiple \(>= 1\) of the step dt = 0.01 s; got 0.015 s"):
         simulate(lead, LinearController(*K), 2, radio=Radio(message_period=0.015))
-    with pytest.raises(StringStabError, match="message phase must be a step in 0..9"):
+    with pytest.raises(StringStabError, match=r"message phase must be a step in 0\.\.9"):
         simulate(lead, LinearController(*K), 2, radio=Radio(message_period=0.1, message_phase=10))
     with pytest.raises(StringStabError, match="fallback gains need a controller of the eq-4 form"):
         from stringstab.traffic import IDMController
