@@ -84,8 +84,9 @@ def check_loss(loss: Any, burst: Any = None) -> tuple[float, float | None]:
                               f"got {show(burst)}")
     if p < 1.0 and p > b / (b + 1.0) * (1 + 1e-12):
         raise StringStabError(f"loss {p:g} with bursts of {b:g} messages on average is impossible: a "
-                              f"loss rate needs bursts of at least p/(1 − p) = {p / (1 - p):.4g} "
-                              f"messages; expected loss <= burst/(burst + 1) = {b / (b + 1):.4g}")
+                              f"loss rate of {p:g} needs bursts of at least p/(1 − p) = "
+                              f"{p / (1 - p):.4g} messages; expected loss <= burst/(burst + 1) = "
+                              f"{b / (b + 1):.4g}")
     return p, b
 
 
