@@ -197,11 +197,11 @@ def radio_from_args(args: Any, dt: float) -> tuple[Any, Any]:
         for name in ("loss", "burst", "stale_after"):
             if _given(args, name):
                 kw[name] = _float(name, getattr(args, name))
-        P = kw.get("message_period")
-        if "stale_after" in kw and P is not None and kw["stale_after"] < P * (1 - 1e-12):
+        period = kw.get("message_period")
+        if "stale_after" in kw and period is not None and kw["stale_after"] < period * (1 - 1e-12):
             raise StringStabError(f"--stale-after {kw['stale_after']:g} s is shorter than the message period "
-                                  f"{P:g} s: every follower would fall back between two messages; "
-                                  f"expected --stale-after >= {P:g}")
+                                  f"{period:g} s: every follower would fall back between two messages; "
+                                  f"expected --stale-after >= {period:g}")
         if _given(args, "fallback_gains"):
             kw["fallback_gains"] = _fallback_gains(args.fallback_gains)
         try:
