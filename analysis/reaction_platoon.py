@@ -92,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
         c.update({"max_m_p": dict(zip(LEADERS, w.round(4).tolist())), "max_m_p_at_peak": round(float(pk), 4),
                   "holds": holds})
         sup = "inf" if c["sup_gain"] is None else f"{c['sup_gain']:.3f}"
-        print(f"{str(c['K']):>16} {c['theta_r']:5.2f} {c['verdict']:>14} {sup:>7} "
+        print(f"{c['K']!s:>16} {c['theta_r']:5.2f} {c['verdict']:>14} {sup:>7} "
               f"{(c['peak_omega'] or 0):7.3f} " + " ".join(f"{v:8.4f}" for v in w) + f" {pk:8.4f}  {holds}")
     elapsed = time.perf_counter() - t0
     print(f"{'every verdict held' if ok else 'SOME VERDICT DID NOT HOLD'}; {elapsed:.1f} s, "
