@@ -129,7 +129,7 @@ class MessageLoss:
         bool array of ``shape``
             True where a due message is lost.
         """
-        if self.p == 0.0:
+        if self.p == 0.0 or not due.any():
             return np.zeros(self.shape, dtype=bool)
         if self.p == 1.0:
             return np.array(due, dtype=bool, copy=True)

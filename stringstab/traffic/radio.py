@@ -270,6 +270,10 @@ class RadioLink:
         self.stale = np.zeros(shape, dtype=bool)
         self.held: Array | None = None
         self.last = np.zeros(shape, dtype=np.int64)
+        self._all = np.ones(shape, dtype=bool)
+        # stale once (k − k_last)Δt > T_s, i.e. k − k_last > T_s/Δt (10⁻⁹ relative slack)
+        self._stale_steps = (None if radio.stale_after is None
+                             else radio.stale_after / self.dt * (1 + 1e-9))
         self._fresh: npt.NDArray[np.bool_] | None = None  # rows to start afresh at the next step
 
     @property
@@ -300,15 +304,25 @@ class RadioLink:
             self.held[self._fresh] = value[self._fresh]
             self.last[self._fresh] = k
             self._fresh = None
-        due = np.broadcast_to((k - self.phase) % self.n == 0, self.shape)
-        got = due if self.loss is None else due & ~self.loss.lost(due)
-        self.held = np.where(got, value, self.held)
-        self.last[got] = k
-        self.received += got
-        self.lost += due & ~got
+        if isinstance(self.phase, int):  # one schedule for every link: all due or none
+            due: Any = self._all if (k - self.phase) % self.n == 0 else None
+        else:
+            due = (k - self.phase) % self.n == 0
+        if due is not None:
+            if self.loss is None:
+                np.copyto(self.held, value, where=due)
+                np.copyto(self.last, k, where=due)
+                self.received += due
+            else:
+                lost = self.loss.lost(due)
+                got = due & ~lost
+                np.copyto(self.held, value, where=got)
+                np.copyto(self.last, k, where=got)
+                self.received += got
+                self.lost += lost
         ad = self.held
-        if self.radio.stale_after is not None:
-            self.stale = (k - self.last) * self.dt > self.radio.stale_after * (1 + 1e-9)
+        if self._stale_steps is not None:
+            self.stale = (k - self.last) > self._stale_steps
             self.fallback_steps += self.stale
             ad = np.where(self.stale, 0.0, self.held)
         return dataclasses.replace(obs, pred_accel_delayed=ad)

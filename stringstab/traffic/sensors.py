@@ -156,23 +156,26 @@ class Sensors:
     """
 
     def __init__(self, noise: SensorNoise, shape: tuple[int, ...], dt: float) -> None:
-        self.noise, self.shape = noise, shape
+        self.noise, self.shape = noise, tuple(shape)
         self.rng = np.random.default_rng([int(noise.seed), SENSOR_STREAM])
         tc, tf = noise.correlation_time, noise.filter_time
         self.rho = None if tc is None else math.exp(-dt / tc)
         self.alpha = None if tf is None else -math.expm1(-dt / tf)
-        self.state: list[Array | None] = [None, None, None]  # the Gauss–Markov n per quantity
+        self.noisy = [i for i, sg in enumerate(noise.sigmas) if sg > 0]  # quantities with noise
+        self.sigma = np.array([noise.sigmas[i] for i in self.noisy]).reshape(-1, *([1] * len(shape)))
+        self.state: Array | None = None  # the Gauss–Markov n of the noisy quantities
         self.filtered: Array | None = None  # y per quantity, (3, P, N)
         self._restart = False  # some rows of the filter start afresh (NaN) at the next step
 
-    def _noise(self, i: int, sigma: float) -> Array:
-        w = self.rng.standard_normal(self.shape)
+    def _noise(self) -> Array:
+        w = self.rng.standard_normal((len(self.noisy), *self.shape))
         if self.rho is None:
-            return sigma * w
-        n = self.state[i]
-        n = sigma * w if n is None else self.rho * n + sigma * math.sqrt(1.0 - self.rho**2) * w
-        self.state[i] = n
-        return n
+            return self.sigma * w
+        if self.state is None:
+            self.state = self.sigma * w
+        else:
+            self.state = self.rho * self.state + (self.sigma * math.sqrt(1.0 - self.rho**2)) * w
+        return self.state
 
     def measure(self, obs: Observation) -> Observation:
         """The observation as the follower's sensors report it (this step's noise drawn).
@@ -188,20 +191,20 @@ class Sensors:
             Gap, gap rate and speed measured (noisy, filtered); the predecessor's speed is
             measured speed + measured gap rate; every other field as in ``obs``.
         """
-        z = [np.asarray(getattr(obs, f), dtype=np.float64) for f in MEASURED]
-        for i, sigma in enumerate(self.noise.sigmas):
-            if sigma > 0:
-                z[i] = z[i] + self._noise(i, sigma)
+        z = np.empty((3, *self.shape))
+        for i, f in enumerate(MEASURED):
+            z[i] = getattr(obs, f)
+        if self.noisy:
+            z[self.noisy] += self._noise()
         if self.alpha is not None:
-            zs = np.stack(np.broadcast_arrays(*z))
             if self.filtered is None:
-                self.filtered = zs
+                self.filtered = z
             else:
-                y = self.filtered + self.alpha * (zs - self.filtered)
-                self.filtered = np.where(np.isnan(y), zs, y) if self._restart else y
+                y = self.filtered + self.alpha * (z - self.filtered)
+                self.filtered = np.where(np.isnan(y), z, y) if self._restart else y
                 self._restart = False
-            z = list(self.filtered)
-        gap, rel, spd = z
+            z = self.filtered
+        gap, rel, spd = z[0], z[1], z[2]
         return dataclasses.replace(obs, gap=gap, rel_speed=rel, speed=spd, pred_speed=spd + rel)
 
     def reset(self, rows: Any = None) -> None:
@@ -213,13 +216,12 @@ class Sensors:
             Platoons (first axis) whose sensors start afresh at the next measurement.
         """
         if rows is None:
-            self.state = [None, None, None]
+            self.state = None
             self.filtered = None
             return
         r = np.asarray(rows)
-        for i, n in enumerate(self.state):
-            if n is not None:
-                n[r] = self.noise.sigmas[i] * self.rng.standard_normal(n[r].shape)
+        if self.state is not None:  # restarted in the stationary law
+            self.state[:, r] = self.sigma * self.rng.standard_normal(self.state[:, r].shape)
         if self.filtered is not None:
             self.filtered[:, r] = np.nan  # y_0 = z̃_0 again at the next measurement
             self._restart = True
