@@ -275,3 +275,29 @@ def test_state_round_trip_with_reaction_delay_continues_bit_for_bit():
     steps(c, range(25, 60))
     np.testing.assert_array_equal(a.position, c.position)
     np.testing.assert_array_equal(a.accel, c.accel)
+
+
+def test_kinematic_exact_fractional_delay_receives_the_applied_command():
+    # with model="kinematic" the acceleration is the applied command itself, so the exact
+    # received value a_{i−1}(t_k − δ) is the command of step ⌊(t_k − δ − θ_r)/Δt⌋ of the predecessor
+    lead = sinusoid(omega=1.0, amplitude=1.0, speed=20.0, duration=6.0, dt=0.1)
+    seen = []
+    inner = LinearController(*K)
+
+    class Rec(Controller):
+        def command(self, obs):
+            seen.append(np.array(obs.pred_accel_delayed[0], copy=True))
+            return inner.command(obs)
+
+        def equilibrium_gap(self, speed):
+            return inner.equilibrium_gap(speed)
+
+    theta, delta = [0.13, 0.07, 0.31], 0.25
+    res = simulate(lead, Rec(), 3, model="kinematic", delta=delta, fractional_delay="exact",
+                   reaction_delay=theta)
+    seen = np.array(seen)
+    for k in range(res.t.size):
+        for i in (1, 2):  # followers 2 and 3, whose predecessors are followers
+            j = math.floor((k * 0.1 - delta - theta[i - 1]) / 0.1 + 1e-9)
+            want = res.command[i - 1, j] if j >= 0 else 0.0
+            assert seen[k, i] == pytest.approx(want, abs=1e-12)
