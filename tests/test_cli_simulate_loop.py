@@ -140,3 +140,32 @@ def test_from_identify_carries_the_fitted_reaction_delay(tmp_path, capsys):
     rc = main(["simulate", "--from", str(fitted), "--reaction-delay", "0.1", *BASE, "--out", str(tmp_path / "c")])
     err = capsys.readouterr().err
     assert rc == 2 and "takes the reaction delay of the fit (0.3 s); expected no --reaction-delay" in err
+
+
+def test_report_shows_the_reaction_delay_the_radio_and_the_sensors(tmp_path, capsys):
+    rc, out = _run(tmp_path, "o", "--reaction-delay", "0.1", "--message-period", "0.2", "--loss", "0.1",
+                   "--stale-after", "0.4", "--noise-gap", "0.05", "--radio-seed", "3")
+    capsys.readouterr()
+    assert rc == 0
+    doc = json.loads((out / "metrics.json").read_text(encoding="utf-8"))
+    rows = {line.split(" | ")[0].lstrip("| "): line for line in
+            (out / "report.md").read_text(encoding="utf-8").splitlines() if line.startswith("| ")}
+    assert rows["reaction_delay"] == "| reaction_delay | 0.1 |"
+    assert rows["radio"] == ("| radio | message_period = 0.2, message_phase = 0, loss = 0.1, "
+                             "stale_after = 0.4, seed = 3 |")
+    assert rows["sensors"].startswith("| sensors | noise_gap = 0.05, ")
+    cert = next(v for k, v in rows.items() if k.startswith("K = (1.2, 0.5, 0.6) certified"))
+    assert "reaction delay θ_r = 0.1 s" in cert and doc["certificate"]["verdict"] == "certified"
+    assert "scope: the continuous-time loop" in cert and "covered by no certificate" in cert
+    rad = doc["radio"]
+    received = sum(rad["messages_received"])
+    assert rows["the radio"] == (f"| the radio | **finding** | {received} messages received, "
+                                 f"{100 * rad['loss_share']:.2f} % lost; time in fallback "
+                                 f"{100 * rad['fallback_share']:.2f} % of follower time |")
+    assert 0 < rad["loss_share"] < 0.3 and received > 200  # 3 followers × 100 messages due
+    plain = tmp_path / "p"
+    assert main(["simulate", *BASE, "--out", str(plain)]) == 0
+    capsys.readouterr()
+    rows = {line.split(" | ")[0].lstrip("| ") for line in
+            (plain / "report.md").read_text(encoding="utf-8").splitlines() if line.startswith("| ")}
+    assert {"tau", "delta", "model"} <= rows and not rows & {"reaction_delay", "radio", "sensors", "the radio"}

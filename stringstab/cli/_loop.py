@@ -1,6 +1,7 @@
 """The loop as it runs, on the command line: ``--reaction-delay`` and the radio and sensor flags.
 
-One definition for ``simulate``, ``evaluate``, ``compare`` and ``sumo run`` (issues 25 and 26):
+One definition for the commands that run the platoon (issues 25 and 26; ``simulate`` and
+``sumo run``):
 the reaction delay θ_r of every follower, its V2V radio (:class:`stringstab.traffic.Radio`) and
 its sensors (:class:`stringstab.traffic.SensorNoise`).  Without any of them a command runs what
 it always ran, bit for bit.
