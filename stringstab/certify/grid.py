@@ -130,7 +130,9 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
                             heterogeneous=heterogeneous)
         return ok
     point = params if isinstance(params, Params) else params.centre()
-    cand = ~surely_uncertifiable(K, point) if sample_time is None else np.ones(len(K), bool)
+    # the screen is of the loop without reaction delay: with θ_r > 0 (issue 25) every row goes on
+    screened = sample_time is None and not point.reaction_delay
+    cand = ~surely_uncertifiable(K, point) if screened else np.ones(len(K), bool)
     idx = np.flatnonzero(cand)
     if not isinstance(params, Params) and idx.size:
         idx = idx[_check_certified(K[idx], point, sample_time, heterogeneous)]
