@@ -79,7 +79,8 @@ def test_one_reaction_delay_maps_the_certificate_with_it(tmp_path, capsys):
 
 def test_parse_reaction_delays():
     np.testing.assert_allclose(parse_reaction_delays("0:0.3:7"), np.linspace(0, 0.3, 7),
-                               rtol=0, atol=0)
+                               rtol=0, atol=1e-12)
+    assert parse_reaction_delays("0:0.3:4").tolist() == parse_reaction_delays("0,0.1,0.2,0.3").tolist()
     assert parse_reaction_delays("0.1,0.2").tolist() == [0.1, 0.2]
     assert parse_reaction_delays("0.2") is None and parse_reaction_delays("0.1:0.3") is None
 

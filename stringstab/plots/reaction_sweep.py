@@ -88,7 +88,7 @@ def _table(sweep: ReactionSweep) -> str:
     rows = sweep.rows()
     head = ["# " + json.dumps(sweep.summary()["params"], ensure_ascii=False),
             ",".join(rows[0])]
-    body = [",".join(f"{v:.17g}" if isinstance(v, float) else str(v) for v in r.values())
+    body = [",".join(repr(v) for v in r.values())
             for r in rows]
     return "\n".join(head + body) + "\n"
 

