@@ -36,6 +36,7 @@ def _files(out):
     return {p.name: p for p in out.iterdir()}
 
 
+@pytest.mark.slow  # 20.3 s alone at load ≈ 24 on 2 shared cores (two CLI runs with figures)
 def test_reaction_delay_zero_writes_what_the_command_without_it_writes(tmp_path, capsys):
     a, b = tmp_path / "a", tmp_path / "b"
     assert main([*BASE, "--out", str(a)]) == 0
@@ -106,6 +107,7 @@ def test_sweep_shares_equal_single_maps_and_do_not_increase_on_the_idl_grid():
         assert not np.any(b.stable("exact") & ~a.stable("exact"))
 
 
+@pytest.mark.slow  # 17.5 s alone at load ≈ 24 on 2 shared cores (two CLI runs with figures)
 def test_cli_sweep_writes_slices_table_and_figure(tmp_path, capsys):
     out = tmp_path / "sweep"
     assert main([*BASE, "--reaction-delay", "0:0.2:3", "--out", str(out)]) == 0
