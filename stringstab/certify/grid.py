@@ -132,7 +132,10 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
                             heterogeneous=heterogeneous)
         return ok
     point = params if isinstance(params, Params) else params.centre()
-    if sample_time is None:
+    if point.reaction_delay:
+        # the screens are of the loop without reaction delay: with θ_r > 0 (issue 25) every row goes on
+        cand = np.ones(len(K), bool)
+    elif sample_time is None:
         cand = ~surely_uncertifiable(K, point)
     else:  # the sampled loop's own screen (at the centre of a box: a member)
         H = checked_sample_time(sample_time)
