@@ -510,7 +510,8 @@ class StringDecision:
     right : ndarray
         The domain's right end (Ω in rad/s, or π in rad/sample).
     minimum, argmin : ndarray
-        The smallest normalised G found and where (the witness of a violation).
+        The smallest normalised G found, and a witness of a violation (where G < −slack: at
+        ω > 0 whenever one is found, also when the smallest G is at 0).
     sup_gain, peak : ndarray
         sup ∏|Γ_i| found and where (reporting only; ``inf`` when not internally stable).
     n_evals : ndarray of int
@@ -576,14 +577,27 @@ def decide(loop: StringLoop, *, n_grid: int, max_rounds: int = 30,
                                           max_rounds=max_rounds, max_intervals=max_intervals,
                                           refine=~fail)
     v = verdict_codes(bb.status)
+    argmin = bb.argmin.copy()
+    at0 = np.flatnonzero((v == NOT_CERTIFIED) & (argmin == 0))
+    if at0.size:  # G(0) < 0: a positive witness close to 0, where the product itself exceeds 1
+        argmin[at0] = _positive_witness(loop, at0, right[at0] / n_grid)
     v[~sure] = np.where(fail[~sure], NOT_CERTIFIED, INCONCLUSIVE)
     sup = np.where(v == 0, 1.0, np.nan)
     peak = np.zeros(n)
     need = np.flatnonzero(v != 0)
     if peaks and need.size:
-        sup[need], peak[need] = _peak(loop, need, bb.grid_x[need], bb.argmin[need], right[need])
+        sup[need], peak[need] = _peak(loop, need, bb.grid_x[need], argmin[need], right[need])
     sup = np.where(sure, sup, np.inf)
-    return StringDecision(v, sure, fail, right, bb.minimum, bb.argmin, sup, peak, bb.n_evals)
+    return StringDecision(v, sure, fail, right, bb.minimum, argmin, sup, peak, bb.n_evals)
+
+
+def _positive_witness(loop: StringLoop, idx: Index, h: Array) -> Array:
+    """The largest of h·2^−k (k = 0..40) with G < −slack, per item (0 where none is found)."""
+    X = h[:, None] * 2.0 ** -np.arange(41.0)[None, :]
+    val, slack, _ = point_margin(loop.parts(idx, Interval(X)), loop.scale[:, idx][:, :, None])
+    ok = val < -slack
+    first = np.argmax(ok, axis=1)
+    return np.where(ok.any(axis=1), X[np.arange(idx.size), first], 0.0)
 
 
 def _peak(loop: StringLoop, idx: Index, W: Array, worst: Array,
