@@ -414,7 +414,7 @@ def certify_batch(
     >>> b = certify_batch([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1)
     >>> b.verdict.tolist()
     ['certified', 'not_certified']
-    >>> b.summary()["m_fss"]
+    >>> b.summary()["certified_row_share"]
     0.5
     >>> r = certify_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta="0.1:0.3",
     ...                   headway=1.1)

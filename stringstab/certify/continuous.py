@@ -382,10 +382,10 @@ class CertificateBatch(BatchResult):
         return cols
 
     def summary(self) -> dict[str, Any]:
-        """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27).
+        """Counts per verdict and ``certified_row_share``, the share of rows certified (a fraction).
 
-        ``m_fss`` is eq 27's M_fss without its ×100 % (docs/conventions.md): every M_fss of
-        the toolkit is a fraction.
+        Each row counts once; m_fss (IDL eq 27) weighs each gain by the time it is in force and
+        is computed where time is known (``simulate``, ``evaluate``; docs/conventions.md).
         """
         return super().summary()
 

@@ -20,6 +20,7 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import check_params
+from ..ranges import metric_caveat
 from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, limits_from_args
 from ._outcome import collision_status
 
@@ -265,6 +266,9 @@ def run(args: argparse.Namespace) -> int:
           f"M_CI = {_fmt(metrics.get('M_CI'), '.4g', ' m²/s⁶')}, "
           f"M_effi = {_fmt(metrics.get('M_effi'), '.3f', ' s')}, "
           f"m_fss = {_fmt(metrics['m_fss'], '.3f')} (share of vehicle-moments certified)")
+    for k in ("max_m_p", "M_lss", "TIT", "M_CI", "M_effi"):
+        if metric_caveat(k, metrics.get(k)):
+            print(f"note: {k} = {metrics[k]:.3g} {metric_caveat(k, metrics[k])}")
     print(f"wrote {', '.join(files.values())} to {out.root}/")
     return collision_status(args, metrics["collisions"], first_collision(result),
                             metrics["m_fss"])
