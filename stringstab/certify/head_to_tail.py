@@ -355,7 +355,10 @@ def point_margin(parts: Sequence[Parts], scale: Array) -> tuple[Array, Array, Ar
         c = scale[i]
         n, r = _factor(p.re_n, p.im_n, p.pre_n, c)
         d, q = _factor(p.re_d, p.im_d, p.pre_d, c)
-        ns.append(n), nr.append(r), ds.append(d), dr.append(q)
+        ns.append(n)
+        nr.append(r)
+        ds.append(d)
+        dr.append(q)
         gs.append(p.g.lo * c)
         ge.append(ROUNDOFF_SLACK * p.g.mag * c * (1.0 + 4.0 * _U) + _U * np.abs(p.g.lo * c))
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -446,7 +449,8 @@ class ContinuousString:
                                                   par(a.delta), par(a.headway), jet_cos, jet_sin)
             co = [Interval(self.co[i][r, idx][:, None], None, self.sc[i][r, idx][:, None])
                   for r in range(5)]
-            g = _gen.margin_from_coefficients(x, *co, par(a.delta), jet_cos, jet_sin)
+            g = _gen.margin_from_coefficients(x, co[0], co[1], co[2], co[3], co[4], par(a.delta),
+                                              jet_cos, jet_sin)
             out.append(Parts(ren, imn, red, imd, g))
         return out
 
@@ -476,7 +480,8 @@ class ContinuousString:
             co = [Jet(Enclosure.around(self.co[i][r, idx][:, None],
                                        ROUNDOFF_SLACK * self.sc[i][r, idx][:, None]))
                   for r in range(5)]
-            g = _gen.margin_from_coefficients(x, *co, par(a.delta), jet_cos, jet_sin)
+            g = _gen.margin_from_coefficients(x, co[0], co[1], co[2], co[3], co[4], par(a.delta),
+                                              jet_cos, jet_sin)
             c = Jet(Enclosure(self.scale[i, idx][:, None]))
             out.append((c * (ren * ren + imn * imn), c * (red * red + imd * imd), c * g))
         return out

@@ -48,6 +48,8 @@ from .head_to_tail import (
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, VERDICTS, Verdict, num
 
 __all__ = [
+    "OPTIONAL",
+    "REQUIRED",
     "StringCertificate",
     "Substring",
     "certify_string_kernel",
@@ -325,7 +327,7 @@ def _loop(strings: Sequence[Sequence[Vehicle]], sample_time: float | None,
 
 def _vehicle_certificates(vehicles: Sequence[Vehicle], sample_time: float | None,
                           leader_tau: float | None) -> tuple[Any, ...]:
-    out = []
+    out: list[Any] = []
     for i, v in enumerate(vehicles):
         kx, kv, ka = (np.array([x]) for x in (v.k_x, v.k_v, v.k_a))
         p = v.params
