@@ -43,9 +43,10 @@ from typing import Any
 
 import numpy as np
 
-from stringstab.certify.head_to_tail import StringArrays, Vehicle, decide
+from stringstab.certify.head_to_tail import StringArrays, Vehicle
 from stringstab.certify.head_to_tail_sampled import SampledString
 from stringstab.certify.string_certificate import default_grid
+from stringstab.certify.string_decision import decide
 from stringstab.params import Params
 
 #: The sample time of the sampled strings, s.

@@ -21,7 +21,6 @@ from stringstab.certify.head_to_tail import (
     ContinuousString,
     StringArrays,
     Vehicle,
-    decide,
     point_margin,
     square_sum,
     string_margin,
@@ -29,6 +28,7 @@ from stringstab.certify.head_to_tail import (
 from stringstab.certify.head_to_tail_sampled import SampledString
 from stringstab.certify.interval import Interval
 from stringstab.certify.interval_jets import Enclosure, Jet, cos_range, jet_cos, jet_sin, sin_range
+from stringstab.certify.string_decision import decide
 from stringstab.errors import StringStabError
 from stringstab.params import Params
 

@@ -47,7 +47,8 @@ unstable: ``not_certified``; one within the 10⁻¹² boundary band: ``inconclus
 The loop is an object with the parts the decision needs (:class:`ContinuousString` here,
 :class:`stringstab.certify.head_to_tail_sampled.SampledString` for the sampled-data loop):
 its items (strings of one length, as columns), its domain, the factors (n_i, d_i, g_i) at
-points or on jets, and the internal stability of each item.
+points or on jets, and the internal stability of each item.  The branch and bound on them is
+:func:`stringstab.certify.string_decision.decide`.
 
 References
 ----------
@@ -69,20 +70,20 @@ import numpy.typing as npt
 from ..derive import generated as _gen
 from ..params import Params
 from . import margin as _margin
-from .branch_bound import BranchAndBound, branch_and_bound, verdict_codes, zoom_max
 from .criteria import hurwitz_bands_kernel
 from .interval import Interval
 from .interval_jets import Enclosure, Jet, jet_cos, jet_sin
-from .verdicts import INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
+from .verdicts import ROUNDOFF_SLACK
 
 __all__ = [
     "MAX_VEHICLES",
     "ContinuousString",
+    "Factor",
+    "Index",
+    "Parts",
     "StringArrays",
-    "StringDecision",
     "StringLoop",
     "Vehicle",
-    "decide",
     "normalisation",
     "point_margin",
     "square_sum",
@@ -497,123 +498,3 @@ class ContinuousString:
             sure &= s
             fail |= f
         return sure, fail
-
-
-# ---------------------------------------------------------------------------
-# The decision (any loop)
-# ---------------------------------------------------------------------------
-@dataclass
-class StringDecision:
-    """The head-to-tail verdicts of many strings of one length (codes) and what was found.
-
-    Attributes
-    ----------
-    verdict : ndarray of int8
-        Verdict codes (:data:`stringstab.certify.verdicts.VERDICTS`).
-    stable, unstable : ndarray of bool
-        Every vehicle surely internally stable; some vehicle surely not.
-    right : ndarray
-        The domain's right end (Ω in rad/s, or π in rad/sample).
-    minimum, argmin : ndarray
-        The smallest normalised G found, and a witness of a violation (where G < −slack: at
-        ω > 0 whenever one is found, also when the smallest G is at 0).
-    sup_gain, peak : ndarray
-        sup ∏|Γ_i| found and where (reporting only; ``inf`` when not internally stable).
-    n_evals : ndarray of int
-        Points evaluated per string.
-    """
-
-    verdict: npt.NDArray[np.int8]
-    stable: npt.NDArray[np.bool_]
-    unstable: npt.NDArray[np.bool_]
-    right: Array
-    minimum: Array
-    argmin: Array
-    sup_gain: Array
-    peak: Array
-    n_evals: npt.NDArray[np.int64]
-
-
-def _evaluator(loop: StringLoop) -> Callable[[Index, Array], tuple[Array, Array, Array, Array]]:
-    def evaluate(idx: Index, X: Array) -> tuple[Array, Array, Array, Array]:
-        val, slack, _ = point_margin(loop.parts(idx, Interval(X)), loop.scale[:, idx][:, :, None])
-        M = string_margin(loop.factors(idx, Jet.variable(X[:, :-1], X[:, 1:]))).bound2()
-        ok = np.isfinite(val) & np.isfinite(slack)
-        # an overflow or NaN is never a witness and never settles an interval
-        point = np.where(ok, val, np.inf)
-        low = np.where(ok, val, -np.inf)
-        slack = np.where(ok, slack, np.inf)
-        M = np.where(np.isfinite(M), M, np.inf)
-        return point, low, slack, M
-
-    return evaluate
-
-
-def _gain_squared(loop: StringLoop, idx: Index, X: Array) -> Array:
-    """∏ n_i/d_i = ∏ |Γ_i|² at the points X (rows: the items idx); NaN where a d_i = 0."""
-    return point_margin(loop.parts(idx, Interval(X)), loop.scale[:, idx][:, :, None])[2]
-
-
-def decide(loop: StringLoop, *, n_grid: int, max_rounds: int = 30,
-           max_intervals: int = 4096, peaks: bool = True) -> StringDecision:
-    """The head-to-tail verdict of every item of ``loop`` (module docstring).
-
-    Parameters
-    ----------
-    loop : StringLoop
-        The strings and their loop.
-    n_grid : int
-        Initial intervals on each item's domain.
-    max_rounds, max_intervals : int
-        Refinement rounds, and the undecided intervals per string beyond which it is
-        inconclusive.
-    peaks : bool
-        Also search sup ∏|Γ_i| (reporting only); else ``sup_gain`` is 1 for certified strings
-        and NaN for the others.
-
-    Returns
-    -------
-    StringDecision
-    """
-    n = loop.arrays.count
-    sure, fail = loop.stability()
-    right = np.asarray(loop.right(), dtype=float)
-    bb: BranchAndBound = branch_and_bound(n, _evaluator(loop), right=right, n_grid=n_grid,
-                                          max_rounds=max_rounds, max_intervals=max_intervals,
-                                          refine=~fail)
-    v = verdict_codes(bb.status)
-    argmin = bb.argmin.copy()
-    at0 = np.flatnonzero((v == NOT_CERTIFIED) & (argmin == 0))
-    if at0.size:  # G(0) < 0: a positive witness close to 0, where the product itself exceeds 1
-        argmin[at0] = _positive_witness(loop, at0, right[at0] / n_grid)
-    v[~sure] = np.where(fail[~sure], NOT_CERTIFIED, INCONCLUSIVE)
-    sup = np.where(v == 0, 1.0, np.nan)
-    peak = np.zeros(n)
-    need = np.flatnonzero(v != 0)
-    if peaks and need.size:
-        sup[need], peak[need] = _peak(loop, need, bb.grid_x[need], argmin[need], right[need])
-    sup = np.where(sure, sup, np.inf)
-    return StringDecision(v, sure, fail, right, bb.minimum, argmin, sup, peak, bb.n_evals)
-
-
-def _positive_witness(loop: StringLoop, idx: Index, h: Array) -> Array:
-    """The largest of h·2^−k (k = 0..40) with G < −slack, per item (0 where none is found)."""
-    X = h[:, None] * 2.0 ** -np.arange(41.0)[None, :]
-    val, slack, _ = point_margin(loop.parts(idx, Interval(X)), loop.scale[:, idx][:, :, None])
-    ok = val < -slack
-    first = np.argmax(ok, axis=1)
-    return np.where(ok.any(axis=1), X[np.arange(idx.size), first], 0.0)
-
-
-def _peak(loop: StringLoop, idx: Index, W: Array, worst: Array,
-          right: Array) -> tuple[Array, Array]:
-    """sup ∏|Γ_i| on the grid and at the witness, refined locally (reporting only)."""
-    Wall = np.concatenate([W, worst[:, None]], axis=1)
-    G2 = _gain_squared(loop, idx, Wall)
-    G2 = np.where(np.isnan(G2), np.inf, G2)
-    j = np.argmax(G2, axis=1)
-    rows = np.arange(idx.size)
-    best, bw = zoom_max(lambda X: _gain_squared(loop, idx, X), Wall[rows, j], G2[rows, j],
-                        right / max(W.shape[1] - 1, 1), lo=0.0, hi=float(right.max()))
-    at_zero = ~(best > 1.0)  # Γ_i(0) = 1: the product reaches 1 at ω = 0
-    return np.sqrt(np.where(at_zero, 1.0, best)), np.where(at_zero, 0.0, bw)

@@ -36,15 +36,8 @@ from ..errors import StringStabError, show
 from ..params import Params, as_gains, positive
 from ..params import sample_time as checked_sample_time
 from . import continuous
-from .head_to_tail import (
-    MAX_VEHICLES,
-    ContinuousString,
-    StringArrays,
-    StringDecision,
-    StringLoop,
-    Vehicle,
-    decide,
-)
+from .head_to_tail import MAX_VEHICLES, ContinuousString, StringArrays, StringLoop, Vehicle
+from .string_decision import StringDecision, decide
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, VERDICTS, Verdict, num
 
 __all__ = [

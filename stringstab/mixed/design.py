@@ -41,71 +41,21 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .. import constants
-from ..certify.head_to_tail import ContinuousString, StringArrays, Vehicle, point_margin, square_sum
-from ..certify.interval import Interval
-from ..errors import StringStabError, show
-from ..params import Params
+from ..certify.head_to_tail import Vehicle
+from .attenuation import (
+    attenuation_margin,
+    cav_forms,
+    margin_curve,
+    margins,
+    rate,
+    scan_grid,
+    terms,
+)
+from .cav import CavSpec, check_positions, string_with_cavs
 
-__all__ = [
-    "CavSpec",
-    "Design",
-    "attenuation_margin",
-    "design_auto",
-    "design_cavs",
-    "string_with_cavs",
-]
+__all__ = ["Design", "design_auto", "design_cavs"]
 
 Array = npt.NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class CavSpec:
-    """The CAV: its parameters (fixed) and the bounds of its gains (designed).
-
-    Attributes
-    ----------
-    tau : float
-        Actuator lag τ, s (default the toolkit's 0.1 s).
-    delta : float
-        Communication delay δ on the predecessor's acceleration, s (IDL Table 2: 0.2 s).
-    headway : float
-        Desired time headway T*, s (IDL Table 2: 1.1 s).
-    bounds : (float, float)
-        Bounds of each gain (IDL Table 2: [−2, 2]).
-    hurwitz_margin : float
-        Lower bound of the CAV's Hurwitz conditions k_x and k_v + (T* − τ)k_x in the NLP.
-    standstill : float
-        l_0 of the CAV's spacing policy, m (simulation only).
-    name : str
-        The CAV's name in outputs.
-    """
-
-    tau: float = constants.TAU
-    delta: float = constants.DELTA
-    headway: float = constants.HEADWAY
-    bounds: tuple[float, float] = constants.GAIN_BOUNDS
-    hurwitz_margin: float = 1e-3
-    standstill: float = 2.0
-    name: str = "CAV"
-
-    def params(self) -> Params:
-        """τ, δ, T* as checked :class:`~stringstab.params.Params`."""
-        return Params(self.tau, self.delta, self.headway)
-
-    def vehicle(self, K: Sequence[float]) -> Vehicle:
-        """The CAV with gains K = (k_x, k_v, k_a).
-
-        Parameters
-        ----------
-        K : sequence of float
-            The gains.
-
-        Returns
-        -------
-        Vehicle
-        """
-        return Vehicle(float(K[0]), float(K[1]), float(K[2]), self.params(), self.name)
 
 
 @dataclass(frozen=True)
@@ -165,121 +115,6 @@ def _num(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def string_with_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int],
-                     gains: Sequence[Sequence[float]], spec: CavSpec) -> tuple[Vehicle, ...]:
-    """The string with the followers at ``positions`` replaced by CAVs with ``gains``.
-
-    Parameters
-    ----------
-    vehicles : sequence of Vehicle
-        The recorded followers, positions 1..N.
-    positions : sequence of int
-        1-based positions.
-    gains : sequence of (k_x, k_v, k_a)
-        One per position.
-    spec : CavSpec
-        The CAV's parameters.
-
-    Returns
-    -------
-    tuple of Vehicle
-    """
-    out = list(vehicles)
-    for p, K in zip(positions, gains):
-        out[p - 1] = spec.vehicle(K)
-    return tuple(out)
-
-
-# ---------------------------------------------------------------------------
-# The margin μ on a grid, and its quadratic forms
-# ---------------------------------------------------------------------------
-def _grid(vehicles: Sequence[Vehicle]) -> Array:
-    """ω = 0 and a log grid up to well past every recorded vehicle's resonance (the scan)."""
-    loop = ContinuousString(StringArrays.of([list(vehicles)]))
-    top = max(10.0, 3.0 * float(loop.right()[0]))
-    return np.concatenate([[0.0], np.geomspace(1e-3, top, 700)])
-
-
-def _terms(strings: Sequence[Sequence[Vehicle]], omega: Array) -> tuple[Array, Array, Array]:
-    """G (unnormalised), ∏ d_i and the CAV-independent stability flags, per string and ω."""
-    loop = ContinuousString(StringArrays.of([list(s) for s in strings]))
-    n = len(strings)
-    X = np.broadcast_to(omega, (n, omega.size))
-    parts = loop.parts(np.arange(n), Interval(np.ascontiguousarray(X)))
-    ones = np.ones((len(parts), 1, 1))
-    G = point_margin(parts, ones)[0]
-    D = np.ones(X.shape)
-    for p in parts:
-        D = D * square_sum(p.re_d, p.im_d)[0]
-    stable, _ = loop.stability()
-    return G, D, stable
-
-
-def attenuation_margin(vehicles: Sequence[Vehicle], omega: Array | None = None) -> float:
-    """μ of a string on a dense grid (module docstring): > 0 when the product stays below 1.
-
-    A scan, for the design's search and for reporting; ``-inf`` when a vehicle is not
-    internally stable.  It never certifies anything.
-
-    Parameters
-    ----------
-    vehicles : sequence of Vehicle
-        The string.
-    omega : ndarray, optional
-        The grid, rad/s (default: ω = 0 and a log grid past every vehicle's resonance).
-
-    Returns
-    -------
-    float
-        min over the grid of −ln(∏|Γ_i|²)(1 + ω²)/ω² (G(0)/∏ d_i(0) at ω = 0).
-    """
-    w = _grid(vehicles) if omega is None else np.asarray(omega, dtype=float)
-    return float(_margins([vehicles], w)[0])
-
-
-def _margin_curve(G: Array, D: Array, omega: Array) -> Array:
-    """μ(ω) = −ln(1 − ω²G/D)(1 + ω²)/ω², G/D at ω = 0 (rows: strings)."""
-    w2 = omega * omega
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        x = w2 * G / D  # 1 − ∏|Γ_i|²
-        mu = -np.log1p(-np.minimum(x, 1.0)) * (1.0 + w2) / np.where(w2 > 0, w2, 1.0)
-        return np.where(w2 > 0, mu, G / D)
-
-
-def _margins(strings: Sequence[Sequence[Vehicle]], omega: Array) -> Array:
-    G, D, stable = _terms(strings, omega)
-    mu = np.min(_margin_curve(G, D, omega), axis=1)
-    return np.where(stable & ~np.isnan(mu), mu, -np.inf)
-
-
-def _rate(mu: float, omega: Array) -> Array:
-    """r(ω) with μ(ω) ≥ μ ⇔ G(ω) − r(ω) ∏d_i(ω) ≥ 0 (module docstring); r(0) = μ."""
-    w2 = omega * omega
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(w2 > 0, -np.expm1(-mu * w2 / (1.0 + w2)) / np.where(w2 > 0, w2, 1.0), mu)
-
-
-def _forms(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec,
-           omega: Array) -> tuple[Array, Array]:
-    """Quadratic forms in the CAV's gains of G(ω) and of ∏d_i(ω), shapes (10, n).
-
-    Both are evaluated at the ten polarisation points of
-    :func:`stringstab.tuning.constraints.quadratic_form` in one pass (stacked side by side).
-    """
-    from ..tuning.constraints import quadratic_form
-
-    n = omega.size
-
-    def terms(kx: Array, kv: Array, ka: Array) -> Array:
-        strings = [string_with_cavs(vehicles, [pos], [(a, b, c)], spec)
-                   for a, b, c in zip(kx, kv, ka)]
-        G, D, _ = _terms(strings, omega)
-        return np.concatenate([G, D], axis=1)
-
-    F = quadratic_form(terms)
-    return F[:, :n], F[:, n:]
-
-
 # ---------------------------------------------------------------------------
 # One CAV: the largest margin by bisection, each level by the exchange method
 # ---------------------------------------------------------------------------
@@ -318,8 +153,8 @@ def _feasible(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, mu: float, K
 
     def slots_for(x: Array, fs: list[float]) -> list[Any]:
         w = np.asarray(fs, dtype=float)
-        fG, fD = _forms(vehicles, pos, spec, w)
-        F = fG - _rate(level, w)[None, :] * fD
+        fG, fD, _ = cav_forms(vehicles, pos, spec, w)
+        F = fG - rate(level, w)[None, :] * fD
         # each constraint scaled by its ∏d_i at x: O(1) rows for IPOPT
         from ..tuning.constraints import evaluate_forms
 
@@ -336,10 +171,10 @@ def _feasible(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, mu: float, K
 
     def step(x: Array) -> str:
         s = string_with_cavs(vehicles, [pos], [x], spec)
-        G, D, stable = _terms([s], omega)
+        G, _, D, stable = terms([s], omega)
         if not stable[0]:
             return "stuck"
-        mu_w = _margin_curve(G, D, omega)[0]
+        mu_w = margin_curve(G, D, omega)[0]
         j = int(np.argmin(mu_w))
         if mu_w[j] >= mu - tol:
             return "certified"  # feasible at this level (the certificate judges the end result)
@@ -378,7 +213,7 @@ def _best_start(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, omega: Arr
     C = _candidates(spec)
     if current is not None:
         C = np.vstack([current[None, :], C])
-    mus = _margins([string_with_cavs(vehicles, [pos], [k], spec) for k in C], omega)
+    mus = margins([string_with_cavs(vehicles, [pos], [k], spec) for k in C], omega)
     j = int(np.argmax(mus))
     return C[j], float(mus[j])
 
@@ -396,8 +231,8 @@ def _design_one(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, omega: Arr
         return K, lo, feasible
 
     def start_freqs(K: Array) -> list[float]:
-        G, D, _ = _terms([string_with_cavs(vehicles, [pos], [K], spec)], omega)
-        return _local_minima(_margin_curve(G, D, omega)[0], omega)
+        G, _, D, _ = terms([string_with_cavs(vehicles, [pos], [K], spec)], omega)
+        return _local_minima(margin_curve(G, D, omega)[0], omega)
 
     def attempt(mu: float) -> tuple[Array, float] | None:
         x = _feasible(vehicles, pos, spec, mu, K, omega, start_freqs(K))
@@ -461,7 +296,7 @@ def _min_sup(vehicles: Sequence[Vehicle], positions: Sequence[int], gains: list[
     def sup(flat: Array) -> float:
         gs = np.clip(flat.reshape(-1, 3), lo, hi)
         s = string_with_cavs(vehicles, positions, list(gs), spec)
-        G, D, stable = _terms([s], omega)
+        G, _, D, stable = terms([s], omega)
         if not stable[0]:
             return 1e6
         prod2 = 1.0 - omega * omega * G[0] / D[0]
@@ -507,8 +342,8 @@ def design_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int], spec: Cav
     spec = spec or CavSpec()
     spec.params()
     vs = tuple(vehicles)
-    pos = _check_positions(positions, len(vs))
-    omega = _grid(vs)
+    pos = check_positions(positions, len(vs))
+    omega = scan_grid(vs)
     gains: list[Array | None] = [None for _ in pos]
     mu = -math.inf
     history: list[list[tuple[float, Array]]] = [[] for _ in pos]
@@ -561,20 +396,6 @@ def _triple(g: Any) -> tuple[float, float, float]:
 
 def _positions(pos: Sequence[int]) -> str:
     return ("position " if len(pos) == 1 else "positions ") + ",".join(str(p) for p in pos)
-
-
-def _check_positions(positions: Sequence[int], n: int) -> tuple[int, ...]:
-    out = []
-    for p in positions:
-        if isinstance(p, bool) or not float(p).is_integer() or not 1 <= int(p) <= n:
-            raise StringStabError(f"a CAV position must be a follower's position 1..{n} "
-                                  f"(the leader is 0); got {show(p)}")
-        out.append(int(p))
-    if not out:
-        raise StringStabError("expected at least one CAV position; got none")
-    if len(set(out)) != len(out):
-        raise StringStabError(f"CAV positions must be distinct; got {out}")
-    return tuple(sorted(out))
 
 
 def design_auto(vehicles: Sequence[Vehicle], spec: CavSpec | None = None, *, max_cavs: int = 2,
