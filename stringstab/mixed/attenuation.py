@@ -179,7 +179,8 @@ def cav_forms(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec,
     from ten evaluations by :func:`stringstab.tuning.constraints.quadratic_form` (in one pass,
     stacked side by side).  Each coefficient of G's form combines the ten values with weights
     of total magnitude ≤ 2, so it is within 2 max_p e_p of the exact one (e_p the round-off
-    bound of the p-th value, :func:`terms`).
+    bound of the p-th value, :func:`terms`), plus the rounding of that combination (at most
+    four operations: 8u max_p |G_p|, u = 2⁻⁵³).
 
     Parameters
     ----------
@@ -208,9 +209,9 @@ def cav_forms(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec,
         strings = [string_with_cavs(vehicles, [pos], [(a, b, c)], spec)
                    for a, b, c in zip(kx, kv, ka)]
         G, E, D, _ = terms(strings, omega)
-        slack.append(E)
+        slack.append(2.0 * np.max(E, axis=0) + 8.0 * 2.0 ** -53 * np.max(np.abs(G), axis=0))
         return np.concatenate([G, D], axis=1)
 
     F = quadratic_form(both)
-    err = 2.0 * np.max(slack[0], axis=0)
+    err = slack[0]
     return F[:, :n], F[:, n:], err

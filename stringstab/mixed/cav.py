@@ -10,6 +10,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+import numpy.typing as npt
+
 from .. import constants
 from ..certify.head_to_tail import Vehicle
 from ..errors import StringStabError, show
@@ -32,6 +35,10 @@ class CavSpec:
         Desired time headway T*, s (IDL Table 2: 1.1 s).
     bounds : (float, float)
         Bounds of each gain (IDL Table 2: [−2, 2]).
+    min_kx : float
+        The least k_x, 1/s² (default 0.01: a spacing error decays within about 10 s).  With
+        k_x → 0 the CAV stops holding its gap: it then filters its predecessor's speed ever
+        more slowly and the string's sup ∏|Γ_i| creeps towards 1 — a CAV in name only.
     hurwitz_margin : float
         Lower bound of the CAV's Hurwitz conditions k_x and k_v + (T* − τ)k_x in the NLP.
     standstill : float
@@ -44,6 +51,7 @@ class CavSpec:
     delta: float = constants.DELTA
     headway: float = constants.HEADWAY
     bounds: tuple[float, float] = constants.GAIN_BOUNDS
+    min_kx: float = 0.01
     hurwitz_margin: float = 1e-3
     standstill: float = 2.0
     name: str = "CAV"
@@ -51,6 +59,39 @@ class CavSpec:
     def params(self) -> Params:
         """τ, δ, T* as checked :class:`~stringstab.params.Params`."""
         return Params(self.tau, self.delta, self.headway)
+
+    def lower(self) -> npt.NDArray[np.float64]:
+        """The lower bounds of (k_x, k_v, k_a): k_x ≥ max(bounds[0], min_kx).
+
+        Returns
+        -------
+        ndarray, shape (3,)
+        """
+        lo = self.bounds[0]
+        return np.array([max(lo, self.min_kx), lo, lo])
+
+    def upper(self) -> npt.NDArray[np.float64]:
+        """The upper bounds of (k_x, k_v, k_a).
+
+        Returns
+        -------
+        ndarray, shape (3,)
+        """
+        return np.full(3, float(self.bounds[1]))
+
+    def clip(self, K: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """K within the bounds (:meth:`lower`, :meth:`upper`).
+
+        Parameters
+        ----------
+        K : array_like, shape (..., 3)
+            Gains.
+
+        Returns
+        -------
+        ndarray
+        """
+        return np.asarray(np.clip(np.asarray(K, dtype=float), self.lower(), self.upper()))
 
     def vehicle(self, K: Sequence[float]) -> Vehicle:
         """The CAV with gains K = (k_x, k_v, k_a).

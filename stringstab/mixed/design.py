@@ -80,6 +80,9 @@ class Design:
         What was found, in words.
     tried : list of dict
         ``auto``: every set of positions tried (positions, verdict, margin, sup).
+    proven_none : bool
+        Not certified, and proven that no gains within the bounds certify this one CAV
+        (:func:`stringstab.mixed.exclusion.prove_no_cav`).
     """
 
     positions: tuple[int, ...]
@@ -90,6 +93,7 @@ class Design:
     certified: bool
     note: str
     tried: list[dict[str, Any]] = field(default_factory=list)
+    proven_none: bool = False
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON of ``stringstab platoon design``: ``vehicles``, ``head_to_tail``, ``design``.
@@ -107,7 +111,7 @@ class Design:
         d["design"] = {"cav_positions": list(self.positions),
                        "gains": [dict(zip(("k_x", "k_v", "k_a"), g)) for g in self.gains],
                        "margin": _num(self.margin), "certified": self.certified,
-                       "note": self.note, "tried": self.tried}
+                       "proven_none": self.proven_none, "note": self.note, "tried": self.tried}
         return d
 
 
@@ -129,6 +133,11 @@ def _stability_slots(spec: CavSpec) -> list[Any]:
             hurwitz_conditions(kx, kv, ka, tau=spec.tau, headway=spec.headway)[i], dtype=float)
             * np.ones_like(kx))
         out.append(Slot("stability", m, math.nan, i, form))
+    # k_x ≥ min_kx, as a stability row (its lower bound is the Hurwitz margin m):
+    # k_x − min_kx + m ≥ m
+    form = np.zeros(10)
+    form[0], form[1] = spec.hurwitz_margin - spec.min_kx, 1.0
+    out.append(Slot("stability", m, math.nan, 2, form))
     return out
 
 
@@ -199,12 +208,12 @@ def _local_minima(values: Array, omega: Array, k: int = 8) -> list[float]:
 
 def _candidates(spec: CavSpec) -> Array:
     lo, hi = spec.bounds
-    kx = [v for v in (0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0) if lo <= v <= hi]
+    kx = [v for v in (0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
+          if max(lo, spec.min_kx) <= v <= hi]
     kv = [v for v in (0.05, 0.1, 0.2, 0.4, 0.7, 1.0, 1.5, 2.0) if lo <= v <= hi]
     ka = [v for v in (-0.3, 0.0, 0.3, 0.6, 0.9) if lo <= v <= hi]
     if not (kx and kv and ka):
-        mid = 0.5 * (lo + hi)
-        return np.array([[mid, mid, mid]])
+        return np.array([0.5 * (spec.lower() + spec.upper())])
     return np.array([(a, b, c) for a in kx for b in kv for c in ka])
 
 
@@ -270,10 +279,8 @@ def _climb(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, omega: Array,
     """Nelder-Mead on the scanned margin μ from K, within the bounds (a search, no proof)."""
     from scipy.optimize import minimize
 
-    lo_b, hi_b = spec.bounds
-
     def neg_mu(k: Array) -> float:
-        kc = np.clip(k, lo_b, hi_b)
+        kc = spec.clip(k)
         m = attenuation_margin(string_with_cavs(vehicles, [pos], [kc], spec), omega)
         return 1e6 if not math.isfinite(m) else -m
 
@@ -281,7 +288,7 @@ def _climb(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, omega: Array,
                    options={"maxfev": 300, "xatol": 1e-5, "fatol": 1e-6,
                             "initial_simplex": np.asarray(K)[None, :] + np.vstack(
                                 [np.zeros(3), 0.3 * np.diag(np.maximum(np.abs(K), 0.05))])})
-    k = np.clip(res.x, lo_b, hi_b)
+    k = spec.clip(res.x)
     return k, -neg_mu(k)
 
 
@@ -290,11 +297,10 @@ def _min_sup(vehicles: Sequence[Vehicle], positions: Sequence[int], gains: list[
     """A local search (Nelder-Mead) for the smallest sup ∏|Γ_i| on the grid (a search, no proof)."""
     from scipy.optimize import minimize
 
-    lo, hi = spec.bounds
     gains = [np.asarray(g, dtype=float) for g in gains]
 
     def sup(flat: Array) -> float:
-        gs = np.clip(flat.reshape(-1, 3), lo, hi)
+        gs = spec.clip(flat.reshape(-1, 3))
         s = string_with_cavs(vehicles, positions, list(gs), spec)
         G, _, D, stable = terms([s], omega)
         if not stable[0]:
@@ -306,7 +312,7 @@ def _min_sup(vehicles: Sequence[Vehicle], positions: Sequence[int], gains: list[
     res = minimize(sup, x0, method="Nelder-Mead",
                    options={"maxfev": 400 * len(gains), "xatol": 1e-4, "fatol": 1e-6})
     best = res.x if res.fun <= sup(x0) else x0
-    return list(np.clip(best.reshape(-1, 3), lo, hi))
+    return list(spec.clip(best.reshape(-1, 3)))
 
 
 def design_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int], spec: CavSpec | None = None,
@@ -344,36 +350,36 @@ def design_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int], spec: Cav
     vs = tuple(vehicles)
     pos = check_positions(positions, len(vs))
     omega = scan_grid(vs)
+    proof = _exclusion(vs, pos, spec)
     gains: list[Array | None] = [None for _ in pos]
     mu = -math.inf
     history: list[list[tuple[float, Array]]] = [[] for _ in pos]
-    for _sweep in range(max(1, sweeps) if len(pos) > 1 else 1):
-        for j, p in enumerate(pos):
-            held = [(q, g) for i, (q, g) in enumerate(zip(pos, gains)) if i != j and g is not None]
-            base = string_with_cavs(vs, [q for q, _ in held], [g for _, g in held], spec)
-            K, mu, feas = _design_one(base, p, spec, omega, gains[j], steps)
-            gains[j] = K
-            history[j] = feas
-    designed = [g for g in gains if g is not None]
-    # the certificate judges, from the largest margin down
-    tries: list[list[Array]] = [designed]
-    if len(pos) == 1:
-        tries += [[K] for m, K in sorted(history[0], key=lambda t: -t[0])[1:4] if m > 0]
-    cert = None
-    chosen = tries[0]
-    for gs in tries:
-        cert = certify_string(string_with_cavs(vs, pos, gs, spec))
-        chosen = gs
-        if cert.certified:
-            break
-    assert cert is not None
-    final = string_with_cavs(vs, pos, chosen, spec)
-    mu_final = attenuation_margin(final, omega)
-    if cert.certified:
-        note = (f"certified head to tail with CAV(s) at {_positions(pos)}: attenuation margin "
-                f"μ = {mu_final:.4g} on the search grid")
-        return Design(pos, tuple(_triple(g) for g in chosen), final, cert, mu_final, True, note)
-    # none certified: the smallest sup the local search finds, reported as such
+    if proof is None or not proof.proven:  # no search where none exists
+        for _sweep in range(max(1, sweeps) if len(pos) > 1 else 1):
+            for j, p in enumerate(pos):
+                held = [(q, g) for i, (q, g) in enumerate(zip(pos, gains))
+                        if i != j and g is not None]
+                base = string_with_cavs(vs, [q for q, _ in held], [g for _, g in held], spec)
+                K, mu, feas = _design_one(base, p, spec, omega, gains[j], steps)
+                gains[j] = K
+                history[j] = feas
+        designed = [g for g in gains if g is not None]
+        # the certificate judges, from the largest margin down
+        tries: list[list[Array]] = [designed]
+        if len(pos) == 1:
+            tries += [[K] for m, K in sorted(history[0], key=lambda t: -t[0])[1:4] if m > 0]
+        for gs in tries:
+            cert = certify_string(string_with_cavs(vs, pos, gs, spec))
+            if cert.certified:
+                final = string_with_cavs(vs, pos, gs, spec)
+                mu_final = attenuation_margin(final, omega)
+                note = (f"certified head to tail with CAV(s) at {_positions(pos)}: attenuation "
+                        f"margin μ = {mu_final:.4g} on the search grid")
+                return Design(pos, tuple(_triple(g) for g in gs), final, cert, mu_final, True,
+                              note)
+    else:
+        designed = [_min_sup_start(vs, p, spec, omega) for p in pos]
+    # none certified: the smallest sup a local search finds, reported as such
     best = _min_sup(vs, pos, designed, spec, omega)
     final = string_with_cavs(vs, pos, best, spec)
     cert = certify_string(final)
@@ -382,12 +388,43 @@ def design_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int], spec: Cav
         note = (f"certified head to tail with CAV(s) at {_positions(pos)} (found by the search "
                 f"for the smallest sup; attenuation margin μ = {mu_final:.4g} on the search grid)")
         return Design(pos, tuple(_triple(g) for g in best), final, cert, mu_final, True, note)
-    note = (f"no certified design found at {_positions(pos)} within the gain bounds "
-            f"{list(spec.bounds)} (largest margin reached μ = {mu:.4g}); the smallest sup ∏|Γ_i| "
-            f"found by a local search is {cert.sup_gain:.4g} ({cert.verdict}) - a search result, "
-            "not a proof that no gains do better")
+    why = _exclusion_words(proof)
+    reached = "" if proof is not None and proof.proven else \
+        f"; the largest margin the search reached is μ = {mu:.4g}"
+    note = (f"no certified design at {_positions(pos)} within the gain bounds "
+            f"{list(spec.bounds)} (k_x >= {spec.min_kx:g}): {why}{reached}; the smallest sup ∏|Γ_i| a local search "
+            f"found is {cert.sup_gain:.4g} ({cert.verdict}; a search result, not a proven minimum)")
     return Design(pos, tuple(_triple(g) for g in best), final, cert,
-                  attenuation_margin(final, omega), bool(cert.certified), note)
+                  attenuation_margin(final, omega), False, note, proven_none=bool(proof and proof.proven))
+
+
+def _exclusion(vs: Sequence[Vehicle], pos: Sequence[int], spec: CavSpec) -> Any:
+    """The exclusion proof for one CAV (None for several: it does not cover them)."""
+    if len(pos) != 1:
+        return None
+    from .exclusion import prove_no_cav
+
+    return prove_no_cav(vs, pos[0], spec)
+
+
+def _exclusion_words(ex: Any) -> str:
+    if ex is None:
+        return "none found by the search (not proven: the proof covers one CAV)"
+    if ex.proven:
+        return (f"none exists (proven: every gain box fails the CAV's Hurwitz conditions or "
+                f"G(ω) ≥ 0 at one of {ex.frequencies} frequencies; {ex.boxes} boxes)")
+    return (f"none found by the search (the exclusion proof left {ex.remaining} of "
+            f"{ex.boxes} boxes undecided: not proven)")
+
+
+def _min_sup_start(vs: Sequence[Vehicle], pos: int, spec: CavSpec, omega: Array) -> Array:
+    """The gains of the coarse grid with the smallest scanned sup ∏|Γ_i| (internally stable)."""
+    C = _candidates(spec)
+    strings = [string_with_cavs(vs, [pos], [k], spec) for k in C]
+    G, _, D, stable = terms(strings, omega)
+    sup2 = np.max(1.0 - omega * omega * G / D, axis=1)
+    sup2 = np.where(stable, sup2, np.inf)
+    return C[int(np.argmin(sup2))]
 
 
 def _triple(g: Any) -> tuple[float, float, float]:
@@ -432,7 +469,7 @@ def design_auto(vehicles: Sequence[Vehicle], spec: CavSpec | None = None, *, max
             d = design_cavs(vs, pos, spec, steps=steps)
             tried.append({"positions": list(pos), "verdict": d.certificate.verdict,
                           "margin": _num(d.margin), "sup_gain": _num(d.certificate.sup_gain),
-                          "gains": [list(g) for g in d.gains]})
+                          "proven_none": d.proven_none, "gains": [list(g) for g in d.gains]})
             if d.certified:
                 found.append(d)
             elif best_fail is None or d.certificate.sup_gain < best_fail.certificate.sup_gain:
