@@ -80,8 +80,61 @@ def add_parser(sub: Any) -> None:
                    help="table (default) or json ({\"head_to_tail\": ..., \"vehicles\": [...]})")
     c.set_defaults(func=run)
 
+    d = ps.add_parser(
+        "design",
+        help="CAV gains at given positions (or the fewest CAVs, auto) that certify the string",
+        description=(
+            "Replace the recorded followers at --cav-at (string positions, the leader is 0) by "
+            "CAVs running the predecessor-following eq-4 law with the CAV's own tau, delta, T* "
+            "and gain bounds, and find their gains with the largest attenuation margin (the "
+            "tuning's CasADi NLP under the exchange method); the head-to-tail certificate judges "
+            "the result.  When no design certifies, it says so — proven for one CAV when the "
+            "exclusion proof covers the gain bounds — and gives the smallest sup found.  "
+            "--cav-at auto tries every position, then pairs (up to --max-cavs).  Exit 0 when a "
+            "design is certified, 1 when none is, 2 on bad input."),
+        epilog=_DESIGN_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _add_input_arguments(d, flag=True, loop=False)
+    _add_cav_arguments(d)
+    d.add_argument("--format", choices=("table", "json"), default="table",
+                   help="table (default) or json (vehicles, head_to_tail, design)")
+    d.set_defaults(func=run)
 
-def _add_input_arguments(p: argparse.ArgumentParser, *, flag: bool) -> None:
+
+_DESIGN_EPILOG = """\
+examples:
+  stringstab platoon design --from runs/acc/identify.json --cav-at 5
+  stringstab platoon design --from runs/acc/identify.json --cav-at 5 --cav-headway 3
+  stringstab platoon design --from string.csv --cav-at auto --max-cavs 2 --format json
+
+The CAV's defaults: tau 0.1 s, delta 0.2 s, T* 1.1 s (IDL Table 2), gains in [-2, 2] with
+k_x >= 0.01 1/s^2 (a CAV must hold its gap). See docs/platoon.md.
+"""
+
+
+def _add_cav_arguments(p: argparse.ArgumentParser) -> None:
+    from .. import constants
+
+    p.add_argument("--cav-at", required=True, metavar="P[,Q]|auto",
+                   help="string positions (1..N; the leader is 0) of the CAVs, or auto")
+    p.add_argument("--cav-tau", default=str(constants.TAU), metavar="S",
+                   help=f"the CAV's actuator lag, s (default {constants.TAU:g})")
+    p.add_argument("--cav-delta", default=str(constants.DELTA), metavar="S",
+                   help=f"the CAV's communication delay, s (default {constants.DELTA:g})")
+    p.add_argument("--cav-headway", default=str(constants.HEADWAY), metavar="S",
+                   help=f"the CAV's desired time headway T*, s (default {constants.HEADWAY:g})")
+    p.add_argument("--cav-reaction-delay", default="0", metavar="S",
+                   help="the CAV's reaction delay θ_r, s (default 0)")
+    lo, hi = constants.GAIN_BOUNDS
+    p.add_argument("--gain-bounds", default=f"{lo:g}:{hi:g}", metavar="LO:HI",
+                   help=f"bounds of each CAV gain (default {lo:g}:{hi:g}, IDL Table 2)")
+    p.add_argument("--min-kx", default="0.01", metavar="X",
+                   help="the least k_x of a CAV, 1/s² (default 0.01: it holds its gap)")
+    p.add_argument("--max-cavs", default="2", metavar="N",
+                   help="--cav-at auto: the most CAVs tried (default 2)")
+
+
+def _add_input_arguments(p: argparse.ArgumentParser, *, flag: bool, loop: bool = True) -> None:
     if flag:
         p.add_argument("--from", dest="file", required=True, metavar="FILE",
                        help="identify.json or a CSV list of followers (see certify)")
@@ -89,10 +142,14 @@ def _add_input_arguments(p: argparse.ArgumentParser, *, flag: bool) -> None:
         p.add_argument("file", metavar="FILE", help="identify.json or a CSV list of followers")
     p.add_argument("--platoon", metavar="N",
                    help="identify.json of several logs: which platoon (its index)")
-    p.add_argument("--sample-time", metavar="H",
-                   help="certify the sampled-data loop (every vehicle samples with period H s)")
-    p.add_argument("--leader-tau", metavar="S",
-                   help="sampled loop: the leader's actuator lag, s (default: the first follower's)")
+    p.add_argument("--positions", metavar="A:B",
+                   help="identify.json: the recorded positions A..B of the string (default the "
+                        "longest run of consecutive identified followers)")
+    if loop:
+        p.add_argument("--sample-time", metavar="H",
+                       help="certify the sampled-data loop (every vehicle samples with period H s)")
+        p.add_argument("--leader-tau", metavar="S",
+                       help="sampled loop: the leader's actuator lag, s (default: the first follower's)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -108,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
     int
         The sub-command's exit code.
     """
-    return {"certify": run_certify}[args.platoon_command](args)
+    return {"certify": run_certify, "design": run_design}[args.platoon_command](args)
 
 
 def _platoon(args: argparse.Namespace) -> int | None:
@@ -117,6 +174,118 @@ def _platoon(args: argparse.Namespace) -> int | None:
     from ._common import integer
 
     return integer("--platoon", args.platoon, 0)
+
+
+def _span(args: argparse.Namespace) -> tuple[int, int] | None:
+    if args.positions is None:
+        return None
+    text = str(args.positions)
+    parts = text.split(":")
+    try:
+        a, b = (int(x) for x in parts) if len(parts) == 2 else (int(text), int(text))
+    except ValueError as e:
+        raise StringStabError(f"--positions must be A:B (recorded positions, integers); got "
+                              f"{text!r}") from e
+    if a < 1 or b < a:
+        raise StringStabError(f"--positions must be A:B with 1 <= A <= B; got {text!r}")
+    return a, b
+
+
+def _cav_spec(args: argparse.Namespace) -> Any:
+    from ..mixed.cav import CavSpec
+    from ..params import check_params, parse_interval, positive
+
+    tau, delta, headway = check_params(args.cav_tau, args.cav_delta, args.cav_headway)
+    theta = positive("--cav-reaction-delay", args.cav_reaction_delay, allow_zero=True, unit=" s")
+    if theta > 0:
+        raise StringStabError(
+            f"--cav-reaction-delay {theta:g}: the head-to-tail certificate takes θ_r = 0 only "
+            "until the reaction-delay certificate (issue 25) is available")
+    lo, hi = parse_interval(args.gain_bounds, "--gain-bounds")
+    min_kx = positive("--min-kx", args.min_kx, allow_zero=True, unit=" 1/s²")
+    if max(lo, min_kx) > hi:
+        raise StringStabError(f"--gain-bounds {args.gain_bounds} leaves no k_x >= --min-kx "
+                              f"{min_kx:g}")
+    return CavSpec(tau=tau, delta=delta, headway=headway, bounds=(lo, hi), min_kx=min_kx)
+
+
+def _cav_positions(text: str, n: int) -> tuple[int, ...] | None:
+    """``auto`` (None) or the positions, each checked within 1..n."""
+    from ..mixed.cav import check_positions
+
+    if str(text).strip().lower() == "auto":
+        return None
+    out = []
+    for part in str(text).split(","):
+        try:
+            out.append(int(part))
+        except ValueError as e:
+            raise StringStabError(f"--cav-at must be positions P[,Q] (integers 1..{n}, the leader "
+                                  f"is 0) or auto; got {text!r}") from e
+    return check_positions(out, n)
+
+
+def run_design(args: argparse.Namespace) -> int:
+    """``platoon design``: CAV gains that certify the string (module docstring).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        0 when a design is certified head to tail, 1 when none is; bad input raises (exit 2).
+    """
+    from ..mixed import read_vehicles
+    from ..mixed.design import design_auto, design_cavs
+    from ._common import integer
+
+    spec = _cav_spec(args)
+    max_cavs = integer("--max-cavs", args.max_cavs, 1)
+    rec = read_vehicles(args.file, platoon=_platoon(args), positions=_span(args))
+    pos = _cav_positions(args.cav_at, len(rec.vehicles))
+    d = design_auto(rec.vehicles, spec, max_cavs=max_cavs) if pos is None else \
+        design_cavs(rec.vehicles, pos, spec)
+    doc = d.as_dict()
+    _describe(doc, rec)
+    doc["design"]["cav"] = {"tau": spec.tau, "delta": spec.delta, "headway": spec.headway,
+                            "gain_bounds": list(spec.bounds), "min_kx": spec.min_kx}
+    if args.format == "json":
+        json.dump(doc, sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        sys.stdout.write(render_design(doc))
+    return 0 if d.certified else 1
+
+
+def render_design(doc: dict[str, Any]) -> str:
+    """The human text of ``platoon design``: the design's lines, then the certificate's text.
+
+    Parameters
+    ----------
+    doc : dict
+        The JSON document of ``platoon design``.
+
+    Returns
+    -------
+    str
+        Newline-terminated text.
+    """
+    ds = doc["design"]
+    cav = ds["cav"]
+    lines = [f"# CAV: τ = {cav['tau']:g} s, δ = {cav['delta']:g} s, T* = {cav['headway']:g} s, "
+             f"gains in [{cav['gain_bounds'][0]:g}, {cav['gain_bounds'][1]:g}], k_x >= {cav['min_kx']:g}",
+             f"# design at position(s) {','.join(str(p) for p in ds['cav_positions'])}: "
+             + ("certified" if ds["certified"] else "NOT certified") + f" - {ds['note']}"]
+    for p, g in zip(ds["cav_positions"], ds["gains"]):
+        lines.append(f"#   CAV at {p}: k_x = {g['k_x']:.5g}, k_v = {g['k_v']:.5g}, k_a = {g['k_a']:.5g}")
+    for t in ds["tried"]:
+        lines.append(f"#   tried {','.join(str(p) for p in t['positions'])}: {t['verdict']}, "
+                     f"sup {_g(t['sup_gain'])}, margin {_g(t['margin'])}"
+                     + (" (none exists: proven)" if t.get("proven_none") else ""))
+    return "\n".join(lines) + "\n" + render_certify(doc)
 
 
 def _loop_args(args: argparse.Namespace) -> tuple[float | None, float | None]:
@@ -146,7 +315,7 @@ def run_certify(args: argparse.Namespace) -> int:
     from ..mixed import read_vehicles
 
     H, lt = _loop_args(args)
-    rec = read_vehicles(args.file, platoon=_platoon(args))
+    rec = read_vehicles(args.file, platoon=_platoon(args), positions=_span(args))
     emp = None
     emp_note = None
     if rec.kind == "identify" and not args.no_empirical:
@@ -159,7 +328,7 @@ def run_certify(args: argparse.Namespace) -> int:
     cert = certify_string(rec.vehicles, sample_time=H, leader_tau=lt,
                           substrings=not args.no_substrings)
     doc = cert.as_dict()
-    doc["source"] = rec.source
+    _describe(doc, rec)
     if rec.kind == "identify":
         doc["head_to_tail"]["empirical"] = None if emp is None else emp.as_dict()
         if emp_note:
@@ -170,6 +339,27 @@ def run_certify(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(render_certify(doc))
     return 0 if cert.certified else 1
+
+
+def _describe(doc: dict[str, Any], rec: Any) -> None:
+    """The ``string`` object (where the vehicles come from) and each row's recorded position."""
+    doc["string"] = {"source": rec.source, "kind": rec.kind, "leader": rec.leader or None,
+                     "recorded_positions": list(rec.positions), "log": rec.log,
+                     "note": rec.note or None}
+    for row, p in zip(doc["vehicles"], rec.positions):
+        row["recorded_position"] = p
+
+
+def _string_lines(doc: dict[str, Any]) -> list[str]:
+    s = doc.get("string", {})
+    if s.get("kind") != "identify":
+        return []
+    pos = s["recorded_positions"]
+    lines = [f"# string: recorded followers {pos[0]}..{pos[-1]} of {s['source']} behind "
+             f"{s.get('leader') or 'the leader'} (string positions 1..{len(pos)})"]
+    if s.get("note"):
+        lines.append(f"# note: {s['note']}")
+    return lines
 
 
 def _g(x: Any, fmt: str = ".4g") -> str:
@@ -192,7 +382,7 @@ def render_certify(doc: dict[str, Any]) -> str:
     from ..io import TableColumn, columns_from_records, format_results
 
     h = doc["head_to_tail"]
-    lines = [f"# head to tail ({h['n_vehicles']} vehicles): {h['verdict']} - {h['reason']}",
+    lines = [*_string_lines(doc), f"# head to tail ({h['n_vehicles']} vehicles): {h['verdict']} - {h['reason']}",
              f"# sup prod|Γ_i| = {_g(h['sup_gain'], '.6g')} at ω = {_g(h['peak_omega'])} rad/s"
              + (f"; witness ω = {_g(h['witness_omega'])} rad/s" if h.get("witness_omega") is not None else "")]
     w = h.get("worst_substring")

@@ -1,7 +1,7 @@
 """The recorded string's own head-to-tail amplification, from the log it was identified from.
 
-The measured transfer from the first car's speed (the leader, position 0) to the last
-follower's (position N), by the Welch estimate of
+The measured transfer from the first car's speed (the string's leader: the first follower's
+predecessor) to the last follower's, by the Welch estimate of
 :func:`stringstab.identify.empirical.empirical_transfer` — the same estimate, coherence
 threshold, band and error as the per-follower transfer of ``stringstab identify`` — on the
 stretches where *every* follower of the string is fully measured (the intersection of their
@@ -13,6 +13,7 @@ peak-to-peak and energy ratios set the data beside the certificate's sup ∏|Γ_
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -68,15 +69,16 @@ class StringEmpirical:
                 "seconds": float(sum(len(s) for s in self.segments) * self.dt)}
 
 
-def common_segments(log: PlatoonLog, last: int, *, min_duration: float) -> list[Segment]:
-    """The runs where followers 1..``last`` are all fully measured, at least ``min_duration`` long.
+def common_segments(log: PlatoonLog, positions: Sequence[int], *,
+                    min_duration: float) -> list[Segment]:
+    """The runs where every follower of ``positions`` is fully measured (≥ ``min_duration``).
 
     Parameters
     ----------
     log : PlatoonLog
         The recorded platoon.
-    last : int
-        The last follower's position.
+    positions : sequence of int
+        The followers' recorded positions (each with its predecessor in the log).
     min_duration : float
         Shortest run kept, s.
 
@@ -85,7 +87,7 @@ def common_segments(log: PlatoonLog, last: int, *, min_duration: float) -> list[
     list of Segment
     """
     ok = np.ones(log.t.size, dtype=bool)
-    for p in range(1, last + 1):
+    for p in positions:
         m = np.zeros(log.t.size, dtype=bool)
         for s in clean_segments(log, p, min_duration=0.0):
             m[s.start:s.stop] = True
@@ -126,11 +128,11 @@ def string_empirical(rec: RecordedString) -> StringEmpirical:
         raise StringStabError(f"the log {show(rec.log)} has {len(logs)} platoons; {rec.source} "
                               f"names platoon {rec.platoon}")
     log = logs[rec.platoon]
-    last = rec.positions[-1]
-    segs = common_segments(log, last, min_duration=rec.min_duration)
+    first, last = rec.positions[0], rec.positions[-1]
+    segs = common_segments(log, rec.positions, min_duration=rec.min_duration)
     if not segs:
         raise StringStabError(f"the log {show(rec.log)} has no stretch of {rec.min_duration:g} s "
-                              f"with every follower 1..{last} measured")
-    v0 = log.speed[log.row(0)]
+                              f"with every follower {first}..{last} measured")
+    v0 = log.speed[log.row(first - 1)]
     vN = log.speed[log.row(last)]
     return StringEmpirical(empirical_transfer(v0, vN, segs, log.dt), segs, log.dt, log)

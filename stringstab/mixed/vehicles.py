@@ -5,7 +5,10 @@
 * an ``identify.json`` written by ``stringstab identify`` (:mod:`stringstab.identify.report`):
   its ``vehicles`` in recorded order (positions 1..N behind the leader, position 0) with their
   fitted k_x, k_v, k_a, τ, δ, T* (and the standstill distance l_0), and the log they were
-  identified from (``sources``); or
+  identified from (``sources``).  A string needs every follower between its head and its
+  tail: the longest run of consecutive identified positions is used (the others are named in
+  a note), or the run chosen with ``positions``; its head's predecessor is the string's
+  leader.  The string's own positions are 1..N (the leader 0), whatever the log's numbers; or
 * a CSV with one row per follower in order and the columns ``k_x,k_v,k_a,tau,delta,headway``
   (optional ``reaction_delay``, ``name``, ``standstill``).
 
@@ -55,11 +58,15 @@ class RecordedString:
     platoon : int
         The platoon (log) of identify.json used.
     positions : tuple of int
-        The recorded positions (1..N).
+        The recorded positions (in the log's numbering) of followers 1..N.
     sample_time : float or None
         identify's sample time (identify.json), s.
     min_duration : float
         identify's shortest clean segment, s (the empirical transfer uses the same).
+    leader : str
+        The name of the string's leader (the first follower's recorded predecessor).
+    note : str
+        Followers of the file left out of the string, and why ("" when none).
     """
 
     vehicles: tuple[Vehicle, ...]
@@ -71,6 +78,8 @@ class RecordedString:
     positions: tuple[int, ...] = ()
     sample_time: float | None = None
     min_duration: float = 30.0
+    leader: str = ""
+    note: str = ""
 
     @property
     def names(self) -> list[str]:
@@ -156,7 +165,19 @@ def _checked(path: Path, recs: list[dict[str, Any]]) -> tuple[Vehicle, ...]:
         raise StringStabError(f"{_where(path)}: {e}") from e
 
 
-def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None) -> RecordedString:
+def _runs(positions: list[int]) -> list[list[int]]:
+    """Runs of consecutive integers in a sorted list."""
+    runs: list[list[int]] = []
+    for p in positions:
+        if runs and p == runs[-1][-1] + 1:
+            runs[-1].append(p)
+        else:
+            runs.append([p])
+    return runs
+
+
+def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None,
+                   span: tuple[int, int] | None) -> RecordedString:
     vehicles = doc.get("vehicles")
     if not isinstance(vehicles, list):
         raise StringStabError(f"{_where(path)}: expected an identify.json with a 'vehicles' list "
@@ -175,14 +196,29 @@ def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None) -> Reco
                               f"{platoons or 'none'}")
     rows = sorted((v for v in rows if int(v.get("platoon", 0)) == platoon),
                   key=lambda v: int(v.get("position", 0)))
+    if not rows:
+        raise StringStabError(f"{_where(path)}: expected vehicles in platoon {platoon}; found none")
     positions = [int(v.get("position", -1)) for v in rows]
-    expected = list(range(1, len(rows) + 1))
-    if positions != expected:
-        gaps = sorted(set(range(1, max(positions, default=0) + 1)) - set(positions))
-        skipped = "; ".join(str(s) for s in doc.get("skipped", [])) or "no reason recorded"
-        raise StringStabError(
-            f"{_where(path)}: the string needs every follower 1..N in order; found positions "
-            f"{positions}" + (f" (missing {gaps}; identify skipped: {skipped})" if gaps else ""))
+    runs = _runs(positions)
+    if span is not None:
+        a, b = span
+        if not any(r[0] <= a and b <= r[-1] for r in runs):
+            raise StringStabError(
+                f"{_where(path)}: --positions {a}:{b} is not a run of consecutive identified "
+                f"followers; the runs are {', '.join(f'{r[0]}:{r[-1]}' for r in runs)}")
+        chosen = list(range(a, b + 1))
+    else:
+        chosen = max(runs, key=len)  # the longest run (the first of equal ones)
+    dropped = [v for v in rows if int(v["position"]) not in chosen]
+    rows = [v for v in rows if int(v["position"]) in chosen]
+    note = ""
+    if dropped:
+        note = (f"used the recorded followers {chosen[0]}..{chosen[-1]} (the "
+                + ("chosen" if span is not None else "longest") + " run of consecutive identified "
+                "positions); left out: " + ", ".join(f"{v.get('position')} {v.get('name', '')}".strip()
+                                                      for v in dropped)
+                + " (a string needs every follower between its head and its tail)")
+    positions = chosen
     recs = []
     standstill = []
     for v in rows:
@@ -200,10 +236,12 @@ def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None) -> Reco
     H = doc.get("sample_time")
     return RecordedString(vs, tuple(standstill), str(path), "identify", log, platoon,
                           tuple(positions), None if H is None else float(H),
-                          float(settings.get("min_duration", 30.0)))  # type: ignore[union-attr]
+                          float(settings.get("min_duration", 30.0)),  # type: ignore[union-attr]
+                          str(rows[0].get("predecessor", "")), note)
 
 
-def read_vehicles(path: str | Path, *, platoon: int | None = None) -> RecordedString:
+def read_vehicles(path: str | Path, *, platoon: int | None = None,
+                  positions: tuple[int, int] | None = None) -> RecordedString:
     """The string of followers in a file (module docstring).
 
     Parameters
@@ -212,6 +250,9 @@ def read_vehicles(path: str | Path, *, platoon: int | None = None) -> RecordedSt
         ``identify.json`` (any ``.json``) or a CSV list.
     platoon : int, optional
         identify.json of several logs: which one (its ``platoon`` index).
+    positions : (int, int), optional
+        identify.json: the recorded positions first..last of the string (a run of consecutive
+        identified followers); default the longest such run.
 
     Returns
     -------
@@ -239,7 +280,8 @@ def read_vehicles(path: str | Path, *, platoon: int | None = None) -> RecordedSt
                                   f"{type(doc).__name__}")
         if platoon is not None and platoon < 0:
             raise StringStabError(f"--platoon must be an integer >= 0; got {platoon}")
-        return _read_identify(p, doc, platoon)
-    if platoon is not None:
-        raise StringStabError("--platoon is for identify.json (a CSV list is one string)")
+        return _read_identify(p, doc, platoon, positions)
+    if platoon is not None or positions is not None:
+        raise StringStabError("--platoon and --positions are for identify.json (a CSV list is "
+                              "one string)")
     return _read_csv(p, text)
