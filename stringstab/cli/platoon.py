@@ -100,6 +100,27 @@ def add_parser(sub: Any) -> None:
                    help="table (default) or json (vehicles, head_to_tail, design)")
     d.set_defaults(func=run)
 
+    m = ps.add_parser(
+        "simulate",
+        help="replay the recorded leader through the string with and without the designed CAV(s)",
+        description=(
+            "Design the CAV(s) at --cav-at (as 'platoon design'), then replay the recorded leader "
+            "(the string's first car, as logged) through the identified followers and through "
+            "the string with the CAV(s), in the toolkit's simulator (or SUMO with --sumo): m_p "
+            "along the string, energy and peak-to-peak ratios, figures and a report in --out.  "
+            "Needs an identify.json (its log).  Exit 0 when it ran, 2 on bad input."),
+        epilog=_DESIGN_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _add_input_arguments(m, flag=True, loop=False)
+    _add_cav_arguments(m)
+    m.add_argument("--cav-gains", metavar="KX,KV,KA",
+                   help="use these CAV gains (one CAV) instead of designing them")
+    m.add_argument("--sumo", action="store_true",
+                   help="replay in Eclipse SUMO (the sumo extra) instead of the toolkit's simulator")
+    m.add_argument("--no-figures", action="store_true", help="skip the figures")
+    m.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    m.set_defaults(func=run)
+
 
 _DESIGN_EPILOG = """\
 examples:
@@ -165,7 +186,8 @@ def run(args: argparse.Namespace) -> int:
     int
         The sub-command's exit code.
     """
-    return {"certify": run_certify, "design": run_design}[args.platoon_command](args)
+    return {"certify": run_certify, "design": run_design,
+            "simulate": run_simulate}[args.platoon_command](args)
 
 
 def _platoon(args: argparse.Namespace) -> int | None:
@@ -258,6 +280,121 @@ def run_design(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(render_design(doc))
     return 0 if d.certified else 1
+
+
+def _gains(text: str) -> tuple[float, float, float]:
+    parts = str(text).split(",")
+    try:
+        vals = tuple(float(x) for x in parts)
+    except ValueError as e:
+        raise StringStabError(f"--cav-gains must be KX,KV,KA (three numbers); got {text!r}") from e
+    if len(vals) != 3:
+        raise StringStabError(f"--cav-gains must be KX,KV,KA (three numbers); got {text!r}")
+    return vals  # type: ignore[return-value]
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """``platoon simulate``: design, replay, figures and report (module docstring).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    int
+        0 when it ran; bad input raises (exit 2).
+    """
+    import time
+
+    from ..certify.api import certify_string
+    from ..io import OutputDir
+    from ..mixed import read_vehicles
+    from ..mixed.cav import string_with_cavs
+    from ..mixed.design import Design, design_cavs
+    from ..mixed.replay import replay
+    from ..report import command_line
+    from ..report.mixed import platoon_report
+
+    t0 = time.perf_counter()
+    spec = _cav_spec(args)
+    rec = read_vehicles(args.file, platoon=_platoon(args), positions=_span(args))
+    if rec.kind != "identify":
+        raise StringStabError("platoon simulate replays the recorded leader: expected the "
+                              f"identify.json of a log; got the CSV list {rec.source}")
+    pos = _cav_positions(args.cav_at, len(rec.vehicles))
+    if pos is None:
+        raise StringStabError("platoon simulate needs the CAV positions (--cav-at P[,Q]); find "
+                              "them first with 'platoon design --cav-at auto'")
+    out = OutputDir(args.out, command="platoon simulate", what="--out")
+    recorded = certify_string(rec.vehicles)
+    if args.cav_gains is not None:
+        if len(pos) != 1:
+            raise StringStabError("--cav-gains gives one CAV's gains; got several --cav-at positions")
+        K = spec.clip(_gains(args.cav_gains))
+        vs = string_with_cavs(rec.vehicles, pos, [K], spec)
+        cert = certify_string(vs)
+        design = Design(pos, ((float(K[0]), float(K[1]), float(K[2])),), vs, cert, float("nan"),
+                        cert.certified, f"the given gains: {cert.verdict}")
+    else:
+        design = design_cavs(rec.vehicles, pos, spec)
+    l0 = list(rec.standstill)
+    for p in pos:
+        l0[p - 1] = spec.standstill
+    label = f"CAV at {','.join(str(p) for p in pos)}"
+    rp = replay(rec, [(label, design.vehicles, l0)], simulator="sumo" if args.sumo else "toolkit")
+    emp = None
+    try:
+        from ..mixed.empirical import string_empirical
+
+        emp = string_empirical(rec)
+    except StringStabError:
+        emp = None
+    doc = {"recorded": recorded.as_dict(), "design": design.as_dict(), "replay": rp.as_dict(),
+           "empirical": None if emp is None else emp.as_dict()}
+    _describe(doc["recorded"], rec)
+    _describe(doc["design"], rec)
+    figures: list[str] = []
+    with out:
+        out.write_json("platoon.json", doc)
+        if not args.no_figures:
+            figures = _figures(out, rec, design, rp, emp, label)
+        names = list(out.written)
+        names += platoon_report(rec, recorded, design, rp, figures, empirical=emp,
+                                command=command_line(args), started=t0).write(out)
+    for r in rp.runs:
+        print(f"{r.label}: energy ratio last/leader {r.band_ratio:.3g} (0 < ω ≤ 1 rad/s), "
+              f"{r.energy_ratio:.3g} (all ω); peak-to-peak {r.peak_to_peak:.3g}; min gap "
+              f"{r.min_gap:.3g} m; collisions {r.collisions}")
+    print(f"recorded string: {recorded.verdict} (sup {recorded.sup_gain:.4g}); with {label}: "
+          f"{design.certificate.verdict} (sup {design.certificate.sup_gain:.4g})")
+    print(f"wrote {len(names)} files to {out.root}/ (platoon.json, figures, report.md, report.html)")
+    return 0
+
+
+def _figures(out: Any, rec: Any, design: Any, rp: Any, emp: Any, label: str) -> list[str]:
+    from ..plots._common import pyplot
+    from ..plots.mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
+
+    plt = pyplot()
+    made = []
+    r = plot_head_to_tail([("recorded", rec.vehicles), (label, design.vehicles)], empirical=emp)
+    r.figure.savefig(out.path("head_to_tail.png"), dpi=110)
+    plt.close(r.figure)
+    made.append("head_to_tail.png|∏|Γ_i(jω)| of the recorded string and of the string with the "
+                "CAV(s), with the data's own first-to-last transfer |Ĝ| where coherent: above the "
+                "dashed line 1 a wave grows from the head to the tail.")
+    r = plot_replay_speeds(rp)
+    r.figure.savefig(out.path("replay_speeds.png"), dpi=110)
+    plt.close(r.figure)
+    made.append("replay_speeds.png|The recorded leader's speed and the last car's in each replay.")
+    r = plot_replay_energy(rp)
+    r.figure.savefig(out.path("replay_energy.png"), dpi=110)
+    plt.close(r.figure)
+    made.append("replay_energy.png|The acceleration energy of each follower over the leader's "
+                "(0 < ω ≤ 1 rad/s) along the string, in each replay: above 1 the wave has grown.")
+    return made
 
 
 def render_design(doc: dict[str, Any]) -> str:
