@@ -308,6 +308,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     """
     import time
 
+    import numpy as np
+
     from ..certify.api import certify_string
     from ..io import OutputDir
     from ..mixed import read_vehicles
@@ -344,6 +346,11 @@ def run_simulate(args: argparse.Namespace) -> int:
         l0[p - 1] = spec.standstill
     label = f"CAV at {','.join(str(p) for p in pos)}"
     rp = replay(rec, [(label, design.vehicles, l0)], simulator="sumo" if args.sumo else "toolkit")
+    from ..mixed.replay import probe
+
+    w_probe = recorded.peak_omega if recorded.peak_omega > 0 else 0.2
+    pr = probe([("recorded", rec.vehicles, rec.standstill), (label, design.vehicles, l0)],
+               w_probe, speed=float(np.mean(np.asarray(rp.runs[0].result.speed)[0])))
     emp = None
     try:
         from ..mixed.empirical import string_empirical
@@ -352,7 +359,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     except StringStabError:
         emp = None
     doc = {"recorded": recorded.as_dict(), "design": design.as_dict(), "replay": rp.as_dict(),
-           "empirical": None if emp is None else emp.as_dict()}
+           "probe": pr.as_dict(), "empirical": None if emp is None else emp.as_dict()}
     _describe(doc["recorded"], rec)
     _describe(doc["design"], rec)
     figures: list[str] = []
@@ -361,12 +368,15 @@ def run_simulate(args: argparse.Namespace) -> int:
         if not args.no_figures:
             figures = _figures(out, rec, design, rp, emp, label)
         names = list(out.written)
-        names += platoon_report(rec, recorded, design, rp, figures, empirical=emp,
+        names += platoon_report(rec, recorded, design, rp, figures, empirical=emp, probe=pr,
                                 command=command_line(args), started=t0).write(out)
     for r in rp.runs:
         print(f"{r.label}: energy ratio last/leader {r.band_ratio:.3g} (0 < ω ≤ 1 rad/s), "
               f"{r.energy_ratio:.3g} (all ω); peak-to-peak {r.peak_to_peak:.3g}; min gap "
               f"{r.min_gap:.3g} m; collisions {r.collisions}")
+    for lab, m_, p_ in zip(pr.labels, pr.measured, pr.predicted):
+        print(f"probe at ω = {pr.omega:.3g} rad/s, {lab}: last/leader acceleration amplitude "
+              f"{m_:.4g} simulated, {p_:.4g} from ∏|Γ_i(jω)|")
     print(f"recorded string: {recorded.verdict} (sup {recorded.sup_gain:.4g}); with {label}: "
           f"{design.certificate.verdict} (sup {design.certificate.sup_gain:.4g})")
     print(f"wrote {len(names)} files to {out.root}/ (platoon.json, figures, report.md, report.html)")

@@ -19,7 +19,11 @@ so the raw ratio says little about the waves — the band is that of the data's 
 ratio, :data:`stringstab.identify.empirical.OMEGA_MAX`), the peak-to-peak speed ratio of the
 last car to the leader, the smallest gap and the collisions.  For a linear
 string with sup ∏|Γ_i| ≤ 1 the head-to-tail energy ratio cannot exceed 1 (Parseval), up to
-the finite window and the start from equilibrium.
+the finite window and the start from equilibrium.  A recorded leader excites the frequencies
+it happens to hold; :func:`probe` drives the strings instead with a sinusoid at the
+certificate's peak frequency (around the recorded mean speed) and measures the last car's
+steady acceleration amplitude over the leader's, to set beside ∏_i |Γ_i(jω)| computed from the
+transfer functions.
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ from ..errors import StringStabError
 from .empirical import common_segments
 from .vehicles import RecordedString
 
-__all__ = ["Replay", "ReplayRun", "band_energy", "leader_of", "replay"]
+__all__ = ["Probe", "Replay", "ReplayRun", "band_energy", "leader_of", "probe", "replay"]
 
 Array = npt.NDArray[np.float64]
 
@@ -295,3 +299,94 @@ def replay(rec: RecordedString, variants: Sequence[tuple[str, tuple[Vehicle, ...
         notes.append("a simulated speed reached 0 m/s, where the simulator holds it (the loop is "
                      "not linear there)")
     return Replay(runs, simulator, seconds, leader.name, notes)
+
+
+@dataclass
+class Probe:
+    """The strings driven by a sinusoid at ω: measured and predicted amplitude ratios.
+
+    Attributes
+    ----------
+    omega : float
+        The frequency, rad/s.
+    labels : list of str
+        The strings (as in :class:`Replay`).
+    measured : list of float
+        The last car's steady acceleration amplitude over the leader's, simulated (a least-
+        squares sinusoid fitted to the last third of the run).
+    predicted : list of float
+        ∏_i |Γ_i(jω)| (:func:`stringstab.certify.frequency.gain`).
+    """
+
+    omega: float
+    labels: list[str]
+    measured: list[float]
+    predicted: list[float]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON form.
+
+        Returns
+        -------
+        dict
+        """
+        return {"omega": self.omega, "labels": self.labels, "measured": self.measured,
+                "predicted": self.predicted}
+
+
+def _amplitude(t: Array, a: Array, omega: float) -> float:
+    """The amplitude of the sinusoid of frequency ω fitted to a(t) by least squares."""
+    M = np.stack([np.sin(omega * t), np.cos(omega * t), np.ones_like(t)], axis=1)
+    coef, *_ = np.linalg.lstsq(M, a, rcond=None)
+    return float(np.hypot(coef[0], coef[1]))
+
+
+def probe(strings: Sequence[tuple[str, Sequence[Vehicle], Sequence[float]]], omega: float, *,
+          speed: float = 15.0, amplitude: float = 1.0, dt: float = 0.1,
+          periods: int = 30) -> Probe:
+    """Drive each string with v_0(t) = speed + amplitude·sin(ωt) (module docstring).
+
+    Parameters
+    ----------
+    strings : sequence of (label, vehicles, standstill)
+        The strings.
+    omega : float
+        The frequency, rad/s (> 0).
+    speed, amplitude : float
+        The leader's mean speed and speed amplitude, m/s.
+    dt : float
+        The simulator's step, s.
+    periods : int
+        The run's length in periods (at least 120 s).
+
+    Returns
+    -------
+    Probe
+    """
+    from ..certify.frequency import gain
+    from ..traffic import Limits, from_speed, simulate
+
+    w = float(omega)
+    if not (math.isfinite(w) and w > 0):
+        raise StringStabError(f"the probe's frequency must be a number > 0 rad/s; got {omega!r}")
+    T = max(120.0, periods * 2.0 * math.pi / w)
+    t = np.arange(0.0, T, dt)
+    leader = from_speed(t, speed + amplitude * np.sin(w * t), dt=dt, name=f"sine {w:.3g} rad/s")
+    limits = Limits(accel_min=-15.0, accel_max=15.0, speed_min=0.0, speed_max=70.0)
+    labels, measured, predicted = [], [], []
+    for label, vs, l0 in strings:
+        vs = tuple(vs)
+        res = simulate(leader, _controller(vs, l0), len(vs), tau=np.array([v.params.tau for v in vs]),
+                       delta=_delta(vs), limits=limits, progress=False)
+        a = np.asarray(res.accel)
+        tt = np.asarray(res.t)
+        keep = tt >= tt[-1] * 2.0 / 3.0
+        measured.append(_amplitude(tt[keep], a[-1][keep], w) / _amplitude(tt[keep], a[0][keep], w))
+        g = 1.0
+        for v in vs:
+            p = v.params
+            g *= float(gain(w, v.k_x, v.k_v, v.k_a, tau=p.tau, delta=p.delta, headway=p.headway))
+        predicted.append(g)
+        labels.append(label)
+    return Probe(w, labels, measured, predicted)
+

@@ -22,7 +22,8 @@ def _g(x: Any, digits: int = 4) -> str:
 
 
 def platoon_report(rec: Any, recorded: Any, design: Any, replay: Any, files: Sequence[str], *,
-                   empirical: Any = None, command: str, started: float | None = None) -> Report:
+                   empirical: Any = None, probe: Any = None, command: str,
+                   started: float | None = None) -> Report:
     """The report of ``stringstab platoon simulate``.
 
     Parameters
@@ -40,6 +41,8 @@ def platoon_report(rec: Any, recorded: Any, design: Any, replay: Any, files: Seq
         ``"name|caption"`` or plain names.
     empirical : StringEmpirical, optional
         The data's own head-to-tail amplification.
+    probe : Probe, optional
+        The strings driven by a sinusoid at the recorded string's peak frequency.
     command : str
         The command line.
     started : float, optional
@@ -92,6 +95,13 @@ def platoon_report(rec: Any, recorded: Any, design: Any, replay: Any, files: Seq
              "leader's acceleration), peak-to-peak speed ratio, smallest gap, collisions.")
     for n in replay.notes:
         s2.text(f"Note: {n}")
+    if probe is not None:
+        s3 = rep.section(f"A sinusoid at the peak frequency ω = {probe.omega:.3g} rad/s")
+        s3.table([{"string": lab, "simulated": m, "∏|Γ_i(jω)|": p}
+                  for lab, m, p in zip(probe.labels, probe.measured, probe.predicted)],
+                 caption="The last car's steady acceleration amplitude over the leader's when "
+                 "the leader's speed oscillates at the recorded string's peak frequency: "
+                 "simulated, and from the transfer functions.")
     figs = rep.section("Figures")
     for f in files:
         name, _, caption = str(f).partition("|")
