@@ -5,9 +5,12 @@ For ``--n`` random strings of 2-12 vehicles (seeded), the head-to-tail verdict o
 gives the whole string) is set against a check that shares no code with it:
 
 * **continuous time**: ∏_i |Γ_i(jω)| from the model's transfer function written out here in
-  complex arithmetic, Γ = (k_x + k_v s + k_a s² e^{−δs})/(τs³ + s² + (k_v + T*k_x)s + k_x),
-  on a fine grid (a log grid from 10⁻⁵ to 10³ rad/s and a linear one on [0, 20] rad/s), and
-  internal stability from ``numpy.roots`` of each cubic;
+  complex arithmetic, Γ = e^{−θ_r s}(k_x + k_v s + k_a s² e^{−δs})/(τs³ + s² +
+  e^{−θ_r s}((k_v + T*k_x)s + k_x)) (a third of the vehicles get a reaction delay θ_r ∈ (0,
+  0.5] s), on a fine grid (a log grid from 10⁻⁵ to 10³ rad/s and a linear one on [0, 20]
+  rad/s), and internal stability from ``numpy.roots`` of each cubic (θ_r = 0) or of the cubic
+  with e^{−θ_r s} replaced by its (10, 10) Padé approximant (θ_r > 0: an approximation, so a
+  disagreement there is flagged for a look, within 10⁻⁶ of the axis it is not counted);
 * **sampled data** (``--sampled-share`` of the strings, H = 0.1 s): the state-space ZOH
   discretisation with ``scipy.linalg.expm`` of ``tests/_sampled_truth.py`` (the predecessor's
   lag of each vehicle is the one ahead of it), on its θ grid, and the roots of each closed loop.
@@ -69,8 +72,11 @@ def _truth_module() -> Any:
 # ---------------------------------------------------------------------------
 # Random strings
 # ---------------------------------------------------------------------------
-def random_vehicle(rng: np.random.Generator) -> Vehicle:
-    """A follower: recorded-car-like (ACC or human, k_a = 0), CAV-like, or anything (10 %)."""
+def random_vehicle(rng: np.random.Generator, reaction: float = 0.0) -> Vehicle:
+    """A follower: recorded-car-like (ACC or human, k_a = 0), CAV-like, or anything (10 %).
+
+    With probability ``reaction`` it gets a reaction delay θ_r uniform on (0, 0.5] s.
+    """
     u = rng.random()
     if u < 0.5:
         kx, kv, ka = rng.uniform(0.02, 0.6), rng.uniform(0.05, 1.2), 0.0
@@ -81,22 +87,45 @@ def random_vehicle(rng: np.random.Generator) -> Vehicle:
     else:
         kx, kv, ka = rng.uniform(-0.2, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-1.0, 1.0)
         tau, delta, T = rng.uniform(0.02, 1.0), rng.uniform(0.0, 0.6), rng.uniform(0.0, 3.0)
-    return Vehicle(float(kx), float(kv), float(ka), Params(tau, delta, T))
+    theta = float(rng.uniform(0.0, 0.5)) if rng.random() < reaction else 0.0
+    return Vehicle(float(kx), float(kv), float(ka), Params(tau, delta, T, theta))
 
 
 def gamma_jw(omega: np.ndarray, v: Vehicle) -> np.ndarray:
     """Γ(jω) of one vehicle, from the model written out (not from the toolkit's code)."""
     s = 1j * omega
     p = v.params
-    num = v.k_x + v.k_v * s + v.k_a * s * s * np.exp(-p.delta * s)
-    den = p.tau * s ** 3 + s * s + (v.k_v + p.headway * v.k_x) * s + v.k_x
+    e = np.exp(-p.reaction_delay * s)
+    num = e * (v.k_x + v.k_v * s + v.k_a * s * s * np.exp(-p.delta * s))
+    den = p.tau * s ** 3 + s * s + e * ((v.k_v + p.headway * v.k_x) * s + v.k_x)
     return num / den
 
 
-def stable(v: Vehicle) -> bool:
-    """All roots of τs³ + s² + (k_v + T*k_x)s + k_x in Re s < 0 (``numpy.roots``)."""
+def _pade(theta: float, m: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """(num, den) of the (m, m) Padé approximant of e^{−θs}, highest power first."""
+    c = np.array([math.factorial(2 * m - k) * math.factorial(m)
+                  / (math.factorial(2 * m) * math.factorial(k) * math.factorial(m - k))
+                  for k in range(m + 1)])
+    den = c * theta ** np.arange(m + 1)
+    num = den * (-1.0) ** np.arange(m + 1)
+    return num[::-1], den[::-1]
+
+
+def stable(v: Vehicle) -> bool | None:
+    """Internally stable by ``numpy.roots`` (θ_r = 0), or by the Padé approximant (θ_r > 0).
+
+    None where a Padé root lies within 10⁻⁶ of the axis (undecided by the approximation).
+    """
     p = v.params
-    return bool(np.all(np.roots([p.tau, 1.0, v.k_v + p.headway * v.k_x, v.k_x]).real < 0))
+    P = np.array([p.tau, 1.0, 0.0, 0.0])
+    Q = np.array([v.k_v + p.headway * v.k_x, v.k_x])
+    if p.reaction_delay == 0:
+        return bool(np.all(np.roots(np.polyadd(P, Q)).real < 0))
+    num, den = _pade(p.reaction_delay)
+    roots = np.roots(np.polyadd(np.polymul(P, den), np.polymul(Q, num)))
+    if np.any(np.abs(roots.real) < 1e-6):
+        return None
+    return bool(np.all(roots.real < 0))
 
 
 def product_continuous(s: list[Vehicle], omega: np.ndarray = OMEGA) -> np.ndarray:
@@ -132,7 +161,8 @@ def near_boundary(rng: np.random.Generator, s: list[Vehicle]) -> list[Vehicle]:
     rest = product_continuous(s[:-1], grid)
 
     def peak(T: float) -> float:
-        v = Vehicle(last.k_x, last.k_v, last.k_a, Params(last.params.tau, last.params.delta, T))
+        v = Vehicle(last.k_x, last.k_v, last.k_a,
+                    Params(last.params.tau, last.params.delta, T, last.params.reaction_delay))
         return float(np.max(rest * np.abs(gamma_jw(grid, v)))) if stable(v) else math.inf
 
     lo, hi = 0.0, 5.0
@@ -143,15 +173,18 @@ def near_boundary(rng: np.random.Generator, s: list[Vehicle]) -> list[Vehicle]:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if peak(mid) > target else (lo, mid)
     T = hi
-    return [*s[:-1], Vehicle(last.k_x, last.k_v, last.k_a, Params(last.params.tau, last.params.delta, T))]
+    p = last.params
+    return [*s[:-1], Vehicle(last.k_x, last.k_v, last.k_a,
+                             Params(p.tau, p.delta, T, p.reaction_delay))]
 
 
-def strings(n: int, seed: int, near: float = 0.1) -> list[list[Vehicle]]:
+def strings(n: int, seed: int, near: float = 0.1,
+            reaction: float = 1 / 3) -> list[list[Vehicle]]:
     """``n`` seeded random strings of 2-12 vehicles, a share ``near`` placed near the boundary."""
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(n):
-        s = [random_vehicle(rng) for _ in range(int(rng.integers(2, 13)))]
+        s = [random_vehicle(rng, reaction) for _ in range(int(rng.integers(2, 13)))]
         if rng.random() < near:
             s = near_boundary(rng, s)
         out.append(s)
@@ -162,8 +195,11 @@ def strings(n: int, seed: int, near: float = 0.1) -> list[list[Vehicle]]:
 # The comparison
 # ---------------------------------------------------------------------------
 def judge(verdict: str, witness: float, stable_all: bool, unstable_any: bool, peak: float,
-          at_witness: float) -> str:
-    """``unsound``, ``sound`` or ``conservative`` (an inconclusive verdict the check would certify)."""
+          at_witness: float, undecided: bool = False) -> str:
+    """``unsound``, ``sound``, ``conservative`` (an inconclusive verdict the check would certify)
+    or ``unchecked`` (the Padé check of a delayed vehicle's stability undecided)."""
+    if undecided:
+        return "unchecked"
     if verdict == "certified":
         return "unsound" if (not stable_all or peak > 1 + TOL) else "sound"
     if verdict == "not_certified":
@@ -176,7 +212,7 @@ def judge(verdict: str, witness: float, stable_all: bool, unstable_any: bool, pe
 
 
 def run(n: int, seed: int, sampled_share: float = 0.1, near: float = 0.1,
-        chunk: int = 200) -> dict[str, Any]:
+        chunk: int = 200, reaction: float = 1 / 3) -> dict[str, Any]:
     """Certify and check ``n`` strings; return the counts (see the module docstring).
 
     Parameters
@@ -187,6 +223,8 @@ def run(n: int, seed: int, sampled_share: float = 0.1, near: float = 0.1,
         Share of the strings certified as sampled-data loops (H = 0.1 s).
     near : float
         Share placed near the boundary.
+    reaction : float
+        Share of the vehicles of continuous strings with a reaction delay θ_r > 0.
     chunk : int
         Strings per batch of the certificate.
 
@@ -198,8 +236,13 @@ def run(n: int, seed: int, sampled_share: float = 0.1, near: float = 0.1,
     """
     truth = _truth_module()
     rng = np.random.default_rng(seed + 1)
-    all_strings = strings(n, seed, near)
-    kinds = ["sampled" if rng.random() < sampled_share else "continuous" for _ in all_strings]
+    kinds = ["sampled" if rng.random() < sampled_share else "continuous" for _ in range(n)]
+    all_strings = strings(n, seed, near, reaction)
+    # the sampled loop has no reaction delay (yet): those strings drop it
+    all_strings = [s if k == "continuous" else
+                   [Vehicle(v.k_x, v.k_v, v.k_a, Params(v.params.tau, v.params.delta,
+                                                        v.params.headway)) for v in s]
+                   for s, k in zip(all_strings, kinds)]
     counts: Counter[tuple[str, str, str]] = Counter()
     unsound: list[dict[str, Any]] = []
     seconds = 0.0
@@ -222,8 +265,11 @@ def run(n: int, seed: int, sampled_share: float = 0.1, near: float = 0.1,
             seconds += time.perf_counter() - t0
             for j, (i, s) in enumerate(zip(ids, batch)):
                 verdict = ("certified", "not_certified", "inconclusive")[int(dec.verdict[j])]
+                undecided = False
                 if kind == "continuous":
-                    stab = [stable(v) for v in s]
+                    st = [stable(v) for v in s]
+                    undecided = any(x is None for x in st)
+                    stab = [bool(x) for x in st]
                     peak = float(product_continuous(s).max()) if all(stab) else math.inf
                     w = float(dec.argmin[j])
                     at_w = float(product_continuous(s, np.array([w]))[0])
@@ -233,7 +279,7 @@ def run(n: int, seed: int, sampled_share: float = 0.1, near: float = 0.1,
                             if all(stab) else math.inf)
                     w = float(dec.argmin[j])
                     at_w = float(product_sampled(truth, s, np.array([max(w, 1e-9)]), s[0].params.tau)[0])
-                j_ = judge(verdict, w, all(stab), not all(stab), peak, at_w)
+                j_ = judge(verdict, w, all(stab), not all(stab), peak, at_w, undecided)
                 counts[(kind, verdict, j_)] += 1
                 if j_ == "unsound":
                     unsound.append({"string": i, "kind": kind, "verdict": verdict, "peak": peak,
@@ -248,9 +294,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--sampled-share", type=float, default=0.1)
     ap.add_argument("--near", type=float, default=0.1, help="share placed near the boundary")
+    ap.add_argument("--reaction", type=float, default=1 / 3,
+                    help="share of continuous vehicles with a reaction delay (default 1/3)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    res = run(args.n, args.seed, args.sampled_share, args.near)
+    res = run(args.n, args.seed, args.sampled_share, args.near, reaction=args.reaction)
     counts = res["counts"]
     print(f"# {res['n']} strings of 2-12 vehicles, seed {args.seed}; load "
           + " ".join(f"{x:.2f}" for x in os.getloadavg()))

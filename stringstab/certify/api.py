@@ -558,7 +558,7 @@ def certify_string(
     ----------
     vehicles : sequence of Vehicle or mapping
         The followers in order from the head (the leader is position 0, not listed), each
-        with its own k_x, k_v, k_a, tau, delta, headway (and optional name).
+        with its own k_x, k_v, k_a, tau, delta, headway (optional reaction_delay θ_r, name).
     sample_time : float, optional
         H > 0 (s): the sampled-data loop (every vehicle sampling with period H).
     leader_tau : float, optional

@@ -106,7 +106,7 @@ class Vehicle:
     k_x, k_v, k_a : float
         Gains of IDL eq 4: k_x in 1/s², k_v in 1/s, k_a dimensionless.
     params : Params
-        τ, δ, T* (and the reaction delay θ_r once the model has it), s.
+        τ, δ, T* and the reaction delay θ_r (issue 25), s.
     name : str
         A label (the recorded car's name, ``"CAV"``, ...).
     """
@@ -119,8 +119,8 @@ class Vehicle:
 
     @property
     def reaction_delay(self) -> float:
-        """θ_r, s (0 for the models without a reaction delay)."""
-        return float(getattr(self.params, "reaction_delay", 0.0))
+        """θ_r, s (``params.reaction_delay``)."""
+        return float(self.params.reaction_delay)
 
 
 @dataclass(frozen=True)
@@ -401,29 +401,70 @@ def point_margin(parts: Sequence[Parts], scale: Array) -> tuple[Array, Array, Ar
 class ContinuousString:
     """The continuous-time loop of strings of one length (module docstring).
 
+    A vehicle slot in which some string has a reaction delay θ_r > 0 (issue 25) takes the
+    θ_r margin g_θ of :mod:`stringstab.certify.margin_reaction` (its coefficients, round-off
+    scales and proven tail; at θ_r = 0 it equals g), the generated ``reaction_gamma_parts``
+    for N_i and D_i, and the exact root count of the retarded quasi-polynomial
+    (:func:`stringstab.certify.quasipolynomial.count_unstable_roots`) for its internal
+    stability; a slot without θ_r runs the θ_r = 0 code (:mod:`stringstab.certify.margin`,
+    the Hurwitz bands).
+
     Parameters
     ----------
     arrays : StringArrays
-        The strings (θ_r = 0: the reaction delay is not part of this certificate yet).
+        The strings.
     """
 
     def __init__(self, arrays: StringArrays) -> None:
-        if np.any(arrays.reaction_delay != 0):
-            raise ValueError("the continuous head-to-tail certificate has no reaction delay yet")
+        from . import margin_reaction as _mr
+
         self.arrays = a = arrays
-        self.co = [np.asarray(_gen.margin_coefficients(a.kx[i], a.kv[i], a.ka[i], a.tau[i],
-                                                       a.delta[i], a.headway[i]), dtype=float)
-                   for i in range(a.length)]
-        self.sc = [np.asarray(_gen.margin_coefficient_scales(a.kx[i], a.kv[i], a.ka[i], a.tau[i],
-                                                             a.delta[i], a.headway[i]), dtype=float)
-                   for i in range(a.length)]
-        om = np.stack([_margin.tail_bound(*(c[r] for r in range(5))) for c in self.co])
-        self._right = om.max(axis=0)
+        self.react = [bool(np.any(a.reaction_delay[i] > 0)) for i in range(a.length)]
+        self.co: list[Array] = []
+        self.sc: list[Array] = []
+        om = []
+        for i in range(a.length):
+            args = (a.kx[i], a.kv[i], a.ka[i], a.tau[i], a.delta[i], a.headway[i])
+            if self.react[i]:
+                Q = _mr.coefficient_table(*args, a.reaction_delay[i])
+                k = _mr.N_COEFFICIENTS
+                self.co.append(Q[:k])
+                self.sc.append(Q[k:2 * k])
+                om.append(_mr.tail_bound(Q))
+            else:
+                self.co.append(np.asarray(_gen.margin_coefficients(*args), dtype=float))
+                self.sc.append(np.asarray(_gen.margin_coefficient_scales(*args), dtype=float))
+                om.append(_margin.tail_bound(*(self.co[-1][r] for r in range(5))))
+        self._right = np.stack(om).max(axis=0)
         self.scale = normalisation(a.kx, a.kv, a.tau, a.headway, self._right[None, :])
 
     def right(self) -> Array:
         """Ω per item: the largest of its vehicles' tail bounds (module docstring, step 1)."""
         return self._right
+
+    def _vehicle(self, i: int, idx: Index, x: Any, const: Callable[[Array], Any],
+                 coef: Callable[[Array, Array], Any]) -> tuple[Any, ...]:
+        """(Re N, Im N, Re D, Im D, g) of vehicle ``i`` at ``x``, in the arithmetic of ``x``."""
+        a = self.arrays
+
+        def par(v: Array) -> Any:
+            return const(v[i, idx][:, None])
+
+        co = [coef(self.co[i][r, idx][:, None], self.sc[i][r, idx][:, None])
+              for r in range(self.co[i].shape[0])]
+        if self.react[i]:
+            th = par(a.reaction_delay)
+            parts = _gen.reaction_gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
+                                              par(a.delta), par(a.headway), th, jet_cos, jet_sin)
+            zero = [0.0] * len(co)  # the scales' outputs are not used
+            g = _gen.reaction_margin_and_scale(x, *co, *zero, par(a.delta), th, jet_cos,
+                                               jet_sin)[0]
+        else:
+            parts = _gen.gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
+                                     par(a.delta), par(a.headway), jet_cos, jet_sin)
+            g = _gen.margin_from_coefficients(x, co[0], co[1], co[2], co[3], co[4], par(a.delta),
+                                              jet_cos, jet_sin)
+        return (*parts, g)
 
     def parts(self, idx: Index, x: Interval) -> list[Parts]:
         """Re N_i, Im N_i, Re D_i, Im D_i (the generated ``gamma_parts``) and g_i at ω = ``x``.
@@ -438,20 +479,13 @@ class ContinuousString:
         Returns
         -------
         list of Parts
-            Per vehicle, point intervals with their magnitude companions.
+            Per vehicle, point intervals with their magnitude companions (a coefficient of g
+            carries its round-off scale as its companion).
         """
-        a = self.arrays
         out = []
-        for i in range(a.length):
-            def par(v: Array, i: int = i) -> Interval:
-                return Interval(v[i, idx][:, None])
-
-            ren, imn, red, imd = _gen.gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
-                                                  par(a.delta), par(a.headway), jet_cos, jet_sin)
-            co = [Interval(self.co[i][r, idx][:, None], None, self.sc[i][r, idx][:, None])
-                  for r in range(5)]
-            g = _gen.margin_from_coefficients(x, co[0], co[1], co[2], co[3], co[4], par(a.delta),
-                                              jet_cos, jet_sin)
+        for i in range(self.arrays.length):
+            ren, imn, red, imd, g = self._vehicle(i, idx, x, Interval,
+                                                  lambda v, sc: Interval(v, None, sc))
             out.append(Parts(ren, imn, red, imd, g))
         return out
 
@@ -470,31 +504,34 @@ class ContinuousString:
         list of (n, d, g)
             Jets; the coefficients of g enter as enclosures of their round-off.
         """
-        a = self.arrays
         out = []
-        for i in range(a.length):
-            def par(v: Array, i: int = i) -> Jet:
-                return Jet(Enclosure(v[i, idx][:, None]))
-
-            ren, imn, red, imd = _gen.gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
-                                                  par(a.delta), par(a.headway), jet_cos, jet_sin)
-            co = [Jet(Enclosure.around(self.co[i][r, idx][:, None],
-                                       ROUNDOFF_SLACK * self.sc[i][r, idx][:, None]))
-                  for r in range(5)]
-            g = _gen.margin_from_coefficients(x, co[0], co[1], co[2], co[3], co[4], par(a.delta),
-                                              jet_cos, jet_sin)
+        for i in range(self.arrays.length):
+            ren, imn, red, imd, g = self._vehicle(
+                i, idx, x, lambda v: Jet(Enclosure(v)),
+                lambda v, sc: Jet(Enclosure.around(v, ROUNDOFF_SLACK * sc)))
             c = Jet(Enclosure(self.scale[i, idx][:, None]))
             out.append((c * (ren * ren + imn * imn), c * (red * red + imd * imd), c * g))
         return out
 
     def stability(self) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
-        """(every vehicle surely Hurwitz, some vehicle surely not), per item."""
+        """(every vehicle surely internally stable, some vehicle surely not), per item.
+
+        The Hurwitz bands (θ_r = 0) or the exact root count of the quasi-polynomial (θ_r > 0).
+        """
         a = self.arrays
         sure = np.ones(a.count, dtype=bool)
         fail = np.zeros(a.count, dtype=bool)
         for i in range(a.length):
             s, f = hurwitz_bands_kernel(a.kx[i], a.kv[i], tau=a.tau[i],  # type: ignore[arg-type]
                                         headway=a.headway[i])  # type: ignore[arg-type]
+            th = a.reaction_delay[i] > 0
+            if th.any():
+                from .quasipolynomial import count_unstable_roots
+
+                j = np.flatnonzero(th)
+                rc = count_unstable_roots(a.kx[i][j], a.kv[i][j], a.tau[i][j], a.headway[i][j],
+                                          a.reaction_delay[i][j])
+                s[j], f[j] = rc.stable, rc.unstable
             sure &= s
             fail |= f
         return sure, fail

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError, show
-from ..params import Params, as_gains, positive
+from ..params import Params, as_gains, check_reaction_delay, positive
 from ..params import sample_time as checked_sample_time
 from . import continuous
 from .head_to_tail import MAX_VEHICLES, ContinuousString, StringArrays, StringLoop, Vehicle
@@ -243,13 +243,8 @@ def _vehicle(i: int, v: Any) -> Vehicle:
                               f"{', '.join(REQUIRED)})")
     try:
         kx, kv, ka = (float(np.asarray(g).item()) for g in as_gains(rec["k_x"], rec["k_v"], rec["k_a"]))
-        theta = positive("reaction_delay (reaction delay θ_r)", rec.get("reaction_delay") or 0.0,
-                         allow_zero=True, unit=" s")
-        if theta > 0:
-            raise StringStabError(
-                f"reaction_delay = {theta:g} s: the head-to-tail certificate takes θ_r = 0 only "
-                "until the reaction-delay certificate (issue 25) is available")
-        p = Params(rec["tau"], rec["delta"], rec["headway"])
+        theta = check_reaction_delay(rec.get("reaction_delay") or 0.0)
+        p = Params(rec["tau"], rec["delta"], rec["headway"], theta)
     except (StringStabError, TypeError, ValueError) as e:
         raise StringStabError(f"{label}: {e}") from e
     return Vehicle(kx, kv, ka, p, "" if name is None else str(name))
@@ -278,7 +273,8 @@ def check_vehicles(vehicles: Any, *, sample_time: Any = None,
     StringStabError
         One line saying which vehicle and what was expected: fewer than 2 or more than
         :data:`~stringstab.certify.head_to_tail.MAX_VEHICLES` vehicles, a missing, non-finite
-        or out-of-range value, a reaction delay (not yet certified), a bad sample time.
+        or out-of-range value, a bad sample time, a reaction delay with a sample time (the
+        sampled loop has none yet).
 
     Examples
     --------
@@ -297,6 +293,13 @@ def check_vehicles(vehicles: Any, *, sample_time: Any = None,
         raise StringStabError(f"a string has at most {MAX_VEHICLES} vehicles; got {len(vs)}")
     out = tuple(_vehicle(i, v) for i, v in enumerate(vs, start=1))
     H = None if sample_time is None else checked_sample_time(sample_time)
+    if H is not None:
+        late = [f"{i} ({v.name})" if v.name else str(i) for i, v in enumerate(out, start=1)
+                if v.reaction_delay > 0]
+        if late:
+            raise StringStabError(
+                f"vehicle {', '.join(late)} has a reaction delay θ_r > 0: the sampled-data loop "
+                "is certified with θ_r = 0 only so far (issue 25 part 3); drop --sample-time")
     if leader_tau is not None and H is None:
         raise StringStabError("leader_tau (the leader's lag) is for the sampled loop; got it "
                               "without sample_time")
@@ -324,7 +327,11 @@ def _vehicle_certificates(vehicles: Sequence[Vehicle], sample_time: float | None
     for i, v in enumerate(vehicles):
         kx, kv, ka = (np.array([x]) for x in (v.k_x, v.k_v, v.k_a))
         p = v.params
-        if sample_time is None:
+        if sample_time is None and p.reaction_delay > 0:
+            from . import reaction
+
+            out.append(reaction.certify_kernel(kx, kv, ka, p)[0])
+        elif sample_time is None:
             out.append(continuous.certify_kernel(kx, kv, ka, p)[0])
         else:
             from . import sampled
@@ -337,14 +344,15 @@ def _vehicle_certificates(vehicles: Sequence[Vehicle], sample_time: float | None
 def _reason(dec: StringDecision, j: int, vehicles: Sequence[Vehicle], certificates: Sequence[Any],
             x_to_omega: float) -> str:
     v = int(dec.verdict[j])
-    loop = "Schur" if x_to_omega != 1.0 else "Hurwitz"
+    loop = ("a pole on or outside the unit circle" if x_to_omega != 1.0
+            else "a pole in the closed right half-plane")
     if dec.unstable[j] or not dec.stable[j]:
         bad = [f"{i} ({vv.name})" if vv.name else str(i)
                for i, (vv, c) in enumerate(zip(vehicles, certificates), start=1)
                if not (c.hurwitz if hasattr(c, "hurwitz") else c.schur)]
         which = ", ".join(bad) if bad else "?"
         if v == NOT_CERTIFIED:
-            return f"vehicle {which} is not internally stable (not {loop}): the string is not"
+            return f"vehicle {which} is not internally stable ({loop}): the string is not"
         return (f"vehicle {which} is within 10^-12 of the internal-stability boundary: "
                 "undecided")
     if v == CERTIFIED:

@@ -215,20 +215,17 @@ def _span(args: argparse.Namespace) -> tuple[int, int] | None:
 
 def _cav_spec(args: argparse.Namespace) -> Any:
     from ..mixed.cav import CavSpec
-    from ..params import check_params, parse_interval, positive
+    from ..params import check_params, check_reaction_delay, parse_interval, positive
 
     tau, delta, headway = check_params(args.cav_tau, args.cav_delta, args.cav_headway)
-    theta = positive("--cav-reaction-delay", args.cav_reaction_delay, allow_zero=True, unit=" s")
-    if theta > 0:
-        raise StringStabError(
-            f"--cav-reaction-delay {theta:g}: the head-to-tail certificate takes θ_r = 0 only "
-            "until the reaction-delay certificate (issue 25) is available")
+    theta = check_reaction_delay(args.cav_reaction_delay, "--cav-reaction-delay")
     lo, hi = parse_interval(args.gain_bounds, "--gain-bounds")
     min_kx = positive("--min-kx", args.min_kx, allow_zero=True, unit=" 1/s²")
     if max(lo, min_kx) > hi:
         raise StringStabError(f"--gain-bounds {args.gain_bounds} leaves no k_x >= --min-kx "
                               f"{min_kx:g}")
-    return CavSpec(tau=tau, delta=delta, headway=headway, bounds=(lo, hi), min_kx=min_kx)
+    return CavSpec(tau=tau, delta=delta, headway=headway, reaction_delay=theta, bounds=(lo, hi),
+                   min_kx=min_kx)
 
 
 def _cav_positions(text: str, n: int) -> tuple[int, ...] | None:
@@ -273,6 +270,7 @@ def run_design(args: argparse.Namespace) -> int:
     doc = d.as_dict()
     _describe(doc, rec)
     doc["design"]["cav"] = {"tau": spec.tau, "delta": spec.delta, "headway": spec.headway,
+                            "reaction_delay": spec.reaction_delay,
                             "gain_bounds": list(spec.bounds), "min_kx": spec.min_kx}
     if args.format == "json":
         json.dump(doc, sys.stdout, indent=2, allow_nan=False)
@@ -423,6 +421,7 @@ def render_design(doc: dict[str, Any]) -> str:
     ds = doc["design"]
     cav = ds["cav"]
     lines = [f"# CAV: τ = {cav['tau']:g} s, δ = {cav['delta']:g} s, T* = {cav['headway']:g} s, "
+             + (f"θ_r = {cav['reaction_delay']:g} s, " if cav.get("reaction_delay") else "") +
              f"gains in [{cav['gain_bounds'][0]:g}, {cav['gain_bounds'][1]:g}], k_x >= {cav['min_kx']:g}",
              f"# design at position(s) {','.join(str(p) for p in ds['cav_positions'])}: "
              + ("certified" if ds["certified"] else "NOT certified") + f" - {ds['note']}"]
@@ -551,11 +550,14 @@ def render_certify(doc: dict[str, Any]) -> str:
              TableColumn("k_x[1/s²]", "k_x", "%.4g"), TableColumn("k_v[1/s]", "k_v", "%.4g"),
              TableColumn("k_a", "k_a", "%.4g"), TableColumn("τ[s]", "tau", "%.4g"),
              TableColumn("δ[s]", "delta", "%.4g"), TableColumn("T*[s]", "headway", "%.4g"),
+             *([TableColumn("θ_r[s]", "reaction_delay", "%.4g", missing="0")]
+               if any(r.get("reaction_delay") for r in doc["vehicles"]) else []),
              TableColumn("stable", "stable"), TableColumn("verdict", "verdict", "%s"),
              TableColumn("sup|Γ|", "sup_gain", "%.5g", missing="inf"),
              TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g")]
     rows = [{k: r.get(k) for k in ("position", "name", "k_x", "k_v", "k_a", "tau", "delta",
-                                    "headway", "stable", "verdict", "sup_gain", "peak_omega")}
+                                    "headway", "reaction_delay", "stable", "verdict", "sup_gain",
+                                    "peak_omega")}
             for r in doc["vehicles"]]
     text = format_results(columns_from_records(rows), "table", table=table)
     return "\n".join(lines) + "\n" + text

@@ -33,6 +33,8 @@ class CavSpec:
         Communication delay δ on the predecessor's acceleration, s (IDL Table 2: 0.2 s).
     headway : float
         Desired time headway T*, s (IDL Table 2: 1.1 s).
+    reaction_delay : float
+        The CAV's reaction (actuation) delay θ_r, s (issue 25; default 0).
     bounds : (float, float)
         Bounds of each gain (IDL Table 2: [−2, 2]).
     min_kx : float
@@ -50,6 +52,7 @@ class CavSpec:
     tau: float = constants.TAU
     delta: float = constants.DELTA
     headway: float = constants.HEADWAY
+    reaction_delay: float = 0.0
     bounds: tuple[float, float] = constants.GAIN_BOUNDS
     min_kx: float = 0.01
     hurwitz_margin: float = 1e-3
@@ -57,8 +60,8 @@ class CavSpec:
     name: str = "CAV"
 
     def params(self) -> Params:
-        """τ, δ, T* as checked :class:`~stringstab.params.Params`."""
-        return Params(self.tau, self.delta, self.headway)
+        """τ, δ, T*, θ_r as checked :class:`~stringstab.params.Params`."""
+        return Params(self.tau, self.delta, self.headway, self.reaction_delay)
 
     def lower(self) -> npt.NDArray[np.float64]:
         """The lower bounds of (k_x, k_v, k_a): k_x ≥ max(bounds[0], min_kx).

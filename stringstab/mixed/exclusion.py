@@ -1,7 +1,8 @@
 r"""A proof that no gains of one CAV at a position certify the string: a branch and bound in K.
 
-If the string with a CAV of gains K is certified, the CAV is internally stable — k_x > 0 and
-k_v + (T* − τ)k_x > 0 (its Hurwitz conditions) — and G(ω; K) ≥ 0 at every ω ≥ 0 (the
+If the string with a CAV of gains K is certified, the CAV is internally stable — k_x > 0 (else
+D(0) = k_x ≤ 0 and D(s) → ∞ as s → +∞ put a real root in s ≥ 0) and, without a reaction delay,
+k_v + (T* − τ)k_x > 0 (its other Hurwitz condition) — and G(ω; K) ≥ 0 at every ω ≥ 0 (the
 telescoping margin of :mod:`stringstab.certify.head_to_tail`, continuous at 0).  So a box of
 gains in which every K violates one of these at one of finitely many frequencies ω_j holds
 no certifiable K.  For one CAV, G(ω_j; K) is a quadratic form q_j(K) in its gains
@@ -168,8 +169,9 @@ def prove_no_cav(vehicles: Sequence[Vehicle], pos: int, spec: CavSpec, *,
         examined += lo.shape[0]
         # the CAV's Hurwitz conditions k_x > 0 and k_v + (T* − τ) k_x > 0 fail on the whole box
         kx_max = hi[:, 0]
-        c_max = hi[:, 1] + np.maximum(T * lo[:, 0], T * hi[:, 0])
-        out = (kx_max <= 0) | (c_max <= 0)
+        out = kx_max <= 0  # D(0) = k_x ≤ 0: a root at s ≥ 0, with or without θ_r
+        if spec.reaction_delay == 0:
+            out |= (hi[:, 1] + np.maximum(T * lo[:, 0], T * hi[:, 0])) <= 0
         up = quadratic_upper(forms, lo, hi)
         out |= np.any(up < -slack[None, :], axis=1)
         lo, hi = lo[~out], hi[~out]

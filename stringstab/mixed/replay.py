@@ -237,10 +237,19 @@ def _delta(vehicles: Sequence[Vehicle]) -> float:
     return ds.pop() if ds else 0.0
 
 
+def _no_reaction_delay(vehicles: Sequence[Vehicle]) -> None:
+    late = [v.name or str(i) for i, v in enumerate(vehicles, start=1) if v.reaction_delay > 0]
+    if late:
+        raise StringStabError(
+            f"the simulator has no reaction delay yet (issue 25, part 5); vehicle(s) "
+            f"{', '.join(late)} have θ_r > 0: certify and design with it, replay without")
+
+
 def _run(label: str, leader: Any, vehicles: tuple[Vehicle, ...], standstill: Sequence[float],
          simulator: str) -> ReplayRun:
     from ..traffic import Limits, simulate
 
+    _no_reaction_delay(vehicles)
     limits = Limits(accel_min=-15.0, accel_max=15.0, speed_min=0.0, speed_max=70.0)
     tau = np.array([v.params.tau for v in vehicles])
     ctrl = _controller(vehicles, standstill)
@@ -376,6 +385,7 @@ def probe(strings: Sequence[tuple[str, Sequence[Vehicle], Sequence[float]]], ome
     labels, measured, predicted = [], [], []
     for label, vs, l0 in strings:
         vs = tuple(vs)
+        _no_reaction_delay(vs)
         res = simulate(leader, _controller(vs, l0), len(vs), tau=np.array([v.params.tau for v in vs]),
                        delta=_delta(vs), limits=limits, progress=False)
         a = np.asarray(res.accel)
