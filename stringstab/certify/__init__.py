@@ -29,7 +29,11 @@ bound (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
 (:mod:`~stringstab.certify.criteria`), |Γ(jω)| (:mod:`~stringstab.certify.frequency`) and
 sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screen
 (:mod:`~stringstab.certify.screen`) and the certified points of a grid of gains
-(:mod:`~stringstab.certify.grid`).
+(:mod:`~stringstab.certify.grid`).  Strings of different vehicles are certified head to tail
+(:func:`~stringstab.certify.api.certify_string`: :mod:`~stringstab.certify.head_to_tail`,
+:mod:`~stringstab.certify.head_to_tail_sampled`, :mod:`~stringstab.certify.string_decision`,
+:mod:`~stringstab.certify.string_certificate`, on the interval jets of
+:mod:`~stringstab.certify.interval_jets`).
 
 The function :func:`certify` and this subpackage share a name: ``stringstab.certify`` is the
 function (the façade binds it); import the modules with ``from stringstab.certify import
