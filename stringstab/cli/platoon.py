@@ -382,10 +382,10 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 
 def _figures(out: Any, rec: Any, design: Any, rp: Any, emp: Any, label: str) -> list[str]:
-    from ..plots._common import pyplot
+    import matplotlib.pyplot as plt
+
     from ..plots.mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
 
-    plt = pyplot()
     made = []
     r = plot_head_to_tail([("recorded", rec.vehicles), (label, design.vehicles)], empirical=emp)
     r.figure.savefig(out.path("head_to_tail.png"), dpi=110)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError, show
-from ..identify.empirical import Empirical, empirical_transfer
+from ..identify.empirical import COHERENCE_MIN, OMEGA_MAX, Empirical, empirical_transfer
 from ..io.platoon_logs import PlatoonLog, Segment, clean_segments
 from .vehicles import RecordedString
 
@@ -49,6 +49,16 @@ class StringEmpirical:
     segments: list[Segment]
     dt: float
     log: PlatoonLog
+
+    @property
+    def coherence_min(self) -> float:
+        """The coherence below which a frequency is noise (identify's threshold)."""
+        return float(COHERENCE_MIN)
+
+    @property
+    def omega_max(self) -> float:
+        """The highest frequency describing the cars, rad/s (identify's band)."""
+        return float(OMEGA_MAX)
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON form: the peak |Ĝ|, where, ± 2ε, the data's word, p2p, energy, seconds used.

@@ -61,13 +61,12 @@ def plot_head_to_tail(strings: Sequence[tuple[str, Sequence[Any]]], *, empirical
         peaks[label] = (float(w[j]), float(g[j]))
     emp = None
     if empirical is not None:
-        from ..identify.empirical import COHERENCE_MIN, OMEGA_MAX
-
         e = empirical.empirical
-        ok = (e.omega > 0) & (e.coherence >= COHERENCE_MIN) & (e.omega <= OMEGA_MAX)
+        cmin, wmax = empirical.coherence_min, empirical.omega_max
+        ok = (e.omega > 0) & (e.coherence >= cmin) & (e.omega <= wmax)
         (emp,) = ax.semilogx(e.omega[ok], np.abs(e.transfer[ok]), "k.", ms=5,
-                             label=f"data |Ĝ| first → last car (coherence ≥ {COHERENCE_MIN:g}, "
-                                   f"ω ≤ {OMEGA_MAX:g} rad/s)")
+                             label=f"data |Ĝ| first → last car (coherence ≥ {cmin:g}, "
+                                   f"ω ≤ {wmax:g} rad/s)")
     ax.axhline(1.0, color="0.5", lw=0.8, ls="--")
     ax.set_xlabel("ω [rad/s]")
     ax.set_ylabel("∏ |Γ_i(jω)|  (head to tail)")
