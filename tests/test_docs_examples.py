@@ -93,6 +93,9 @@ NOT_RUN: dict[str, str] = {
         "the probe on small strings",
     "platoon design --from runs/acc/identify.json --cav-at auto": "designs every position and "
         "pair of the string (minutes); tests/test_platoon_cli.py runs single designs",
+    "platoon design --from runs/acc/identify.json --cav-at 1": "a full design search (bisection "
+        "of NLPs, ~20 s of CPU, a minute under load); the quick `--cav-at 5` example runs, and "
+        "tests/test_platoon_cli.py runs certified designs on small strings",
 }
 
 

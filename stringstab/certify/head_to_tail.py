@@ -456,9 +456,10 @@ class ContinuousString:
             th = par(a.reaction_delay)
             parts = _gen.reaction_gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
                                               par(a.delta), par(a.headway), th, jet_cos, jet_sin)
-            zero = [0.0] * len(co)  # the scales' outputs are not used
-            g = _gen.reaction_margin_and_scale(x, *co, *zero, par(a.delta), th, jet_cos,
-                                               jet_sin)[0]
+            z = 0.0  # the scales' output is not used
+            g = _gen.reaction_margin_and_scale(x, co[0], co[1], co[2], co[3], co[4], co[5], co[6],
+                                               co[7], z, z, z, z, z, z, z, z, par(a.delta), th,
+                                               jet_cos, jet_sin)[0]
         else:
             parts = _gen.gamma_parts(x, par(a.kx), par(a.kv), par(a.ka), par(a.tau),
                                      par(a.delta), par(a.headway), jet_cos, jet_sin)

@@ -356,10 +356,11 @@ def run_simulate(args: argparse.Namespace) -> int:
         emp = string_empirical(rec)
     except StringStabError:
         emp = None
-    doc = {"recorded": recorded.as_dict(), "design": design.as_dict(), "replay": rp.as_dict(),
+    rec_doc, des_doc = recorded.as_dict(), design.as_dict()
+    _describe(rec_doc, rec)
+    _describe(des_doc, rec)
+    doc = {"recorded": rec_doc, "design": des_doc, "replay": rp.as_dict(),
            "probe": pr.as_dict(), "empirical": None if emp is None else emp.as_dict()}
-    _describe(doc["recorded"], rec)
-    _describe(doc["design"], rec)
     figures: list[str] = []
     with out:
         out.write_json("platoon.json", doc)

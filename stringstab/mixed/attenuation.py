@@ -46,7 +46,7 @@ def scan_grid(vehicles: Sequence[Vehicle]) -> Array:
 
 
 def terms(strings: Sequence[Sequence[Vehicle]],
-          omega: Array) -> tuple[Array, Array, Array, Array]:
+          omega: Array) -> tuple[Array, Array, Array, npt.NDArray[np.bool_]]:
     """G, its round-off bound, ∏ d_i and internal stability, per string (row) and ω (column).
 
     G is the telescoping margin of :mod:`stringstab.certify.head_to_tail` without the
@@ -72,7 +72,7 @@ def terms(strings: Sequence[Sequence[Vehicle]],
     X = np.ascontiguousarray(np.broadcast_to(omega, (n, omega.size)))
     parts = loop.parts(np.arange(n), Interval(X))
     G, E, _ = point_margin(parts, np.ones((len(parts), 1, 1)))
-    D = np.ones(X.shape)
+    D: Array = np.ones(X.shape)
     for p in parts:
         D = D * square_sum(p.re_d, p.im_d)[0]
     stable, _ = loop.stability()

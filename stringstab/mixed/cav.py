@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -96,7 +97,7 @@ class CavSpec:
         """
         return np.asarray(np.clip(np.asarray(K, dtype=float), self.lower(), self.upper()))
 
-    def vehicle(self, K: Sequence[float]) -> Vehicle:
+    def vehicle(self, K: Any) -> Vehicle:
         """The CAV with gains K = (k_x, k_v, k_a).
 
         Parameters
@@ -112,7 +113,7 @@ class CavSpec:
 
 
 def string_with_cavs(vehicles: Sequence[Vehicle], positions: Sequence[int],
-                     gains: Sequence[Sequence[float]], spec: CavSpec) -> tuple[Vehicle, ...]:
+                     gains: Sequence[Any], spec: CavSpec) -> tuple[Vehicle, ...]:
     """The string with the followers at ``positions`` replaced by CAVs with ``gains``.
 
     Parameters

@@ -131,9 +131,11 @@ def _stability_slots(spec: CavSpec) -> list[Any]:
     # the Hurwitz conditions of the cubic hold for θ_r = 0 only; with θ_r the root count of the
     # certificate judges (k_x ≥ min_kx below stays necessary: k_x ≤ 0 puts a root in s ≥ 0)
     for i in range(2 if spec.reaction_delay == 0 else 0):
-        form = quadratic_form(lambda kx, kv, ka, i=i: np.asarray(
-            hurwitz_conditions(kx, kv, ka, tau=spec.tau, headway=spec.headway)[i], dtype=float)
-            * np.ones_like(kx))
+        def cond(kx: Array, kv: Array, ka: Array, i: int = i) -> Array:
+            return np.asarray(hurwitz_conditions(kx, kv, ka, tau=spec.tau, headway=spec.headway)[i],
+                              dtype=float) * np.ones_like(kx)
+
+        form = quadratic_form(cond)
         out.append(Slot("stability", m, math.nan, i, form))
     # k_x ≥ min_kx, as a stability row (its lower bound is the Hurwitz margin m):
     # k_x − min_kx + m ≥ m

@@ -88,7 +88,7 @@ class ReplayRun:
     @property
     def cumulative(self) -> Array:
         """The energy ratio of each follower to the leader along the string (∏_{i≤k} m_p)."""
-        return np.cumprod(self.m_p)
+        return np.asarray(np.cumprod(self.m_p), dtype=float)
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON form (no trajectories).
