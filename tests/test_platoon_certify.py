@@ -238,7 +238,7 @@ def test_sampled_strings_take_the_predecessors_lag():
     ([ACC, dict(CAV, k_x=float("nan"))], "vehicle 2: k_x must be finite"),
     ([dict(ACC, tau=-0.5), CAV], "vehicle 1: tau .* must be a finite number > 0"),
     ([ACC, dict(CAV, headway=1e9)], "vehicle 2: .*far outside"),
-    ([ACC, dict(CAV, reaction_delay=0.3, name="cav")], r"vehicle 2 \(cav\): reaction_delay"),
+    ([ACC, dict(CAV, reaction_delay=-0.3, name="cav")], r"vehicle 2 \(cav\): reaction_delay"),
     ("ACC", "sequence of vehicles"),
 ])
 def test_bad_strings_are_refused_in_one_line(vehicles, match):
@@ -250,3 +250,20 @@ def test_bad_strings_are_refused_in_one_line(vehicles, match):
 def test_leader_tau_needs_a_sample_time():
     with pytest.raises(StringStabError, match="leader_tau"):
         certify_string([ACC, CAV], leader_tau=0.3)
+
+
+def test_a_reaction_delay_per_vehicle():
+    # θ_r enters each vehicle's own Γ_i (issue 25): the head-to-tail verdict follows the grid
+    # of the written-out model, and the sampled loop refuses it in one line
+    for theta, verdict in ((0.05, "certified"), (0.5, "not_certified")):
+        vs = [ACC, dict(CAV, reaction_delay=theta)]
+        c = certify_string(vs)
+        assert c.verdict == verdict
+        model = [Vehicle(d["k_x"], d["k_v"], d["k_a"],
+                         Params(d["tau"], d["delta"], d["headway"], d.get("reaction_delay", 0.0)))
+                 for d in vs]
+        peak = VALIDATE.product_continuous(model).max()
+        assert (peak <= 1 + 1e-9) == (verdict == "certified")
+        assert c.certificates[1].params.reaction_delay == theta
+    with pytest.raises(StringStabError, match="reaction delay"):
+        certify_string([ACC, dict(CAV, reaction_delay=0.1)], sample_time=0.1)
