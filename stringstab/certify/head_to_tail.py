@@ -345,7 +345,8 @@ def point_margin(parts: Sequence[Parts], scale: Array) -> tuple[Array, Array, Ar
     G : ndarray
         Σ_k (∏_{i<k} c_i n_i) c_k g_k (∏_{i>k} c_i d_i).
     slack : ndarray
-        A bound on |G computed − G exact| (``inf`` where a factor is 0 or the bound fails).
+        A bound on |G computed − G exact| (``inf`` where a product of factors is computed as
+        0 — a factor computed as 0, or an underflow — or the bound fails).
     gain2 : ndarray
         ∏_i n_i/d_i = ∏_i |Γ_i|² (reporting; NaN where a d_i = 0).
     """
@@ -384,7 +385,9 @@ def point_margin(parts: Sequence[Parts], scale: Array) -> tuple[Array, Array, Ar
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             rho1 = np.where(rho < 0.5, rho / (1.0 - np.minimum(rho, 0.5)), np.inf)
             Ek = np.abs(A) * (rho1 * (np.abs(gs[k]) + ge[k]) + ge[k])
-        Ek = np.where(A == 0, 0.0, Ek) + 2.0 * _U * np.abs(T)
+        # a product computed as 0 (a factor computed as 0, or an underflow) bounds nothing:
+        # the point is left undecided (its slack infinite)
+        Ek = np.where(A == 0, np.inf, Ek) + 2.0 * _U * np.abs(T)
         G = G + T
         E = E + Ek
         T_abs = T_abs + np.abs(T)
