@@ -2,7 +2,8 @@
 
 Independent truths: ∏|Γ_i(jω)| of the written-out model on a fine grid
 (``analysis/platoon_validate.py``), the toolkit's time-domain simulator against the transfer
-functions (a sinusoid's steady amplitude), and random gains against the exclusion proof.
+functions (a sinusoid's steady amplitude), the recorded leader's replay in Eclipse SUMO against
+the toolkit's simulator, and random gains against the exclusion proof.
 """
 
 from __future__ import annotations
@@ -202,3 +203,32 @@ def test_simulate_needs_an_identify_json(tmp_path):
         from stringstab.mixed.replay import leader_of
 
         leader_of(read_vehicles(_identify_json(tmp_path, [1, 2])))
+
+
+@pytest.mark.slow
+def test_the_recorded_leader_replayed_in_sumo_matches_the_toolkit(tmp_path):
+    """The replay's two simulators, SUMO and the toolkit's exact-ZOH one, agree (issue 27, item 4)."""
+    pytest.importorskip("libsumo", reason="needs the optional extra 'sumo' (pip install 'stringstab[sumo]')")
+    from stringstab.mixed.replay import replay
+
+    log = ROOT / "stringstab" / "data" / "openacc" / "zalazone_acc_short_dynamic_part1.csv.gz"
+    # the first two recorded followers, with the ACC log's identified parameters (rounded)
+    vs = [{"platoon": 0, "position": p, "name": n, "predecessor": q, "k_x": kx, "k_v": kv,
+           "k_a": 0.0, "tau": tau, "delta": 0.0, "headway": 0.0, "standstill": l0}
+          for p, n, q, kx, kv, tau, l0 in ((1, "MERCEDES_GLE450", "SMART_TARGET", 0.125, 0.349, 0.76, 15.0),
+                                           (2, "JAGUAR_I_PACE", "MERCEDES_GLE450", 0.15, 0.45, 0.6, 13.0))]
+    path = write(tmp_path, json.dumps({"command": "identify", "vehicles": vs, "skipped": [],
+                                       "sources": [str(log)]}), "identify.json")
+    rec = read_vehicles(path)
+    cav = (rec.vehicles[0], Vehicle(0.3, 1.0, 0.5, Params(0.1, 0.2, 1.1), "cav"))
+    variants = [("cav", cav, list(rec.standstill))]
+    toolkit = replay(rec, variants, simulator="toolkit")
+    sumo = replay(rec, variants, simulator="sumo")
+    assert toolkit.seconds > 500 and sumo.simulator == "sumo"
+    for a, b in zip(toolkit.runs, sumo.runs):
+        assert np.allclose(b.m_p, a.m_p, rtol=0.01)
+        assert b.band_ratio == pytest.approx(a.band_ratio, rel=0.01)
+        assert b.min_gap == pytest.approx(a.min_gap, abs=0.1)
+        assert b.collisions == a.collisions == 0
+    # the CAV changes the second follower's m_p: the comparison covers two different strings
+    assert toolkit.runs[1].m_p[1] != pytest.approx(toolkit.runs[0].m_p[1], rel=0.05)
