@@ -88,6 +88,14 @@ NOT_RUN: dict[str, str] = {
     "sweep analysis/sweeps/certificate": "minutes of certificates on a local cluster; "
         "tests/test_sweep_run.py runs tiny sweeps on one",
     "demo ": "the whole pipeline, a few minutes; tests/test_demo*.py run its steps",
+    "platoon simulate ": "designs a CAV and replays ~550 s of the recorded leader twice and a "
+        "probe (~30 s of CPU, minutes under load); tests/test_platoon_cli.py runs the design and "
+        "the probe on small strings",
+    "platoon design --from runs/acc/identify.json --cav-at auto": "designs every position and "
+        "pair of the string (minutes); tests/test_platoon_cli.py runs single designs",
+    "platoon design --from runs/acc/identify.json --cav-at 1": "a full design search (bisection "
+        "of NLPs, ~20 s of CPU, a minute under load); the quick `--cav-at 5` example runs, and "
+        "tests/test_platoon_cli.py runs certified designs on small strings",
 }
 
 

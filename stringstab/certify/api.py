@@ -37,10 +37,13 @@ from .continuous import Certificate, CertificateBatch
 from .verdicts import Check, one_triple
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from .robust import RobustCertificate, RobustCertificateBatch
     from .sampled import SampledCertificate, SampledCertificateBatch
+    from .string_certificate import StringCertificate
 
-__all__ = ["Loop", "LoopKind", "certify", "certify_batch", "check", "gains"]
+__all__ = ["Loop", "LoopKind", "certify", "certify_batch", "certify_string", "check", "gains"]
 
 Array = npt.NDArray[np.float64]
 #: Which certificate answers: the continuous-time loop, the sampled-data loop, or a box.
@@ -538,3 +541,57 @@ def certify(
                    reaction_delay)
     return _certify(loop, *gains([k_x], [k_v], [k_a]), pade_order=pade_order, progress=False,
                     chunk=4096, n_grid=None, max_rounds=30, max_intervals=1024)[0]
+
+
+def certify_string(
+    vehicles: Sequence[Any], *, sample_time: float | None = None, leader_tau: float | None = None,
+    substrings: bool = True, n_grid: int | None = None, max_rounds: int = 30,
+    max_intervals: int = 4096,
+) -> StringCertificate:
+    """Certify a heterogeneous string head to tail: every vehicle stable and sup ∏|Γ_i| ≤ 1.
+
+    The sound certificate of :mod:`stringstab.certify.head_to_tail` (the telescoping margin,
+    the one branch and bound, exact delays), each vehicle's own certificate, and the worst
+    sub-string (:mod:`stringstab.certify.string_certificate`).
+
+    Parameters
+    ----------
+    vehicles : sequence of Vehicle or mapping
+        The followers in order from the head (the leader is position 0, not listed), each
+        with its own k_x, k_v, k_a, tau, delta, headway (optional reaction_delay θ_r, name).
+    sample_time : float, optional
+        H > 0 (s): the sampled-data loop (every vehicle sampling with period H).
+    leader_tau : float, optional
+        Sampled loop only: the leader's lag (the first follower's predecessor), default the
+        first follower's.
+    substrings : bool
+        Also certify every run of consecutive vehicles (the worst sub-string).
+    n_grid, max_rounds, max_intervals : int
+        The branch and bound's initial intervals (default 64 + 8N), rounds and cap on
+        undecided intervals per string.
+
+    Returns
+    -------
+    StringCertificate
+
+    Raises
+    ------
+    StringStabError
+        On fewer than 2 vehicles, a missing, non-finite or out-of-range parameter (the message
+        names the vehicle), or a bad sample time.
+
+    Examples
+    --------
+    >>> acc = {"k_x": 0.1, "k_v": 0.3, "k_a": 0.0, "tau": 0.5, "delta": 0.0, "headway": 1.5}
+    >>> cav = {"k_x": 0.5, "k_v": 1.0, "k_a": 0.6, "tau": 0.2, "delta": 0.2, "headway": 2.0}
+    >>> c = certify_string([acc, cav])
+    >>> c.verdict, c.certificates[0].verdict, round(c.certificates[0].sup_gain, 4)
+    ('certified', 'not_certified', 1.1243)
+    >>> c.worst_substring.first, c.worst_substring.last, c.worst_substring.verdict
+    (1, 1, 'not_certified')
+    """
+    from .string_certificate import certify_string_kernel, check_vehicles
+
+    vs, H, lt = check_vehicles(vehicles, sample_time=sample_time, leader_tau=leader_tau)
+    return certify_string_kernel(vs, sample_time=H, leader_tau=lt, substrings=substrings,
+                                 n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
