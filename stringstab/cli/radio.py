@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import itertools
 import math
 import sys
 from typing import Any
@@ -22,7 +23,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import StringStabError, show
-from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, integer, limits_from_args
+from ._common import (
+    add_limit_arguments,
+    add_vehicle_arguments,
+    checked_leaders,
+    integer,
+    limits_from_args,
+)
 from ._loop import add_loop_arguments, radio_from_args, reaction_from_args
 
 __all__ = ["DEFAULT_TRIPLES", "FILES", "MAX_VEHICLES", "add_parser", "float_or", "run", "summary_lines"]
@@ -85,6 +92,8 @@ def add_parser(sub: Any) -> None:
     add_limit_arguments(p)
     add_loop_arguments(p, loss=False)
     p.set_defaults(func=run, message_period="0.1")
+    period = next(a for a in p._actions if a.dest == "message_period")
+    period.help = f"{period.help} (default 0.1: 10 Hz, as ETSI CAM / SAE BSM)"
 
 
 def _list(option: str, text: str) -> list[str]:
@@ -103,7 +112,7 @@ def _point(args: argparse.Namespace, loss: str, burst: str | None, dt: float) ->
 
 def _increasing(option: str, items: list[str]) -> None:
     x = [float(t) for t in items]
-    if any(b <= a for a, b in zip(x, x[1:], strict=False)):
+    if any(b <= a for a, b in itertools.pairwise(x)):
         raise StringStabError(f"{option} must be strictly increasing; got {','.join(items)}")
 
 

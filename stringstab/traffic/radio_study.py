@@ -221,7 +221,7 @@ class RadioStudy:
         values = {"amplification": self.amplification, "gain_first": self.gain_first,
                   "gain_leader": self.gain_leader}[metric]
         level = float(self.settings.get("level", 0.95))
-        out = np.empty(values.shape[:-1] + (3,))
+        out = np.empty((*values.shape[:-1], 3))
         for idx in np.ndindex(*values.shape[:-1]):
             out[idx] = t_interval(values[idx], level)
         return out
@@ -439,7 +439,7 @@ def run_radio_study(
     if not np.isfinite(K).all():
         raise StringStabError(f"gains must be finite (k_x, k_v, k_a) triples; got {show(K.tolist())}")
     shape = (len(K), len(b), len(p), seeds)
-    mp = np.full(shape + (n_followers,), np.nan)
+    mp = np.full((*shape, n_followers), np.nan)
     gf, gl, ls, fs = (np.full(shape, np.nan) for _ in range(4))
     coll = np.zeros(shape, dtype=np.int64)
     noise = None if sensors is None else dataclasses.replace(sensors, seed=seed)
