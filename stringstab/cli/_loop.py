@@ -24,7 +24,7 @@ RADIO_FLAGS = ("message_period", "message_phase", "loss", "burst", "stale_after"
 
 
 def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True,
-                       loss: bool = True) -> None:
+                       loss: bool = True, message_period_note: str = "") -> None:
     """``--reaction-delay`` and the radio and sensor options (values checked later).
 
     Parameters
@@ -36,6 +36,8 @@ def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True,
     loss : bool
         Also add ``--loss`` and ``--burst`` (False where the command defines them, e.g. as the
         lists ``stringstab radio`` sweeps; :func:`radio_from_args` checks each value).
+    message_period_note : str
+        Appended to ``--message-period``'s help (a command's own default, said in words).
     """
     if reaction:
         p.add_argument("--reaction-delay", metavar="SECONDS", default=None,
@@ -44,7 +46,8 @@ def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True,
     g = p.add_argument_group(
         "radio and sensors (default: the predecessor's acceleration every step, exact sensors)")
     g.add_argument("--message-period", metavar="SECONDS",
-                   help="V2V messages every P s (a whole multiple of the step), the last one held")
+                   help="V2V messages every P s (a whole multiple of the step), the last one held"
+                        + (f" {message_period_note}" if message_period_note else ""))
     g.add_argument("--message-phase", metavar="STEPS",
                    help="the step (0..P/dt - 1) at which messages are used (default 0)")
     if loss:

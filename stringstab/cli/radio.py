@@ -90,10 +90,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output folder (an earlier radio study in it is replaced)")
     add_limit_arguments(p)
-    add_loop_arguments(p, loss=False)
+    add_loop_arguments(p, loss=False,
+                       message_period_note="(default 0.1: 10 Hz, as ETSI CAM / SAE BSM)")
     p.set_defaults(func=run, message_period="0.1")
-    period = next(a for a in p._actions if a.dest == "message_period")
-    period.help = f"{period.help} (default 0.1: 10 Hz, as ETSI CAM / SAE BSM)"
 
 
 def _list(option: str, text: str) -> list[str]:
