@@ -37,7 +37,7 @@ from stringstab.identify import (
     simulate_follower,
 )
 from stringstab.identify.closed_loop import FollowerModel
-from stringstab.identify.core import block_counts
+from stringstab.identify.estimate import block_counts
 from stringstab.identify.logs import example_log
 from stringstab.traffic import LinearController, from_speed, simulate
 

@@ -22,7 +22,8 @@ import numpy as np
 
 from ..certify.verdicts import Verdict
 from ..io import OutputDir, TableColumn, columns_from_records, format_results, write_results
-from .core import IdentifyResult, VehicleResult, simulated
+from .core import IdentifyResult, VehicleResult
+from .estimate import simulated
 
 __all__ = ["TABLE", "render", "write_outputs"]
 
@@ -36,12 +37,14 @@ TABLE = [
     TableColumn("τ[s]", "tau", "%.3g"),
     TableColumn("T*[s]", "headway", "%.3g"),
     TableColumn("l0[m]", "standstill", "%.3g"),
+    TableColumn("θ_r[s]", "reaction_delay", "%.3g"),
     TableColumn("rmse_v[m/s]", "rmse_speed", "%.3g"),
     TableColumn("rmse_gap[m]", "rmse_gap", "%.3g"),
     TableColumn("sup|Γ|", "sup_gain", "%.4g"),
     TableColumn("sup|Γ| 5-95%", "sup_interval", "%s"),
     TableColumn("ω_peak[rad/s]", "peak_omega", "%.3g"),
     TableColumn("verdict", "verdict", "%s"),
+    TableColumn("bootstrap", "supported_verdict", "%s"),
     TableColumn(Verdict.CERTIFIED.value, "certified_share", "%.2f"),
     TableColumn("box", "box_verdict", "%s"),
     TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),

@@ -288,24 +288,28 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     sec = rep.section("Verdicts")
     for v in res.vehicles:
         r = v.row()
+        sv = r["supported_verdict"]  # yes/no only where every bootstrap fit agrees (issue 28)
         sec.verdict(f"{v.position} {v.name}: fitted gains certified string stable (exact delay)",
-                    r["verdict"] == "certified",
-                    f"{r['verdict']}; sup|Γ| = {r['sup_gain']:.4g}; {v.statement()}")
+                    None if sv == "inconclusive" else sv == "certified",
+                    f"{v.statement()}; the point fit: {r['verdict']}, sup|Γ| = {r['sup_gain']:.4g}")
     rows = []
     for v in res.vehicles:
         r = v.row()
         rows.append({"pos": r["position"], "name": r["name"], "k_x": _denoise(r["k_x"]),
                      "k_v": _denoise(r["k_v"]), "k_a": _denoise(r["k_a"]), "τ": _denoise(r["tau"]),
                      "T*": _denoise(r["headway"]), "l0": _denoise(r["standstill"]),
+                     "θ_r": _denoise(r["reaction_delay"]),
                      "RMSE v": r["rmse_speed"], "RMSE gap": r["rmse_gap"], "sup|Γ|": r["sup_gain"],
                      "sup|Γ| 5 %": r["sup_gain_lo"], "sup|Γ| 95 %": r["sup_gain_hi"],
-                     "verdict": r["verdict"], "certified share (%)": 100 * r["certified_share"],
+                     "verdict": r["verdict"], "bootstrap verdict": r["supported_verdict"],
+                     "certified share (%)": 100 * r["certified_share"],
                      "not certified share (%)": 100 * r["not_certified_share"]})
     rep.section("Fitted followers").table(
         rows, caption="Per follower: the fitted parameters, the fit's error, sup|Γ| with its "
-        "5-95 % bootstrap interval, the certificate's verdict and the shares of bootstrap fits "
-        "certified / not certified.",
-        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "T*": "s", "l0": "m", "RMSE v": "m/s",
+        "5-95 % bootstrap interval, the certificate's verdict on the point fit, the verdict the "
+        "bootstrap supports (certified or not certified only when every refit agrees, else "
+        "inconclusive) and the shares of bootstrap fits certified / not certified.",
+        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "T*": "s", "l0": "m", "θ_r": "s", "RMSE v": "m/s",
                "RMSE gap": "m"})
     amp = [{"pos": v.position, "name": v.name, "max |Ĝ|": v.empirical.gain,
             "at ω": v.empirical.gain_omega, "± (2ε)": 2 * v.empirical.gain_error * v.empirical.gain,
