@@ -23,10 +23,10 @@ from __future__ import annotations
 from ..io.platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
 from .closed_loop import FollowerModel, simulate_follower
 from .core import IdentifyResult, VehicleResult, identify
-from .wording import statement
 from .empirical import Empirical, empirical_transfer
 from .fit import BOUNDS, PARAMETERS, FitResult, FollowerData, fit_follower
 from .logs import EXAMPLES, example_log, read_logs
+from .wording import statement
 
 __all__ = [
     "BOUNDS",

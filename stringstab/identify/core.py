@@ -18,7 +18,7 @@ logs of each car instead.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -135,6 +135,21 @@ class FitProgress:
         if self.p.bar is not None:
             self.p.bar.set_postfix_str(what, refresh=False)
 
+    def labelled(self, who: str) -> Callable[[str], None]:
+        """A step function naming ``who`` on the bar.
+
+        Parameters
+        ----------
+        who : str
+            The follower or car being fitted.
+
+        Returns
+        -------
+        callable
+            ``step(what)`` that counts one fit and shows ``who what``.
+        """
+        return lambda what: self.step(f"{who} {what}")
+
     def close(self) -> None:
         """End the bar."""
         self.p.close()
@@ -236,7 +251,7 @@ def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,
     out = []
     try:
         for li, lg, p, rec in jobs:
-            est = estimate(rec.data, s, rng, lambda what, lg=lg, p=p: bar.step(f"{lg.name(p)} {what}"))
+            est = estimate(rec.data, s, rng, bar.labelled(lg.name(p)))
             setting, raw = distance_setting(lg.meta)
             vr = VehicleResult(**{k: getattr(est, k) for k in est.__dataclass_fields__},
                                platoon=li, position=p, name=lg.name(p), predecessor=lg.name(p - 1),

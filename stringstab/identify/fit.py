@@ -290,7 +290,8 @@ class FitResult:
         Correlations of the estimates above :data:`CORRELATION_LIMIT` in absolute value.
     starts : int
         Starting points tried; ``nfev`` evaluations in all; ``best_start`` the index of the
-        one whose optimum was kept (0: the first).
+        one whose optimum was kept (0: the first; a later one only when better by more than
+        10⁻⁶ of the cost), ``start_costs`` the optimum's cost from each.
     theta, names : array, tuple of str
         The whole solution vector (the parameters ``names``, then the initial states) and
         the parameter names.
@@ -315,6 +316,7 @@ class FitResult:
     names: tuple[str, ...] = ()
     initial: Array | None = None
     best_start: int = 0
+    start_costs: list[float] = field(default_factory=list)
     rmse_speed_measured_start: float = math.nan
     rmse_gap_measured_start: float = math.nan
 
@@ -434,6 +436,7 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
               for x in _starts(names, data, max(n_starts, 1), np.random.default_rng(seed), fixed)]
     best: Any = None
     best_start = 0
+    costs: list[float] = []
     nfev = 0
     with single_threaded_blas():
         for i, x in enumerate(xs):
@@ -441,7 +444,8 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
             res = least_squares(_residuals, xc, bounds=(lb, ub), args=(names, data, sv, sg, w),
                                 x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8, tr_solver="lsmr")
             nfev += int(res.nfev)
-            if best is None or res.cost < best.cost * (1 - 1e-9):
+            costs.append(float(res.cost))
+            if best is None or res.cost < best.cost * (1 - 1e-6):
                 best, best_start = res, i
     theta = best.x
     m = model_of(theta[:p], names)
@@ -459,7 +463,7 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     egm = np.concatenate([g - data.gap[s.start:s.stop] for s, g in zip(data.segments, gm)])
     out = FitResult(params, float(np.sqrt(np.mean(ev ** 2))), float(np.sqrt(np.mean(eg ** 2))),
                     float(best.cost), at_bound, starts=len(xs), nfev=nfev, theta=theta, names=names,
-                    initial=init, best_start=best_start,
+                    initial=init, best_start=best_start, start_costs=costs,
                     rmse_speed_measured_start=float(np.sqrt(np.mean(evm ** 2))),
                     rmse_gap_measured_start=float(np.sqrt(np.mean(egm ** 2))))
     if identifiability:

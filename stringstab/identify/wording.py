@@ -132,8 +132,8 @@ def model_only(verdict: str, peak_omega: float, lowest_resolved: float) -> str:
     """
     if (str(verdict) == "not_certified" and math.isfinite(peak_omega) and math.isfinite(lowest_resolved)
             and 0 < peak_omega < lowest_resolved):
-        return (f"model-only: the peak at {peak_omega:.2g} rad/s is below the lowest frequency the "
-                f"log resolves, {lowest_resolved:.2g} rad/s")
+        return (f"model-only: the peak at {peak_omega:.3g} rad/s is below the lowest frequency the "
+                f"log resolves, {lowest_resolved:.3g} rad/s")
     return ""
 
 
