@@ -381,7 +381,8 @@ def start_points(data: FollowerData, model: str = "acc", n: int = 1, *, seed: in
 def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, seed: int = 0,
                  x0: Array | list[Array] | None = None, counts: Array | None = None,
                  identifiability: bool = True, fixed: dict[str, float] | None = None,
-                 fit_delay: bool = False) -> FitResult:
+                 fit_delay: bool = False,
+                 bounds: dict[str, tuple[float, float]] | None = None) -> FitResult:
     """Fit the eq-4 law and the lag to one follower by closed-loop simulation error.
 
     Parameters
@@ -406,6 +407,9 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
         Parameters held at a value (e.g. ``{"headway": 1.0}`` for a profile).
     fit_delay : bool
         Also estimate the reaction delay θ_r on the whole law (issue 25).
+    bounds : dict, optional
+        Narrower search intervals for some parameters (e.g. T* within the spacing policy's
+        interval), replacing :data:`BOUNDS` for them.
 
     Returns
     -------
@@ -421,7 +425,7 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
         raise StringStabError("--model cacc needs the predecessor's acceleration; this log has none")
     sv, sg = data.scales()
     w = None if counts is None else residual_weights(data, counts)
-    box = dict(BOUNDS)
+    box = {**BOUNDS, **(bounds or {})}
     for k, val in (fixed or {}).items():
         box[k] = (float(val), float(val) + 1e-9)
     init0 = measured_initial(data)
@@ -467,12 +471,12 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
                     rmse_speed_measured_start=float(np.sqrt(np.mean(evm ** 2))),
                     rmse_gap_measured_start=float(np.sqrt(np.mean(egm ** 2))))
     if identifiability:
-        out.notes, out.correlation = _identifiability(best.jac, names, data, at_bound)
+        out.notes, out.correlation = _identifiability(best.jac, names, data, at_bound, box)
     return out
 
 
-def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
-                     at_bound: list[str]) -> tuple[list[str], dict[str, float]]:
+def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData, at_bound: list[str],
+                     box: dict[str, tuple[float, float]]) -> tuple[list[str], dict[str, float]]:
     notes: list[str] = []
     corr: dict[str, float] = {}
     J = np.asarray(J, dtype=float)
@@ -506,8 +510,9 @@ def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
         notes.append(f"the speed stays within {lo:.3g}-{hi:.3g} m/s (5-95 %): T* v + l_0 is "
                      "nearly constant, so T* and the standstill distance are weakly separated")
     for k in at_bound:
-        lo_b, hi_b = BOUNDS[k]
-        notes.append(f"{k} stopped at the bound of its search box [{lo_b:g}, {hi_b:g}]: the "
+        lo_b, hi_b = box[k]
+        where = "search box" if box[k] == BOUNDS[k] else "constraint"
+        notes.append(f"{k} stopped at the bound of its {where} [{lo_b:.3g}, {hi_b:.3g}]: the "
                      "fit would go further; treat it and the verdict with care")
     return notes, corr
 

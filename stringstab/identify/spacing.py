@@ -65,8 +65,6 @@ class SpacingPolicy:
         T* (s) and l_0 (m) of the straight line (NaN without steady samples).
     headway_interval, standstill_interval : tuple of float
         Their 5-95 % bootstrap intervals.
-    headway_draws : ndarray
-        The bootstrap's T* (one per refit), for propagating T* into a fit's bootstrap.
     n_steady, n_runs : int
         Quasi-steady samples and stretches.
     speed_range : tuple of float
@@ -83,7 +81,6 @@ class SpacingPolicy:
     standstill: float
     headway_interval: tuple[float, float]
     standstill_interval: tuple[float, float]
-    headway_draws: Array
     n_steady: int
     n_runs: int
     speed_range: tuple[float, float]
@@ -175,7 +172,7 @@ def spacing_policy(data: FollowerData, *, seed: int = 0) -> SpacingPolicy:
     runs = list(zip(edges[::2], edges[1::2]))
     nan2 = (math.nan, math.nan)
     if not runs:
-        return SpacingPolicy(math.nan, math.nan, nan2, nan2, np.empty(0), 0, 0, nan2, tg, False,
+        return SpacingPolicy(math.nan, math.nan, nan2, nan2, 0, 0, nan2, tg, False,
                              f"no quasi-steady stretch of at least {STEADY_MIN:g} s")
     v, g = data.v[m], data.gap[m]
     slope, icpt = _line(v, g)
@@ -200,7 +197,7 @@ def spacing_policy(data: FollowerData, *, seed: int = 0) -> SpacingPolicy:
                        f"{SPEED_RANGE_MIN:g} m/s), so the slope T* is extrapolated")
     if math.isfinite(slope) and not reasons and slope < 0:
         reasons.append(f"the steady gaps fall with speed (slope {slope:.3g} s)")
-    return SpacingPolicy(slope, icpt, (hl, hh), (sl, sh), draws[:, 0].copy(), int(m.sum()), len(runs),
+    return SpacingPolicy(slope, icpt, (hl, hh), (sl, sh), int(m.sum()), len(runs),
                          (lo, hi), tg, not reasons, "; ".join(reasons))
 
 
