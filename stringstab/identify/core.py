@@ -31,10 +31,9 @@ from .estimate import Estimate, Settings, estimate
 from .fit import PARAMETERS
 from .record import follower_record, missing_vehicles
 from .spacing import distance_setting
-from .wording import statement
 
 __all__ = ["DEFAULT_BLOCK", "DEFAULT_BOOTSTRAP", "FitProgress", "IdentifyResult", "VehicleResult",
-           "check_settings", "identify", "statement"]
+           "check_settings", "identify"]
 
 #: Default number of bootstrap refits per follower.
 DEFAULT_BOOTSTRAP = 50
