@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -219,12 +220,12 @@ def identify_cars(logs: Sequence[PlatoonLog], model: str = "acc", *, sample_time
         for (car, setting), members in groups.items():
             data = pool_records([r for _, _, r in members])
             est = estimate(data, s, rng, bar.labelled(car))
-            names = [f"{lg.source}#{p}" for lg, p, _ in members]
+            names = [f"{Path(lg.source).name}#{p}" for lg, p, _ in members]
             records = [{"log": lg.source, "position": p, "predecessor": lg.name(p - 1),
                         "samples": r.data.n_samples, "segments": len(r.data.segments)} for lg, p, r in members]
             cr = CarResult(**{k: getattr(est, k) for k in est.__dataclass_fields__}, car=car, setting=setting,
                            distance_setting=raw_setting[(car, setting)], logs=names, records=records)
-            cr.notes = [f"{n} ({lg.source}#{p})" for lg, p, r in members for n in r.notes] + cr.notes
+            cr.notes = [f"{n} ({Path(lg.source).name}#{p})" for lg, p, r in members for n in r.notes] + cr.notes
             if len(members) > 1:
                 cr.notes.insert(0, f"pooled: {len(members)} logs, {data.n_samples} samples in "
                                    f"{len(data.segments)} segments, one joint fit")
