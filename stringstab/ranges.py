@@ -14,6 +14,8 @@ gain k         \|k\| <= 10        \|k\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s
 τ              (0, 2] s          > 100 s       actuator lags are 0.1-1 s
 δ              [0, 2] s          > 100 s       V2V delays are 0.01-0.5 s
 T*             [0, 5] s          > 100 s       time headways are 0.3-3 s
+θ_r            [0, 2] s          > 100 s       reaction/actuation delays: ACC 0.1-0.6 s,
+                                               drivers 0.5-1.5 s
 H              (0, 1] s          > 100 s       control periods are 0.01-0.2 s
 duration       <= 1 day          > 1 year      a run, an episode, a cycle
 =============  ================  ============  ==========================================
@@ -40,6 +42,7 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "tau": (2.0, 100.0, " s", "actuator lag tau"),
     "delta": (2.0, 100.0, " s", "communication delay delta"),
     "headway": (5.0, 100.0, " s", "time headway T*"),
+    "reaction_delay": (2.0, 100.0, " s", "reaction delay theta_r"),
     "sample_time": (1.0, 100.0, " s", "sample time H"),
     "duration": (86_400.0, 3.2e7, " s", "duration"),
 }
@@ -51,8 +54,8 @@ def check_magnitude(kind: str, value: Any, *, name: str | None = None) -> float:
     Parameters
     ----------
     kind : str
-        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``, ``sample_time``,
-        ``duration``).
+        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``,
+        ``reaction_delay``, ``sample_time``, ``duration``).
     value : float
         The number (already checked finite by the caller's own parser; NaN is refused too).
     name : str, optional

@@ -168,6 +168,9 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
         H > 0) or beyond the physical bound.
     """
     values = (args.tau, args.delta, args.headway)
+    # the reaction delay θ_r of the commands that take --reaction-delay (issue 25)
+    theta = getattr(args, "reaction_delay", None)
+    values += () if theta is None else (theta,)
     if any(":" in str(v) for v in values):
         model: Params | Box = parameter_model(*(str(v) for v in values))
     else:  # numbers: the point checks and messages ('tau ... must be ... > 0 s; got '0'')
@@ -179,7 +182,8 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     box = Box.of(model)
     warn_beyond_sensible(args, [("tau", box.tau[1], "--tau"), ("delta", box.delta[1], "--delta"),
                                 ("headway", box.headway[1], "--headway"),
-                                ("sample_time", H, "--sample-time")])
+                                ("sample_time", H, "--sample-time"),
+                                ("reaction_delay", box.reaction_delay[1], "--reaction-delay")])
     return model, H
 
 
