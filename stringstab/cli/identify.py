@@ -86,6 +86,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--by", choices=("log", "car"), default="log",
                    help="log: one row per follower of each log (default); car: one row per car and "
                         "distance setting, all its logs fitted jointly (cars.json)")
+    p.add_argument("--fit-delay", action=argparse.BooleanOptionalAction, default=None,
+                   help="fit the reaction delay θ_r on the whole law beside the lag τ and certify "
+                        "with it (default: on, except with --sample-time, which has no θ_r "
+                        "certificate yet)")
     p.add_argument("--baselines", action="store_true",
                    help="also calibrate IDM and OVRV on the same segments and judge their "
                         "linearisations (slower: the IDM is simulated step by step)")
@@ -143,8 +147,13 @@ def run(args: argparse.Namespace) -> int:
 
     logs = [lg for path in (args.log or [example_log(args.example)])
             for lg in read_logs(path, min_duration=min_seg)]
+    if args.fit_delay and H is not None:
+        raise StringStabError("--fit-delay certifies θ_r in continuous time only so far; expected it "
+                              f"without --sample-time (got --sample-time {H:g})")
+    fit_delay = H is None if args.fit_delay is None else bool(args.fit_delay)
     opts = dict(sample_time=H, bootstrap=B, block=block, n_starts=starts, seed=seed, min_duration=min_seg,
-                progress=not args.no_progress, baselines=args.baselines, screen=not args.no_screen)
+                progress=not args.no_progress, baselines=args.baselines, screen=not args.no_screen,
+                fit_delay=fit_delay)
     from ..report import command_line
 
     if args.by == "car":

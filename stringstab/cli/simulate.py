@@ -180,6 +180,11 @@ def _from_identified(args: argparse.Namespace) -> None:
         raise StringStabError(f"--from {args.from_identify}: {len(rows)} vehicles; expected --vehicle POS, "
                               f"one of {[r['position'] for r in rows]}")
     r = rows[0]
+    if r["reaction_delay"] > 0:
+        raise StringStabError(
+            f"--from {args.from_identify}: vehicle {r['position']} ({r['name']}) was fitted with a reaction "
+            f"delay θ_r = {r['reaction_delay']:.3g} s, which the simulator does not model yet; expected a "
+            "fit without it (stringstab identify --no-fit-delay)")
     args.gains = f"{r['k_x']!r},{r['k_v']!r},{r['k_a']!r}"
     args.tau, args.delta, args.headway, args.standstill = r["tau"], r["delta"], r["headway"], r["standstill"]
 

@@ -18,7 +18,7 @@ one log, or every log of one car pooled: :mod:`stringstab.identify.cars`):
    whose refits start from the point estimate *and* from a random draw (the better optimum
    kept, so a second optimum is seen), each certified;
 5. the **box certificate** at the point gains over the bootstrap's 5-95 % intervals of τ, T*
-   (δ, θ_r);
+   (and δ) — not with θ_r fitted: the θ_r certificate takes points only so far;
 6. the **profiles** over T* (when weakly determined) and over θ_r (when fitted);
 7. the data's own **empirical transfer** (:mod:`stringstab.identify.empirical`) and, on
    request, the **baselines** (:mod:`stringstab.identify.baselines`).
@@ -343,7 +343,7 @@ def estimate(data: FollowerData, s: Settings, rng: np.random.Generator,
                      f"(l_0 {free.params['standstill']:.3g} m) at a cost {100 * (free.cost / fit.cost - 1):+.1f} % "
                      "of the constrained fit's")
         pre.append(text)
-    elif _weak_headway(fit, np.empty(0)):
+    elif _weak_headway(fit, np.empty(0)):  # T* profiled before the bootstrap: a better optimum restarts the fit
         prof, pfits = _profile(data, s, fit, policy)
         alt = min(pfits, key=lambda f: f.cost)
         if alt.cost < fit.cost * (1 - 1e-6):  # the starts missed a better optimum
@@ -353,14 +353,28 @@ def estimate(data: FollowerData, s: Settings, rng: np.random.Generator,
                            f"(cost {100 * (refit.cost / fit.cost - 1):+.1f} %); the point fit was restarted "
                            "from it")
                 fit = refit
+    dfits: list[FitResult] = []
+    if s.fit_delay:  # the θ_r profile, also before the bootstrap, for the same reason
+        dfits = _delay_fits(data, s, fit, box)
+        alt = min(dfits, key=lambda f: f.cost)
+        if alt.cost < fit.cost * (1 - 1e-6):
+            refit = fit_follower(data, s.model, x0=alt.theta, seed=s.seed, fit_delay=True, bounds=box)
+            if refit.cost < fit.cost:
+                pre.append(f"the profile over θ_r found a better optimum than the {fit.starts} starts "
+                           f"(cost {100 * (refit.cost / fit.cost - 1):+.1f} %); the point fit was restarted "
+                           "from it")
+                fit = refit
     step("fitted")
     cert = certify_fit(fit.params, s.sample_time)
     boot, verdicts, second = _bootstrap(data, s, fit, box, rng, step)
-    box = _box(fit.params, boot, s) if s.bootstrap >= 2 else None
+    box_cert = _box(fit.params, boot, s) if s.bootstrap >= 2 and not s.fit_delay else None
     emp = empirical_transfer(data.v_pred, data.v, data.segments, data.dt)
-    est = Estimate(fit, list(data.segments), cert, boot, verdicts, box, emp, data, policy=policy,
+    est = Estimate(fit, list(data.segments), cert, boot, verdicts, box_cert, emp, data, policy=policy,
                    free_fit=free, second_optimum=second)
     est.notes += pre
+    if s.fit_delay and s.bootstrap >= 2:
+        est.notes.append("no box certificate: the θ_r certificate takes points only so far (each "
+                         "bootstrap refit is certified at its own θ_r instead)")
     if s.bootstrap and second:
         est.notes.append(f"in {second} of {s.bootstrap} bootstrap refits the random start reached an "
                          "optimum lower by more than 0.1 % than the start at the point estimate: the "
@@ -370,10 +384,13 @@ def estimate(data: FollowerData, s: Settings, rng: np.random.Generator,
     if prof:
         est.profile = prof
         est.notes.append(profile_note(prof, fit.rmse_speed, str(cert.verdict)))
-    if s.fit_delay:
-        est.delay_profile = _delay_profile(data, s, fit, box)
+    if dfits:
+        est.delay_profile = _profile_rows(data, s, np.asarray(DELAY_GRID), "reaction_delay", dfits)
         est.notes.append(profile_note(est.delay_profile, fit.rmse_speed, str(cert.verdict),
                                       name="reaction_delay", symbol="θ_r"))
+        sep = _separation_note(est.delay_profile, min(fit.rmse_speed, *(f.rmse_speed for f in dfits)))
+        if sep:
+            est.notes.append(sep)
     est.notes.append(f"RMSE from the measured initial state of each segment: speed "
                      f"{fit.rmse_speed_measured_start:.3g} m/s, gap {fit.rmse_gap_measured_start:.3g} m "
                      f"(with the fitted restarts: {fit.rmse_speed:.3g} m/s, {fit.rmse_gap:.3g} m)")
@@ -455,9 +472,9 @@ def _profile(data: FollowerData, s: Settings, fit: FitResult,
     return _profile_rows(data, s, grid, "headway", fits), fits
 
 
-def _delay_profile(data: FollowerData, s: Settings, fit: FitResult,
-                   box: dict[str, tuple[float, float]] | None) -> list[dict[str, Any]]:
-    """Refit with θ_r held on :data:`DELAY_GRID`, each from the point estimate, and certify."""
+def _delay_fits(data: FollowerData, s: Settings, fit: FitResult,
+                box: dict[str, tuple[float, float]] | None) -> list[FitResult]:
+    """Refit with θ_r held on :data:`DELAY_GRID`, each from the point estimate."""
     assert fit.theta is not None
     i = fit.names.index("reaction_delay")
     fits = []
@@ -466,7 +483,17 @@ def _delay_profile(data: FollowerData, s: Settings, fit: FitResult,
         x[i] = th
         fits.append(fit_follower(data, s.model, x0=x, identifiability=False, fit_delay=True,
                                  fixed={"reaction_delay": th}, bounds=box))
-    return _profile_rows(data, s, np.asarray(DELAY_GRID), "reaction_delay", fits)
+    return fits
+
+
+def _separation_note(rows: list[dict[str, Any]], best_rmse: float) -> str:
+    """Which θ_r the data tell apart: the held values within 1 % of the best speed RMSE."""
+    near = [r["reaction_delay"] for r in rows if r["rmse_speed"] <= 1.01 * best_rmse]
+    if len(near) <= 1:
+        return ""
+    return (f"θ_r held at {', '.join(f'{x:g}' for x in near)} s fits within 1 % of the best speed RMSE "
+            "(τ and the others refitted): the data separate the delay θ_r from the lag τ only weakly; "
+            "read θ_r's bootstrap interval and the profile above, not the point value")
 
 
 def _box(p: dict[str, float], bp: dict[str, Array], s: Settings) -> Any:
@@ -479,12 +506,9 @@ def _box(p: dict[str, float], bp: dict[str, Array], s: Settings) -> Any:
         return (lo, hi) if hi > lo else p[k]
 
     delta = iv("delta") if s.model == "cacc" else p["delta"]
-    extra: dict[str, Any] = {}
-    if s.fit_delay:
-        extra["reaction_delay"] = iv("reaction_delay")
     try:
         return ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=iv("tau"), delta=delta,
-                          headway=iv("headway"), sample_time=s.sample_time, **extra)
+                          headway=iv("headway"), sample_time=s.sample_time)
     except StringStabError:
         return None
 

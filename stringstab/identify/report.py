@@ -243,8 +243,14 @@ def _fig_transfer(v: Any, H: float | None) -> Any:
     # from a decade below the model's peak (or the data) up: the model's whole shape is shown
     w_lo = min(w_data, peak_w / 10 if math.isfinite(peak_w) and peak_w > 0 else w_data, 0.01)
     w = np.geomspace(w_lo, 10.0, 600)
-    ax1.loglog(w, gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
-                       headway=p["headway"]), color="#D55E00", label="model |Γ(jω)| (continuous)")
+    if p.get("reaction_delay", 0.0) > 0:
+        from ..certify.reaction import gain_squared
+
+        model = np.sqrt(gain_squared(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
+                                     headway=p["headway"], reaction_delay=p["reaction_delay"]))
+    else:
+        model = gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"], headway=p["headway"])
+    ax1.loglog(w, model, color="#D55E00", label="model |Γ(jω)| (continuous)")
     if math.isfinite(sup) and math.isfinite(peak_w) and peak_w > 0:
         ax1.plot([peak_w], [sup], "D", color="#D55E00", ms=6,
                  label=f"model peak: sup|Γ| = {sup:.3g} at {peak_w:.2g} rad/s")
@@ -436,7 +442,8 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
     Returns
     -------
     list of dict
-        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill.
+        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill and
+        reaction_delay (0 in a file written before θ_r was fitted).
 
     Raises
     ------
@@ -461,6 +468,11 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
         bad = [k for k in need if k not in r or (k != "name" and not isinstance(r[k], (int, float)))]
         if bad:
             raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} lacks numeric {bad}")
+    for r in rows:
+        theta = r.setdefault("reaction_delay", 0.0)
+        if not isinstance(theta, (int, float)) or not theta >= 0:
+            raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} has reaction_delay "
+                                  f"{theta!r}; expected a number of seconds >= 0")
     if vehicle is not None:
         rows = [r for r in rows if r["position"] == vehicle]
         if not rows:
