@@ -211,7 +211,8 @@ def test_identify_by_car_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     one row per (car, setting) with issue 28's fields, the logs pooled."""
     from stringstab.cli import main
 
-    files = [_openacc_file(tmp_path / f"log{i}.csv", car_log(_model(T), PROFILES[i], setting=s, seed=i))
+    files = [_openacc_file(tmp_path / f"log{i}.csv",
+                           car_log(_model(T), PROFILES[i][:3], setting=s, seed=i, ramp=4.0))
              for i, (s, T) in enumerate((("S", 1.0), ("S", 1.0), ("L", 2.0)))]
     out = tmp_path / "cars"
     rc = main(["identify", *map(str, files), "--by", "car", "--bootstrap", "2", "--starts", "1",

@@ -217,16 +217,26 @@ def simulate_follower(m: FollowerModel, v_pred: Array, dt: float, *, s0: float, 
     return y[0], y[1]
 
 
+def _charpolys(M: Array) -> Array:
+    """det(zI − M) of a stack of 3×3 matrices (N, 3, 3): rows [1, −tr M, Σ 2×2 minors, −det M]."""
+    a, b, c = M[:, 0, 0], M[:, 0, 1], M[:, 0, 2]
+    d, e, f = M[:, 1, 0], M[:, 1, 1], M[:, 1, 2]
+    g, h, i = M[:, 2, 0], M[:, 2, 1], M[:, 2, 2]
+    minors = (a * e - b * d) + (a * i - c * g) + (e * i - f * h)
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    return np.stack([np.ones_like(a), -(a + e + i), minors, -det], axis=1)
+
+
 def _delayed_loop(m: FollowerModel, A0: Array, K: Array, w: Array, d: Array, dt: float,
                   x0: Array) -> tuple[Array, Array]:
     """Gap and speed with a reaction delay θ_r > 0 on the whole law (module docstring).
 
-    The sequences run from index −1 (zero state; the initial state enters there as a forcing
-    x0, so x_0 = x0) to T − 1; commands before t_0 are a_0 (the forcing h below).  With
-    G(z) = z^{−q−1}(z Γ_0 + Γ_1), the state obeys (zI − A − G K) x = f + G w, so each output
-    is one closed-loop filter over D(z) = z^{q+1} det(zI − A − G K); its numerators come from
-    c adj(M) b = det(M + b c) − det(M), and each determinant from 3×3 characteristic
-    polynomials (det(zI − A − G K) = det(zI − A) − K adj(zI − A) G).
+    The sequences run from index −1 (zero state; the initial state enters there as an impulse
+    x0, so x_0 = x0) to T − 1; commands before t_0 are a_0.  With G(z) = z^{−q−1}(z Γ_0 + Γ_1),
+    the state obeys M(z) x = f + G w with M(z) = zI − A − G K, so each output is one closed-loop
+    filter over D(z) = z^{q+1} det M(z): its numerators are c adj(M) b = det(M + b c) − det(M)
+    (linear in b: three per output, for the unit vectors), and each determinant comes from 3×3
+    characteristic polynomials, det(zI − A − G K) = det(zI − A) − K adj(zI − A) G.
     """
     from scipy.signal import lfilter
 
@@ -238,38 +248,36 @@ def _delayed_loop(m: FollowerModel, A0: Array, K: Array, w: Array, d: Array, dt:
     A_late, G0 = lag_step(m.tau, dt - eps)  # G0 multiplies u_{k-q}
     _, b_early = lag_step(m.tau, eps)
     G1 = A_late @ b_early  # multiplies u_{k-q-1}
-
-    def zdet(A: Array) -> Array:
-        """z^{q+1} det(zI − A − G(z) K): q + 5 coefficients, highest power first."""
-        ph = _charpoly(A)
-        out = np.zeros(q + 5)
-        out[:4] = ph
-        out[-5:-1] -= _charpoly(A - np.outer(G0, K)) - ph  # z K adj(zI − A) Γ_0
-        out[-4:] -= _charpoly(A - np.outer(G1, K)) - ph  # K adj(zI − A) Γ_1
-        return out
-
-    D = zdet(A0)
+    # the matrices X whose z^{q+1} det(zI − X − G K) are needed: A, and A − e_j c_r (r: gap, speed)
+    X = np.repeat(A0[None], 7, axis=0)
+    X[np.arange(1, 7), [0, 1, 2, 0, 1, 2], [0, 0, 0, 1, 1, 1]] -= 1.0  # A − e_j c_r, r-major
+    ph = _charpolys(np.concatenate([X, X - np.outer(G0, K), X - np.outer(G1, K)]))
+    nX = X.shape[0]
+    zd = np.zeros((nX, q + 5))
+    zd[:, :4] = ph[:nX]
+    zd[:, -5:-1] -= ph[nX:2 * nX] - ph[:nX]  # z K adj(zI − X) Γ_0
+    zd[:, -4:] -= ph[2 * nX:] - ph[:nX]  # K adj(zI − X) Γ_1
+    D = zd[0]
+    N = (zd[1:] - D).reshape(2, 3, q + 5)  # N[r, j]: numerator of input e_j to output r
     n = T + 1
-    # the known forcing of the plant: initial state, commands before t_0 (= a_0), predecessor
-    f = np.zeros((3, n))
-    f[:, 0] = x0
-    f[0, 1:] += d
-    h0 = np.zeros(n)
-    h0[1:1 + q] = x0[2]  # u_{k-q} for k < q
-    h1 = np.zeros(n)
-    h1[1:2 + q] = x0[2]  # u_{k-q-1} for k < q + 1
-    f += np.outer(G0, h0) + np.outer(G1, h1)
-    we = np.r_[0.0, w]
-    eye = np.eye(3)
+    z = np.zeros((2, n))
+    h0 = np.zeros(q + 2)  # the commands before t_0 (= a_0) as forcing: h0 on k < q, h1 on k < q + 1
+    h0[1:1 + q] = x0[2]
+    h1 = np.zeros(q + 2)
+    h1[1:2 + q] = x0[2]
+    nG0 = np.einsum("j,rjk->rk", G0, N)  # (2, q + 5): the numerators of the inputs Γ_0, Γ_1
+    nG1 = np.einsum("j,rjk->rk", G1, N)
+    head = np.zeros((2, 2 * q + 6))
+    head[:, :q + 5] = np.einsum("j,rjk->rk", x0, N)  # the initial state, an impulse at index 0
+    nw = np.zeros((2, 2 * q + 6))
+    nw[:, q + 1:-1] += nG0[:, 1:]  # z num(Γ_0), delayed q + 1
+    nw[:, q + 1:] += nG1
+    k = min(2 * q + 6, n)
     with np.errstate(all="ignore"):
-        z = np.zeros((2, n))
         for r in range(2):
-            def num(b: Array, r: int = r) -> Array:
-                return zdet(A0 - np.outer(b, eye[r])) - D
-
-            for j in range(3):
-                z[r] += np.convolve(num(eye[j]), f[j])[:n]
-            nw = np.r_[np.zeros(q + 1), num(G0)[1:], 0.0] + np.r_[np.zeros(q + 1), num(G1)]
-            z[r] += np.convolve(nw, we)[:n]
+            head[r] += np.convolve(nG0[r], h0) + np.convolve(nG1[r], h1)
+            z[r, 1:] += np.convolve(N[r, 0], d)[:T]  # the predecessor's displacement (gap row)
+            z[r, 1:] += np.convolve(nw[r], w)[:T]
+        z[:, :k] += head[:, :k]
         y = lfilter([1.0], D, z, axis=1)
     return y[0, 1:], y[1, 1:]
