@@ -8,9 +8,11 @@ pooling, fits each car once on its whole log and once on the log cut in two halv
 (no bootstrap): the two estimates differ only by the restart at the cut.
 
 Writes ``analysis/openacc_cars.md`` (the table, the notes that matter for each car, the split
-check, the command, the time taken and the machine's load).  Example::
+check, the command, the time taken and the machine's load) and, with ``--outputs DIR``, the
+command's own files of the same run there (``cars.json``, ``cars.csv``, figures, report), from
+which docs/identify.md's figures are copied.  Example::
 
-    python analysis/openacc_cars.py --fit-delay
+    python analysis/openacc_cars.py --fit-delay --outputs runs/openacc_cars
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ def main() -> None:
     ap.add_argument("--fit-delay", action="store_true")
     ap.add_argument("--no-baselines", action="store_true")
     ap.add_argument("--out", default=str(Path(__file__).with_name("openacc_cars.md")))
+    ap.add_argument("--outputs", metavar="DIR", help="also write the command's files of this run here")
     a = ap.parse_args()
     load0 = os.getloadavg()
     t0 = time.perf_counter()
@@ -58,6 +61,14 @@ def main() -> None:
                         progress=True)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     load1 = os.getloadavg()
+    if a.outputs:
+        from stringstab.identify.report import write_cars_outputs
+        from stringstab.io import OutputDir
+        from stringstab.report.commands import cars_report
+
+        with OutputDir(a.outputs, command="identify", what="--outputs") as out:
+            names = list(write_cars_outputs(res, out))
+            cars_report(res, names, command="python analysis/openacc_cars.py", started=t0).write(out)
     lines = ["# OpenACC cars: one row per car and setting (generated)", "",
              f"`python analysis/openacc_cars.py{' --fit-delay' if a.fit_delay else ''}"
              f"{'' if a.bootstrap == 50 else f' --bootstrap {a.bootstrap}'}"
