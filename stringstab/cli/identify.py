@@ -59,10 +59,13 @@ def add_parser(sub: Any) -> None:
         "identify",
         help="identify and certify the car-following law of recorded vehicles (OpenACC, CSV, NGSIM)",
         description=(
-            "For each follower of a recorded platoon, fit u = k_x Δp + k_v Δv [+ k_a a_{i-1}(t-δ)] "
-            "and the actuator lag τ, T*, l0 by closed-loop simulation error (driven by the measured "
-            "predecessor), certify the fit (exact delay), bootstrap it (moving blocks over time), "
-            "and set the model's |Γ(jω)| beside the measured speed transfer and amplification."
+            "For each follower of a recorded platoon (or, with --by car, each car and distance "
+            "setting over all its logs), fit u = k_x Δp + k_v Δv [+ k_a a_{i-1}(t-δ)], the actuator "
+            "lag τ, the reaction delay θ_r, T*, l0 by closed-loop simulation error (driven by the "
+            "measured predecessor; T* held to the spacing policy of the steady parts where they "
+            "identify it), certify the fit (exact delay), bootstrap it (moving blocks over time, "
+            "two starts per refit), and set the model's |Γ(jω)| beside the measured speed transfer "
+            "and amplification."
         ),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
