@@ -546,12 +546,17 @@ def _quality(v: Estimate) -> list[str]:
     if g.min() <= 0:
         notes.append(f"the recorded gap drops to {g.min():.3g} m (GPS error or a collision): the "
                      "record is used as it is")
-    gaps, _ = simulated(v)
+    gaps, speeds = simulated(v)
     smin = min(float(x.min()) for x in gaps)
     if smin <= 0 < g.min():
         notes.append(f"the fitted model's simulated gap reaches {smin:.3g} m where the measured one "
                      f"stays above {g.min():.3g} m: the linear law misses part of this car's response "
                      "(large, asymmetric manoeuvres)")
+    vmin = min(float(x.min()) for x in speeds)
+    vmeas = float(np.concatenate([d.v[s.start:s.stop] for s in v.segments]).min())
+    if vmin < -0.1 and vmeas >= -0.1:
+        notes.append(f"the fitted model's simulated speed goes negative ({vmin:.3g} m/s) where the "
+                     f"measured one stays at {vmeas:.3g} m/s or more: the linear law has no v >= 0")
     rel = v.fit.rmse_gap / max(float(g.mean()), 1.0)
     if rel > 0.15:
         notes.append(f"poor fit: the gap RMSE is {100 * rel:.0f} % of the mean gap; the verdict "
