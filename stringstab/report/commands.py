@@ -368,8 +368,9 @@ def cars_report(res: Any, files: Sequence[Any], *, command: str, started: float 
         r = c.row()
         sec.verdict(f"{c.car} ({c.setting}, {len(c.logs)} log{'s' if len(c.logs) != 1 else ''}): string "
                     "stable (exact delay)", None if r["verdict"] == "inconclusive" else r["verdict"] == "certified",
-                    f"{c.statement()}; sup|Γ| = {r['sup_gain']:.4g} "
-                    f"({r['sup_gain_interval'][0]:.3g}-{r['sup_gain_interval'][1]:.3g})")
+                    f"{c.statement()}; sup|Γ| = {r['sup_gain']:.4g}"
+                    + ("" if not all(math.isfinite(x) for x in r["sup_gain_interval"])
+                       else f" ({r['sup_gain_interval'][0]:.3g}-{r['sup_gain_interval'][1]:.3g})"))
     rows = []
     for c in res.cars:
         r = c.row()
