@@ -192,6 +192,11 @@ def test_profile_note_is_computed_from_the_profile() -> None:
     assert "the verdict is not_certified at every value" in same
     # a profile that agrees with itself but not with the point fit is not "the same at every value"
     assert "depends on T*" in profile_note(rows[:2], 0.30, "certified")
+    # a refit whose loop diverged is named as such, never averaged into "every value"
+    bad = [*rows[:2], {"headway": 1.5, "verdict": "not_certified", "sup_gain": math.inf, "rmse_speed": 1e40}]
+    note = profile_note(bad, 0.30, "not_certified")
+    assert "T* = 1.5 s: not_certified, sup|Γ| inf (no fit found: the refitted loop diverges)" in note
+    assert "at every value" not in note
 
 
 def _openacc_file(path: Path, lg: PlatoonLog) -> Path:

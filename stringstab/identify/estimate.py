@@ -474,15 +474,24 @@ def _profile(data: FollowerData, s: Settings, fit: FitResult,
 
 def _delay_fits(data: FollowerData, s: Settings, fit: FitResult,
                 box: dict[str, tuple[float, float]] | None) -> list[FitResult]:
-    """Refit with θ_r held on :data:`DELAY_GRID`, each from the point estimate."""
+    """Refit with θ_r held on :data:`DELAY_GRID`, each from the point estimate.
+
+    A refit whose loop diverges from there (gains that are stable without the delay may not be
+    with it) is restarted from a typical ACC as well, the lower optimum kept.
+    """
     assert fit.theta is not None
     i = fit.names.index("reaction_delay")
     fits = []
     for th in DELAY_GRID:
         x = fit.theta.copy()
         x[i] = th
-        fits.append(fit_follower(data, s.model, x0=x, identifiability=False, fit_delay=True,
-                                 fixed={"reaction_delay": th}, bounds=box))
+        fixed = {"reaction_delay": th}
+        f = fit_follower(data, s.model, x0=x, identifiability=False, fit_delay=True, fixed=fixed, bounds=box)
+        if not f.rmse_speed <= 10 * fit.rmse_speed:
+            typical = start_points(data, s.model, 1, fit_delay=True, fixed=fixed)
+            f = fit_follower(data, s.model, x0=[x, *typical], identifiability=False, fit_delay=True,
+                             fixed=fixed, bounds=box)
+        fits.append(f)
     return fits
 
 

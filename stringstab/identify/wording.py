@@ -157,7 +157,8 @@ def profile_note(rows: list[dict[str, Any]], best_rmse: float, point_verdict: st
     -------
     str
         "the verdict is V at every value ..." only when every row's verdict and the point
-        fit's are the same; otherwise each value with its verdict.
+        fit's are the same (and every refit converged); otherwise each value with its verdict
+        (a refit more than 10 times the point fit's speed RMSE is called diverged).
 
     Examples
     --------
@@ -168,16 +169,23 @@ def profile_note(rows: list[dict[str, Any]], best_rmse: float, point_verdict: st
     """
     for r in rows:
         r["rmse_speed_increase"] = r["rmse_speed"] / best_rmse - 1.0 if best_rmse > 0 else math.nan
+
+    def inc(r: dict[str, Any]) -> str:
+        x = r["rmse_speed_increase"]
+        return (f"speed RMSE {100 * x:+.1f} %" if math.isfinite(x) and x <= 10 else
+                "no fit found: the refitted loop diverges")
+
     verdicts = [str(r["verdict"]) for r in rows]
     values = ", ".join(f"{r[name]:g}" for r in rows)
-    inc = [100 * r["rmse_speed_increase"] for r in rows]
-    sups = [r["sup_gain"] for r in rows]
-    if len(set(verdicts) | {str(point_verdict)}) == 1:
+    fair = [r for r in rows if math.isfinite(r["rmse_speed_increase"]) and r["rmse_speed_increase"] <= 10]
+    incs = [100 * r["rmse_speed_increase"] for r in fair]
+    sups = [r["sup_gain"] for r in fair]
+    if len(set(verdicts) | {str(point_verdict)}) == 1 and len(fair) == len(rows):
         return (f"profile over {symbol}: with {symbol} held at {values} s (the others refitted; speed "
-                f"RMSE {min(inc):+.1f} to {max(inc):+.1f} % of the point fit's, sup|Γ| "
+                f"RMSE {min(incs):+.1f} to {max(incs):+.1f} % of the point fit's, sup|Γ| "
                 f"{min(sups):.4g}-{max(sups):.4g}) the verdict is {verdicts[0]} at every value, as at "
                 f"the point fit: the {symbol} ambiguity does not change it")
-    which = "; ".join(f"{symbol} = {r[name]:g} s: {r['verdict']}, sup|Γ| {r['sup_gain']:.4g} (speed RMSE "
-                      f"{100 * r['rmse_speed_increase']:+.1f} %)" for r in rows)
+    which = "; ".join(f"{symbol} = {r[name]:g} s: {r['verdict']}, sup|Γ| {r['sup_gain']:.4g} ({inc(r)})"
+                      for r in rows)
     return (f"profile over {symbol}: the verdict depends on {symbol} (the point fit: {point_verdict}; "
             f"the others refitted at each value, speed RMSE relative to the point fit's): {which}")
