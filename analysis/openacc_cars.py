@@ -106,8 +106,9 @@ def main() -> None:
             f"{100 * r['certified_share']:.0f} % | {_f(f['empirical_gain'])} ± {_f(f['empirical_gain_error'], '.2g')} "
             f"({f['data_amplifies']}) | {_f(f['rmse_speed_measured_start'])} | {idm} | {ovrv} |")
     lines += ["", "## Notes per car", ""]
-    keep = ("spacing policy", "profile over", "T* constrained", "not following", "bridged", "model-only",
-            "poor fit", "model and data", "the data alone", "in ", "stopped at the bound")
+    keep = ("spacing policy", "profile over", "the profile over", "T* constrained", "not following", "bridged",
+            "model-only", "poor fit", "model and data", "the data alone", "in ", "stopped at the bound",
+            "θ_r held at", "the fitted model's simulated")
     for c in res.cars:
         lines.append(f"**{c.car} ({c.setting})**: {c.statement()}")
         lines += [f"- {n}" for n in c.fit.notes + c.notes if n.startswith(keep)]

@@ -220,13 +220,14 @@ def _fig_fit(v: Any) -> Any:
     b = list(v.fit.at_bound)
     theta = (f", θ_r = {_num(p['reaction_delay'], 'reaction_delay', b, 's')}"
              if "reaction_delay" in v.fit.names else "")
-    ax1.set_title(f"{_who(v)}, fitted: k_x = {_num(p['k_x'], 'k_x', b, '1/s²')}, "
-                  f"k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, τ = {_num(p['tau'], 'tau', b, 's')}{theta}, "
-                  f"T* = {_num(p['headway'], 'headway', b, 's')}, "
-                  f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}\n"
-                  f"fit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
-                  f"{_small(v.fit.rmse_gap, 'm')}",
-                  fontsize=9)
+    params = (f"k_x = {_num(p['k_x'], 'k_x', b, '1/s²')}, k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, "
+              f"τ = {_num(p['tau'], 'tau', b, 's')}{theta}, T* = {_num(p['headway'], 'headway', b, 's')}, "
+              f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}")
+    head = f"{_who(v)}, fitted: {params}"
+    if len(head) > 110:  # the parameters on a line of their own (θ_r and bounds lengthen it)
+        head = f"{_who(v)}, fitted:\n{params}"
+    ax1.set_title(f"{head}\nfit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
+                  f"{_small(v.fit.rmse_gap, 'm')}", fontsize=9)
     return fig
 
 
@@ -407,9 +408,10 @@ def write_cars_outputs(res: Any, out: OutputDir, *, figures: bool = True) -> lis
 def _fig_cars(res: Any) -> Any:
     import textwrap
 
-    fig = _figure(7, 4.2)
+    n = len(res.cars)
+    fig = _figure(max(7.0, 0.85 * n), 4.6)
     ax = fig.add_subplot()
-    x = np.arange(len(res.cars))
+    x = np.arange(n)
     sup = np.array([float(c.certificate.sup_gain) for c in res.cars])
     iv = np.array([c.interval("sup_gain") for c in res.cars]).reshape(-1, 2)
     lo = np.where(np.isfinite(iv[:, 0]), sup - iv[:, 0], 0.0)
@@ -421,8 +423,9 @@ def _fig_cars(res: Any) -> Any:
     ax.errorbar(x + 0.08, g, yerr=np.where(np.isfinite(ge), 2 * ge * g, 0.0), fmt="s", color="k",
                 capsize=3, label="data's max |Ĝ| ± 2ε (pooled)")
     ax.axhline(1.0, color="0.3", lw=0.6, ls=":")
-    ax.set_xticks(x, [textwrap.fill(c.car.replace("_", " "), 14) + f"\n{c.setting}, {len(c.logs)} log"
-                      + ("s" if len(c.logs) != 1 else "") for c in res.cars], fontsize=7)
+    ax.set_xticks(x, [textwrap.fill(c.car.replace("_", " "), 9) + f"\n({c.setting}, {len(c.logs)})"
+                      for c in res.cars], fontsize=7)
+    ax.set_xlabel("car (setting, logs pooled)", fontsize=8)
     ax.set_ylabel("amplification (follower over predecessor)")
     ax.set_title("one row per car and setting: above the dotted line at 1 a car amplifies", fontsize=9)
     ax.legend(fontsize=8)
