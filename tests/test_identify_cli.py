@@ -154,7 +154,7 @@ def test_identify_fit_delay_cli(tmp_path: Path, capsys: pytest.CaptureFixture[st
     """--fit-delay (the default in continuous time) on a noisy log of a car with θ_r = 0.4 s:
     θ_r recovered within 0.1 s, its interval and profile in identify.json, the certificate at that
     θ_r, certify --from re-certifies each vehicle at its own θ_r (same verdict and sup|Γ|), and
-    simulate --from refuses it (the simulator has no θ_r yet)."""
+    simulate --from runs a platoon of that car at its θ_r."""
     import sys
 
     sys.path.insert(0, str(Path(__file__).parent))
@@ -184,5 +184,8 @@ def test_identify_fit_delay_cli(tmp_path: Path, capsys: pytest.CaptureFixture[st
     [cr] = json.loads(capsys.readouterr().out)["results"]
     assert cr["verdict"] == r["verdict"] and cr["sup_gain"] == pytest.approx(r["sup_gain"], rel=1e-9)
     assert main(["simulate", "--from", str(out / "identify.json"), "--vehicle", "1", "--no-figures",
-                 "--out", str(tmp_path / "sim")]) == 2
-    assert "which the simulator does not model yet" in capsys.readouterr().err
+                 "--leader", "sinusoid:omega=0.3,amplitude=1", "--duration", "20", "--followers", "2",
+                 "--out", str(tmp_path / "sim")]) == 0
+    sim = json.loads((tmp_path / "sim" / "metrics.json").read_text(encoding="utf-8"))
+    assert sim["run"]["reaction_delay"] == r["reaction_delay"]  # the fitted θ_r, simulated
+    assert sim["certificate"]["reaction_delay"] == r["reaction_delay"]
