@@ -235,12 +235,16 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
         from ..params import parameter_model
 
         tau, delta, headway = (given.get(k, r[k]) for k in ("tau", "delta", "headway"))
-        loop = Loop(parameter_model(tau, delta, headway, theta), H)
+        # each vehicle at its own fitted θ_r (identify --fit-delay) unless --reaction-delay is given
+        theta_r = theta if getattr(args, "reaction_delay", None) is not None else r["reaction_delay"]
+        loop = Loop(parameter_model(tau, delta, headway, theta_r), H)
         b = loop.certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]])
         c: dict[str, Any] = b.records()[0]
         rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
         for k in ("tau", "delta", "headway"):
             rec[k] = given.get(k, f"{r[k]:.6g}")
+        if theta_r:
+            rec["reaction_delay"] = f"{theta_r:.6g}"
         for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega"):
             if k in c:
                 rec[k] = c[k]
@@ -250,6 +254,10 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
              TableColumn("τ[s]", "tau", "%s"), TableColumn("δ[s]", "delta", "%s"),
              TableColumn("T*[s]", "headway", "%s"), TableColumn("sup|Γ|", "sup_gain"),
              TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"), TableColumn("verdict", "verdict", "%s")]
+    if any("reaction_delay" in r for r in records):  # a θ_r = 0 file writes what it always did
+        table.insert(8, TableColumn("θ_r[s]", "reaction_delay", "%s"))
+        for r in records:
+            r.setdefault("reaction_delay", "0")
     n_ok = sum(r["verdict"] == "certified" for r in records)
     write_results(columns_from_records(records), out, args.format,
                   params={"from": args.from_identify, "sample_time": H},
