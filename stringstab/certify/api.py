@@ -9,7 +9,10 @@ the sample time H or None) and decides which certificate answers, :attr:`Loop.ki
 * ``"continuous"`` — point parameters, no sample time
   (:mod:`stringstab.certify.continuous`);
 * ``"sampled"`` — point parameters and a sample time (:mod:`stringstab.certify.sampled`);
-* ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`).
+* ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`);
+* ``"multirate"`` — point parameters, a sample time H and a V2V message period N·H with
+  N ≥ 2 (:mod:`stringstab.certify.multirate`); N = 1 is the sampled loop, answered by the
+  sampled certificate (the same loop: messages every control step).
 
 The gains are broadcast, checked finite and within range, and flattened once
 (:func:`gains`).  The kernels of the three certificates (``certify_kernel`` and
@@ -37,6 +40,7 @@ from .continuous import Certificate, CertificateBatch
 from .verdicts import Check, one_triple
 
 if TYPE_CHECKING:
+    from .multirate import MultirateCertificate, MultirateCertificateBatch
     from .robust import RobustCertificate, RobustCertificateBatch
     from .sampled import SampledCertificate, SampledCertificateBatch
 
@@ -44,7 +48,7 @@ __all__ = ["Loop", "LoopKind", "certify", "certify_batch", "check", "gains"]
 
 Array = npt.NDArray[np.float64]
 #: Which certificate answers: the continuous-time loop, the sampled-data loop, or a box.
-LoopKind = Literal["continuous", "sampled", "robust"]
+LoopKind = Literal["continuous", "sampled", "robust", "multirate"]
 #: The methods of :func:`certify_batch`: the exact certificate, or it plus the Padé cross-check.
 METHODS = ("exact", "pade")
 
@@ -98,6 +102,15 @@ class Loop:
         Sampled box only: the predecessor's lag ranges over the τ box independently.
     method : {"exact", "pade"}
         ``"pade"`` adds python-control's cross-check (continuous point loop only).
+    message_steps : int or None
+        N: the predecessor's acceleration arrives by V2V message every N control steps and
+        is held (the multi-rate loop, N ≥ 2); None or 1: every step (the sampled loop).
+    message_phase : int
+        φ ∈ {0, …, N − 1}: the step, modulo N, at which messages are used (recorded; the
+        certificate holds for every phase).
+    fallback : (float, float) or None
+        Multi-rate loop only: the fallback (ACC) gains (k_x, k_v) certified beside it
+        (default: each triple's own with k_a = 0).
     """
 
     model: Params | Box
@@ -105,6 +118,9 @@ class Loop:
     tau_prev: float | None = None
     heterogeneous: bool = True
     method: str = "exact"
+    message_steps: int | None = None
+    message_phase: int = 0
+    fallback: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         box, H = isinstance(self.model, Box), self.sample_time
@@ -118,10 +134,36 @@ class Loop:
             raise StringStabError(
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
+        self._check_messages()
+
+    # -- the multi-rate loop: its combinations checked here (delimited; issue 26) ----------
+    def _check_messages(self) -> None:
+        N = self.message_steps
+        if N is None:
+            if self.fallback is not None:
+                raise StringStabError("fallback gains are for the multi-rate loop; expected "
+                                      "message_period with them, got none")
+            return
+        if self.sample_time is None:
+            raise StringStabError("message_period (the V2V message period) needs the control "
+                                  "period: expected sample_time with it, got none")
+        if N < 2:
+            if self.fallback is not None:
+                raise StringStabError("fallback gains are for the multi-rate loop (message "
+                                      "period >= 2 sample times); got a message every sample")
+            return
+        if isinstance(self.model, Box):
+            raise StringStabError("the multi-rate certificate is for one τ, δ, T*; got a "
+                                  "parameter box with message_period (not supported)")
+        if self.tau_prev is not None:
+            raise StringStabError("the multi-rate certificate is for a homogeneous platoon; "
+                                  f"got tau_prev={self.tau_prev!r} with message_period")
 
     @classmethod
     def of(cls, tau: Any, delta: Any, headway: Any, sample_time: Any = None,
-           tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact") -> Loop:
+           tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact",
+           message_period: Any = None, message_phase: Any = None,
+           fallback_gains: Any = None) -> Loop:
         """The loop a caller asks for, every value checked (the one place they are).
 
         Parameters
@@ -137,6 +179,13 @@ class Loop:
             Sampled box only: independent predecessor lag.
         method : {"exact", "pade"}
             The method of :func:`certify_batch`.
+        message_period : float, optional
+            P = N·H (s): the V2V message period, a whole multiple of ``sample_time``
+            (:func:`stringstab.certify.message.message_steps`); P = H is the sampled loop.
+        message_phase : int, optional
+            φ ∈ {0, …, N − 1} (default 0).
+        fallback_gains : (float, float), optional
+            The fallback (ACC) gains (k_x, k_v) of the multi-rate loop.
 
         Returns
         -------
@@ -154,10 +203,13 @@ class Loop:
         'sampled'
         >>> Loop.of("0.1:0.3", 0.2, 1.1).kind
         'robust'
+        >>> Loop.of(0.1, 0.2, 1.1, sample_time=0.01, message_period=0.1).kind
+        'multirate'
         """
         model = parameter_model(tau, delta, headway)
         H = None if sample_time is None else checked_sample_time(sample_time)
-        loop = cls(model, H, tau_prev, heterogeneous, method)
+        N, phase, fb = _messages(H, message_period, message_phase, fallback_gains)
+        loop = cls(model, H, tau_prev, heterogeneous, method, N, phase, fb)
         if tau_prev is None:
             return loop
         tp = positive("tau_prev (predecessor's actuator lag)", tau_prev, unit=" s")
@@ -172,16 +224,19 @@ class Loop:
 
     @property
     def kind(self) -> LoopKind:
-        """Which certificate answers: ``"continuous"``, ``"sampled"`` or ``"robust"``."""
+        """Which certificate answers: ``"continuous"``, ``"sampled"``, ``"robust"`` or ``"multirate"``."""
         if isinstance(self.model, Box):
             return "robust"
+        if self.message_steps is not None and self.message_steps >= 2:
+            return "multirate"
         return "continuous" if self.sample_time is None else "sampled"
 
     def certify_batch(
         self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *, pade_order: int = 5,
         progress: bool = False, chunk: int = 4096, n_grid: int | None = None,
         max_rounds: int = 30, max_intervals: int = 1024,
-    ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    ) -> (CertificateBatch | SampledCertificateBatch | RobustCertificateBatch
+          | MultirateCertificateBatch):
         """Certify many gain triples on this loop (:func:`certify_batch` with a checked loop).
 
         Parameters
@@ -193,7 +248,7 @@ class Loop:
 
         Returns
         -------
-        CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
+        CertificateBatch, SampledCertificateBatch, RobustCertificateBatch or MultirateCertificateBatch
             By :attr:`kind`.
         """
         return _certify(self, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
@@ -222,12 +277,49 @@ class Loop:
                       max_intervals=max_intervals)
 
 
+def _messages(H: float | None, message_period: Any, message_phase: Any,
+              fallback_gains: Any) -> tuple[int | None, int, tuple[float, float] | None]:
+    """The message schedule and fallback gains a caller gives, checked (issue 26)."""
+    if message_period is None:
+        if message_phase is not None:
+            raise StringStabError("message_phase is for the multi-rate loop; expected "
+                                  "message_period with it, got none")
+        if fallback_gains is not None:
+            raise StringStabError("fallback gains are for the multi-rate loop; expected "
+                                  "message_period with them, got none")
+        return None, 0, None
+    if H is None:
+        raise StringStabError("message_period (the V2V message period) needs the control "
+                              "period: expected sample_time with it, got none")
+    from .message import message_phase as checked_phase
+    from .message import message_steps
+
+    N = message_steps(message_period, H)
+    phase = 0 if message_phase is None else checked_phase(message_phase, N)
+    fb = None
+    if fallback_gains is not None:
+        try:
+            fx, fv = (float(v) for v in fallback_gains)
+        except (TypeError, ValueError) as e:
+            raise StringStabError("fallback gains must be two numbers (k_x, k_v); got "
+                                  f"{fallback_gains!r}") from e
+        fx_, fv_, _ = as_gains(fx, fv, 0.0)
+        fb = (float(fx_), float(fv_))
+    return N, phase, fb
+
+
 # ---------------------------------------------------------------------------
 # The dispatch: checked loop and gains in, the kernel of the loop's kind called
 # ---------------------------------------------------------------------------
 def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
            max_rounds: int, max_intervals: int) -> Check:
     model, H = loop.model, loop.sample_time
+    if loop.kind == "multirate":
+        from . import multirate
+
+        assert isinstance(model, Params) and H is not None and loop.message_steps is not None
+        return multirate.check_kernel(kx, kv, ka, model, H, loop.message_steps, n_grid=n_grid,
+                                      max_rounds=max_rounds, max_intervals=max_intervals)
     if isinstance(model, Box):
         from . import robust
 
@@ -246,8 +338,16 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
 def _certify(
     loop: Loop, kx: Array, kv: Array, ka: Array, *, pade_order: int, progress: bool, chunk: int,
     n_grid: int | None, max_rounds: int, max_intervals: int,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch | MultirateCertificateBatch:
     model, H = loop.model, loop.sample_time
+    if loop.kind == "multirate":
+        from . import multirate
+
+        assert isinstance(model, Params) and H is not None and loop.message_steps is not None
+        return multirate.certify_kernel(
+            kx, kv, ka, model, H, loop.message_steps, phase=loop.message_phase,
+            fallback=loop.fallback, progress=progress, n_grid=n_grid, max_rounds=max_rounds,
+            max_intervals=max_intervals)
     if isinstance(model, Box):
         from . import robust
 
@@ -279,6 +379,7 @@ def check(
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
     tau_prev: float | None = None, heterogeneous: bool = True,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    message_period: float | None = None, message_phase: int | None = None,
 ) -> Check:
     """The certificate's verdicts alone, for inner loops (e.g. gain repair).
 
@@ -305,6 +406,8 @@ def check(
         follower's (default; a platoon of different vehicles), or equals it.
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
+    message_period, message_phase
+        As for :func:`certify_batch`.
 
     Returns
     -------
@@ -322,7 +425,8 @@ def check(
     >>> c.verdict.tolist(), c.sample_time
     (['certified', 'not_certified'], 0.1)
     """
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous,
+                   message_period=message_period, message_phase=message_phase)
     return _check(loop, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                   max_intervals=max_intervals)
 
@@ -344,7 +448,10 @@ def certify_batch(
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     tau_prev: float | None = None, heterogeneous: bool = True,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> (CertificateBatch | SampledCertificateBatch | RobustCertificateBatch
+      | MultirateCertificateBatch): ...
 
 
 def certify_batch(
@@ -353,7 +460,9 @@ def certify_batch(
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     tau_prev: float | None = None, heterogeneous: bool = True,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch | MultirateCertificateBatch:
     """Certify many gain triples at once (exact delay, sound; see :mod:`stringstab.certify.continuous`).
 
     With point parameters and no sample time this is the continuous-time certificate of
@@ -393,12 +502,22 @@ def certify_batch(
         rounds, and the cap on undecided intervals *per triple* beyond which that triple is
         declared inconclusive (per triple, so a verdict never depends on the rest of the
         batch).
+    message_period : float, optional
+        P = N·H (s), with ``sample_time``: the predecessor's acceleration arrives by V2V
+        message every N control steps and is held (the multi-rate certificate,
+        :mod:`stringstab.certify.multirate`); P = H is the sampled loop.
+    message_phase : int, optional
+        φ ∈ {0, …, N − 1}: the step at which messages are used (recorded; every phase has
+        the same certificate).
+    fallback_gains : (float, float), optional
+        Multi-rate only: the fallback (ACC, k_a = 0) gains (k_x, k_v) certified beside
+        (default: each triple's own k_x, k_v).
 
     Returns
     -------
-    CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
-        The last two carry ``sample_time`` and the parameter box in their columns, rows and
-        summary.
+    CertificateBatch, SampledCertificateBatch, RobustCertificateBatch or MultirateCertificateBatch
+        The last three carry ``sample_time`` and the parameter box in their columns, rows and
+        summary (the multi-rate batch also the message schedule and the fallback columns).
 
     Raises
     ------
@@ -418,7 +537,8 @@ def certify_batch(
     >>> r.verdict.tolist(), r.summary()["box"]["tau"]
     (['certified', 'not_certified'], [0.1, 0.3])
     """
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
+                   message_period, message_phase, fallback_gains)
     return _certify(loop, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
                     chunk=chunk, n_grid=n_grid, max_rounds=max_rounds,
                     max_intervals=max_intervals)
@@ -437,14 +557,18 @@ def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
     tau_prev: float | None = None, heterogeneous: bool = True,
-) -> Certificate | SampledCertificate | RobustCertificate: ...
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> Certificate | SampledCertificate | RobustCertificate | MultirateCertificate: ...
 
 
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
     tau_prev: float | None = None, heterogeneous: bool = True,
-) -> Certificate | SampledCertificate | RobustCertificate:
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> Certificate | SampledCertificate | RobustCertificate | MultirateCertificate:
     """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
 
     Parameters
@@ -466,11 +590,21 @@ def certify(
         follower's (default; a platoon of different vehicles), or equals it.
     method, pade_order
         As for :func:`certify_batch`.
+    message_period : float, optional
+        P = N·H (s), with ``sample_time``: the predecessor's acceleration arrives by V2V
+        message every N control steps and is held (the multi-rate certificate,
+        :mod:`stringstab.certify.multirate`); P = H is the sampled loop.
+    message_phase : int, optional
+        φ ∈ {0, …, N − 1}: the step at which messages are used (recorded; every phase has
+        the same certificate).
+    fallback_gains : (float, float), optional
+        Multi-rate only: the fallback (ACC, k_a = 0) gains (k_x, k_v) certified beside
+        (default: each triple's own k_x, k_v).
 
     Returns
     -------
-    Certificate, SampledCertificate or RobustCertificate
-        The continuous, sampled-data or robust certificate of the triple.
+    Certificate, SampledCertificate, RobustCertificate or MultirateCertificate
+        The continuous, sampled-data, robust or multi-rate certificate of the triple.
 
     Examples
     --------
@@ -483,8 +617,13 @@ def certify(
     >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)
     ('not_certified', 1.0911, 1.379, 0.1379)
+    >>> m = certify(1.2, 0.5, 0.6, tau=0.1, delta=0.2, headway=1.1, sample_time=0.01,
+    ...             message_period=0.1)
+    >>> m.verdict, m.message_steps, m.fallback_verdict
+    ('certified', 10, 'certified')
     """
     one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
+                   message_period, message_phase, fallback_gains)
     return _certify(loop, *gains([k_x], [k_v], [k_a]), pade_order=pade_order, progress=False,
                     chunk=4096, n_grid=None, max_rounds=30, max_intervals=1024)[0]
