@@ -281,12 +281,21 @@ def lifted_response(link: LiftedLink, theta: npt.ArrayLike) -> npt.NDArray[np.co
     Returns
     -------
     ndarray of complex, shape (n, k, N, N)
-        The lifted frequency response.
+        The lifted frequency response (NaN at an eigenvalue of A on the circle).
     """
     A, B, C, D = link.A.mid, link.B.mid, link.C.mid, link.D.mid
     th = np.broadcast_to(np.asarray(theta, dtype=float), (A.shape[0], np.shape(theta)[-1]))
     z = np.exp(1j * th)
     nx = A.shape[-1]
     W = z[..., None, None] * np.eye(nx) - A[:, None]
-    X = np.linalg.solve(W, np.broadcast_to(B[:, None], (*W.shape[:2], nx, B.shape[-1])))
+    rhs = np.broadcast_to(B[:, None], (*W.shape[:2], nx, B.shape[-1]))
+    try:
+        X = np.linalg.solve(W, rhs)
+    except np.linalg.LinAlgError:  # a pole on the circle (k_x = 0: z = 1): NaN there
+        X = np.full(rhs.shape, np.nan, dtype=complex)
+        for i, j in np.ndindex(*W.shape[:2]):
+            try:
+                X[i, j] = np.linalg.solve(W[i, j], rhs[i, j])
+            except np.linalg.LinAlgError:
+                pass
     return np.asarray(C[:, None] @ X + D[:, None])

@@ -22,7 +22,7 @@ from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ..regions import CONTINUOUS, GAIN_NAMES
-from ._common import add_model_arguments, loop_params
+from ._common import add_message_arguments, add_model_arguments, loop_params, message_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -38,6 +38,7 @@ examples:
   stringstab region --fix k_a=0.3 --range k_x=0,1.5 --range k_v=-1,1 --overlay rollout.csv
   stringstab region --fix k_a=0.5 --sample-time 0.1 --compare continuous --out maps_dt01/
   stringstab region --fix k_a=0.5 --tau 0.1:0.3 --delta 0.1:0.3 --n 101 --out maps_box/
+  stringstab region --fix k_a=0.5 --sample-time 0.01 --message-period 0.2 --compare continuous
   stringstab region --3d --n 81 --method exact --scheduler tcp://head:8786 --out maps3d/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
@@ -86,6 +87,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--n", metavar="N[,N2[,N3]]",
                    help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
     add_model_arguments(p)
+    add_message_arguments(p)
     p.add_argument("--method", metavar="M[,M...]",
                    help="methods among exact, taylor, printed (default: all three; exact alone "
                         "with --sample-time or an interval)")
@@ -277,6 +279,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     axes, fixed = _grid(args)
     model, H = loop_params(args)
+    N, _ = message_from_args(args, H)  # the multi-rate map (issue 26): exact is its certificate
     methods = args.method
     if args.compare is not None:
         if H is None:
@@ -316,7 +319,8 @@ def run(args: argparse.Namespace) -> int:
             rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
                               headway=model.headway, sample_time=H, methods=methods,
                               workers=n_dask or workers, executor=executor,
-                              progress=False if args.no_progress else None)
+                              progress=False if args.no_progress else None,
+                              message_period=None if N is None else args.message_period)
     finally:
         warm.join()
     verdicts = None
