@@ -132,7 +132,7 @@ def lifted_truth(case: Case, K: np.ndarray, max_steps: int = 40_000):
     rad = monodromy_radius(case, K)
     worst = float(rad.max()) if rad.size else 0.0
     _, _, m, _ = step_model(case.tau, case.headway, case.H, case.delta)
-    steps = m + 2 * N + int(math.ceil(math.log(1e-13) / math.log(max(worst, 1e-3))))
+    steps = m + 2 * N + math.ceil(math.log(1e-13) / math.log(max(worst, 1e-3)))
     steps = min(max_steps, N * math.ceil(steps / N))
     up = np.zeros((len(K), N, steps))
     for l_ in range(N):
@@ -197,7 +197,7 @@ def simulated_gain(case: Case, K: np.ndarray, G: np.ndarray, theta: np.ndarray, 
 def random_case(rng: np.random.Generator, N: int) -> Case:
     H = float(rng.choice(HS))
     if rng.random() < 0.5:  # a whole number of steps
-        m = int(rng.integers(0, int(round(0.3 / H)) + 1))
+        m = int(rng.integers(0, round(0.3 / H) + 1))
         delta = round(m * H, 10)
     else:
         delta = float(np.round(rng.uniform(0.0, 0.3), 4))

@@ -134,30 +134,10 @@ class Loop:
             raise StringStabError(
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
-        self._check_messages()
+        if self.message_steps is not None or self.fallback is not None:  # issue 26
+            from .message import check_message_loop
 
-    # -- the multi-rate loop: its combinations checked here (delimited; issue 26) ----------
-    def _check_messages(self) -> None:
-        N = self.message_steps
-        if N is None:
-            if self.fallback is not None:
-                raise StringStabError("fallback gains are for the multi-rate loop; expected "
-                                      "message_period with them, got none")
-            return
-        if self.sample_time is None:
-            raise StringStabError("message_period (the V2V message period) needs the control "
-                                  "period: expected sample_time with it, got none")
-        if N < 2:
-            if self.fallback is not None:
-                raise StringStabError("fallback gains are for the multi-rate loop (message "
-                                      "period >= 2 sample times); got a message every sample")
-            return
-        if isinstance(self.model, Box):
-            raise StringStabError("the multi-rate certificate is for one τ, δ, T*; got a "
-                                  "parameter box with message_period (not supported)")
-        if self.tau_prev is not None:
-            raise StringStabError("the multi-rate certificate is for a homogeneous platoon; "
-                                  f"got tau_prev={self.tau_prev!r} with message_period")
+            check_message_loop(self.message_steps, H, box, self.tau_prev, self.fallback)
 
     @classmethod
     def of(cls, tau: Any, delta: Any, headway: Any, sample_time: Any = None,
@@ -208,7 +188,11 @@ class Loop:
         """
         model = parameter_model(tau, delta, headway)
         H = None if sample_time is None else checked_sample_time(sample_time)
-        N, phase, fb = _messages(H, message_period, message_phase, fallback_gains)
+        N, phase, fb = None, 0, None
+        if message_period is not None or message_phase is not None or fallback_gains is not None:
+            from .message import message_schedule
+
+            N, phase, fb = message_schedule(H, message_period, message_phase, fallback_gains)
         loop = cls(model, H, tau_prev, heterogeneous, method, N, phase, fb)
         if tau_prev is None:
             return loop
@@ -275,37 +259,6 @@ class Loop:
         """
         return _check(self, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                       max_intervals=max_intervals)
-
-
-def _messages(H: float | None, message_period: Any, message_phase: Any,
-              fallback_gains: Any) -> tuple[int | None, int, tuple[float, float] | None]:
-    """The message schedule and fallback gains a caller gives, checked (issue 26)."""
-    if message_period is None:
-        if message_phase is not None:
-            raise StringStabError("message_phase is for the multi-rate loop; expected "
-                                  "message_period with it, got none")
-        if fallback_gains is not None:
-            raise StringStabError("fallback gains are for the multi-rate loop; expected "
-                                  "message_period with them, got none")
-        return None, 0, None
-    if H is None:
-        raise StringStabError("message_period (the V2V message period) needs the control "
-                              "period: expected sample_time with it, got none")
-    from .message import message_phase as checked_phase
-    from .message import message_steps
-
-    N = message_steps(message_period, H)
-    phase = 0 if message_phase is None else checked_phase(message_phase, N)
-    fb = None
-    if fallback_gains is not None:
-        try:
-            fx, fv = (float(v) for v in fallback_gains)
-        except (TypeError, ValueError) as e:
-            raise StringStabError("fallback gains must be two numbers (k_x, k_v); got "
-                                  f"{fallback_gains!r}") from e
-        fx_, fv_, _ = as_gains(fx, fv, 0.0)
-        fb = (float(fx_), float(fv_))
-    return N, phase, fb
 
 
 # ---------------------------------------------------------------------------

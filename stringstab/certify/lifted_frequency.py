@@ -51,6 +51,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -157,8 +158,7 @@ class Prepared:
     r: Array
 
 
-def _verified_inverse(W: npt.NDArray[np.generic], rW: Array,
-                      complex_: bool) -> tuple[npt.NDArray[np.generic], Array, Array]:
+def _verified_inverse(W: Any, rW: Array, complex_: bool) -> tuple[Any, Array, Array]:
     """X ≈ W^{−1} of a stack, ρ ≥ ‖exact W^{−1}‖₂ and d ≥ ‖exact W^{−1} − X‖₂ (inf if unproven).
 
     ``rW`` bounds ‖exact W − W‖₂.  ε = ‖I − XW‖_F (computed) + its round-off + ‖X‖_F rW;
@@ -179,7 +179,7 @@ def _verified_inverse(W: npt.NDArray[np.generic], rW: Array,
     return X, rho, np.where(eps < 0.5, eps * rho, np.inf)
 
 
-def _safe_inv(w: npt.NDArray[np.generic]) -> npt.NDArray[np.generic]:
+def _safe_inv(w: Any) -> Any:
     try:
         return np.asarray(np.linalg.inv(w))
     except np.linalg.LinAlgError:
@@ -336,7 +336,7 @@ class Margin:
         return np.asarray(self.local[..., LOCAL.index("rho")])
 
 
-def _norm2(x: npt.NDArray[np.generic]) -> Array:
+def _norm2(x: Any) -> Array:
     """Upper bounds of the spectral norms of a stack: min(‖x‖_F, √(‖x‖₁‖x‖_∞)), rounded up."""
     a = np.abs(x)
     n1 = a.sum(axis=-2).max(axis=-1, initial=0.0)
@@ -344,7 +344,7 @@ def _norm2(x: npt.NDArray[np.generic]) -> Array:
     return np.asarray(np.minimum(fro(x), np.sqrt(n1 * ni) * (1.0 + gamma(sum(x.shape[-2:])))))
 
 
-def _vnorm(x: npt.NDArray[np.generic]) -> Array:
+def _vnorm(x: Any) -> Array:
     """Euclidean norms of a stack of vectors (last axis), rounded up."""
     return np.asarray(np.sqrt(np.sum((x * np.conj(x)).real, axis=-1)) * (1.0 + gamma(x.shape[-1])))
 
@@ -386,7 +386,7 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array) -> Margin:
     nCh = _norm2(C)
     blocks = (slice(0, N - 1), slice(N - 1, N), slice(N, N + 1), slice(N + 1, 2 * N))
 
-    def bnorms(a: npt.NDArray[np.generic]) -> Array:
+    def bnorms(a: Any) -> Array:
         return np.stack([_norm2(a[:, :, b]) for b in blocks], axis=1)
 
     # W_k = X^k Q ≈ R₀^k Q; per block b, Ek[k][b] bounds ‖R₀^k Q_b − W_k,b‖

@@ -225,7 +225,7 @@ def _peak(link: LiftedLink, grid: Array, worst: Array) -> tuple[Array, Array]:
 
         def sig(th: Array, sub: LiftedLink = sub) -> Array:
             G = lifted_response(sub, th)
-            bad = ~np.isfinite(G).all(axis=(-2, -1))
+            bad = np.asarray(~np.isfinite(G).all(axis=(-2, -1)))
             S = np.linalg.norm(np.where(bad[..., None, None], 0.0, G), 2, axis=(-2, -1))
             return np.asarray(np.where(bad, np.inf, S))  # a pole on the circle
 

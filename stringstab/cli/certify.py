@@ -22,24 +22,23 @@ from typing import Any
 
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
-
-#: The default cap of ``--max-message-period`` (s); the library's
-#: :data:`stringstab.certify.message_period.DEFAULT_CAP` (not imported: the CLI starts light).
-DEFAULT_CAP = 0.5
 from ._common import (
     add_gain_arguments,
-    add_message_arguments,
     add_model_arguments,
     add_output_arguments,
     check_horizon,
     check_output,
     gains_from_args,
     loop_params,
-    message_from_args,
     shown_params,
 )
+from ._message import add_message_arguments, message_from_args
 
-__all__ = ["PROGRESS_ROWS", "add_parser", "run"]
+__all__ = ["DEFAULT_CAP", "PROGRESS_ROWS", "add_parser", "run"]
+
+#: The default cap of ``--max-message-period`` (s); the library's
+#: :data:`stringstab.certify.message_period.DEFAULT_CAP` (not imported: the CLI starts light).
+DEFAULT_CAP = 0.5
 
 #: Show a progress bar when there are more rows than this (or stderr is a terminal).
 PROGRESS_ROWS = 10_000

@@ -22,7 +22,8 @@ from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
 from ..regions import CONTINUOUS, GAIN_NAMES
-from ._common import add_message_arguments, add_model_arguments, loop_params, message_from_args
+from ._common import add_model_arguments, loop_params
+from ._message import add_message_arguments, message_from_args
 
 __all__ = ["add_parser", "run"]
 
