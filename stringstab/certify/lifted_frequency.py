@@ -323,12 +323,15 @@ class Margin:
         The bounds named in :data:`LOCAL` (inf where unproven).
     m_ee : ndarray, shape (k, p)
         The unweighted m_ee(θ) computed (to choose the weight).
+    M : ndarray of complex, shape (k, p, N, N), or None
+        The computed M_r(θ) itself, when asked for (tests).
     """
 
     lam: Array
     slack: Array
     local: Array
     m_ee: Array
+    M: npt.NDArray[np.complex128] | None = None
 
     @property
     def rho(self) -> Array:
@@ -354,7 +357,8 @@ def _ne(e: Array) -> float:
     return float(np.linalg.norm(e)) * (1.0 + gamma(e.size))
 
 
-def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array) -> Margin:
+def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
+             matrices: bool = False) -> Margin:
     """λ_min(M_r(θ)) with a proven slack, and the local bounds, at the points θ of ``idx``.
 
     Parameters
@@ -365,6 +369,8 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array) -> Margin:
         The triple of each row of ``theta``.
     theta : ndarray, shape (k, p)
         Frequencies in rad per message period.
+    matrices : bool
+        Also return the matrices M_r(θ) computed.
 
     Returns
     -------
@@ -477,7 +483,7 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array) -> Margin:
     slack = np.where(good, slack, np.inf)
     local = np.where(good[:, None], local, np.inf)
     return Margin(lam.reshape(k, p), slack.reshape(k, p), local.reshape(k, p, len(LOCAL)),
-                  m_ee0.reshape(k, p))
+                  m_ee0.reshape(k, p), M.reshape(k, p, N, N) if matrices else None)
 
 
 def _mul(a: tuple[Array, ...], b: tuple[Array, ...]) -> tuple[Array, Array, Array]:
