@@ -79,8 +79,8 @@ def fro(a: npt.ArrayLike) -> Array:
     >>> float(fro(np.eye(2)[None])[0]) >= 2**0.5
     True
     """
-    x = np.asarray(a)
-    s = np.sqrt(np.sum((x * np.conj(x)).real, axis=(-2, -1)))
+    x = np.abs(np.asarray(a))
+    s = np.sqrt(np.einsum("...ij,...ij->...", x, x))
     return np.asarray(s * (1.0 + gamma(x.shape[-1] * x.shape[-2])))
 
 

@@ -342,14 +342,18 @@ class Margin:
 def _norm2(x: Any) -> Array:
     """Upper bounds of the spectral norms of a stack: min(‖x‖_F, √(‖x‖₁‖x‖_∞)), rounded up."""
     a = np.abs(x)
-    n1 = a.sum(axis=-2).max(axis=-1, initial=0.0)
-    ni = a.sum(axis=-1).max(axis=-1, initial=0.0)
-    return np.asarray(np.minimum(fro(x), np.sqrt(n1 * ni) * (1.0 + gamma(sum(x.shape[-2:])))))
+    if a.shape[-1] == 0 or a.shape[-2] == 0:
+        return np.zeros(a.shape[:-2])
+    f = np.sqrt(np.einsum("...ij,...ij->...", a, a))
+    n1 = a.sum(axis=-2).max(axis=-1)
+    ni = a.sum(axis=-1).max(axis=-1)
+    return np.asarray(np.minimum(f, np.sqrt(n1 * ni)) * (1.0 + gamma(sum(x.shape[-2:]))))
 
 
 def _vnorm(x: Any) -> Array:
     """Euclidean norms of a stack of vectors (last axis), rounded up."""
-    return np.asarray(np.sqrt(np.sum((x * np.conj(x)).real, axis=-1)) * (1.0 + gamma(x.shape[-1])))
+    a = np.abs(x)
+    return np.asarray(np.sqrt(np.einsum("...i,...i->...", a, a)) * (1.0 + gamma(x.shape[-1])))
 
 
 def _ne(e: Array) -> float:
@@ -358,7 +362,7 @@ def _ne(e: Array) -> float:
 
 
 def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
-             matrices: bool = False) -> Margin:
+             matrices: bool = False, local: bool = True) -> Margin:
     """λ_min(M_r(θ)) with a proven slack, and the local bounds, at the points θ of ``idx``.
 
     Parameters
@@ -371,6 +375,9 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
         Frequencies in rad per message period.
     matrices : bool
         Also return the matrices M_r(θ) computed.
+    local : bool
+        Compute the local bounds of :func:`curvature` (False: λ_min, its slack and ρ₀ only;
+        the other local bounds are inf, so no interval can be settled from them).
 
     Returns
     -------
@@ -399,7 +406,8 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
     Wk = [Q]
     nW = [bnorms(Q)]
     Ek = [rQ]
-    for _ in range(3):
+    powers = 3 if local else 1
+    for _ in range(powers):
         Wn = X @ Wk[-1]
         En = (dR[:, None] * (nW[-1] + Ek[-1]) + nX[:, None] * Ek[-1]
               + gc * nX[:, None] * nW[-1])
@@ -407,13 +415,9 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
         nW.append(bnorms(Wn))
         Ek.append(En)
     # Y_j = C W_{j+1} ≈ C R₀^{j+1} Q, with error bounds per block
-    Y = [C @ Wk[j] for j in (1, 2, 3)]
+    Y = [C @ Wk[j] for j in range(1, powers + 1)]
     EY = [rC[:, None] * (nW[j] + Ek[j]) + nCh[:, None] * Ek[j] + gc * nCh[:, None] * nW[j]
-          for j in (1, 2, 3)]
-    zz = z[:, None, None]
-    D1 = -1j * zz * Y[1]                   # (PRQ)' = −jz PR²Q
-    D2 = zz * Y[1] - 2.0 * zz * zz * Y[2]  # (PRQ)'' = P(zR² − 2z²R³)Q
-    E1, E2 = EY[1], EY[1] + 2.0 * EY[2]
+          for j in range(1, powers + 1)]
     gN = gamma(2 * N + 2)
     # the pieces' values (with signs) at θ₀ and their error bounds
     GV = Y[0][:, :, blocks[0]] + pr.DV[rows]
@@ -427,20 +431,6 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
     eGdV = -np.einsum("i,kij->kj", e, Y[0][:, :, blocks[3]])
     reGdV = ne * EY[0][:, 3] + gN * ne * _norm2(Y[0][:, :, blocks[3]])
     nGV, nGde, neGdV = _norm2(GV), _vnorm(Gde), _vnorm(eGdV)
-    # ‖PR₀‖ for P = C and eᵀC, and ‖R₀Q_b‖
-    CX = C @ X
-    eCX = rC * rho + nCh * dR + gc * nCh * nX
-    pC = _norm2(CX) + eCX
-    peC = _vnorm(e @ CX) + ne * eCX
-    Rq = nW[1] + Ek[1]
-
-    def derivs(b: int, contract: bool) -> tuple[Array, Array]:
-        if contract:
-            v1 = np.einsum("i,kij->kj", e, D1[:, :, blocks[b]])
-            v2 = np.einsum("i,kij->kj", e, D2[:, :, blocks[b]])
-            return _vnorm(v1) + ne * E1[:, b], _vnorm(v2) + ne * E2[:, b]
-        return _norm2(D1[:, :, blocks[b]]) + E1[:, b], _norm2(D2[:, :, blocks[b]]) + E2[:, b]
-
     g1 = pr.g1[rows]
     m_ee0 = 2.0 * (gam + c1).real - g1 - nGde * nGde
     r_ee = 2.0 * (rgam + rc1) + pr.rg1[rows] + 2.0 * nGde * rGde + rGde * rGde
@@ -467,22 +457,41 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
     M = 0.5 * (M + np.swapaxes(M.conj(), 1, 2))
     lam = np.linalg.eigvalsh(M)[:, 0]
     slack = r_ee + r_eV + r_VV + gamma(4 * N) * fro(M)
-    cols = []
-    for val, rv, b, P, contract in ((nGV, rGV, 0, pC, False), (nGde, rGde, 1, pC, False),
-                                    (np.abs(gam), rgam, 1, peC, True),
-                                    (np.abs(c1), rc1, 2, peC, True),
-                                    (neGdV, reGdV, 3, peC, True)):
-        d1_, d2_ = derivs(b, contract)
-        cols += [val + rv, d1_, d2_, P * Rq[:, b]]
-    ur = (1.0 + gw) * u + gw * (1.0 + r) ** 2
-    local = np.stack([*cols, rho, np.abs(g1) + pr.rg1[rows], r, mee_b, meV_b, ur,
-                      (1.0 + gw) * fz + gw * (1.0 + r), np.abs(np.sin(theta.reshape(-1)))],
-                     axis=-1)
     good = np.isfinite(rho) & np.isfinite(slack)
     lam = np.where(good, lam, np.inf)
     slack = np.where(good, slack, np.inf)
-    local = np.where(good[:, None], local, np.inf)
-    return Margin(lam.reshape(k, p), slack.reshape(k, p), local.reshape(k, p, len(LOCAL)),
+    if local:
+        # the derivatives at θ₀ (with their bounds), ‖PR₀‖ for P = C and eᵀC, and ‖R₀Q_b‖
+        zz = z[:, None, None]
+        D1 = -1j * zz * Y[1]                   # (PRQ)' = −jz PR²Q
+        D2 = zz * Y[1] - 2.0 * zz * zz * Y[2]  # (PRQ)'' = P(zR² − 2z²R³)Q
+        E1, E2 = EY[1], EY[1] + 2.0 * EY[2]
+        CX = C @ X
+        eCX = rC * rho + nCh * dR + gc * nCh * nX
+        pC = _norm2(CX) + eCX
+        peC = _vnorm(e @ CX) + ne * eCX
+        Rq = nW[1] + Ek[1]
+        cols = []
+        for val, rv, b, P, contract in ((nGV, rGV, 0, pC, False), (nGde, rGde, 1, pC, False),
+                                        (np.abs(gam), rgam, 1, peC, True),
+                                        (np.abs(c1), rc1, 2, peC, True),
+                                        (neGdV, reGdV, 3, peC, True)):
+            d1, d2 = D1[:, :, blocks[b]], D2[:, :, blocks[b]]
+            if contract:
+                n1 = _vnorm(np.einsum("i,kij->kj", e, d1)) + ne * E1[:, b]
+                n2 = _vnorm(np.einsum("i,kij->kj", e, d2)) + ne * E2[:, b]
+            else:
+                n1, n2 = _norm2(d1) + E1[:, b], _norm2(d2) + E2[:, b]
+            cols += [val + rv, n1, n2, P * Rq[:, b]]
+        ur = (1.0 + gw) * u + gw * (1.0 + r) ** 2
+        loc = np.stack([*cols, rho, np.abs(g1) + pr.rg1[rows], r, mee_b, meV_b, ur,
+                        (1.0 + gw) * fz + gw * (1.0 + r), np.abs(np.sin(theta.reshape(-1)))],
+                       axis=-1)
+        loc = np.where(good[:, None], loc, np.inf)
+    else:
+        loc = np.full((k * p, len(LOCAL)), np.inf)
+        loc[:, LOCAL.index("rho")] = rho
+    return Margin(lam.reshape(k, p), slack.reshape(k, p), loc.reshape(k, p, len(LOCAL)),
                   m_ee0.reshape(k, p), M.reshape(k, p, N, N) if matrices else None)
 
 

@@ -86,11 +86,14 @@ def _default_grid(N: int) -> int:
     return 32 + 2 * N
 
 
-def _evaluator(pr: Prepared, items: npt.NDArray[np.intp], rho_max: Array) -> Evaluate:
+def _evaluator(pr: Prepared, items: npt.NDArray[np.intp], rho_max: Array,
+               local: bool = True) -> Evaluate:
     """The branch and bound's :data:`~stringstab.certify.branch_bound.Evaluate` of λ_min(M_r(θ)).
 
     Item i of the branch and bound is row ``items[i]`` of ``pr``; the largest resolvent bound
-    seen per item is kept in ``rho_max`` (to size the next grid).
+    seen per item is kept in ``rho_max`` (to size the next grid).  Without ``local`` the
+    points are evaluated without the local bounds (a violation can still be found; no
+    interval is settled).
     """
 
     def evaluate_(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
@@ -100,7 +103,7 @@ def _evaluator(pr: Prepared, items: npt.NDArray[np.intp], rho_max: Array) -> Eva
         loc = np.empty((k, p, len(LOCAL)))
         step = max(1, _BATCH_POINTS // p)
         for s in range(0, k, step):
-            mg = evaluate(pr, items[idx[s:s + step]], X[s:s + step])
+            mg = evaluate(pr, items[idx[s:s + step]], X[s:s + step], local=local)
             lam[s:s + step], slack[s:s + step], loc[s:s + step] = mg.lam, mg.slack, mg.local
         np.maximum.at(rho_max, idx, loc[:, :, LOCAL.index("rho")].max(axis=1))
         K = curvature(loc[:, :-1], loc[:, 1:], X[:, 1:2] - X[:, :1])
@@ -187,12 +190,14 @@ def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
     idx = np.flatnonzero(sure)
     if idx.size:
         pr = prepare(link.take(idx))
-        # a first look on a coarse grid finds most violations; the rest are decided on a grid
-        # fine enough for the resolvent bounds there (grouped by size, powers of two)
+        # a first look at the points of a coarse grid finds most violations (no interval is
+        # settled there); the rest are decided on a grid fine enough for the resolvent bounds
+        # (grouped by size, powers of two)
         rho = np.zeros(idx.size)
         items = np.arange(idx.size)
-        bb = branch_and_bound(idx.size, _evaluator(pr, items, rho), right=np.full(idx.size, np.pi),
-                              n_grid=ng, max_rounds=0, max_intervals=max_intervals, refine=pr.ok)
+        bb = branch_and_bound(idx.size, _evaluator(pr, items, rho, local=False),
+                              right=np.full(idx.size, np.pi), n_grid=ng, max_rounds=0,
+                              max_intervals=max_intervals, refine=pr.ok)
         v = verdict_codes(bb.status)
         mn, am, ne_ = bb.minimum, bb.argmin, bb.n_evals.copy()
         again = np.flatnonzero((v == INCONCLUSIVE) & pr.ok)
