@@ -482,7 +482,8 @@ def evaluate(pr: Prepared, idx: npt.NDArray[np.intp], theta: Array, *,
                 n2 = _vnorm(np.einsum("i,kij->kj", e, d2)) + ne * E2[:, b]
             else:
                 n1, n2 = _norm2(d1) + E1[:, b], _norm2(d2) + E2[:, b]
-            cols += [val + rv, n1, n2, P * Rq[:, b]]
+            # (the products by z, z² and 2 round by a few u: the factor covers them)
+            cols += [val + rv, n1 * (1.0 + gw), n2 * (1.0 + gw), P * Rq[:, b]]
         ur = (1.0 + gw) * u + gw * (1.0 + r) ** 2
         loc = np.stack([*cols, rho, np.abs(g1) + pr.rg1[rows], r, mee_b, meV_b, ur,
                         (1.0 + gw) * fz + gw * (1.0 + r), np.abs(np.sin(theta.reshape(-1)))],
