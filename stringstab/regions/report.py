@@ -153,7 +153,9 @@ def render_report(rmap: ReportedMap) -> str:
     if "continuous" in rmap.methods:
         band = int((rmap.stable("continuous") & ~rmap.stable("exact")).sum())
         back = int((rmap.stable("exact") & ~rmap.stable("continuous")).sum())
-        lines.append(f"certified in continuous time but not when sampled: {band:,} points "
-                     f"({percent(band / rmap.size)}); certified when sampled but not in "
+        how = ("when sampled" if rmap.message_period is None  # a multi-rate map (issue 26)
+               else f"with messages every {rmap.message_period:g} s")
+        lines.append(f"certified in continuous time but not {how}: {band:,} points "
+                     f"({percent(band / rmap.size)}); certified {how} but not in "
                      f"continuous time: {back:,}")
     return "\n".join(lines)
