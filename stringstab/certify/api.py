@@ -102,15 +102,9 @@ class Loop:
         Sampled box only: the predecessor's lag ranges over the τ box independently.
     method : {"exact", "pade"}
         ``"pade"`` adds python-control's cross-check (continuous point loop only).
-    message_steps : int or None
-        N: the predecessor's acceleration arrives by V2V message every N control steps and
-        is held (the multi-rate loop, N ≥ 2); None or 1: every step (the sampled loop).
-    message_phase : int
-        φ ∈ {0, …, N − 1}: the step, modulo N, at which messages are used (recorded; the
-        certificate holds for every phase).
-    fallback : (float, float) or None
-        Multi-rate loop only: the fallback (ACC) gains (k_x, k_v) certified beside it
-        (default: each triple's own with k_a = 0).
+    message_steps, message_phase, fallback : int or None, int, (float, float) or None
+        The multi-rate loop (N ≥ 2; None or 1: the sampled loop): V2V messages every N steps
+        at phase φ, and the fallback (ACC) gains, default each triple's own (docs/sampled.md §9).
     """
 
     model: Params | Box
@@ -159,13 +153,8 @@ class Loop:
             Sampled box only: independent predecessor lag.
         method : {"exact", "pade"}
             The method of :func:`certify_batch`.
-        message_period : float, optional
-            P = N·H (s): the V2V message period, a whole multiple of ``sample_time``
-            (:func:`stringstab.certify.message.message_steps`); P = H is the sampled loop.
-        message_phase : int, optional
-            φ ∈ {0, …, N − 1} (default 0).
-        fallback_gains : (float, float), optional
-            The fallback (ACC) gains (k_x, k_v) of the multi-rate loop.
+        message_period, message_phase, fallback_gains : optional
+            The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 
         Returns
         -------
@@ -270,9 +259,8 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
     if loop.kind == "multirate":
         from . import multirate
 
-        assert isinstance(model, Params) and H is not None and loop.message_steps is not None
-        return multirate.check_kernel(kx, kv, ka, model, H, loop.message_steps, n_grid=n_grid,
-                                      max_rounds=max_rounds, max_intervals=max_intervals)
+        return multirate.check_kernel(kx, kv, ka, model, H, loop.message_steps,  # type: ignore[arg-type]
+                                      n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
     if isinstance(model, Box):
         from . import robust
 
@@ -296,9 +284,8 @@ def _certify(
     if loop.kind == "multirate":
         from . import multirate
 
-        assert isinstance(model, Params) and H is not None and loop.message_steps is not None
         return multirate.certify_kernel(
-            kx, kv, ka, model, H, loop.message_steps, phase=loop.message_phase,
+            kx, kv, ka, model, H, loop.message_steps, phase=loop.message_phase,  # type: ignore[arg-type]
             fallback=loop.fallback, progress=progress, n_grid=n_grid, max_rounds=max_rounds,
             max_intervals=max_intervals)
     if isinstance(model, Box):
@@ -455,16 +442,9 @@ def certify_batch(
         rounds, and the cap on undecided intervals *per triple* beyond which that triple is
         declared inconclusive (per triple, so a verdict never depends on the rest of the
         batch).
-    message_period : float, optional
-        P = N·H (s), with ``sample_time``: the predecessor's acceleration arrives by V2V
-        message every N control steps and is held (the multi-rate certificate,
-        :mod:`stringstab.certify.multirate`); P = H is the sampled loop.
-    message_phase : int, optional
-        φ ∈ {0, …, N − 1}: the step at which messages are used (recorded; every phase has
-        the same certificate).
-    fallback_gains : (float, float), optional
-        Multi-rate only: the fallback (ACC, k_a = 0) gains (k_x, k_v) certified beside
-        (default: each triple's own k_x, k_v).
+    message_period, message_phase, fallback_gains : optional
+        With ``sample_time``: V2V messages every P = N·H s, used at step φ and held, and the
+        fallback (ACC) gains: the multi-rate certificate (:mod:`stringstab.certify.multirate`).
 
     Returns
     -------
@@ -541,18 +521,8 @@ def certify(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    method, pade_order
+    method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
-    message_period : float, optional
-        P = N·H (s), with ``sample_time``: the predecessor's acceleration arrives by V2V
-        message every N control steps and is held (the multi-rate certificate,
-        :mod:`stringstab.certify.multirate`); P = H is the sampled loop.
-    message_phase : int, optional
-        φ ∈ {0, …, N − 1}: the step at which messages are used (recorded; every phase has
-        the same certificate).
-    fallback_gains : (float, float), optional
-        Multi-rate only: the fallback (ACC, k_a = 0) gains (k_x, k_v) certified beside
-        (default: each triple's own k_x, k_v).
 
     Returns
     -------

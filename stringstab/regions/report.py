@@ -78,6 +78,9 @@ class ReportedMap(Protocol):
         """
         ...
 
+    #: The V2V message period (s) of a multi-rate map, else None (issue 26).
+    message_period: float | None
+
     def stable(self, method: str) -> np.ndarray:
         """Where ``method`` says string stable.
 
