@@ -78,8 +78,10 @@ class ReportedMap(Protocol):
         """
         ...
 
-    #: The V2V message period (s) of a multi-rate map, else None (issue 26).
-    message_period: float | None
+    @property
+    def message_period(self) -> float | None:
+        """The V2V message period (s) of a multi-rate map, else None (issue 26)."""
+        ...
 
     def stable(self, method: str) -> np.ndarray:
         """Where ``method`` says string stable.
