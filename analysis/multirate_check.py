@@ -38,6 +38,11 @@ import os
 import time
 from dataclasses import dataclass
 
+# one BLAS thread per process: the batched linear algebra is many small problems, and a
+# multi-threaded OpenBLAS waiting for busy cores made it 10-25x slower on a shared machine
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 import numpy as np
 from scipy.linalg import expm
 
@@ -147,8 +152,9 @@ def lifted_truth(case: Case, K: np.ndarray, max_steps: int = 40_000):
 def response(G: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """Σ_j G_j e^{−jθj} at the θ of each row (theta: (n, k)) → (n, k, N, N)."""
     n, J, N, _ = G.shape
-    ph = np.exp(-1j * theta[:, :, None] * np.arange(J)[None, None, :])
-    return (ph @ G.reshape(n, J, N * N).astype(complex)).reshape(n, theta.shape[1], N, N)
+    arg = theta[:, :, None] * np.arange(J)[None, None, :]
+    Gr = G.reshape(n, J, N * N)  # real: two real products, no complex copy of G
+    return (np.cos(arg) @ Gr - 1j * (np.sin(arg) @ Gr)).reshape(n, theta.shape[1], N, N)
 
 
 def smax(Gz: np.ndarray) -> np.ndarray:

@@ -27,6 +27,11 @@ import argparse
 import os
 import time
 
+# one BLAS thread per process: the batched linear algebra is many small problems, and a
+# multi-threaded OpenBLAS waiting for busy cores made it 10-25x slower on a shared machine
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 import numpy as np
 
 from stringstab import constants
