@@ -97,25 +97,28 @@ def simulate(case: Case, K: np.ndarray, up: np.ndarray) -> np.ndarray:
     Phi, Gam, m, (c0, c1) = step_model(case.tau, case.headway, case.H, case.delta)
     n, cols, T = up.shape
     dt = up.dtype
-    s = np.zeros((n, cols, 4), dtype=dt)
+    # one row per triple and column: X = [s (4), u_i, u_{i−1}], so s⁺ = X @ [Φᵀ; Γᵀ]
+    X = np.zeros((n * cols, 6), dtype=dt)
+    M = np.concatenate([Phi.T, Gam.T], axis=0)
     # the delay line as a ring: slot k mod (m + 1) holds (a_{i−1}, u_{i−1}) of step k
-    ring_a = np.zeros((m + 1, n, cols), dtype=dt)
-    ring_u = np.zeros((m + 1, n, cols), dtype=dt)
-    h = np.zeros((n, cols), dtype=dt)
-    kx, kv, ka = (K[:, i][:, None] for i in range(3))
-    y = np.empty((n, cols, T), dtype=dt)
-    PhiT = Phi.T
+    ring_a = np.zeros((m + 1, n * cols), dtype=dt)
+    ring_u = np.zeros((m + 1, n * cols), dtype=dt)
+    h = np.zeros(n * cols, dtype=dt)
+    kx, kv, ka = (np.repeat(K[:, i], cols) for i in range(3))
+    upT = np.ascontiguousarray(up.reshape(n * cols, T).T)
+    y = np.empty((T, n * cols), dtype=dt)
     for k in range(T):
         old = k % (m + 1)  # the slot of step k − m − 1 (zero before the start)
         if k % case.N == case.phase:
             h = c0 * ring_a[old] + c1 * ring_u[old]
-        u = kx * s[:, :, 0] + kv * s[:, :, 1] + ka * h
-        y[:, :, k] = u
-        upk = up[:, :, k]
-        ring_a[old] = s[:, :, 3]
-        ring_u[old] = upk
-        s = s @ PhiT + u[:, :, None] * Gam[:, 0] + upk[:, :, None] * Gam[:, 1]
-    return y
+        u = kx * X[:, 0] + kv * X[:, 1] + ka * h
+        y[k] = u
+        ring_a[old] = X[:, 3]
+        ring_u[old] = upT[k]
+        X[:, 4] = u
+        X[:, 5] = upT[k]
+        X[:, :4] = X @ M
+    return y.T.reshape(n, cols, T)
 
 
 def monodromy_radius(case: Case, K: np.ndarray) -> np.ndarray:
