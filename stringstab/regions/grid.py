@@ -44,6 +44,9 @@ _EXACT_SECONDS_PER_POINT = 2e-5
 _TAYLOR_SECONDS_PER_POINT = 1.5e-7
 #: Cost of the other certificates relative to the continuous one (analysis/bench_certify.py).
 _COST = {(False, False): 1.0, (True, False): 4.0, (False, True): 3.0, (True, True): 400.0}
+#: ... times this with a reaction delay θ_r > 0 (certify_batch on a 41³ grid of [−2, 2]³ at
+#: τ = 0.1, δ = 0.2, T* = 1.1 s: 2.4e-4 s per triple at θ_r = 0.2 s vs 5.7e-5 at θ_r = 0).
+_REACTION_COST = 4.0
 
 
 # --------------------------------------------------------------------------- Taylor on a grid
@@ -87,8 +90,14 @@ class _Spec:
 
     @property
     def continuous_point(self) -> bool:
-        """The continuous loop at one τ, δ, T* (the Taylor criteria apply)."""
-        return self.sample_time is None and isinstance(self.params, Params)
+        """The continuous loop at one τ, δ, T* without reaction delay (the Taylor criteria apply)."""
+        return (self.sample_time is None and isinstance(self.params, Params)
+                and not self.params.reaction_delay)
+
+
+def _reaction(p: Params | Box) -> float:
+    """θ_r of a point (0 for a box: a box with θ_r > 0 is refused before any work)."""
+    return p.reaction_delay if isinstance(p, Params) else 0.0
 
 
 def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, int]) -> dict[str, Any]:
@@ -99,6 +108,7 @@ def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, in
     out: dict[str, Any] = {}
     b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway,
                       sample_time=spec.sample_time, heterogeneous=spec.heterogeneous,
+                      reaction_delay=_reaction(p),
                       message_period=spec.message_period)
     out["hurwitz"] = np.asarray(b.stable).reshape(shape)
     out["verdict_exact"] = codes(b.verdict).reshape(shape)
@@ -182,7 +192,8 @@ def _warm(spec: _Spec) -> None:
 
         p = spec.params
         certify_batch([1.0], [0.5], [0.2], tau=p.tau, delta=p.delta, headway=p.headway,
-                      sample_time=spec.sample_time, message_period=spec.message_period)
+                      sample_time=spec.sample_time, reaction_delay=_reaction(p),
+                      message_period=spec.message_period)
 
 
 # --------------------------------------------------------------------------- validation
@@ -250,7 +261,8 @@ def _check_methods(methods: str | Sequence[str] | None, continuous_point: bool,
     for m in ms:
         if m not in allowed:
             if m in (*METHODS, CONTINUOUS):
-                why = ("the Taylor criteria are for the continuous loop at one τ, δ, T*"
+                why = ("the Taylor criteria are for the continuous loop at one τ, δ, T* "
+                       "without reaction delay"
                        if m in METHODS else "'continuous' compares a sampled map with the "
                        "continuous loop (it needs sample_time)")
                 raise StringStabError(f"methods must be among {list(allowed)} here ({why}); got {m!r}")
@@ -279,6 +291,7 @@ def region_map(
     heterogeneous: bool = True,
     executor: Any = None,
     message_period: float | None = None,
+    reaction_delay: Any = 0.0,
 ) -> RegionMap:
     """Evaluate every method on a grid of gains (see the module docstring).
 
@@ -320,6 +333,13 @@ def region_map(
         With ``sample_time``: ``exact`` is the multi-rate certificate of V2V messages every
         ``message_period`` s (:mod:`stringstab.certify.multirate`); equal to the sample time,
         the sampled one.
+    reaction_delay : float
+        θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25): with θ_r > 0,
+        ``exact`` is the continuous certificate of :mod:`stringstab.certify.reaction` (the one
+        method: the Taylor criteria are of the loop without θ_r; ``hurwitz`` is the proven
+        stability of the quasi-polynomial), in continuous time at one τ, δ, T* only (with a
+        sample time or an interval, the certificate's refusal is raised before any work).
+        θ_r = 0 (the default) computes the map it always did, bit for bit.
 
     Returns
     -------
@@ -347,12 +367,17 @@ def region_map(
     """
     from .._version import __version__  # the package's one version (a constant, not a layer)
 
-    p = parameter_model(tau, delta, headway)
+    p = parameter_model(tau, delta, headway, reaction_delay)
     H = None if sample_time is None else _sample_time(sample_time)
     box = isinstance(p, Box)
     P = _message_period(message_period, H, box)
+    theta = Box.of(p).reaction_delay != (0.0, 0.0)
+    if theta:  # θ_r > 0 (issue 25): refused beyond the continuous point loop, before any work
+        from ..certify.api import Loop
+
+        Loop(p, H)
     coords, fixed_ = _check_axes(axes, fixed)
-    ms = _check_methods(methods, H is None and not box, H is not None)
+    ms = _check_methods(methods, H is None and not box and not theta, H is not None)
     names = tuple(coords) + tuple(fixed_)
     internal = tuple(coords.values()) + tuple(np.array([v]) for v in fixed_.values())
     n0, n1, n2 = (a.size for a in internal)
@@ -362,7 +387,8 @@ def region_map(
     if target < 1:
         raise StringStabError(f"block must be >= 1 grid points; got {block!r}")
     blocks = grid_blocks(n0, n1, n2, target)
-    cost = _COST[H is not None, box] * (30.0 if P is not None else 1.0) + (CONTINUOUS in ms)
+    cost = (_COST[H is not None, box] * (30.0 if P is not None else 1.0) + (CONTINUOUS in ms)) * (
+        _REACTION_COST if theta else 1.0)
     seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:
         workers = 1 if seconds < _PARALLEL_SECONDS and executor is None else cpu_count()
