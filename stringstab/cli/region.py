@@ -303,37 +303,39 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     out = OutputDir(args.out, command="region", what="--out")
 
-    # while the map is computed (in worker processes), a thread here imports the plotting code
-    # and draws once (fonts, mathtext), and imports the CSV writer's pyarrow, so the outputs
-    # (here and in the process forked to share them) do not pay for it afterwards
-    import threading
+    # the process that shares the writing of the files starts first, while this process is
+    # single-threaded (stringstab.parallel: no fork while a thread runs), and imports and warms
+    # up the plotting code and pyarrow while the map is computed in the worker pool
+    from ..plots import start_output_helper
 
-    warm = threading.Thread(target=_warm_up_outputs, name="stringstab-output-warm-up", daemon=True)
-    warm.start()
-    try:
+    with start_output_helper() as helper:
         # region_map validates the methods before computing anything
         with _executor(args.scheduler, workers) as (executor, n_dask):
             rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
                               headway=model.headway, sample_time=H, methods=methods,
                               workers=n_dask or workers, executor=executor,
                               progress=False if args.no_progress else None)
-    finally:
-        warm.join()
+        written = _write(rmap, out, args, formats, gains, dpi, helper, t0)
+    print(rmap.report())
+    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
+    return 0
+
+
+def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], gains: Any,
+           dpi: int, helper: Any, t0: float) -> list[Path]:
+    """The map's files (shared with ``helper``) and the report, all-or-nothing in ``out``."""
+    from ..plots import save_region_outputs
+
     verdicts = None
     if gains is not None:  # compute, then draw: the overlay's own exact verdicts
         from ..plots import trajectory_verdicts
 
         verdicts = trajectory_verdicts(rmap, gains)
-
-    from ..plots import save_region_outputs
-
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi)
+                                      verdicts=verdicts, dpi=dpi, helper=helper)
         from ..report import command_line
         from ..report.commands import region_report
 
         region_report(rmap, written, command=command_line(args), started=t0).write(out)
-    print(rmap.report())
-    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
-    return 0
+    return written

@@ -23,6 +23,7 @@ module / function              shows
 **files of a map**             (:mod:`stringstab.plots.outputs`)
 :func:`save_figures`           the standard figures of a map, in every format
 :func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
+:func:`start_output_helper`    the second of those processes, started (and warming up) early
 **gain repair**                (:mod:`stringstab.plots.tuning`)
 :func:`moves_projection`       the certified region over the repairs' k_a (compute)
 :func:`plot_moves`             repairs K0 → K over the certified region
@@ -39,7 +40,13 @@ from __future__ import annotations
 
 from ..io.figures import FIGURE_FORMATS
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
-from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
+from .outputs import (
+    draw_figure,
+    figure_stems,
+    save_figures,
+    save_region_outputs,
+    start_output_helper,
+)
 from .region_sets import plot_boundaries, plot_facets
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
@@ -71,6 +78,7 @@ __all__ = [
     "plot_vehicles",
     "save_figures",
     "save_region_outputs",
+    "start_output_helper",
     "trajectory_verdicts",
     "warm_up",
 ]

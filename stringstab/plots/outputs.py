@@ -2,15 +2,17 @@
 
 :func:`figure_stems` names the standard figures of a map and :func:`draw_figure` draws one;
 :func:`save_figures` draws them and saves each in every format (:func:`stringstab.io.save_figure`),
-optionally in forked processes (:func:`stringstab.regions.pool.map_forked`).
+optionally in worker processes (:func:`stringstab.parallel.map_processes`).
 
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
 CSV table (2-D maps) and the standard figures — and splits that work between this process
-and one forked process (on a machine with two cores, writing is then about half as long):
+and one helper process (on a machine with two cores, writing is then about half as long):
 the tasks (the NPZ, the CSV, one task per figure) are dealt out by their estimated cost, the
 larger first, each to the process with less work so far (the longest-processing-time rule);
-each task writes its own file.  Files are staged in a :class:`stringstab.io.OutputDir` or
-written into a folder.
+each task writes its own file.  The helper is a :func:`stringstab.parallel.start_helper`
+(the package's start-method policy); :func:`start_output_helper` starts one early, before a
+map's worker pool, so that it imports and warms up the plotting code while the map is
+computed.  Files are staged in a :class:`stringstab.io.OutputDir` or written into a folder.
 
 Every function here draws results computed beforehand: a gain trajectory comes with its
 verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
@@ -18,6 +20,7 @@ verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 from collections.abc import Sequence
@@ -26,8 +29,8 @@ from typing import Any
 
 from ..errors import StringStabError
 from ..io.figures import check_figure_formats, figure_metadata, save_figure
+from ..parallel import Helper, map_processes, start_helper
 from ..regions import RegionMap
-from ..regions.pool import in_background, map_forked
 from ._common import pyplot
 from .map_axes import method_title
 from .projection import plot_projected_region, projected_region
@@ -35,7 +38,8 @@ from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
 from .trajectory import gain_rows, plot_trajectory
 
-__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs"]
+__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs",
+           "start_output_helper"]
 
 
 def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
@@ -159,8 +163,8 @@ def save_figures(
     dpi : int
         Resolution of raster formats.
     workers : int
-        Processes drawing the figures (forked, :func:`stringstab.regions.pool.map_forked`;
-        1 draws them here, one after another).
+        Processes drawing the figures (:func:`stringstab.parallel.map_processes`; 1 draws
+        them here, one after another).
     stems : sequence of str, optional
         Draw only these of :func:`figure_stems`.
 
@@ -184,7 +188,7 @@ def save_figures(
     elif any(s not in every for s in stems):
         raise StringStabError(f"figures must be among {every}; got {list(stems)}")
     jobs = [(stem, [(f, _stage(out, f"{prefix}_{stem}.{f}")) for f in formats]) for stem in stems]
-    map_forked(_FigureJob(rmap, gains, verdicts, dpi), jobs, workers)
+    map_processes(_FigureJob(rmap, gains, verdicts, dpi), jobs, workers)
     return [_final(out, f"{prefix}_{stem}.{f}") for stem in stems for f in formats]
 
 
@@ -213,15 +217,57 @@ def _need_verdicts(gains: Any, verdicts: Any) -> None:
 
 
 #: Estimated costs (s) on one core: per grid point of the NPZ archive and per CSV row and
-#: column; per figure file; importing pyplot in a process.  Only their ratios matter.
+#: column; per figure file; importing pyplot (and drawing once) and pyarrow in a process.
+#: Only their ratios matter.
 _NPZ_PER_POINT = 0.35e-6
 _CSV_PER_CELL = 0.075e-6
 _FIGURE_FILE = {"png": 0.3, "pdf": 0.4, "svg": 0.55}
-_PYPLOT = 0.3
+_PYPLOT = 0.6
+_PYARROW = 0.15
+
+
+def _warm_up_outputs() -> None:
+    """Import and warm up what writing a map's files needs: pyplot (Agg), a first figure, pyarrow.
+
+    Run in the helper of :func:`start_output_helper` while the map is computed.
+    """
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    from ..io.text_formats import warm_up as warm_up_writer
+    from ._common import warm_up
+
+    warm_up()
+    warm_up_writer()
+
+
+def start_output_helper() -> Helper:
+    """Start the helper process of :func:`save_region_outputs`, warming up now.
+
+    Start it before the map's worker pool (both are then started from a single-threaded
+    process, :mod:`stringstab.parallel`): it imports the plotting code and pyarrow and draws
+    once while the map is computed, so the figures it draws afterwards do not wait for that.
+
+    Returns
+    -------
+    stringstab.parallel.Helper
+        To pass to :func:`save_region_outputs` (``helper=``); use it as a context manager
+        (leaving by an error stops it).
+    """
+    return start_helper(_warm_up_outputs, preload=("stringstab.plots.outputs",))
+
+
+def _warm(process: int, helper_warm: bool) -> set[str]:
+    """What process ``process`` (0: this one, 1: the helper) has imported already."""
+    if process == 1:
+        return {"pyplot", "pyarrow"} if helper_warm else set()
+    return {name for name, mod in (("pyplot", "matplotlib.pyplot"), ("pyarrow", "pyarrow.csv"))
+            if mod in sys.modules}
 
 
 def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
-          processes: int) -> list[list[tuple[Any, ...]]]:
+          processes: int, helper_warm: bool = False) -> list[list[tuple[Any, ...]]]:
     """The tasks of each process (0 is this one), dealt out by estimated cost."""
     tasks: list[tuple[float, tuple[Any, ...]]] = [(_NPZ_PER_POINT * rmap.size, ("npz",))]
     if rmap.ndim == 2:
@@ -229,12 +275,16 @@ def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
     tasks += [(sum(_FIGURE_FILE[f] for f in formats), ("fig", s)) for s in stems]
     load = [0.0] * processes
     plan: list[list[tuple[Any, ...]]] = [[] for _ in range(processes)]
-    cold = "matplotlib.pyplot" not in sys.modules  # else forked processes inherit it
+    warm = [_warm(k, helper_warm) for k in range(processes)]
 
     def cost_in(k: int, cost: float, task: tuple[Any, ...]) -> float:
-        # the first figure of a process also pays for importing pyplot there
-        first = task[0] == "fig" and not any(t[0] == "fig" for t in plan[k])
-        return cost + (_PYPLOT if first and cold else 0.0)
+        # the first figure (the CSV) of a process also pays for importing pyplot (pyarrow)
+        if task[0] == "fig" and "pyplot" not in warm[k] \
+                and not any(t[0] == "fig" for t in plan[k]):
+            return cost + _PYPLOT
+        if task[0] == "csv" and "pyarrow" not in warm[k]:
+            return cost + _PYARROW
+        return cost
 
     for cost, task in sorted(tasks, key=lambda t: -t[0]):
         k = min(range(processes), key=lambda i: load[i] + cost_in(i, cost, task))
@@ -243,21 +293,21 @@ def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
     return plan
 
 
-def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: str,
+def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, folder: Path, prefix: str,
          formats: Sequence[str], gains: Any, verdicts: Any, dpi: int) -> None:
-    """Do ``tasks`` (in this process or a forked one): each writes its own staged file."""
+    """Do ``tasks`` (here or in the helper): each writes its own file into ``folder``."""
     stems = [t[1] for t in tasks if t[0] == "fig"]
     for t in tasks:
         if t[0] == "npz":
-            rmap.save_npz(_stage(out, f"{prefix}.npz"))
+            rmap.save_npz(folder / f"{prefix}.npz")
         elif t[0] == "csv":
-            rmap.save_csv(_stage(out, f"{prefix}.csv"))
+            rmap.save_csv(folder / f"{prefix}.csv")
     if stems:
         import matplotlib
 
         if "matplotlib.pyplot" not in sys.modules:
             matplotlib.use("Agg")
-        save_figures(rmap, out, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
+        save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
                      dpi=dpi, stems=stems)
 
 
@@ -274,6 +324,7 @@ def _final(out: Any, name: str) -> Path:
 def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
+    helper: Helper | None = None,
 ) -> list[Path]:
     """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps) and the standard figures.
 
@@ -287,7 +338,11 @@ def save_region_outputs(
     prefix, formats, gains, verdicts, dpi
         As for :func:`save_figures` (``verdicts`` are required with ``gains``).
     processes : int
-        1 writes everything here; 2 (default) shares the work with one forked process.
+        1 writes everything here; 2 (default) shares the work with one helper process
+        (:func:`stringstab.parallel.start_helper`, started now unless ``helper`` is given).
+    helper : stringstab.parallel.Helper, optional
+        A helper started earlier by :func:`start_output_helper` (warm); it is given its share
+        of the work (whatever ``processes``), and is done with when this returns.
 
     Returns
     -------
@@ -314,14 +369,20 @@ def save_region_outputs(
     stems = figure_stems(rmap, gains is not None)
     names = [f"{prefix}.npz", *([f"{prefix}.csv"] if rmap.ndim == 2 else []),
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]
+    folder = Path()
     for name in names:  # register every output here, whichever process writes it
-        _stage(out, name)
-    plan = _plan(rmap, stems, formats, max(1, int(processes)))
-    args = (rmap, out, prefix, formats, gains, verdicts, dpi)
-    join = in_background(_run, plan[1], *args) if len(plan) > 1 and plan[1] else None
-    try:
+        folder = _stage(out, name).parent
+    n = 2 if helper is not None else max(1, int(processes))
+    plan = _plan(rmap, stems, formats, n, helper_warm=helper is not None)
+    args = (rmap, folder, prefix, formats, gains, verdicts, dpi)
+    if len(plan) > 1 and plan[1] and helper is None:
+        helper = start_helper()
+    with contextlib.ExitStack() as stack:
+        if helper is not None:
+            stack.enter_context(helper)
+            if len(plan) > 1 and plan[1]:
+                helper.submit(_run, plan[1], *args)
         _run(plan[0], *args)
-    finally:
-        if join is not None:
-            join()
+        if helper is not None and len(plan) > 1 and plan[1]:
+            helper.result()
     return [_final(out, n) for n in names]
