@@ -268,7 +268,8 @@ def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
     Each worker runs :func:`die_with_parent`, ignores Ctrl-C, ends on SIGTERM, then runs
     ``initializer(*initargs)``.  Leaving the ``with`` normally waits for the pool; leaving it
     by an exception (Ctrl-C, SIGTERM in the command line) cancels what is queued and kills
-    the workers instead of waiting for them.
+    the workers instead of waiting for them.  A worker that died (killed by a signal, or by
+    the kernel when memory ran out) is reported as a :class:`StringStabError`, in one line.
 
     Parameters
     ----------
@@ -288,6 +289,13 @@ def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
     ------
     concurrent.futures.ProcessPoolExecutor
         The pool.
+
+    Raises
+    ------
+    StringStabError
+        When a worker died (the pool is broken).
+    ThreadsRunning
+        When ``method="fork"`` is asked for while other threads run.
     """
     ctx = _context(method, preload)
     before = _children()
@@ -299,7 +307,13 @@ def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
         if ctx.get_start_method() == "fork":
             check_single_threaded("a process pool")
             ex.submit(_nothing)  # forks every worker now, before the management thread starts
-        yield ex
+        try:
+            yield ex
+        except cf.process.BrokenProcessPool as e:
+            raise StringStabError(
+                "a worker process ended unexpectedly (killed: out of memory, or a signal such "
+                "as SIGTERM sent to it alone); expected it to finish its work; nothing was "
+                "written") from e
         ok = True
     finally:
         if ok:

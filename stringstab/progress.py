@@ -266,7 +266,7 @@ class Progress:
         if enabled and (tty if tty is not None else is_terminal(self.stream)):
             self._bar = _bar_class()(
                 total=self.total, initial=self.initial, desc=desc, unit=unit, file=self.stream,
-                mininterval=0.5, leave=False, left=self._left_text,
+                mininterval=0.5, leave=False, left=self._left_text, unit_scale=self.total >= 10_000,
                 bar_format="{l_bar}{bar}| {n_fmt}/{total_fmt} [{elapsed}{left}{postfix}]")
 
     @property

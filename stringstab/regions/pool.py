@@ -10,7 +10,7 @@ from a single-threaded process, dying with their parent).
 from __future__ import annotations
 
 import concurrent.futures as cf
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from typing import Any
 
 from ..parallel import process_pool, start_method
@@ -27,7 +27,7 @@ PRELOAD = ("stringstab.regions.grid",)
 def run_blocks(
     evaluate: Callable[..., dict[str, Any]], spec: Any, blocks: Sequence[Block], workers: int,
     warm: Callable[[Any], None] | None = None, executor: cf.Executor | None = None,
-) -> Iterator[tuple[Block, dict[str, Any]]]:
+) -> Generator[tuple[Block, dict[str, Any]], None, None]:
     """``evaluate(spec, *block)`` for every block, yielding ``(block, result)`` as they finish.
 
     With ``workers`` > 1 the blocks go to a :func:`stringstab.parallel.process_pool`

@@ -98,7 +98,8 @@ def simulate(
         Keep full trajectories (memory P·(N+1)·T·8 bytes per quantity); if False only the
         summaries (collisions, minimum gaps, Σa² for m_p) are kept.
     progress : bool, optional
-        Show a tqdm bar; by default only for long runs (over 10⁸ vehicle-steps).
+        Show progress (:class:`stringstab.progress.Progress`: a bar on a terminal, plain lines
+        otherwise); by default only for long runs (over 10⁸ vehicle-steps).
     fractional_delay : {"linear", "exact"}
         A delay that is not a multiple of Δt: interpolated linearly between received samples
         (default), or the predecessor's exact acceleration inside the step, the loop the
@@ -149,12 +150,10 @@ def simulate(
     min_gap = np.full((P, N), np.inf)
     gains_rec: Array | None = None
     show_bar = (P * N * T > 1e8) if progress is None else bool(progress)
-    steps: Any = range(T)
-    if show_bar:
-        from tqdm.auto import tqdm
+    from ..progress import Progress  # a bar on a terminal, plain lines otherwise
 
-        steps = tqdm(steps, total=T, unit="step", desc=f"simulate {P}x{N}", mininterval=0.5)
-    for k in steps:
+    meter = Progress(T, f"simulate {P}x{N}", unit="steps", enabled=show_bar)
+    for k in meter.over(range(T)):
         obs = plat.observe(LX[k], LV[k], LA[k])
         u = controller.command(obs)
         if controller.time_varying:
@@ -182,8 +181,7 @@ def simulate(
             ul = np.clip(u, lim.accel_min, lim.accel_max)
         if record:
             cmd[k] = ul
-    if show_bar:
-        steps.close()
+    meter.close()
 
     def lead(a: Array | None, axes: tuple[int, ...]) -> Array | None:
         if a is None:
