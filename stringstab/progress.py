@@ -83,11 +83,11 @@ class Pace:
     The time left is given once ``now − t_anchor ≥ warmup`` and some work was done after the
     anchor; it is then ``remaining / rate`` with
 
-        rate = (done_last − done_ref) / (now − t_ref),
+        rate = (done − done_ref) / (now − t_ref),
 
-    where ``(t_ref, done_ref)`` is the newest sample at least ``window`` seconds old (the
-    anchor while none is): the pace of about the last ``window`` seconds, which slows as time
-    passes without progress.
+    where ``done`` is the work done by ``now`` and ``(t_ref, done_ref)`` the newest sample at
+    least ``window`` seconds old (the anchor while none is): the pace of about the last
+    ``window`` seconds, which slows as time passes without progress.
 
     Parameters
     ----------
@@ -103,10 +103,10 @@ class Pace:
     >>> p = Pace(warmup=5.0, window=30.0)
     >>> for t in range(2, 10):
     ...     p.add(float(t), 10 * (t - 2))
-    >>> p.left(6.0, 100) is None  # 4 s after the anchor: still warming up
+    >>> p.left(6.0, 40, 100) is None  # 4 s after the anchor: still warming up
     True
-    >>> p.left(9.0, 100)  # (70 - 0) units / (9 - 2) s = 10 units/s
-    10.0
+    >>> p.left(9.0, 70, 100)  # (70 - 0) units / (9 - 2) s = 10 units/s; 30 units left
+    3.0
     """
 
     #: Default seconds after the first unit before a time left is given.
@@ -137,13 +137,15 @@ class Pace:
         while len(self._samples) > 2 and self._samples[1][0] <= t - self.window:
             self._samples.popleft()
 
-    def rate(self, now: float) -> float | None:
+    def rate(self, now: float, done: float) -> float | None:
         """Units per second over the moving window; None during the warm-up.
 
         Parameters
         ----------
         now : float
             The current time, s.
+        done : float
+            Units done in all by ``now``.
 
         Returns
         -------
@@ -152,34 +154,35 @@ class Pace:
         """
         if self._anchor is None or now - self._anchor[0] < self.warmup:
             return None
-        d_last = self._samples[-1][1]
         ref = self._anchor
         for s in self._samples:
             if s[0] <= now - self.window:
                 ref = s
             else:
                 break
-        if d_last <= ref[1] or now <= ref[0]:
+        if done <= ref[1] or now <= ref[0]:
             return None
-        return (d_last - ref[1]) / (now - ref[0])
+        return (done - ref[1]) / (now - ref[0])
 
-    def left(self, now: float, remaining: float) -> float | None:
-        """Seconds left for ``remaining`` units at the current :meth:`rate`.
+    def left(self, now: float, done: float, total: float) -> float | None:
+        """Seconds left until ``total`` units are done, at the current :meth:`rate`.
 
         Parameters
         ----------
         now : float
             The current time, s.
-        remaining : float
-            Units still to do.
+        done : float
+            Units done in all by ``now``.
+        total : float
+            Units in all.
 
         Returns
         -------
         float or None
             The estimate, or None while there is none (warm-up).
         """
-        r = self.rate(now)
-        return None if r is None else max(remaining, 0.0) / r
+        r = self.rate(now, done)
+        return None if r is None else max(total - done, 0.0) / r
 
 
 def _bar_class() -> type:
@@ -330,7 +333,7 @@ class Progress:
         """
         if self.done >= self.total:
             return None
-        return self.pace.left(self.clock() if now is None else now, self.total - self.done)
+        return self.pace.left(self.clock() if now is None else now, self.done, self.total)
 
     def _left_text(self) -> str:
         left = self.left()
