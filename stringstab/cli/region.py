@@ -96,8 +96,9 @@ def add_parser(sub: Any) -> None:
                    help="gain trajectory (.csv/.json/.npz as for certify) drawn on the 2-D map")
     p.add_argument("--out", "-o", default="maps", metavar="DIR", help="output directory (default: maps)")
     p.add_argument("--prefix", default="region", metavar="NAME", help="file name stem (default: region)")
-    p.add_argument("--format", default="png,pdf", metavar="F[,F...]",
-                   help="figure formats among png, pdf, svg (default: png,pdf)")
+    p.add_argument("--format", default="png", metavar="F[,F...]",
+                   help="figure formats among png, pdf, svg (default: png; e.g. png,pdf for "
+                        "print-ready copies too)")
     p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
     p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
     p.add_argument("--scheduler", metavar="ADDRESS|local",

@@ -6,13 +6,13 @@ optionally in worker processes (:func:`stringstab.parallel.map_processes`).
 
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
 CSV table (2-D maps) and the standard figures — and splits that work between this process
-and one helper process (on a machine with two cores, writing is then about half as long):
-the tasks (the NPZ, the CSV, one task per figure) are dealt out by their estimated cost, the
-larger first, each to the process with less work so far (the longest-processing-time rule);
-each task writes its own file.  The helper is a :func:`stringstab.parallel.start_helper`
-(the package's start-method policy); :func:`start_output_helper` starts one early, before a
-map's worker pool, so that it imports and warms up the plotting code while the map is
-computed.  Files are staged in a :class:`stringstab.io.OutputDir` or written into a folder.
+and a helper process: this one writes the data files (the NPZ, the CSV), the helper the
+figures, shared among processes forked from it (two on a machine with two cores), which
+inherit its warm plotting code: matplotlib is imported once.  The helper is a
+:func:`stringstab.parallel.start_helper` (the package's start-method policy);
+:func:`start_output_helper` starts one early, before a map's worker pool, so that it imports
+and warms up the plotting code while the map is computed.  Files are staged in a
+:class:`stringstab.io.OutputDir` or written into a folder.
 
 Every function here draws results computed beforehand: a gain trajectory comes with its
 verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
@@ -20,7 +20,6 @@ verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
 
 from __future__ import annotations
 
-import contextlib
 import json
 import sys
 from collections.abc import Sequence
@@ -29,7 +28,7 @@ from typing import Any
 
 from ..errors import StringStabError
 from ..io.figures import check_figure_formats, figure_metadata, save_figure
-from ..parallel import Helper, map_processes, start_helper
+from ..parallel import Helper, cpu_count, map_processes, start_helper
 from ..regions import RegionMap
 from ._common import pyplot
 from .map_axes import method_title
@@ -216,18 +215,8 @@ def _need_verdicts(gains: Any, verdicts: Any) -> None:
                               "stringstab.plots.trajectory_verdicts(rmap, gains)); got none")
 
 
-#: Estimated costs (s) on one core: per grid point of the NPZ archive and per CSV row and
-#: column; per figure file; importing pyplot (and drawing once) and pyarrow in a process.
-#: Only their ratios matter.
-_NPZ_PER_POINT = 0.35e-6
-_CSV_PER_CELL = 0.075e-6
-_FIGURE_FILE = {"png": 0.3, "pdf": 0.4, "svg": 0.55}
-_PYPLOT = 0.6
-_PYARROW = 0.15
-
-
 def _warm_up_outputs() -> None:
-    """Import and warm up what writing a map's files needs: pyplot (Agg), a first figure, pyarrow.
+    """Import and warm up what drawing a map's figures needs: pyplot (Agg), a first figure.
 
     Run in the helper of :func:`start_output_helper` while the map is computed.
     """
@@ -235,19 +224,17 @@ def _warm_up_outputs() -> None:
 
     if "matplotlib.pyplot" not in sys.modules:
         matplotlib.use("Agg")
-    from ..io.text_formats import warm_up as warm_up_writer
     from ._common import warm_up
 
     warm_up()
-    warm_up_writer()
 
 
 def start_output_helper() -> Helper:
     """Start the helper process of :func:`save_region_outputs`, warming up now.
 
     Start it before the map's worker pool (both are then started from a single-threaded
-    process, :mod:`stringstab.parallel`): it imports the plotting code and pyarrow and draws
-    once while the map is computed, so the figures it draws afterwards do not wait for that.
+    process, :mod:`stringstab.parallel`): it imports the plotting code and draws once while
+    the map is computed, so that the figures it draws afterwards do not wait for that.
 
     Returns
     -------
@@ -258,57 +245,22 @@ def start_output_helper() -> Helper:
     return start_helper(_warm_up_outputs, preload=("stringstab.plots.outputs",))
 
 
-def _warm(process: int, helper_warm: bool) -> set[str]:
-    """What process ``process`` (0: this one, 1: the helper) has imported already."""
-    if process == 1:
-        return {"pyplot", "pyarrow"} if helper_warm else set()
-    return {name for name, mod in (("pyplot", "matplotlib.pyplot"), ("pyarrow", "pyarrow.csv"))
-            if mod in sys.modules}
+def _draw_all(rmap: RegionMap, folder: Path, prefix: str, formats: Sequence[str],
+              stems: Sequence[str], gains: Any, verdicts: Any, dpi: int, drawers: int) -> None:
+    """The figures (in the helper): shared by ``drawers`` processes forked from it, warm."""
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
+                 dpi=dpi, stems=stems, workers=drawers)
 
 
-def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
-          processes: int, helper_warm: bool = False) -> list[list[tuple[Any, ...]]]:
-    """The tasks of each process (0 is this one), dealt out by estimated cost."""
-    tasks: list[tuple[float, tuple[Any, ...]]] = [(_NPZ_PER_POINT * rmap.size, ("npz",))]
+def _write_data(rmap: RegionMap, folder: Path, prefix: str) -> None:
+    """The NPZ archive and, for a 2-D map, the CSV table."""
+    rmap.save_npz(folder / f"{prefix}.npz")
     if rmap.ndim == 2:
-        tasks.append((_CSV_PER_CELL * rmap.n_columns * rmap.size, ("csv",)))
-    tasks += [(sum(_FIGURE_FILE[f] for f in formats), ("fig", s)) for s in stems]
-    load = [0.0] * processes
-    plan: list[list[tuple[Any, ...]]] = [[] for _ in range(processes)]
-    warm = [_warm(k, helper_warm) for k in range(processes)]
-
-    def cost_in(k: int, cost: float, task: tuple[Any, ...]) -> float:
-        # the first figure (the CSV) of a process also pays for importing pyplot (pyarrow)
-        if task[0] == "fig" and "pyplot" not in warm[k] \
-                and not any(t[0] == "fig" for t in plan[k]):
-            return cost + _PYPLOT
-        if task[0] == "csv" and "pyarrow" not in warm[k]:
-            return cost + _PYARROW
-        return cost
-
-    for cost, task in sorted(tasks, key=lambda t: -t[0]):
-        k = min(range(processes), key=lambda i: load[i] + cost_in(i, cost, task))
-        load[k] += cost_in(k, cost, task)
-        plan[k].append(task)
-    return plan
-
-
-def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, folder: Path, prefix: str,
-         formats: Sequence[str], gains: Any, verdicts: Any, dpi: int) -> None:
-    """Do ``tasks`` (here or in the helper): each writes its own file into ``folder``."""
-    stems = [t[1] for t in tasks if t[0] == "fig"]
-    for t in tasks:
-        if t[0] == "npz":
-            rmap.save_npz(folder / f"{prefix}.npz")
-        elif t[0] == "csv":
-            rmap.save_csv(folder / f"{prefix}.csv")
-    if stems:
-        import matplotlib
-
-        if "matplotlib.pyplot" not in sys.modules:
-            matplotlib.use("Agg")
-        save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
-                     dpi=dpi, stems=stems)
+        rmap.save_csv(folder / f"{prefix}.csv")
 
 
 def _stage(out: Any, name: str) -> Path:
@@ -338,11 +290,12 @@ def save_region_outputs(
     prefix, formats, gains, verdicts, dpi
         As for :func:`save_figures` (``verdicts`` are required with ``gains``).
     processes : int
-        1 writes everything here; 2 (default) shares the work with one helper process
-        (:func:`stringstab.parallel.start_helper`, started now unless ``helper`` is given).
+        1 writes everything here; 2 (default) shares the work with a helper process
+        (:func:`stringstab.parallel.start_helper`, started now unless ``helper`` is given),
+        which draws the figures in processes forked from it while this one writes the data.
     helper : stringstab.parallel.Helper, optional
-        A helper started earlier by :func:`start_output_helper` (warm); it is given its share
-        of the work (whatever ``processes``), and is done with when this returns.
+        A helper started earlier by :func:`start_output_helper` (warm); it draws the figures
+        (whatever ``processes``), and is done with when this returns.
 
     Returns
     -------
@@ -372,17 +325,15 @@ def save_region_outputs(
     folder = Path()
     for name in names:  # register every output here, whichever process writes it
         folder = _stage(out, name).parent
-    n = 2 if helper is not None else max(1, int(processes))
-    plan = _plan(rmap, stems, formats, n, helper_warm=helper is not None)
-    args = (rmap, folder, prefix, formats, gains, verdicts, dpi)
-    if len(plan) > 1 and plan[1] and helper is None:
+    figures = (rmap, folder, prefix, formats, stems, gains, verdicts, dpi)
+    if helper is None and (int(processes) <= 1 or not stems):
+        _write_data(rmap, folder, prefix)
+        _draw_all(*figures, 1)
+        return [_final(out, n) for n in names]
+    if helper is None:
         helper = start_helper()
-    with contextlib.ExitStack() as stack:
-        if helper is not None:
-            stack.enter_context(helper)
-            if len(plan) > 1 and plan[1]:
-                helper.submit(_run, plan[1], *args)
-        _run(plan[0], *args)
-        if helper is not None and len(plan) > 1 and plan[1]:
-            helper.result()
+    with helper:  # the figures there (in its forked drawers), the data files here
+        helper.submit(_draw_all, *figures, min(max(2, cpu_count() - 1), len(stems)))
+        _write_data(rmap, folder, prefix)
+        helper.result()
     return [_final(out, n) for n in names]
