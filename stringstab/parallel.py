@@ -376,9 +376,10 @@ def _message(e: BaseException) -> str:
     return msg.replace("\n", " ")
 
 
-def _helper_main(conn: Any, parent: int, warm: Callable[..., Any] | None,
+def _helper_main(conn: Any, other_end: Any, parent: int, warm: Callable[..., Any] | None,
                  warm_args: tuple[Any, ...]) -> None:
-    """The helper child: warm up, wait for one call, run it, send back None or the error."""
+    """The helper child: warm up, wait for one call, run it, send back its result or error."""
+    other_end.close()  # else the parent's closing its end would never reach us as EOF
     _become_child(parent)
     failed = None
     if warm is not None:
@@ -538,7 +539,7 @@ def start_helper(warm: Callable[..., Any] | None = None, *warm_args: Any,
         return Helper(None, None, warm, warm_args)
     ctx = _context(method, preload)
     here, there = ctx.Pipe(duplex=True)
-    proc = ctx.Process(target=_helper_main, args=(there, os.getpid(), warm, warm_args),
+    proc = ctx.Process(target=_helper_main, args=(there, here, os.getpid(), warm, warm_args),
                        name="stringstab-helper", daemon=False)
     if ctx.get_start_method() == "fork":
         check_single_threaded("a helper process")

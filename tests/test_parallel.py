@@ -135,6 +135,17 @@ def test_a_helper_runs_its_call_and_reports_a_failure_in_one_line(tmp_path):
             h.result()
 
 
+@pytest.mark.parametrize("method", ["fork", "forkserver"])
+def test_a_helper_never_asked_ends_with_the_with_block(method):
+    code = ("from stringstab.parallel import start_helper\n"
+            "if __name__ == '__main__':\n"
+            f"    with start_helper(method={method!r}) as h:\n"
+            "        pass\n"
+            "    print(h.proc.exitcode)\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert res.stdout.strip() == "0", res.stderr
+
+
 def test_leaving_a_pool_by_an_exception_kills_its_workers_at_once():
     t0 = time.perf_counter()
     pids = []
