@@ -228,14 +228,6 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
     return axes, fixed
 
 
-def _warm_up_outputs() -> None:
-    from ..io.text_formats import warm_up as warm_up_writer
-    from ..plots import warm_up as warm_up_plots
-
-    warm_up_plots()
-    warm_up_writer()
-
-
 @contextlib.contextmanager
 def _executor(scheduler: str | None, workers: int | None) -> Iterator[tuple[Any, int | None]]:
     """(executor, its workers) of ``--scheduler``, or (None, None): the local process pool."""
@@ -304,9 +296,9 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     out = OutputDir(args.out, command="region", what="--out")
 
-    # the process that shares the writing of the files starts first, while this process is
-    # single-threaded (stringstab.parallel: no fork while a thread runs), and imports and warms
-    # up the plotting code and pyarrow while the map is computed in the worker pool
+    # the process that draws the figures starts first, while this process is single-threaded
+    # (stringstab.parallel: no fork while a thread runs), and imports and warms up the
+    # plotting code while the map is computed in the worker pool
     from ..plots import start_output_helper
 
     with start_output_helper() as helper:
