@@ -163,6 +163,9 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
     cli = [sys.executable, "-m", "stringstab", "region", "--fix", "k_a=0.5", "--n", str(n),
            "--workers", w, "--no-progress"]
     base_dir = _checkout(base)
+    # run every command from a neutral folder: from the repository root, Python would import
+    # this checkout's package (the current directory comes before PYTHONPATH)
+    outside = tempfile.mkdtemp(prefix="bench_regions_cwd_")
     _adopt_orphans()
     here = dict(os.environ)
     here.pop("STRINGSTAB_START_METHOD", None)
@@ -181,7 +184,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
         for r in range(reps):
             for label, env in (("map before", old), ("map after", here)):
                 res = subprocess.run([sys.executable, "-c", _MAP_ALONE, str(n), w], env=env,
-                                     capture_output=True, text=True, check=True)
+                                     capture_output=True, text=True, check=True, cwd=outside)
                 wall, cpu = (float(x) for x in res.stdout.split())
                 rows[label].append((wall, cpu))
                 print(f"  rep {r + 1}: {label:<18} {wall:6.2f} s wall {cpu:6.2f} s CPU ({_load()})",
@@ -191,7 +194,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
                 try:
                     c0, t0 = _children_cpu(), time.perf_counter()
                     res = subprocess.run([*cli, *extra, "--out", str(work / "maps")], env=env,
-                                         capture_output=True, text=True)
+                                         capture_output=True, text=True, cwd=outside)
                     wall = time.perf_counter() - t0
                     _reap_orphans()
                     cpu = _children_cpu() - c0
@@ -206,6 +209,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
                       f"({_load()})", flush=True)
     finally:
         shutil.rmtree(base_dir, ignore_errors=True)
+        shutil.rmtree(outside, ignore_errors=True)
     for name, fs in files.items():
         print(f"  files, {name}: {len(fs)}: {', '.join(fs)}")
     print(f"  medians over {reps} reps ({_load()}):")

@@ -84,7 +84,8 @@ def main() -> None:
             out = work / f"m{i}"
             t0 = time.perf_counter()
             p = subprocess.Popen([*cmd, "--out", str(out)], stdout=subprocess.DEVNULL,
-                                 stderr=subprocess.PIPE, env=env, start_new_session=True)
+                                 stderr=subprocess.PIPE, env=env, start_new_session=True,
+                                 cwd=work)  # not the repository root: it would shadow --base
             try:
                 _, err = p.communicate(timeout=args.timeout)
                 dt = time.perf_counter() - t0
