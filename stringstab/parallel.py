@@ -105,7 +105,15 @@ def check_single_threaded(what: str) -> None:
 
     Examples
     --------
-    >>> check_single_threaded("a test")  # nothing else runs here
+    >>> import threading
+    >>> done = threading.Event()
+    >>> t = threading.Thread(target=done.wait, name="busy")
+    >>> t.start()
+    >>> check_single_threaded("a pool")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stringstab.parallel.ThreadsRunning: refusing to fork a pool while other threads run (...busy...)...
+    >>> done.set(); t.join()
     """
     if threading.active_count() != 1:
         names = ", ".join(sorted(t.name for t in threading.enumerate()

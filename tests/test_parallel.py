@@ -8,6 +8,7 @@ inherited a lock held by a thread hung for ever: 3 hangs in 20 runs at 801²).
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -45,6 +46,24 @@ def a_thread():
     t.join()
 
 
+def _fresh(fn):
+    """Run the test in a fresh interpreter (``python -c``; its asserts, its exit code).
+
+    A fork needs a single-threaded process, and the tests run before this one in the same
+    process may have left threads behind (a Dask client's offload pool does).
+    """
+    @functools.wraps(fn)
+    def run() -> None:
+        code = (f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
+                f"import test_parallel; test_parallel.{fn.__name__}.__wrapped__()")
+        env = {k: v for k, v in os.environ.items() if k != parallel.ENV}
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             timeout=180, env=env)
+        assert res.returncode == 0, res.stderr[-4000:]
+
+    return run
+
+
 def _signals() -> tuple[object, object, int]:
     return signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM), os.getppid()
 
@@ -67,8 +86,9 @@ def test_the_check_refuses_a_fork_while_another_thread_runs(a_thread):
         check_single_threaded("a test pool")
 
 
+@_fresh
 def test_the_check_lets_a_single_threaded_process_fork():
-    assert threading.active_count() == 1  # the test itself runs in a single thread
+    assert threading.active_count() == 1
     check_single_threaded("a test pool")
 
 
@@ -81,12 +101,12 @@ def test_the_policy_forks_only_without_threads(a_thread, monkeypatch):
 
 
 @pytest.mark.skipif(not LINUX, reason="fork is the policy's choice on Linux only")
-def test_the_policy_forks_a_single_threaded_process_and_the_variable_overrides(monkeypatch):
-    monkeypatch.delenv(parallel.ENV, raising=False)
+@_fresh
+def test_the_policy_forks_a_single_threaded_process_and_the_variable_overrides():
     assert start_method() == "fork"
-    monkeypatch.setenv(parallel.ENV, "forkserver")
+    os.environ[parallel.ENV] = "forkserver"
     assert start_method() == "forkserver"
-    monkeypatch.setenv(parallel.ENV, "fork")  # never "fork on demand": only the safe ones
+    os.environ[parallel.ENV] = "fork"  # never "fork on demand": only the safe ones
     with pytest.raises(StringStabError, match=f"{parallel.ENV} must be one of forkserver, spawn; got 'fork'"):
         start_method()
 
@@ -99,12 +119,20 @@ def test_pools_and_helpers_refuse_to_fork_while_a_thread_runs(a_thread):
 
 
 # --------------------------------------------------------------------------- the children
-@pytest.mark.parametrize("method", ["fork", "forkserver"])
-def test_workers_ignore_ctrl_c_end_on_sigterm_and_compute(method):
+def _workers_ignore_ctrl_c_end_on_sigterm_and_compute(method: str) -> None:
     with process_pool(2, method=method) as ex:
         assert list(ex.map(_square, range(6))) == [0, 1, 4, 9, 16, 25]
         sigint, sigterm, _ = ex.submit(_signals).result()
     assert sigint == signal.SIG_IGN and sigterm == signal.SIG_DFL
+
+
+def test_forkserver_workers_ignore_ctrl_c_end_on_sigterm_and_compute():
+    _workers_ignore_ctrl_c_end_on_sigterm_and_compute("forkserver")
+
+
+@_fresh
+def test_forked_workers_ignore_ctrl_c_end_on_sigterm_and_compute():
+    _workers_ignore_ctrl_c_end_on_sigterm_and_compute("fork")
 
 
 def test_a_pool_started_while_a_thread_runs_is_not_forked_and_works(a_thread, tmp_path):
@@ -118,6 +146,7 @@ def test_a_pool_started_while_a_thread_runs_is_not_forked_and_works(a_thread, tm
 
 
 @pytest.mark.skipif(not LINUX, reason="prctl(PR_SET_PDEATHSIG) is Linux's")
+@_fresh
 def test_a_child_asks_the_kernel_to_kill_it_with_its_parent():
     with process_pool(1, method="fork") as ex:
         how = ex.submit(parallel.die_with_parent, os.getpid()).result()
@@ -146,6 +175,7 @@ def test_a_helper_never_asked_ends_with_the_with_block(method):
     assert res.stdout.strip() == "0", res.stderr
 
 
+@_fresh
 def test_leaving_a_pool_by_an_exception_kills_its_workers_at_once():
     t0 = time.perf_counter()
     pids = []
