@@ -41,6 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
+from .text_input import open_text
 
 __all__ = ["SPEED_ABSURD", "PlatoonLog", "Segment", "clean_segments", "read_platoon_logs"]
 
@@ -223,7 +224,7 @@ def _cell(c: str) -> float:
 
 def _read_rows(path: Path) -> list[list[str]]:
     try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
+        with open_text(path) as fh:  # plain or gzip-compressed (.csv.gz)
             return [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     except OSError as e:
         raise StringStabError(f"cannot read {_where(path)}: {e.strerror or e}") from e
@@ -443,7 +444,8 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
     Parameters
     ----------
     path : path
-        The file; its format is recognised from its first lines (module docstring).
+        The file, plain or gzip-compressed (``.csv.gz``); its format is recognised from its
+        first lines (module docstring).
     min_duration : float
         For NGSIM files, the shortest leader–follower pair kept, s.
     ngsim : callable, optional

@@ -2,6 +2,7 @@
 
 :func:`load_csv` reads a generic speed profile in SI units; :func:`load_ngsim_pairs` cuts
 the US-101 / I-80 trajectory files (IDL paper §4.1.1) into leader–follower pairs in SI units.
+Both read plain or gzip-compressed files (:func:`stringstab.io.text_input.open_text`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy.typing as npt
 
 from ..constants import DT
 from ..errors import StringStabError, show
+from ..io.text_input import open_text
 from .trajectory import Trajectory, from_speed
 
 __all__ = ["FEET", "FollowingPair", "load_csv", "load_ngsim_pairs"]
@@ -52,7 +54,7 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
     """
     p = Path(path)
     try:
-        with p.open(newline="", encoding="utf-8-sig") as fh:
+        with open_text(p) as fh:  # plain or gzip-compressed (.csv.gz)
             rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     except OSError as e:
         raise StringStabError(f"cannot read leader CSV {show(str(p))}: {e.strerror or e}") from e
@@ -176,7 +178,7 @@ def load_ngsim_pairs(
     """
     p = Path(path)
     try:
-        fh = p.open(newline="", encoding="utf-8-sig")
+        fh = open_text(p)  # plain or gzip-compressed (.csv.gz)
     except OSError as e:
         raise StringStabError(f"cannot read NGSIM file {show(str(p))}: {e.strerror or e}") from e
     with fh:
