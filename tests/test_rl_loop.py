@@ -290,8 +290,7 @@ def test_cli_train_evaluate_compare_with_theta_and_radio(tmp_path, capsys):
     loop = ["--reaction-delay", "0.2", "--message-period", "0.2", "--noise-gap", "0.1"]
     assert main(["train", "--algo", "idl", "--steps", "48", "--num-envs", "2", "--out", str(run),
                  "--no-progress", *loop]) == 0
-    err = capsys.readouterr().err
-    assert "certified by the continuous certificate at θ_r" in err
+    assert "certified by the continuous certificate at θ_r" in capsys.readouterr().out
     cfg = json.loads((run / "config.json").read_text())
     assert cfg["reaction_delay"] == 0.2 and cfg["repair_sampled"] is False
     assert cfg["radio"]["message_period"] == 0.2 and cfg["sensors"]["gap"] == 0.1
@@ -332,6 +331,7 @@ def test_cli_train_evaluate_compare_with_theta_and_radio(tmp_path, capsys):
     (["--loss", "1.5"], "--loss must be a number in [0, 1]"),
     (["--noise-gap", "-1"], "--noise-gap must be a finite number >= 0"),
     (["--burst", "2"], "--burst needs --loss"),
+    (["--reaction-delay", "5"], "no certified gains on the 81^3 lattice"),
 ])
 def test_cli_bad_loop_input_is_one_line_exit_2(tmp_path, capsys, argv, words):
     out = tmp_path / "t"

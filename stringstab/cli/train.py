@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         kw["repair"] = args.repair
     if args.paper and args.algo != "idl":
         raise StringStabError(f"--paper applies to --algo idl; got --algo {args.algo}")
-    config = _with_loop(config_for(args.algo, paper=args.paper, **kw), args)
+    config, note = _with_loop(config_for(args.algo, paper=args.paper, **kw), args)
     out = Path(args.out)
     check_run_folder(out, resume=args.resume, config=config)
     leaders = None
@@ -132,35 +132,37 @@ def run(args: argparse.Namespace) -> int:
           f"ends), stopped by {res.stopped_by}; {t['steps_per_second']:.0f} steps/s this call, "
           f"repair {100 * t['repair_share']:.1f}% of the time")
     print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png and summary.json to {out}/")
+    if note:
+        print(note)
     _note_stale_evaluation(out)
     return 0
 
 
-def _with_loop(config: Any, args: argparse.Namespace) -> Any:
+def _with_loop(config: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
     """The config with ``--reaction-delay`` and the radio and sensor options (issues 25, 26).
 
     With θ_r > 0 the repair certifies with the continuous certificate at θ_r only: the
-    sampled-data certificate has no θ_r, so ``repair_sampled`` is turned off, and said.
+    sampled-data certificate has no θ_r, so ``repair_sampled`` is turned off, and said (the
+    note returned, printed once training ran).
     """
-    import sys
-
     from ._loop import radio_from_args, reaction_from_args
 
     theta = reaction_from_args(args)
     radio, sensors = radio_from_args(args, config.dt)
     loop: dict[str, Any] = {}
+    note = None
     if theta:
         loop["reaction_delay"] = theta
         if config.action == "gains" and config.repair != "off" and config.repair_sampled:
             loop["repair_sampled"] = False
-            print(f"stringstab train: note: --reaction-delay {theta:g}: every executed gain is "
-                  "certified by the continuous certificate at θ_r (exact); the sampled-data "
-                  "certificate has no θ_r, so it is not required", file=sys.stderr)
+            note = (f"note: --reaction-delay {theta:g}: every executed gain was certified by the "
+                    "continuous certificate at θ_r (exact); the sampled-data certificate has no "
+                    "θ_r, so it was not required")
     if radio is not None:
         loop["radio"] = radio
     if sensors is not None:
         loop["sensors"] = sensors
-    return config.replace(**loop) if loop else config
+    return (config.replace(**loop) if loop else config), note
 
 
 def _note_stale_evaluation(out: Path) -> None:

@@ -249,6 +249,8 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         raise StringStabError("envs: gain actions need the environments wrapped in the repair "
                               "(stringstab.rl.envs.RepairedGains, as make_env builds them); "
                               "found no RepairedGains")
+    if repair is not None and repair.method != "off" and repair.reaction_delay:
+        repair.lattice()  # a θ_r at which no lattice gain is certified: refused before any file
     agent = Agent(config, obs_dim, act_dim, low=low, high=high,
                   action_filter=repair.approximate if repair is not None else None)
     buffer = ReplayBuffer(config.buffer_size, obs_dim=obs_dim, act_dim=act_dim, seed=config.seed + 1)
