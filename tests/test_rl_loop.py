@@ -317,6 +317,7 @@ def test_cli_train_evaluate_compare_with_theta_and_radio(tmp_path, capsys):
                  str(cmp), "--no-progress"]) == 0
     table = (cmp / "table.md").read_text()
     assert "reaction delay θ_r = 0.2 s" in table and "not available" in table
+    assert not (cmp / "gains_region.png").exists() and "region map has no reaction delay" in table
     assert json.loads((cmp / "comparison.json").read_text())["loop"]["reaction_delay"] == 0.2
     import matplotlib.pyplot as plt
 

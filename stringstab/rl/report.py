@@ -294,6 +294,10 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         for name, p in platoons.items():
             md.append(f"### {name}\n\n" + platoon_markdown(p["tests"], note=False) + "\n")
         md.append(platoon_markdown([], note=True))
+    no_region = reaction_delay > 0 and any(evs[0].gains is not None for evs in groups.values())
+    if no_region:
+        md.append("\nThe executed gains are not drawn over the certified region (gains_region.png): "
+                  "the region map has no reaction delay θ_r.\n")
     out.write_text("table.md", "".join(md))
     out.write_text("table.csv", table_csv(rows))
     out.write_json("comparison.json", {"summaries": summaries, "rows": rows,
@@ -322,7 +326,7 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots(), **kw)
         save(fig, fname)
     gains = {name: ev.gains[:, 2:] for name, ev in first.items() if ev.gains is not None}
-    if gains:
+    if gains and not no_region:
         fig = Figure(figsize=(6.4, 6.4), layout="constrained")
         plot_gains_over_region(gains, tau=tau, delta=delta, headway=headway, ax=fig.subplots())
         save(fig, "gains_region.png")
