@@ -1,7 +1,7 @@
 """The loop as it runs, on the command line: ``--reaction-delay`` and the radio and sensor flags.
 
-One definition for the commands that run the platoon (issues 25 and 26; ``simulate`` and
-``sumo run``):
+One definition for the commands that run the platoon (issues 25 and 26; ``simulate``,
+``sumo run``, ``train``, ``evaluate`` and ``compare``):
 the reaction delay θ_r of every follower, its V2V radio (:class:`stringstab.traffic.Radio`) and
 its sensors (:class:`stringstab.traffic.SensorNoise`).  Without any of them a command runs what
 it always ran, bit for bit.
@@ -15,7 +15,7 @@ from typing import Any
 
 from ..errors import StringStabError, show
 
-__all__ = ["RADIO_FLAGS", "add_loop_arguments", "radio_from_args", "reaction_from_args"]
+__all__ = ["RADIO_FLAGS", "add_loop_arguments", "loop_asked", "radio_from_args", "reaction_from_args"]
 
 #: The radio and sensor options (dest names), for commands that refuse or report them.
 RADIO_FLAGS = ("message_period", "message_phase", "loss", "burst", "stale_after", "fallback_gains",
@@ -68,6 +68,22 @@ def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True,
     g.add_argument("--noise-filter", metavar="SECONDS",
                    help="time constant of a first-order filter on the measurements")
     g.add_argument("--radio-seed", metavar="N", help="seed of the message loss and the noise (default 0)")
+
+
+def loop_asked(args: Any) -> bool:
+    """Whether any option of :func:`add_loop_arguments` was given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    bool
+        True when ``--reaction-delay`` or a radio or sensor option is present.
+    """
+    return any(getattr(args, n, None) is not None for n in ("reaction_delay", *RADIO_FLAGS))
 
 
 def reaction_from_args(args: Any) -> float:

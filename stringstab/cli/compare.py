@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 from typing import Any
 
 from ..errors import StringStabError
@@ -41,6 +42,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar or lines (stderr)")
     add_limit_arguments(p)
+    from ._loop import add_loop_arguments
+
+    add_loop_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -78,6 +82,15 @@ def run(args: argparse.Namespace) -> int:
     if len(params) != 1:
         raise StringStabError(f"runs must share tau, delta, headway and dt; found {sorted(params)}")
     tau, delta, headway, dt = params.pop()
+    from .evaluate import loop_of
+
+    loops = [loop_of(args, p.info) for _, p in opened]
+    if len({json.dumps(lp[3], sort_keys=True) for lp in loops}) != 1:
+        raise StringStabError(
+            "runs were trained in different loops (reaction delay, radio or sensors): "
+            f"{[lp[3] or 'default' for lp in loops]}; expected one, or give the loop to compare "
+            "in with --reaction-delay and the radio and sensor options")
+    theta, radio, sensors, loop_doc = loops[0]
     leaders, desc = test_leaders(args.leaders, dt=dt)
     limits = limits_from_args(args)
     out = OutputDir(args.out, command="compare")
@@ -87,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
     groups: dict[str, list[Any]] = {}
     platoons: dict[str, Any] = {}
     kw: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "limits": limits}
+    if loop_doc:  # the loop of the runs or of the options (issues 25, 26); none: as before
+        kw.update(reaction_delay=theta, radio=radio, sensors=sensors)
     per = len(leaders) + (10 if args.platoon else 0)
     with Progress(per * (len(opened) + len(base)), "stringstab compare", unit="vehicle-runs",
                   enabled=not args.no_progress) as bar:
@@ -111,7 +126,8 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--reference {ref!r} is not among the strategies {sorted(groups)}")
     with out:
         files = write_comparison(out, groups, reference=ref, tau=tau, delta=delta,
-                                 headway=headway, platoons=platoons or None)
+                                 headway=headway, platoons=platoons or None,
+                                 loop=loop_doc or None)
         from ..report import command_line
         from ..report.commands import compare_report
 

@@ -12,7 +12,7 @@ from ..progress import Progress
 from ._budget import refuse_platoon
 from ._common import add_limit_arguments, checked_leaders, limits_from_args
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "loop_of", "run"]
 
 
 def add_parser(sub: Any) -> None:
@@ -44,6 +44,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--no-progress", action="store_true",
                    help="no progress bar or progress lines (stderr)")
     add_limit_arguments(p)
+    from ._loop import add_loop_arguments
+
+    add_loop_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -88,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
     limits = limits_from_args(args)
     info, policy = open_run(args.run)
     p = policy.info
+    theta, radio, sensors, loop_doc = loop_of(args, p)
     leaders, desc = test_leaders(args.leaders, dt=p["dt"])
     out = OutputDir(Path(args.out) if args.out else Path(args.run) / "evaluation",
                     command="evaluate")
@@ -116,18 +120,21 @@ def run(args: argparse.Namespace) -> int:
             counted[1] = steps
 
         ev = evaluate(policy, leaders, tau=p["tau"], delta=p["delta"], headway=p["headway"],
-                      limits=limits, progress=episodes_done)
+                      limits=limits, progress=episodes_done, reaction_delay=theta, radio=radio,
+                      sensors=sensors)
         platoons = []
         for n in sizes:
             platoons.append(platoon_test(policy, n, tau=p["tau"], delta=p["delta"],
                                          headway=p["headway"], dt=p["dt"], limits=limits,
-                                         progress=lambda _, n=n: bar.update(n)))
+                                         progress=lambda _, n=n: bar.update(n),
+                                         reaction_delay=theta, radio=radio, sensors=sensors))
     s = ev.summary
     verdict, passed = report_verdict(ev, platoons, policy.action)
     run_doc = {**info, "leaders": desc, "tau": p["tau"], "delta": p["delta"],
                "headway": p["headway"], "dt": p["dt"], "repair": p.get("repair"),
                "limits": dataclasses.asdict(limits), "warnings": warnings,
-               "policy_sha256": policy_doc["policy_sha256"], "steps": policy_doc["steps"]}
+               "policy_sha256": policy_doc["policy_sha256"], "steps": policy_doc["steps"],
+               **loop_doc}
     with out:
         files = write_evaluation(out, ev, platoons, run_doc, verdict)
         from ..report import command_line
@@ -145,6 +152,10 @@ def run(args: argparse.Namespace) -> int:
     mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"
     if s.get("m_fss_sampled") is not None:
         fss += f" (sampled-data at dt={p['dt']} s: {s['m_fss_sampled']:.4g})"
+    elif theta and s.get("m_fss") is not None:
+        from ..rl.evaluate import SAMPLED_NOT_AVAILABLE
+
+        fss += f" (certified at θ_r = {theta:g} s; sampled-data {SAMPLED_NOT_AVAILABLE})"
     print(f"m_fss = {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
           f"TIT {s['TIT']:.3f}, M_CI {s['M_CI']:.3f}, M_effi {s['M_effi']:.3f}, M_lss {mlss}")
     for k in ("TIT", "M_CI", "M_effi", "M_lss"):
@@ -156,6 +167,49 @@ def run(args: argparse.Namespace) -> int:
     print(f"verdict: {verdict}")
     print(f"wrote {', '.join(files)} to {out.root}/")
     return 0 if passed else 1
+
+
+def loop_of(args: argparse.Namespace, info: Any) -> tuple[float, Any, Any, dict[str, Any]]:
+    """The loop to evaluate in: the loop options when any is given, else the run's own.
+
+    With any of ``--reaction-delay`` and the radio and sensor options, the loop is what they
+    say (the others at their defaults: θ_r = 0, no radio, exact sensors); with none, the loop
+    the policy was trained in (``policy.json``; θ_r = 0, no radio and exact sensors for a run
+    trained without them).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (the options of :func:`~stringstab.cli._loop.add_loop_arguments`).
+    info : mapping
+        The policy's info (``policy.json``): its ``dt`` and its training loop.
+
+    Returns
+    -------
+    (float, Radio or None, SensorNoise or None, dict)
+        θ_r (s), the radio, the sensors, and their record for the output (empty at the
+        defaults).
+    """
+    from ..rl.config import loop_from_info, sensor_fields
+    from ._loop import loop_asked, radio_from_args, reaction_from_args
+
+    if loop_asked(args):
+        theta = reaction_from_args(args)
+        radio, sensors = radio_from_args(args, float(info["dt"]))
+    else:
+        theta, radio, sensors = loop_from_info(info)
+        if radio is not None and radio.message_period is not None:
+            from ..traffic.radio import message_steps
+
+            message_steps(radio.message_period, float(info["dt"]))
+    doc: dict[str, Any] = {}
+    if theta:
+        doc["reaction_delay"] = theta
+    if radio is not None:
+        doc["radio"] = radio.describe()
+    if sensors is not None:
+        doc["sensors"] = sensor_fields(sensors)
+    return theta, radio, sensors, doc
 
 
 def _policy_of(run: Path, out: Any) -> dict[str, Any]:

@@ -53,6 +53,9 @@ def add_parser(sub: Any) -> None:
                    help="IDL as printed: the eq-16 state, no gain rate limit, episodes started in "
                         "equilibrium (without the toolkit's three IDL options observe, gain_rate and start_spread; docs/training.md)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from ._loop import add_loop_arguments
+
+    add_loop_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -102,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         kw["repair"] = args.repair
     if args.paper and args.algo != "idl":
         raise StringStabError(f"--paper applies to --algo idl; got --algo {args.algo}")
-    config = config_for(args.algo, paper=args.paper, **kw)
+    config, note = _with_loop(config_for(args.algo, paper=args.paper, **kw), args)
     out = Path(args.out)
     check_run_folder(out, resume=args.resume, config=config)
     leaders = None
@@ -129,8 +132,37 @@ def run(args: argparse.Namespace) -> int:
           f"ends), stopped by {res.stopped_by}; {t['steps_per_second']:.0f} steps/s this call, "
           f"repair {100 * t['repair_share']:.1f}% of the time")
     print(f"wrote the policy, checkpoint, train_log.csv, rolling_reward.png and summary.json to {out}/")
+    if note:
+        print(note)
     _note_stale_evaluation(out)
     return 0
+
+
+def _with_loop(config: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
+    """The config with ``--reaction-delay`` and the radio and sensor options (issues 25, 26).
+
+    With θ_r > 0 the repair certifies with the continuous certificate at θ_r only: the
+    sampled-data certificate has no θ_r, so ``repair_sampled`` is turned off, and said (the
+    note returned, printed once training ran).
+    """
+    from ._loop import radio_from_args, reaction_from_args
+
+    theta = reaction_from_args(args)
+    radio, sensors = radio_from_args(args, config.dt)
+    loop: dict[str, Any] = {}
+    note = None
+    if theta:
+        loop["reaction_delay"] = theta
+        if config.action == "gains" and config.repair != "off" and config.repair_sampled:
+            loop["repair_sampled"] = False
+            note = (f"note: --reaction-delay {theta:g}: every executed gain was certified by the "
+                    "continuous certificate at θ_r (exact); the sampled-data certificate has no "
+                    "θ_r, so it was not required")
+    if radio is not None:
+        loop["radio"] = radio
+    if sensors is not None:
+        loop["sensors"] = sensors
+    return (config.replace(**loop) if loop else config), note
 
 
 def _note_stale_evaluation(out: Path) -> None:
@@ -163,6 +195,11 @@ def _argv_of(args: argparse.Namespace) -> list[str]:
             out += [flag, str(getattr(args, name))]
     if getattr(args, "paper", False):
         out.append("--paper")
+    from ._loop import RADIO_FLAGS
+
+    for name in ("reaction_delay", *RADIO_FLAGS):
+        if getattr(args, name, None) is not None:
+            out += ["--" + name.replace("_", "-"), str(getattr(args, name))]
     if getattr(args, "leaders", None):
         out += ["--leaders", *map(str, args.leaders)]
     return out

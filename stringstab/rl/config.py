@@ -28,15 +28,21 @@ from typing import Any, Literal
 
 from .. import constants
 from ..errors import StringStabError, show
+from ..traffic.radio import Radio
+from ..traffic.sensors import SensorNoise
 
 __all__ = [
     "ALGOS",
     "IDL_OPTIONS",
+    "LOOP_FIELDS",
     "REPAIRS",
     "DDPGConfig",
     "TD3Config",
     "config_for",
     "config_from_dict",
+    "loop_from_info",
+    "loop_info",
+    "sensor_fields",
 ]
 
 #: Agent names of the command line.
@@ -45,6 +51,26 @@ ALGOS: tuple[str, str, str] = ("idl", "td3", "ddpg")
 REPAIRS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
 
 Action = Literal["gains", "accel"]
+#: The fields of the loop as it runs (issues 25 and 26), left out of :meth:`TD3Config.as_dict`
+#: at their defaults.
+LOOP_FIELDS: tuple[str, str, str] = ("reaction_delay", "radio", "sensors")
+
+
+def sensor_fields(sensors: SensorNoise) -> dict[str, Any]:
+    """A :class:`~stringstab.traffic.SensorNoise` as its constructor's keywords (JSON-ready).
+
+    Parameters
+    ----------
+    sensors : SensorNoise
+        The sensors.
+
+    Returns
+    -------
+    dict
+        ``gap``, ``gap_rate``, ``speed``, ``correlation_time``, ``filter_time``, ``seed``:
+        ``SensorNoise(**sensor_fields(s)) == s``.
+    """
+    return {f.name: getattr(sensors, f.name) for f in dataclasses.fields(sensors)}
 
 
 @dataclass(frozen=True)
@@ -158,14 +184,38 @@ class TD3Config:
     checkpoint_every: int = 20_000
     #: torch CPU threads (small: the machine is shared and the networks are tiny).
     torch_threads: int = 1
+    #: Reaction (actuation) delay θ_r of the follower, s (issue 25; not in the paper): the
+    #: vehicle applies its command θ_r late, τ ȧ = u(t − θ_r) − a, integrated exactly
+    #: (:mod:`stringstab.traffic.dynamics`); the repair certifies with it (the continuous
+    #: certificate with ``reaction_delay``).  θ_r > 0 needs ``repair_sampled=False``: the
+    #: sampled-data certificate has no θ_r.  0 (default) changes nothing, bit for bit.
+    reaction_delay: float = 0.0
+    #: The follower's V2V radio (issue 26; :class:`stringstab.traffic.Radio`: message period,
+    #: loss, staleness and fallback); None (default): the predecessor's acceleration every step.
+    radio: Radio | None = None
+    #: The follower's sensors (:class:`stringstab.traffic.SensorNoise`: noise and a filter on
+    #: the gap, gap rate and own speed); None (default): exact measurements.
+    sensors: SensorNoise | None = None
 
     # -- construction -------------------------------------------------------------------
     def __post_init__(self) -> None:
         _check(self)
 
     def as_dict(self) -> dict[str, Any]:
-        """The config as JSON-ready plain values (with ``"class"``)."""
+        """The config as JSON-ready plain values (with ``"class"``).
+
+        ``reaction_delay``, ``radio`` and ``sensors`` are left out at their defaults (0, None,
+        None), so a config without them writes what it always wrote.
+        """
         d = dataclasses.asdict(self)
+        for name in LOOP_FIELDS:
+            d.pop(name)
+        if self.reaction_delay:
+            d["reaction_delay"] = self.reaction_delay
+        if self.radio is not None:
+            d["radio"] = self.radio.describe()
+        if self.sensors is not None:
+            d["sensors"] = sensor_fields(self.sensors)
         d["hidden"] = list(self.hidden)
         d["weights"] = list(self.weights)
         d["observe"] = list(self.observe)
@@ -301,9 +351,94 @@ def _check(c: TD3Config) -> None:
     object.__setattr__(c, "start_spread", sp)
     if c.gain_rate > 0 and c.action != "gains":
         raise StringStabError(f"config field gain_rate needs action 'gains'; got action {c.action!r}")
+    _check_loop(c)
     if c.batch_size > c.buffer_size:
         raise StringStabError(
             f"config field batch_size ({c.batch_size}) must not exceed buffer_size ({c.buffer_size})")
+
+
+def _check_loop(c: TD3Config) -> None:
+    """θ_r, the radio and the sensors (issues 25, 26): their types, θ_r's range, the refusal."""
+    from ..params import check_reaction_delay
+
+    if isinstance(c.reaction_delay, bool):
+        raise StringStabError(f"config field reaction_delay must be a number of seconds >= 0; "
+                              f"got {show(c.reaction_delay)}")
+    theta = check_reaction_delay(c.reaction_delay, "config field reaction_delay (reaction delay θ_r)")
+    object.__setattr__(c, "reaction_delay", theta)
+    if c.radio is not None and not isinstance(c.radio, Radio):
+        raise StringStabError(f"config field radio must be a stringstab.traffic.Radio or None; "
+                              f"got {type(c.radio).__name__}")
+    if c.sensors is not None and not isinstance(c.sensors, SensorNoise):
+        raise StringStabError(f"config field sensors must be a stringstab.traffic.SensorNoise or "
+                              f"None; got {type(c.sensors).__name__}")
+    if c.radio is not None and c.radio.message_period is not None:
+        from ..traffic.radio import message_steps
+
+        message_steps(c.radio.message_period, c.dt)  # a whole multiple of the step, or one line
+    if theta > 0 and c.action == "gains" and c.repair != "off" and c.repair_sampled:
+        raise StringStabError(
+            f"config field reaction_delay={theta:g} s with repair_sampled: the sampled-data "
+            "certificate has no reaction delay θ_r; expected repair_sampled=False (the repair "
+            "then certifies with the continuous certificate at θ_r, exact)")
+
+
+def loop_info(config: TD3Config) -> dict[str, Any]:
+    """The loop a policy was trained in, for its ``policy.json`` (only what is not default).
+
+    Parameters
+    ----------
+    config : TD3Config
+        The training config.
+
+    Returns
+    -------
+    dict
+        ``reaction_delay`` (s) when θ_r > 0, ``radio`` (:meth:`Radio.describe
+        <stringstab.traffic.Radio.describe>`) and ``sensors`` (:func:`sensor_fields`) when set;
+        empty at the defaults, so a policy without them is saved as before.
+    """
+    d = config.as_dict()
+    return {k: d[k] for k in LOOP_FIELDS if k in d}
+
+
+def loop_from_info(info: Any) -> tuple[float, Radio | None, SensorNoise | None]:
+    """θ_r, the radio and the sensors of a saved policy's info (:func:`loop_info` read back).
+
+    Parameters
+    ----------
+    info : mapping
+        The policy's info (``policy.json``).
+
+    Returns
+    -------
+    (float, Radio or None, SensorNoise or None)
+        θ_r (0 when absent), the radio and the sensors (None when absent).
+
+    Raises
+    ------
+    StringStabError
+        If an entry is malformed (one line naming it).
+    """
+    from ..params import check_reaction_delay
+
+    theta = check_reaction_delay(info.get("reaction_delay", 0.0), "policy reaction_delay (θ_r)")
+    parts: list[Any] = []
+    for key, kind in (("radio", Radio), ("sensors", SensorNoise)):
+        doc = info.get(key)
+        if doc is None:
+            parts.append(None)
+            continue
+        if not isinstance(doc, dict):
+            raise StringStabError(f"policy {key}: expected a JSON object; found {doc!r}")
+        sub = dict(doc)
+        if key == "radio" and isinstance(sub.get("fallback_gains"), list):
+            sub["fallback_gains"] = tuple(sub["fallback_gains"])
+        try:
+            parts.append(kind(**sub))
+        except TypeError as e:
+            raise StringStabError(f"policy {key}: {e}") from e
+    return theta, parts[0], parts[1]
 
 
 #: The options ``config_for("idl")`` adds to :class:`TD3Config` (none in the paper; chosen on
@@ -406,6 +541,9 @@ def config_from_dict(doc: Any, *, source: str = "config") -> TD3Config:
     for key in ("weights", "observe", "start_spread"):
         if key in d and isinstance(d[key], list):
             d[key] = tuple(d[key])
+    if isinstance(d.get("radio"), dict) or isinstance(d.get("sensors"), dict):
+        _, radio, sensors = loop_from_info({k: d.get(k) for k in ("radio", "sensors")})
+        d["radio"], d["sensors"] = radio, sensors
     try:
         return cls(**d)
     except TypeError as e:

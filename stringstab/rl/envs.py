@@ -206,8 +206,9 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> VectorEnv:
     ----------
     config : TD3Config
         Supplies the number of environments, action mode, τ, δ, T*, gain bounds, reward
-        weights (eq 18) and TTC* (eq 20), ``observe``, the start spread, and for gain actions
-        the repair (:func:`~stringstab.rl.repair.repair_for`) and ``gain_rate``.
+        weights (eq 18) and TTC* (eq 20), ``observe``, the start spread, the reaction delay
+        θ_r, the radio and the sensors (issues 25, 26), and for gain actions the repair
+        (:func:`~stringstab.rl.repair.repair_for`, certifying at θ_r) and ``gain_rate``.
     leaders : list, optional
         The training leaders (trajectories or following pairs); default the bundled training
         episodes (:func:`~stringstab.rl.episodes.default_leaders`).
@@ -226,7 +227,9 @@ def make_env(config: TD3Config, leaders: list[Any] | None = None) -> VectorEnv:
                                  delta=config.delta, headway=config.headway,
                                  gain_bounds=config.gain_bounds, weights=config.weights,
                                  terminate_on_collision=True, ttc_star=config.reward_ttc_star,
-                                 observe=config.observe, start_spread=config.start_spread)
+                                 observe=config.observe, start_spread=config.start_spread,
+                                 reaction_delay=config.reaction_delay, radio=config.radio,
+                                 sensors=config.sensors)
     repair = repair_for(config)
     if repair is None:
         return env

@@ -14,6 +14,12 @@ beside it m_fss_sampled, the
 share certified by the sampled-data certificate of the zero-order-hold loop at the control step
 ``dt`` (:mod:`stringstab.certify.sampled`).  Both are computed in one place, :func:`fss`.
 
+With a reaction delay θ_r > 0 (issue 25) the follower applies its command θ_r late and m_fss is
+the share certified by the continuous certificate at θ_r (exact); m_fss_sampled is *not
+available* (None, and the reports say so): the sampled-data certificate has no θ_r, and a
+share computed without it would describe another loop.  The radio and sensors (issue 26) act
+in the simulation only; no certificate covers message loss or noise.
+
 A platoon test (§5.1): 10 and 100 vehicles running the strategy behind
 :func:`stringstab.traffic.paper_mix` (held 100 s at its final speed so the disturbance reaches
 the tail), m_p per vehicle next to the paper's values.  The certificate holds for frozen gains;
@@ -43,7 +49,7 @@ from ..traffic.metrics import (
 )
 from .policy import Policy
 
-__all__ = ["PAPER_MP_10", "Evaluation", "controller_for", "evaluate", "fss", "platoon_test"]
+__all__ = ["PAPER_MP_10", "SAMPLED_NOT_AVAILABLE", "Evaluation", "controller_for", "evaluate", "fss", "platoon_test"]
 
 Array = npt.NDArray[np.float64]
 
@@ -54,8 +60,12 @@ PAPER_MP_100_MAX = 0.989
 BASELINES = ("cacc", "idm")
 
 
+#: What the reports say for m_fss_sampled with θ_r > 0.
+SAMPLED_NOT_AVAILABLE = "not available: the sampled certificate has no θ_r"
+
+
 def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
-        dt: float | npt.ArrayLike) -> dict[str, Any]:
+        dt: float | npt.ArrayLike, reaction_delay: float = 0.0) -> dict[str, Any]:
     """m_fss (eq 27) of executed gains ``(..., 3)``: the one call site of the certificates.
 
     The continuous certificate is what the repair guarantees (and what the exit code of
@@ -76,6 +86,9 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     dt : float or array_like of float
         Control step, s: the sampling period H of the sampled-data certificate; one per triple
         when the triples ran at different steps (episodes of leaders sampled differently).
+    reaction_delay : float
+        θ_r, s (issue 25): m_fss by the continuous certificate at θ_r; with θ_r > 0
+        ``"m_fss_sampled"`` is None (:data:`SAMPLED_NOT_AVAILABLE`).
 
     Returns
     -------
@@ -102,6 +115,14 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         raise StringStabError(f"dt: expected one step or one per gain triple ({K.shape[0]}); "
                               f"found {step.size}")
     steps = np.broadcast_to(step.reshape(-1) if step.ndim else step, K.shape[:1])
+    hs = sorted(float(h) for h in np.unique(steps))
+    if reaction_delay:
+        return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway,
+                                   reaction_delay=reaction_delay),
+                "m_fss_sampled": None, "n": int(K.shape[0]),
+                "certificate": f"exact (continuous time) with reaction delay θ_r = {reaction_delay:g} s; "
+                               f"sampled-data {SAMPLED_NOT_AVAILABLE}",
+                "dt": hs[0] if len(hs) == 1 else hs}
     ok_s = np.zeros(K.shape[0], dtype=bool)
     for h in np.unique(steps):  # each triple at the step it ran at
         rows = np.flatnonzero(steps == h)
@@ -109,7 +130,6 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
                            headway=headway, sample_time=float(h))
         ok_s[rows] = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
-    hs = sorted(float(h) for h in np.unique(steps))
     return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
             "m_fss_sampled": float(ok_s.mean()), "n": int(K.shape[0]),
             "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",
@@ -229,7 +249,8 @@ def _start(leader: Any, headway: float, standstill: float) -> tuple[Any, float, 
 
 def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delta: float,
              headway: float, name: str | None = None, standstill: float = STANDSTILL,
-             ttc_star: float = TTC_STAR, limits: Any = None, progress: Any = None) -> Evaluation:
+             ttc_star: float = TTC_STAR, limits: Any = None, progress: Any = None,
+             reaction_delay: float = 0.0, radio: Any = None, sensors: Any = None) -> Evaluation:
     """Run ``strategy`` (a policy, ``"cacc"`` or ``"idm"``) on every leader; see the module.
 
     Leaders of equal length and step are simulated together, one follower each.
@@ -258,6 +279,13 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
     progress : callable, optional
         Receives the number of leaders done after each group of equally long leaders (for a
         progress line).
+    reaction_delay : float
+        Reaction delay θ_r of the follower, s (issue 25; :func:`stringstab.traffic.simulate`);
+        m_fss is certified at θ_r (:func:`fss`).
+    radio : Radio, optional
+        The follower's V2V link (issue 26).
+    sensors : SensorNoise, optional
+        The follower's sensors (issue 26).
 
     Returns
     -------
@@ -291,7 +319,7 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         gap0 = np.array([[starts[i][1]] for i in idx])
         v0 = np.array([[starts[i][2]] for i in idx])
         res = simulate(trs, ctrl, 1, tau=tau, delta=delta, initial_gap=gap0, initial_speed=v0,
-                       limits=limits)
+                       limits=limits, reaction_delay=reaction_delay, radio=radio, sensors=sensors)
         assert res.speed is not None and res.accel is not None
         gap = res.gap[:, 0, :]
         spd = res.speed
@@ -312,7 +340,8 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
         if res.gains is not None and res.gains.shape[2] == res.t.size:
             G = res.gains[:, 0, :, :]
             for j, i in enumerate(idx):
-                f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt)
+                f = fss(G[j], tau=tau, delta=delta, headway=headway, dt=dt,
+                        reaction_delay=reaction_delay)
                 episodes[i]["m_fss"] = f["m_fss"]
                 gains_rows.append(np.column_stack([res.t, np.full(res.t.size, i), G[j]]))
                 gains_dt.append(np.full(res.t.size, dt))
@@ -343,7 +372,8 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
     gains = None
     if gains_rows:
         gains = np.concatenate(gains_rows)
-        f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=np.concatenate(gains_dt))
+        f = fss(gains[:, 2:], tau=tau, delta=delta, headway=headway, dt=np.concatenate(gains_dt),
+                reaction_delay=reaction_delay)
         summary["m_fss"], summary["n_gains"] = f["m_fss"], f["n"]
         summary["m_fss_sampled"] = f["m_fss_sampled"]
         summary["certificate"] = f["certificate"]
@@ -353,8 +383,9 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
 
 def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: float,
                  headway: float, dt: float = 0.1, hold: float = 100.0,
-                 standstill: float = STANDSTILL, limits: Any = None,
-                 progress: Any = None) -> dict[str, Any]:
+                 standstill: float = STANDSTILL, limits: Any = None, progress: Any = None,
+                 reaction_delay: float = 0.0, radio: Any = None,
+                 sensors: Any = None) -> dict[str, Any]:
     """``n_vehicles`` running ``strategy`` behind the §5.1-style leader: m_p per vehicle and more.
 
     Parameters
@@ -380,6 +411,12 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
         Bounds on the followers (default IDL Table 2).
     progress : callable, optional
         Called with 1 at each simulated step (a progress report's count).
+    reaction_delay : float
+        Reaction delay θ_r of every follower, s (issue 25).
+    radio : Radio, optional
+        Every follower's V2V link (issue 26).
+    sensors : SensorNoise, optional
+        Every follower's sensors (issue 26).
 
     Returns
     -------
@@ -397,12 +434,14 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     ctrl = controller_for(strategy, headway=headway, standstill=standstill)
     res = simulate(leader, ctrl, n_vehicles, tau=tau, delta=delta,
                    initial_gap=standstill + headway * float(leader.speed[0]), limits=limits,
-                   progress=progress)
+                   progress=progress, reaction_delay=reaction_delay, radio=radio,
+                   sensors=sensors)
     m = platoon_metrics(res, certificate=False)
     out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
            "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],
            "TIT": m["TIT"], "m_fss": None, "m_fss_sampled": None}
     if res.gains is not None and res.gains.shape[-2] == res.t.size:
-        f = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt)
+        f = fss(res.gains, tau=tau, delta=delta, headway=headway, dt=dt,
+                reaction_delay=reaction_delay)
         out["m_fss"], out["m_fss_sampled"] = f["m_fss"], f["m_fss_sampled"]
     return out

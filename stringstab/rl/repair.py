@@ -46,6 +46,15 @@ that contains it — and, with ``sample_time`` H, also by the sampled-data certi
 (:func:`stringstab.certify.sampled.check_sampled` at H, or the cell's proof): the loop the
 simulator runs holds u over each control step, and gains on the continuous certificate's
 boundary need not be string stable in that sampled loop.
+
+With a reaction delay θ_r > 0 (issue 25, ``reaction_delay``) the judge is the continuous
+certificate with θ_r (:func:`~stringstab.certify.api.check` with ``reaction_delay``, exact in
+θ_r).  The proven cells and the cheap screens are objects of the loop without θ_r and are not
+used: every proposal is checked at θ_r; the certified lattice is the points of the θ_r = 0
+lattice that the certificate at θ_r certifies (a subset of the θ_r lattice, so every point is
+certified; points certified only with θ_r are left out, which is conservative, never unsound);
+the ``refine`` steps move towards the proposal by exact checks at θ_r.  The sampled-data
+certificate has no θ_r: ``sample_time`` with θ_r > 0 is refused (one line).
 """
 
 from __future__ import annotations
@@ -66,14 +75,15 @@ from ..errors import StringStabError
 from ..params import Params, positive
 from .config import REPAIRS, TD3Config
 
-__all__ = ["REPAIR_KEYS", "GainRepair", "certified_cells", "certified_lattice", "repair_for"]
+__all__ = ["REPAIR_KEYS", "REPAIR_REACTION_KEY", "GainRepair", "certified_cells", "certified_lattice", "repair_for"]
 
 Array = npt.NDArray[np.float64]
 
 
 @lru_cache(maxsize=8)
 def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
-                      resolution: float, sample_time: float | None = None) -> Array:
+                      resolution: float, sample_time: float | None = None,
+                      reaction_delay: float = 0.0) -> Array:
     """The points of a grid of spacing ``resolution`` over [lo, hi]³ certified by ``check``.
 
     The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
@@ -98,6 +108,9 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     sample_time : float, optional
         Also require the sampled-data certificate of the zero-order-hold loop at this
         period H, s.
+    reaction_delay : float
+        θ_r, s (issue 25): with θ_r > 0, the points of the θ_r = 0 lattice that the
+        continuous certificate at θ_r certifies (module docstring); no ``sample_time`` then.
 
     Returns
     -------
@@ -116,12 +129,22 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     (3, True)
     """
     n = round((hi - lo) / resolution) + 1
-    pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway), sample_time=sample_time,
-                                 also_continuous=True)
+    if reaction_delay:
+        if sample_time is not None:
+            raise StringStabError(f"reaction_delay={reaction_delay:g} s with sample_time={sample_time:g} s: "
+                                  "the sampled-data certificate has no reaction delay θ_r")
+        base = certified_lattice(tau, delta, headway, lo, hi, resolution)
+        keep = grid.certified(base, Params(tau, delta, headway, reaction_delay=reaction_delay))
+        pts = np.array(base[keep])
+        pts.flags.writeable = False
+    else:
+        pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway),
+                                     sample_time=sample_time, also_continuous=True)
     if not pts.shape[0]:
+        extra = f", reaction_delay={reaction_delay:g}" if reaction_delay else ""
         raise StringStabError(
             f"no certified gains on the {n}^3 lattice over [{lo}, {hi}]^3 at tau={tau}, "
-            f"delta={delta}, headway={headway}; expected parameters with a certified region")
+            f"delta={delta}, headway={headway}{extra}; expected parameters with a certified region")
     return pts
 
 
@@ -184,6 +207,9 @@ class GainRepair:
     sample_time : float, optional
         Also require the sampled-data certificate of the zero-order-hold loop at this step
         (:func:`stringstab.certify.sampled.check_sampled`) for every executed triple.
+    reaction_delay : float
+        θ_r, s (issue 25): certify with the continuous certificate at θ_r (module docstring);
+        refused with ``sample_time``.
 
     Attributes
     ----------
@@ -204,11 +230,14 @@ class GainRepair:
 
     def __init__(self, method: str = "projection", *, tau: float, delta: float, headway: float,
                  bounds: tuple[float, float] = GAIN_BOUNDS, resolution: float = 0.05,
-                 refine: int = 4, sample_time: float | None = None) -> None:
+                 refine: int = 4, sample_time: float | None = None,
+                 reaction_delay: float = 0.0) -> None:
         if method not in REPAIRS:
             raise StringStabError(f"repair method must be one of {list(REPAIRS)}; got {method!r}")
         self.method = method
-        self.params = Params(tau, delta, headway)
+        self.params = Params(tau, delta, headway, reaction_delay=reaction_delay)
+        #: θ_r, s (0: the loop without reaction delay).
+        self.reaction_delay = self.params.reaction_delay
         lo, hi = (float(b) for b in bounds)
         if not lo < hi:
             raise StringStabError(f"bounds must be (low, high) with low < high; got {bounds!r}")
@@ -219,13 +248,18 @@ class GainRepair:
         self.refine = int(refine)
         self.sample_time = None if sample_time is None else positive("repair sample_time",
                                                                       sample_time, unit=" s")
+        if self.reaction_delay and self.sample_time is not None:
+            raise StringStabError(
+                f"repair with reaction_delay={self.reaction_delay:g} s and sample_time="
+                f"{self.sample_time:g} s: the sampled-data certificate has no reaction delay θ_r; "
+                "expected no sample_time (the continuous certificate at θ_r certifies)")
         self._tree: Any = None
         self._projector: Any = None
         self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
                                         "fallbacks": 0, "seconds": 0.0}
 
     def describe(self) -> dict[str, Any]:
-        """The settings, for logs and JSON."""
+        """The settings, for logs and JSON (``reaction_delay`` only when θ_r > 0)."""
         return {"method": self.method, **self.params.as_dict(), "bounds": list(self.bounds),
                 "resolution": self.resolution, "refine": self.refine,
                 "sample_time": self.sample_time}
@@ -235,7 +269,7 @@ class GainRepair:
         """The certified lattice of this repair (built on first use)."""
         p = self.params
         return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
-                                 self.sample_time)
+                                 self.sample_time, self.reaction_delay)
 
     def cells(self) -> CertifiedCells:
         """The proven cells of this repair's lattice (:func:`certified_cells`, shared)."""
@@ -250,24 +284,31 @@ class GainRepair:
             self._tree = cKDTree(self.lattice())
         return self._tree
 
+    def _in_cells(self, K: Array) -> npt.NDArray[np.bool_]:
+        """Rows of K in a proven cell; none with θ_r > 0 (the cells are of the loop without it)."""
+        if self.reaction_delay:
+            return np.zeros(K.shape[0], dtype=bool)
+        return self.cells().contains(K)
+
     def _nearest(self, K0: Array) -> Array:
         """The lattice points nearest K0, moved towards K0 by bisection within proven cells.
 
         Each step keeps the farther point of the segment from the lattice point to K0 that
         lies in a proven cell of :meth:`cells`: every point returned is a certified lattice
-        point or in a proven cell, so certified by both certificates.
+        point or in a proven cell, so certified by both certificates.  With θ_r > 0 a point
+        is kept when the certificate at θ_r certifies it (one vectorised check per step).
         """
         _, idx = self._kdtree().query(K0)
         P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
         if self.refine:
-            cells = self.cells()
             lo = np.zeros(K0.shape[0])
             hi = np.ones(K0.shape[0])
             best = P.copy()
             for _ in range(self.refine):  # bisection within the proven cells
                 mid = 0.5 * (lo + hi)
                 C = P + mid[:, None] * (K0 - P)
-                ok = cells.contains(C)
+                ok = (grid.certified(C, self.params) if self.reaction_delay
+                      else self.cells().contains(C))
                 best[ok] = C[ok]
                 lo = np.where(ok, mid, lo)
                 hi = np.where(ok, hi, mid)
@@ -322,7 +363,8 @@ class GainRepair:
             return K0
         p = self.params
         out = K0.copy()
-        bad = np.flatnonzero(surely_uncertifiable(K0, p))
+        # the screen of the loop without θ_r (an approximation either way: never executed)
+        bad = np.flatnonzero(surely_uncertifiable(K0, Params(p.tau, p.delta, p.headway)))
         if bad.size:
             _, idx = self._kdtree().query(K0[bad])
             out[bad] = self.lattice()[np.asarray(idx)]
@@ -338,10 +380,9 @@ class GainRepair:
         out = K0.copy()
         if self.method != "off":
             p = self.params
-            cells = self.cells()
             # a gain in a proven cell is certified by both certificates (the cell's proof);
-            # the others go to the continuous-time certificate (``check``)
-            in_cell = cells.contains(K0)
+            # the others go to the continuous-time certificate (``check``, at θ_r if > 0)
+            in_cell = self._in_cells(K0)
             ok = in_cell.copy()
             rest = np.flatnonzero(~in_cell)
             if rest.size:
@@ -355,7 +396,7 @@ class GainRepair:
                     pending[bad] = False
                 else:
                     out[bad] = self._exact(K0[bad])
-                    pending[bad] = ~cells.contains(out[bad])
+                    pending[bad] = ~self._in_cells(out[bad])
             if self.sample_time is not None and pending.any():
                 # one sampled-data call per step; where it fails, the nearest lattice point
                 j = np.flatnonzero(pending)
@@ -377,6 +418,8 @@ class GainRepair:
 #: The keys of a saved repair (:meth:`GainRepair.describe`, ``policy.json``'s ``"repair"``).
 REPAIR_KEYS = ("method", "tau", "delta", "headway", "bounds", "resolution", "refine",
                "sample_time")
+#: The optional key of a saved repair: θ_r (s), written only when > 0 (issue 25).
+REPAIR_REACTION_KEY = "reaction_delay"
 
 
 def repair_for(saved: TD3Config | Mapping[str, Any], *, where: str = "policy info") -> GainRepair | None:
@@ -384,7 +427,7 @@ def repair_for(saved: TD3Config | Mapping[str, Any], *, where: str = "policy inf
 
     From a :class:`~stringstab.rl.config.TD3Config` (training): its ``repair`` method, τ, δ,
     T*, ``gain_bounds``, ``repair_resolution``, ``repair_refine`` and, with
-    ``repair_sampled``, the sampled-data certificate at ``dt``.  From a policy's info (the
+    ``repair_sampled``, the sampled-data certificate at ``dt``, and its ``reaction_delay``.  From a policy's info (the
     ``policy.json`` document, or :attr:`~stringstab.rl.policy.Policy.info`): its ``"repair"``
     entry, the :meth:`GainRepair.describe` output saved by training, every key of
     :data:`REPAIR_KEYS` required (no defaults).
@@ -422,7 +465,8 @@ def repair_for(saved: TD3Config | Mapping[str, Any], *, where: str = "policy inf
         return GainRepair(saved.repair, tau=saved.tau, delta=saved.delta, headway=saved.headway,
                           bounds=saved.gain_bounds, resolution=saved.repair_resolution,
                           refine=saved.repair_refine,
-                          sample_time=saved.dt if saved.repair_sampled else None)
+                          sample_time=saved.dt if saved.repair_sampled else None,
+                          reaction_delay=saved.reaction_delay)
     for key in ("action", "repair"):
         if key not in saved:
             raise StringStabError(f"expected key {key!r} in {where}, found keys {sorted(saved)}")
@@ -441,4 +485,5 @@ def repair_for(saved: TD3Config | Mapping[str, Any], *, where: str = "policy inf
         raise StringStabError(f"{where}: repair bounds must be [low, high]; found {bounds!r}")
     return GainRepair(r["method"], tau=r["tau"], delta=r["delta"], headway=r["headway"],
                       bounds=(bounds[0], bounds[1]), resolution=r["resolution"],
-                      refine=r["refine"], sample_time=r["sample_time"])
+                      refine=r["refine"], sample_time=r["sample_time"],
+                      reaction_delay=r.get(REPAIR_REACTION_KEY, 0.0))

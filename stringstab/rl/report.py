@@ -13,10 +13,31 @@ import numpy as np
 
 from ..io import OutputDir
 from .compare import table_csv, table_markdown, table_rows
-from .evaluate import PAPER_MP_10, PAPER_MP_100_MAX, Evaluation
+from .evaluate import PAPER_MP_10, PAPER_MP_100_MAX, SAMPLED_NOT_AVAILABLE, Evaluation
 
 __all__ = ["EVALUATION_METRICS", "evaluation_markdown", "platoon_markdown", "verdict", "write_comparison",
            "write_evaluation"]
+
+
+def _sampled_cell(s: Mapping[str, Any], reaction_delay: float) -> str:
+    """The comparison table's m_fss_sampled cell."""
+    if s["m_fss_sampled"] is not None:
+        return _ms(s["m_fss_sampled"])
+    if reaction_delay and s.get("m_fss") is not None:
+        return SAMPLED_NOT_AVAILABLE
+    return "0 (no certified gains executed)"
+
+
+def _loop_words(run: Mapping[str, Any]) -> str:
+    """θ_r, the radio and the sensors of an evaluation, in words (empty at the defaults)."""
+    words = ""
+    if run.get("reaction_delay"):
+        words += f", reaction delay θ_r = {run['reaction_delay']:g} s"
+    if run.get("radio"):
+        words += f", radio {run['radio']}"
+    if run.get("sensors"):
+        words += f", sensors {run['sensors']}"
+    return words
 
 
 def _fmt(v: Any) -> str:
@@ -110,16 +131,23 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
     lines = [f"# Evaluation of {run.get('folder', ev.name)} ({ev.name})\n\n",
              f"**Verdict: {verdict}**\n\n",
              f"{s['episodes']} held-out episodes ({run.get('leaders', '')}); τ = {run['tau']} s, "
-             f"δ = {run['delta']} s, T* = {run['headway']} s.\n\n",
+             f"δ = {run['delta']} s, T* = {run['headway']} s"
+             + _loop_words(run) + ".\n\n",
              "| metric | value | unit |\n|---|---|---|\n"]
     for k, (what, unit) in EVALUATION_METRICS.items():
         if k in s:
             lines.append(f"| {what} ({k}) | {_fmt(s[k])} | {unit} |\n")
-    lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
-                 "certified by the exact, delay-aware certificate (continuous time, frozen gains); "
-                 "m_fss_sampled: by the "
-                 "sampled-data certificate of the zero-order-hold loop at the control step "
-                 f"dt = {run.get('dt')} s, which the simulator runs.\n\n")
+    if run.get("reaction_delay"):
+        lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
+                     "certified by the exact, delay-aware certificate (continuous time, frozen "
+                     f"gains) with the reaction delay θ_r = {run['reaction_delay']:g} s; "
+                     f"m_fss_sampled: {SAMPLED_NOT_AVAILABLE}.\n\n")
+    else:
+        lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
+                     "certified by the exact, delay-aware certificate (continuous time, frozen gains); "
+                     "m_fss_sampled: by the "
+                     "sampled-data certificate of the zero-order-hold loop at the control step "
+                     f"dt = {run.get('dt')} s, which the simulator runs.\n\n")
     lines.append("## Platoon test\n\n" + platoon_markdown(platoons))
     return "".join(lines)
 
@@ -200,7 +228,8 @@ def _mean_std(vals: list[Any]) -> Any:
 
 def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]], *,
                      reference: str | None, tau: float, delta: float, headway: float,
-                     platoons: Mapping[str, Mapping[str, Any]] | None = None) -> list[str]:
+                     platoons: Mapping[str, Mapping[str, Any]] | None = None,
+                     loop: Any = None) -> list[str]:
     """Stage the Table-4 comparison tables and its figures in ``out``.
 
     The tables are ``table.md``, ``table.csv`` and ``comparison.json``; the figures
@@ -221,6 +250,9 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         The loop's parameters (for the executed-gains figure).
     platoons : mapping, optional
         ``{strategy: {"run": ..., "tests": [...]}}``.
+    loop : mapping, optional
+        The loop evaluated when not the default (``reaction_delay``, ``radio``, ``sensors``;
+        issues 25, 26): said in ``table.md`` and recorded in ``comparison.json``.
 
     Returns
     -------
@@ -228,6 +260,9 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         The names staged so far.
     """
     from matplotlib.figure import Figure
+
+    loop = dict(loop or {})
+    reaction_delay = float(loop.get("reaction_delay", 0.0))
 
     from .plots import (
         plot_gains_over_region,
@@ -247,22 +282,27 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
           "executed gains certified; CACC and IDM execute no certified gains). Rows 'X compared "
           "to Y': 100 (Y − X)/Y %, positive when X is better; where Y is 0 the row gives both "
           "values. Mean ± standard deviation over seeds where several runs are given.\n\n",
+          *([f"Evaluated with{_loop_words(loop)[1:]}.\n\n"] if loop else []),
           table_markdown(rows), "\n| strategy | collisions | share of episodes with m_p < 1 | "
           "median headway (s) | m_fss sampled at dt (fraction) |\n|---|---|---|---|---|\n"]
     md += [f"| {n} | {_ms(s['collisions'])} | {_ms(s['share_m_p_below_1'])} | "
            f"{_ms(s['median_headway'])} | "
-           f"{'0 (no certified gains executed)' if s['m_fss_sampled'] is None else _ms(s['m_fss_sampled'])} |\n"
+           f"{_sampled_cell(s, reaction_delay)} |\n"
            for n, s in summaries.items()]
     if platoons:
         md.append("\n## Platoon tests (§5.1)\n\n")
         for name, p in platoons.items():
             md.append(f"### {name}\n\n" + platoon_markdown(p["tests"], note=False) + "\n")
         md.append(platoon_markdown([], note=True))
+    no_region = reaction_delay > 0 and any(evs[0].gains is not None for evs in groups.values())
+    if no_region:
+        md.append("\nThe executed gains are not drawn over the certified region (gains_region.png): "
+                  "the region map has no reaction delay θ_r.\n")
     out.write_text("table.md", "".join(md))
     out.write_text("table.csv", table_csv(rows))
     out.write_json("comparison.json", {"summaries": summaries, "rows": rows,
                                        "runs": {n: [e.summary for e in evs] for n, evs in groups.items()},
-                                       "platoons": platoons or {}})
+                                       "platoons": platoons or {}, **({"loop": loop} if loop else {})})
     first = {name: evs[0] for name, evs in groups.items()}
 
     def save(fig: Any, name: str) -> None:
@@ -286,7 +326,7 @@ def write_comparison(out: OutputDir, groups: Mapping[str, Sequence[Evaluation]],
         fn({name: ev.samples[key] for name, ev in first.items()}, ax=fig.subplots(), **kw)
         save(fig, fname)
     gains = {name: ev.gains[:, 2:] for name, ev in first.items() if ev.gains is not None}
-    if gains:
+    if gains and not no_region:
         fig = Figure(figsize=(6.4, 6.4), layout="constrained")
         plot_gains_over_region(gains, tau=tau, delta=delta, headway=headway, ax=fig.subplots())
         save(fig, "gains_region.png")

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..errors import StringStabError
 from ..io import atomic_path, atomic_write_text, check_output_dir, dumps_json
-from .config import TD3Config, config_from_dict
+from .config import TD3Config, config_from_dict, loop_info
 from .policy import Policy
 
 __all__ = ["RUN_FORMAT", "TrainResult", "train"]
@@ -99,7 +99,8 @@ def _policy_info(config: TD3Config, obs_dim: int, act_dim: int, low: Any, high: 
             "high": [float(v) for v in high], "hidden": list(config.hidden),
             "tau": config.tau, "delta": config.delta, "headway": config.headway, "dt": config.dt,
             "observe": list(config.observe), "gain_rate": config.gain_rate,
-            "repair": repair.describe() if repair is not None else None}
+            "repair": repair.describe() if repair is not None else None,
+            **loop_info(config)}
 
 
 def _check_env(env: Any) -> tuple[int, int, Any, Any]:
@@ -248,6 +249,8 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         raise StringStabError("envs: gain actions need the environments wrapped in the repair "
                               "(stringstab.rl.envs.RepairedGains, as make_env builds them); "
                               "found no RepairedGains")
+    if repair is not None and repair.method != "off" and repair.reaction_delay:
+        repair.lattice()  # a θ_r at which no lattice gain is certified: refused before any file
     agent = Agent(config, obs_dim, act_dim, low=low, high=high,
                   action_filter=repair.approximate if repair is not None else None)
     buffer = ReplayBuffer(config.buffer_size, obs_dim=obs_dim, act_dim=act_dim, seed=config.seed + 1)
@@ -268,9 +271,13 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         saved = config_from_dict(state.get("config"), source="checkpoint config")
         if saved.replace(total_steps=config.total_steps,
                          checkpoint_every=config.checkpoint_every) != config:
+            was, now = saved.as_dict(), config.as_dict()
+            changed = sorted(k for k in set(was) | set(now)
+                             if k not in ("total_steps", "checkpoint_every") and was.get(k) != now.get(k))
             raise StringStabError(
                 "--resume: the checkpoint was written with another configuration (only the step "
-                "budget and the checkpoint interval may change on resume)")
+                "budget and the checkpoint interval may change on resume); changed: "
+                + ", ".join(f"{k} {was.get(k)!r} -> {now.get(k)!r}" for k in changed))
         if not hasattr(envs, "load_state_dict"):
             raise StringStabError("resume: the environment has no load_state_dict()")
         agent.load_state(state["agent"], {k: torch.as_tensor(np.array(v))

@@ -14,7 +14,8 @@
 * the loop as it runs (issue 26): :mod:`~stringstab.traffic.radio` (V2V messages every N
   steps, held, lost, stale, the fallback to ACC), :mod:`~stringstab.traffic.loss` (Bernoulli
   and Gilbert–Elliott message loss), :mod:`~stringstab.traffic.sensors` (noise and a filter on
-  gap, gap rate and speed) and :mod:`~stringstab.traffic.onboard` (a controller behind both);
+  gap, gap rate and speed), :mod:`~stringstab.traffic.onboard` (a controller behind both) and
+  :mod:`~stringstab.traffic.env_onboard` (both for the environments' episodes);
 * :mod:`~stringstab.traffic.metrics` — the IDL evaluation metrics;
 * :mod:`~stringstab.traffic.reward` — the IDL reward (eqs 18-24);
 * environments: :mod:`~stringstab.traffic.state` (the eq-16 state and its extensions),

@@ -64,6 +64,8 @@ from .dynamics import Model
 from .episodes import ActionMode, Episodes
 from .limits import DEFAULT_LENGTH, Limits
 from .loaders import FollowingPair
+from .radio import Radio
+from .sensors import SensorNoise
 from .state import SCALES, state_dim
 from .trajectory import Trajectory
 
@@ -121,6 +123,16 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
         End the episode at a collision (training, §4.1.2).
     order : {"random", "sequential"}
         How :meth:`reset` picks the next leader (``options={"index": i}`` picks one).
+    reaction_delay : float
+        Reaction delay θ_r of the follower, s (issue 25): τ ȧ = u(t − θ_r) − a, exact
+        (:mod:`stringstab.traffic.dynamics`); 0 (default) changes nothing.
+    radio : Radio, optional
+        The follower's V2V link (issue 26, :mod:`stringstab.traffic.radio`); None: the
+        predecessor's acceleration every step.
+    sensors : SensorNoise, optional
+        Noise and a filter on what the follower measures (:mod:`stringstab.traffic.sensors`).
+        With a radio or sensors the state and the law see the measured, message-held
+        observation (:mod:`stringstab.traffic.env_onboard`); reward and collisions stay true.
 
     Examples
     --------
@@ -144,14 +156,16 @@ class CarFollowingEnv(gym.Env[npt.NDArray[np.float32], npt.NDArray[np.float32]])
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True,
-                 order: Literal["random", "sequential"] = "random") -> None:
+                 order: Literal["random", "sequential"] = "random", reaction_delay: float = 0.0,
+                 radio: Radio | None = None, sensors: SensorNoise | None = None) -> None:
         if order not in ("random", "sequential"):
             raise StringStabError(f"order must be 'random' or 'sequential'; got {show(order)}")
         self._core = Episodes(leaders if leaders is not None else _default_leaders(), 1, action=action,
                            tau=tau, delta=delta, headway=headway, standstill=standstill, model=model,
                            limits=limits, length=length, gain_bounds=gain_bounds, weights=weights,
                            ttc_star=ttc_star, scales=scales,
-                           terminate_on_collision=terminate_on_collision)
+                           terminate_on_collision=terminate_on_collision,
+                           reaction_delay=reaction_delay, radio=radio, sensors=sensors)
         self.observation_space, self.action_space = _spaces(action, gain_bounds, limits)  # type: ignore[assignment]
         self.order = order
         self._next = 0
@@ -279,7 +293,8 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                  weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
                  ttc_star: float = TTC_STAR, scales: tuple[float, float, float] = SCALES,
                  terminate_on_collision: bool = True, observe: Sequence[str] = (),
-                 start_spread: tuple[float, float] = (0.0, 0.0)) -> None:
+                 start_spread: tuple[float, float] = (0.0, 0.0), reaction_delay: float = 0.0,
+                 radio: Radio | None = None, sensors: SensorNoise | None = None) -> None:
         if int(num_envs) < 1:
             raise StringStabError(f"num_envs must be >= 1; got {show(num_envs)}")
         self.num_envs = int(num_envs)
@@ -288,7 +303,8 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
                            standstill=standstill, model=model, limits=limits, length=length,
                            gain_bounds=gain_bounds, weights=weights, ttc_star=ttc_star,
                            scales=scales, terminate_on_collision=terminate_on_collision,
-                           observe=observe, start_spread=start_spread)
+                           observe=observe, start_spread=start_spread,
+                           reaction_delay=reaction_delay, radio=radio, sensors=sensors)
         self.single_observation_space, self.single_action_space = _spaces(action, gain_bounds,
                                                                           limits, observe)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -365,6 +381,10 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
         arrays.update({f"platoon.{a}": v for a, v in platoon_arrays.items()})
         meta = {"num_envs": self.num_envs, "n_leaders": len(c.items), **platoon_meta,
                 "rng": self.np_random.bit_generator.state}
+        if c.onboard is not None:  # the sensors and radio (issue 26)
+            onboard_meta, onboard_arrays = c.onboard.state()
+            meta["onboard"] = onboard_meta
+            arrays.update({f"onboard.{a}": v for a, v in onboard_arrays.items()})
         return meta, {k: np.array(v, copy=True) for k, v in arrays.items()}
 
     def load_state_dict(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
@@ -392,15 +412,23 @@ class BatchedCarFollowingEnv(VectorEnv[npt.NDArray[np.float32], npt.NDArray[np.f
             if key not in meta:
                 raise StringStabError(f"environment state: expected key {key!r} in the "
                                       f"environment's meta data, found keys {sorted(meta)}")
-        names = ["which", "k", "ret", "prev_gains", *(f"platoon.{a}" for a in p.STATE_ARRAYS)]
+        names = ["which", "k", "ret", "prev_gains", *(f"platoon.{a}" for a in p.state_arrays)]
         for name in names:
             if name not in arrays:
                 raise StringStabError(f"environment state: expected key {name!r} in the "
                                       f"environment's arrays, found keys {sorted(arrays)}")
         for name in ("which", "k", "ret", "prev_gains"):
             self._restore(getattr(c, name), arrays[name], name)
-        p.load_state(meta, {a: arrays[f"platoon.{a}"] for a in p.STATE_ARRAYS})
+        p.load_state(meta, {a: arrays[f"platoon.{a}"] for a in p.state_arrays})
         self.np_random.bit_generator.state = meta["rng"]
+        if c.onboard is not None:
+            if "onboard" not in meta:
+                raise StringStabError("environment state: expected the sensors' and radio's state "
+                                      "(key 'onboard'); found none")
+            c.onboard.load_state(meta["onboard"],
+                                 {a[len("onboard."):]: v for a, v in arrays.items()
+                                  if a.startswith("onboard.")},
+                                 p.observe(*c.leader_now()))
         c.observe()
 
     @staticmethod

@@ -21,10 +21,13 @@ from ..errors import StringStabError, show
 from .controllers.base import Observation
 from .controllers.linear import linear_law
 from .dynamics import Model, Platoon
+from .env_onboard import EnvOnboard
 from .limits import Limits
 from .loaders import FollowingPair
 from .metrics import time_headway, time_to_collision
+from .radio import Radio
 from .reward import reward
+from .sensors import SensorNoise
 from .state import extend_state, state_dim, state_vector
 from .trajectory import Trajectory
 
@@ -58,6 +61,9 @@ class Episodes:
         Each row's return so far.
     obs : Observation or None
         The last observation (None before the first :meth:`observe`).
+    seen : Observation or None
+        What the followers see of it: :attr:`obs` through their sensors and radio
+        (:class:`~stringstab.traffic.env_onboard.EnvOnboard`); :attr:`obs` itself without them.
     """
 
     def __init__(self, leaders: Sequence[Trajectory | FollowingPair], n: int, *, action: ActionMode,
@@ -65,8 +71,9 @@ class Episodes:
                  limits: Limits | None, length: float, gain_bounds: tuple[float, float],
                  weights: tuple[float, float, float], ttc_star: float,
                  scales: tuple[float, float, float], terminate_on_collision: bool,
-                 observe: Sequence[str] = (), start_spread: tuple[float, float] = (0.0, 0.0)
-                 ) -> None:
+                 observe: Sequence[str] = (), start_spread: tuple[float, float] = (0.0, 0.0),
+                 reaction_delay: float = 0.0, radio: Radio | None = None,
+                 sensors: SensorNoise | None = None) -> None:
         items = list(leaders)
         if not items:
             raise StringStabError("the environment needs at least one leader trajectory or pair")
@@ -116,12 +123,17 @@ class Episodes:
                 init_speed.append(float(tr.speed[0]))
         self.init_gap, self.init_speed = np.array(init_gap), np.array(init_speed)
         self.platoon = Platoon(self.n, 1, dt=self.dt, tau=tau, delta=delta, model=model,
-                               limits=limits, length=length)
+                               limits=limits, length=length, reaction_delay=reaction_delay)
+        #: The followers' sensors and radio (None without either: the true state is seen).
+        self.onboard = (None if radio is None and sensors is None else
+                        EnvOnboard(radio, sensors, self.n, self.dt, headway=self.headway,
+                                   standstill=self.standstill))
         self.which = np.zeros(self.n, dtype=np.int64)
         self.k = np.zeros(self.n, dtype=np.int64)
         #: Gains executed at the previous step (zero, and not rate limited, at an episode start).
         self.prev_gains = np.zeros((self.n, 3))
         self.obs: Observation | None = None
+        self.seen: Observation | None = None
         self.ret = np.zeros(self.n)
 
     def leader_now(self) -> tuple[Array, Array, Array]:
@@ -163,6 +175,8 @@ class Episodes:
             speed = np.where(free, np.maximum(speed + self.start_spread[1] * u[1], 0.0), speed)
         self.platoon.reset(self.LX[which, 0], self.LV[which, 0], self.LA[which, 0],
                            gap=gap[:, None], speed=speed[:, None], accel=0.0, rows=rows)
+        if self.onboard is not None:
+            self.onboard.reset(rows)
 
     def observe(self) -> Observation:
         """Observe the followers now (kept as :attr:`obs`).
@@ -173,10 +187,13 @@ class Episodes:
             What the followers know at this step (shapes ``(n, 1)``).
         """
         self.obs = self.platoon.observe(*self.leader_now())
+        self.seen = self.obs if self.onboard is None else self.onboard.see(self.obs)
         return self.obs
 
     def state(self) -> npt.NDArray[np.float32]:
         """The policy's state of every row: eq 16 with the ``observe`` extras.
+
+        Computed from what the followers see (:attr:`seen`: through the sensors and radio).
 
         Returns
         -------
@@ -184,11 +201,11 @@ class Episodes:
             :func:`~stringstab.traffic.state.state_vector`, extended by
             :func:`~stringstab.traffic.state.extend_state`.
         """
-        assert self.obs is not None
-        s = state_vector(self.obs, headway=self.headway, standstill=self.standstill,
+        assert self.seen is not None
+        s = state_vector(self.seen, headway=self.headway, standstill=self.standstill,
                          scales=self.scales)[:, 0, :]
         if self.extras:
-            s = extend_state(s, observe=self.extras, accel=self.obs.accel[:, 0],
+            s = extend_state(s, observe=self.extras, accel=self.seen.accel[:, 0],
                              prev_gains=self.prev_gains, scales=self.scales)
         return s.astype(np.float32)
 
@@ -207,17 +224,20 @@ class Episodes:
         gains : array (n, 3) or None
             The executed (clipped) gains; None for acceleration actions.
         """
-        assert self.obs is not None
+        assert self.seen is not None
         a = np.asarray(actions, dtype=np.float64).reshape(self.n, -1)
         if self.action == "accel":
             if a.shape[1] != 1:
                 raise StringStabError(f"accel actions must have 1 value per env; got shape {a.shape}")
-            return a[:, :1], None
+            ua = a[:, :1]
+            return (ua if self.onboard is None else self.onboard.command(ua)), None
         if a.shape[1] != 3:
             raise StringStabError(f"gain actions must be (k_x, k_v, k_a) per env; got shape {a.shape}")
         K = np.clip(a, *self.gain_bounds)
         self.prev_gains = K.copy()
-        u = linear_law(K[:, None, :], self.obs, headway=self.headway, standstill=self.standstill)
+        u = linear_law(K[:, None, :], self.seen, headway=self.headway, standstill=self.standstill)
+        if self.onboard is not None:
+            u = self.onboard.command(u)
         return u, K
 
     def step(self, actions: npt.ArrayLike) -> tuple[Array, npt.NDArray[np.bool_], npt.NDArray[np.bool_], dict[str, Any]]:

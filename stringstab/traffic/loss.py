@@ -141,6 +141,31 @@ class MessageLoss:
         self.bad = np.where(due, nxt, self.bad)
         return due & self.bad
 
+    def snapshot(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The loss process between two steps (a checkpoint): the generator and the chains.
+
+        Returns
+        -------
+        meta : dict
+            ``rng``: the generator's state (JSON-ready).
+        arrays : dict
+            ``bad``: the Gilbert–Elliott chains (absent for Bernoulli loss).
+        """
+        return ({"rng": self.rng.bit_generator.state},
+                {} if self.bad is None else {"bad": self.bad.copy()})
+
+    def restore(self, meta: dict[str, Any], arrays: dict[str, Any]) -> None:
+        """Restore :meth:`snapshot` output.
+
+        Parameters
+        ----------
+        meta, arrays : dict
+            As :meth:`snapshot` returns them.
+        """
+        self.rng.bit_generator.state = meta["rng"]
+        if self.bad is not None:
+            self.bad = np.array(arrays["bad"], dtype=bool)
+
     def reset(self, rows: Any = None) -> None:
         """Restart the chains of ``rows`` (default all) in their stationary distribution.
 

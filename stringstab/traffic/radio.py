@@ -384,6 +384,50 @@ class RadioLink:
         return {"messages_received": self.received.copy(), "messages_lost": self.lost.copy(),
                 "fallback_time": self.fallback_steps * self.dt}
 
+    #: The arrays of a link's state between two steps (:meth:`snapshot`).
+    SNAPSHOT_ARRAYS = ("received", "lost", "fallback_steps", "stale", "last")
+
+    def snapshot(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The links between two steps (a checkpoint, to continue bit for bit).
+
+        Returns
+        -------
+        meta : dict
+            Which parts have started and the loss process's generator (JSON-ready).
+        arrays : dict of str to ndarray
+            Counters, ages, the held messages, the rows to start afresh and the loss chains
+            (``loss.``-prefixed).
+        """
+        arrays: dict[str, Any] = {a: np.array(getattr(self, a), copy=True) for a in self.SNAPSHOT_ARRAYS}
+        meta: dict[str, Any] = {"has_held": self.held is not None, "has_fresh": self._fresh is not None}
+        if self.held is not None:
+            arrays["held"] = self.held.copy()
+        if self._fresh is not None:
+            arrays["fresh"] = self._fresh.copy()
+        if self.loss is not None:
+            lm, la = self.loss.snapshot()
+            meta["loss"] = lm
+            arrays.update({f"loss.{k}": v for k, v in la.items()})
+        return meta, arrays
+
+    def restore(self, meta: dict[str, Any], arrays: dict[str, Any]) -> None:
+        """Restore :meth:`snapshot` output.
+
+        Parameters
+        ----------
+        meta : dict
+            As :meth:`snapshot` returns it.
+        arrays : dict of str to array_like
+            As :meth:`snapshot` returns them.
+        """
+        for a in self.SNAPSHOT_ARRAYS:
+            getattr(self, a)[...] = np.asarray(arrays[a])
+        self.held = np.array(arrays["held"], dtype=np.float64) if meta["has_held"] else None
+        self._fresh = np.array(arrays["fresh"], dtype=bool) if meta["has_fresh"] else None
+        if self.loss is not None:
+            self.loss.restore(meta["loss"], {k[5:]: v for k, v in arrays.items()
+                                                if k.startswith("loss.")})
+
     def reset(self, rows: Any = None) -> None:
         """Start the links of ``rows`` (default all) afresh: held value, age, loss chains.
 

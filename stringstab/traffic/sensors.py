@@ -207,6 +207,37 @@ class Sensors:
         gap, rel, spd = z[0], z[1], z[2]
         return dataclasses.replace(obs, gap=gap, rel_speed=rel, speed=spd, pred_speed=spd + rel)
 
+    def snapshot(self) -> tuple[dict[str, Any], dict[str, Array]]:
+        """The sensors between two steps (a checkpoint, to continue bit for bit).
+
+        Returns
+        -------
+        meta : dict
+            The generator's state and which of the processes have started (JSON-ready).
+        arrays : dict of str to ndarray
+            The Gauss–Markov states and the filter outputs, where started.
+        """
+        meta = {"rng": self.rng.bit_generator.state, "restart": self._restart,
+                "has_state": self.state is not None, "has_filtered": self.filtered is not None}
+        arrays = {k: np.array(v, copy=True) for k, v in (("state", self.state),
+                                                         ("filtered", self.filtered)) if v is not None}
+        return meta, arrays
+
+    def restore(self, meta: dict[str, Any], arrays: dict[str, Any]) -> None:
+        """Restore :meth:`snapshot` output.
+
+        Parameters
+        ----------
+        meta : dict
+            As :meth:`snapshot` returns it.
+        arrays : dict of str to array_like
+            As :meth:`snapshot` returns them.
+        """
+        self.rng.bit_generator.state = meta["rng"]
+        self._restart = bool(meta["restart"])
+        self.state = np.array(arrays["state"], dtype=np.float64) if meta["has_state"] else None
+        self.filtered = np.array(arrays["filtered"], dtype=np.float64) if meta["has_filtered"] else None
+
     def reset(self, rows: Any = None) -> None:
         """Restart the noise processes and filters of ``rows`` (default all).
 
