@@ -45,6 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
+from .text_files import read_text, undecodable
 
 __all__ = [
     "GAIN_COLUMNS",
@@ -609,6 +610,26 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
     )
 
 
+def _read_stream(stream: IO[str], name: str) -> str:
+    """All of a text stream (standard input: its bytes decoded as UTF-8), or a one-line refusal."""
+    raw = getattr(stream, "buffer", None)
+    if raw is not None:  # sys.stdin: decode the bytes here (its own decoder may be strict)
+        data = raw.read()
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError as e:
+            raise undecodable(name, "a CSV or JSON gain file", data[:4], e.start) from e
+    else:
+        try:
+            text = stream.read()
+        except UnicodeDecodeError as e:
+            raise undecodable(name, "a CSV or JSON gain file", b"", None) from e
+    if "\0" in text:
+        raise StringStabError(f"{name}: expected a CSV or JSON gain file (UTF-8 text); got binary "
+                              "data, not UTF-8 text (a NUL byte, which no text holds)")
+    return text
+
+
 def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = None) -> GainTable:
     r"""Read gain triples from a CSV, JSON, NPZ or Parquet file (see the module docstring).
 
@@ -662,7 +683,7 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
             raise StringStabError(
                 f"{name}: {fmt.upper()} cannot be read from a text stream; give a path"
             )
-        text = stream.read()
+        text = _read_stream(stream, name)
         if text.startswith("\ufeff"):
             text = text[1:]
         kind = fmt or ("json" if text.lstrip()[:1] in ("[", "{") else "csv")
@@ -690,12 +711,5 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
         return _read_npz(path, name)
     if kind == "parquet":
         return _read_parquet(path, name)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise StringStabError(
-            f"{name}: not UTF-8 text (byte {e.start}); expected a UTF-8 {kind.upper()} file"
-        ) from e
-    except OSError as e:
-        raise StringStabError(f"{name}: cannot read the file ({e.strerror or e})") from e
+    text = read_text(path, label=name, expected=f"a {kind.upper()} gain file")
     return _read_json(text, name) if kind == "json" else _read_csv(text, name)

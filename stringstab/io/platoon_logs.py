@@ -30,6 +30,7 @@ is 3.6 times too large (km/h labelled as m/s) is refused with the ratio found.
 from __future__ import annotations
 
 import csv
+import io
 import math
 import re
 from collections.abc import Callable
@@ -41,6 +42,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
+from .text_files import read_text
 
 __all__ = ["SPEED_ABSURD", "PlatoonLog", "Segment", "clean_segments", "read_platoon_logs"]
 
@@ -222,13 +224,9 @@ def _cell(c: str) -> float:
 
 
 def _read_rows(path: Path) -> list[list[str]]:
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            return [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-    except OSError as e:
-        raise StringStabError(f"cannot read {_where(path)}: {e.strerror or e}") from e
-    except UnicodeDecodeError as e:
-        raise StringStabError(f"{_where(path)}: expected a UTF-8 text (CSV) file; {e.reason}") from e
+    text = read_text(path, label=_where(path),
+                     expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)")
+    return [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(c.strip() for c in r)]
 
 
 def _numeric(rows: list[list[str]], ncol: int, path: Path, first_line: int) -> Array:

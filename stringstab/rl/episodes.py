@@ -143,8 +143,12 @@ def default_leaders(split: Split, *, seconds: float = 30.0, dt: float = 0.1) -> 
 
 
 def _is_ngsim(path: Path) -> bool:
+    from ..io.text_files import decoding
+
     try:
-        with path.open(encoding="utf-8-sig") as fh:
+        with path.open(encoding="utf-8-sig") as fh, decoding(
+                path, label=f"leader file {str(path)!r}",
+                expected="a 't, v' CSV or an NGSIM trajectory file"):
             head = fh.readline()
     except OSError as e:
         raise StringStabError(f"cannot read leader file {str(path)!r}: {e.strerror or e}") from e

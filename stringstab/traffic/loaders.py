@@ -7,6 +7,7 @@ the US-101 / I-80 trajectory files (IDL paper §4.1.1) into leader–follower pa
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import math
 from dataclasses import dataclass
@@ -47,15 +48,16 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
     Raises
     ------
     StringStabError
-        If the file is missing or empty, its columns are not ``t, v`` or ``t, v, a``, a value is
-        not a finite number, times are not strictly increasing or a speed is negative.
+        If the file is missing, empty, binary or not UTF-8 text, its columns are not ``t, v`` or
+        ``t, v, a``, a value is not a finite number, times are not strictly increasing or a
+        speed is negative.
     """
+    from ..io.text_files import read_text
+
     p = Path(path)
-    try:
-        with p.open(newline="", encoding="utf-8-sig") as fh:
-            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-    except OSError as e:
-        raise StringStabError(f"cannot read leader CSV {show(str(p))}: {e.strerror or e}") from e
+    text = read_text(p, label=f"leader CSV {show(str(p))}",
+                     expected="a CSV file with columns 't, v' or 't, v, a'")
+    rows = [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(c.strip() for c in r)]
     if not rows:
         raise StringStabError(f"leader CSV {show(str(p))} is empty; expected a header 't, v' or 't, v, a'")
     header = [c.strip().lower() for c in rows[0]]
@@ -172,14 +174,17 @@ def load_ngsim_pairs(
     Raises
     ------
     StringStabError
-        If the file cannot be read or lacks a required column.
+        If the file cannot be read, is not UTF-8 text or lacks a required column.
     """
+    from ..io.text_files import decoding
+
     p = Path(path)
     try:
         fh = p.open(newline="", encoding="utf-8-sig")
     except OSError as e:
         raise StringStabError(f"cannot read NGSIM file {show(str(p))}: {e.strerror or e}") from e
-    with fh:
+    with fh, decoding(p, label=f"NGSIM file {show(str(p))}",
+                      expected="an NGSIM US-101/I-80 trajectory CSV file"):
         reader = csv.reader(fh)
         header = [c.strip().lower() for c in next(reader, [])]
         missing = [c for c in _NGSIM_REQUIRED if c.lower() not in header]
