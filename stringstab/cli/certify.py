@@ -117,7 +117,9 @@ def _pade_order(text: str) -> int:
         raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}") from e
     if n < 1:
         raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}")
-    return n
+    from ..ranges import check_count
+
+    return check_count("order", n, name="--pade-order")
 
 
 def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:

@@ -77,12 +77,22 @@ def run(args: argparse.Namespace) -> int:
     if len(params) != 1:
         raise StringStabError(f"runs must share tau, delta, headway and dt; found {sorted(params)}")
     tau, delta, headway, dt = params.pop()
+    strategies = sorted({pol.algo for _, pol in opened} | set(base))
+    ref = args.reference or ("idl" if "idl" in strategies else None)
+    if ref is not None and ref not in strategies:  # refused before any evaluation
+        raise StringStabError(f"--reference {ref!r} is not among the strategies {strategies}; "
+                              "expected the --algo of a RUN or a baseline of --baselines")
     leaders, desc = test_leaders(args.leaders, dt=dt)
     limits = limits_from_args(args)
     out = OutputDir(args.out, command="compare")
+    from ..rl.evaluate import controller_for
+    from ..traffic.limits import settling_time
     from ..traffic.synthetic import paper_mix
 
-    checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits)
+    times = [settling_time(controller_for(b, headway=headway), tau) for b in base]
+    settling = max((t for t in times if t is not None), default=None)
+    checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits,
+                    settling=settling)
     groups: dict[str, list[Any]] = {}
     platoons: dict[str, Any] = {}
     kw: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "limits": limits}
@@ -105,9 +115,6 @@ def run(args: argparse.Namespace) -> int:
             if args.platoon:
                 platoons[b] = {"run": None, "tests": [platoon_test(b, 10, dt=dt, **kw)]}
                 bar.update(10)
-    ref = args.reference or ("idl" if "idl" in groups else None)
-    if ref is not None and ref not in groups:
-        raise StringStabError(f"--reference {ref!r} is not among the strategies {sorted(groups)}")
     with out:
         files = write_comparison(out, groups, reference=ref, tau=tau, delta=delta,
                                  headway=headway, platoons=platoons or None)

@@ -288,8 +288,11 @@ def run(args: argparse.Namespace) -> int:
     for f in formats:
         if f not in FIGURE_FORMATS:
             raise StringStabError(f"--format must be among {', '.join(FIGURE_FORMATS)}; got {f!r}")
-    dpi = _int(args.dpi, "--dpi", 10)
-    workers = None if args.workers is None else _int(args.workers, "--workers", 1)
+    from ..ranges import check_count
+
+    dpi = check_count("dpi", _int(args.dpi, "--dpi", 10), name="--dpi")
+    workers = None if args.workers is None else check_count(
+        "workers", _int(args.workers, "--workers", 1), name="--workers")
     if not args.prefix or "/" in args.prefix or args.prefix.startswith("."):
         raise StringStabError(f"--prefix must be a plain file name stem; got {args.prefix!r}")
     gains = None

@@ -21,7 +21,15 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import check_params
-from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, limits_from_args
+from ..ranges import check_magnitude
+from ._common import (
+    add_limit_arguments,
+    add_vehicle_arguments,
+    checked_leaders,
+    integer,
+    limits_from_args,
+    warn_beyond_sensible,
+)
 
 __all__ = ["DEFAULT_GAINS", "add_parser", "parse_gains", "run"]
 
@@ -210,18 +218,20 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "from_identify", None):
         _from_identified(args)
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
-    if args.followers < 1:
-        raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
+    integer("--followers", args.followers, 1)  # the memory estimate bounds it (below)
     for name in ("dt", "standstill", "length", "ttc_star"):
         v = getattr(args, name)
         if not (math.isfinite(v) and (v > 0 or (name == "standstill" and v == 0))):
             raise StringStabError(
                 f"--{name.replace('_', '-')} must be a finite number > 0; got {show(v)}"
             )
+    sizes = [(kind, getattr(args, name), f"--{name.replace('_', '-')}")
+             for name, kind in (("standstill", "length"), ("length", "length"), ("ttc_star", "ttc"))]
+    for kind, v, option in sizes:
+        check_magnitude(kind, v, name=option)
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
     _check_step(args.dt, tau, delta)
-    from ..ranges import check_magnitude
 
     for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
         if v is not None and math.isfinite(v):
@@ -239,7 +249,11 @@ def run(args: argparse.Namespace) -> int:
             f"--gains-file {args.gains_file} has gain series for followers 1..{n_series}; "
             f"expected --followers {n_series}, got {args.followers}"
         )
-    warnings = checked_leaders(args, [leader], limits)
+    from ..traffic.limits import settling_time
+
+    settling = settling_time(controller, tau if args.model == "lag" else 0.0)
+    warnings = checked_leaders(args, [leader], limits, settling=settling)
+    warn_beyond_sensible(args, [("followers", args.followers, "--followers"), *sizes])
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length, limits=limits)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,

@@ -8,6 +8,7 @@ import time
 from typing import Any
 
 from ._common import integer as _int
+from ._common import warn_beyond_sensible
 
 __all__ = ["add_parser", "run"]
 
@@ -89,8 +90,9 @@ def run(args: argparse.Namespace) -> int:
         for pt in spec.points:
             print(f"  {pt.id}  {pt.label}  " + ", ".join(f"{k}={v}" for k, v in pt.varied.items()))
         return 0
-    workers = None if args.workers is None else _int("--workers", args.workers, 1)
-    retries = _int("--retries", args.retries, 0)
+    workers = None if args.workers is None else _int("--workers", args.workers, 1, "workers")
+    retries = _int("--retries", args.retries, 0, "retries")
+    warn_beyond_sensible(args, [("workers", workers, "--workers"), ("retries", retries, "--retries")])
     check_output_dir(args.out, what="--out")
     try:  # SIGTERM arrives as KeyboardInterrupt too (stringstab.cli.main)
         with dask_client(args.scheduler, workers) as client:
