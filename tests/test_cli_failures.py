@@ -207,7 +207,7 @@ def test_a_batch_file_too_big_for_memory_is_refused(capsys, tmp_path, monkeypatc
     """The estimate (4.5 kB per row) against the memory available, before certifying."""
     import numpy as np
 
-    import stringstab.cli._budget as budget
+    import stringstab.memory as budget
 
     monkeypatch.setattr(budget, "available_bytes", lambda: 200_000_000)  # a small machine
     f = tmp_path / "big.npz"

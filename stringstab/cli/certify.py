@@ -41,7 +41,7 @@ BYTES_BASE = 150e6
 
 
 def _available() -> float:
-    from ._budget import available_bytes
+    from ..memory import available_bytes
 
     return float(available_bytes())
 
@@ -171,7 +171,7 @@ def run(args: argparse.Namespace) -> int:
         return _run_identified(args, out, H)
     table = gains_from_args(args)
     check_horizon(H, table)
-    from ._budget import refuse_if_too_big
+    from ..memory import refuse_if_too_big
 
     n_rows = len(table)
     refuse_if_too_big(f"{args.file or 'the triples'} ({n_rows} rows)",

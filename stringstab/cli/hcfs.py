@@ -159,7 +159,7 @@ def run_verify(args: argparse.Namespace) -> int:
         check_magnitude("duration", args.duration, name="--duration")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
-    from ._budget import refuse_platoon
+    from ..memory import refuse_platoon
 
     refuse_platoon(args.followers * max(len(leaders), 1), max(len(ld.speed) for ld in leaders),
                    f"--followers {args.followers}")
@@ -276,7 +276,7 @@ def run_train(args: argparse.Namespace) -> int:
     followers = _int("--followers", args.followers, 1)
     seconds = check_magnitude("duration", positive("--episode-seconds", args.episode_seconds,
                                                    unit=" s"), name="--episode-seconds")
-    from ._budget import refuse_platoon
+    from ..memory import refuse_platoon
 
     refuse_platoon(platoons * followers, round(seconds / DT) + 1,
                    f"--platoons {platoons} --followers {followers}")

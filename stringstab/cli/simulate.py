@@ -238,7 +238,7 @@ def run(args: argparse.Namespace) -> int:
             check_magnitude("duration", v, name=opt)
     out = OutputDir(args.out, command="simulate", owns=RUN_FILES, what="--out")
     leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
-    from ._budget import refuse_platoon
+    from ..memory import refuse_platoon
 
     refuse_platoon(args.followers, len(leader.speed), f"--followers {args.followers}")
     limits = limits_from_args(args)

@@ -59,9 +59,6 @@ def add_parser(sub: Any) -> None:
 
 #: The largest step budget accepted (a year at ~300 steps/s).
 MAX_STEPS = 10**10
-#: Memory per parallel environment, rounded up from a measurement (train --algo idl, peak RSS
-#: 1022 MB with 4 and 1023 MB with 2048 environments: ~0.6 kB each).
-BYTES_PER_ENV = 2048
 
 
 def run(args: argparse.Namespace) -> int:
@@ -92,10 +89,6 @@ def run(args: argparse.Namespace) -> int:
     warn_beyond_sensible(args, [("steps", kw["total_steps"], "--steps")])
     if args.num_envs is not None:
         kw["num_envs"] = _int("--num-envs", args.num_envs, 1)
-        from ._budget import refuse_if_too_big
-
-        refuse_if_too_big(f"--num-envs {kw['num_envs']}", BYTES_PER_ENV * kw["num_envs"],
-                          "expected fewer parallel environments (8 by default)")
     if args.stop_episodes is not None:
         kw["stop_episodes"] = _int("--stop-episodes", args.stop_episodes, 0, "episodes")
     if args.repair is not None:
@@ -105,6 +98,12 @@ def run(args: argparse.Namespace) -> int:
     if args.paper and args.algo != "idl":
         raise StringStabError(f"--paper applies to --algo idl; got --algo {args.algo}")
     config = config_for(args.algo, paper=args.paper, **kw)
+    if args.num_envs is not None:
+        from ..memory import refuse_if_too_big, training_bytes
+
+        refuse_if_too_big(f"--num-envs {config.num_envs}",
+                          training_bytes(config.num_envs, config.buffer_size),
+                          "expected fewer parallel environments (8 by default)")
     out = Path(args.out)
     check_run_folder(out, resume=args.resume, config=config)
     leaders = None

@@ -35,6 +35,9 @@ from .outputs import (
     atomic_write_text,
     check_output_dir,
     check_output_file,
+    claim_folder,
+    read_manifest,
+    write_manifest,
 )
 from .plain import dumps_json, to_plain
 from .platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
@@ -61,6 +64,7 @@ __all__ = [
     "check_figure_formats",
     "check_output_dir",
     "check_output_file",
+    "claim_folder",
     "clean_segments",
     "columns_from_records",
     "dumps_json",
@@ -69,11 +73,13 @@ __all__ = [
     "format_results",
     "parse_triple",
     "read_gains",
+    "read_manifest",
     "read_platoon_logs",
     "records_from_columns",
     "render_table",
     "save_figure",
     "to_plain",
+    "write_manifest",
     "write_results",
     "write_text",
 ]

@@ -44,8 +44,11 @@ __all__ = [
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
+    "claim_folder",
     "deferred_interrupt",
     "invocation",
+    "read_manifest",
+    "write_manifest",
 ]
 
 #: Name of the file in which an :class:`OutputDir` lists what it wrote.
@@ -127,10 +130,11 @@ def check_output_file(path: str | os.PathLike[str], *, what: str = "output file"
 
 
 def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Path:
-    """Check that a folder can be written (or created, with its parents) at ``path``.
+    """Check that a folder can be written (or created in its existing parent) at ``path``.
 
-    Nothing is created: the nearest existing ancestor must be a writable folder (probed with a
-    temporary file, removed at once).
+    Nothing is created, and the folder's parent must exist, as an output file's folder must
+    (:func:`check_output_file`): a mistyped path is an error, not a tree of new folders.  The
+    folder (or its parent) must be writable (probed with a temporary file, removed at once).
 
     Parameters
     ----------
@@ -147,7 +151,8 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
     Raises
     ------
     StringStabError
-        When ``path`` (or an ancestor) is a file, or nothing can be written there.
+        When ``path`` (or an ancestor) is a file, its parent folder does not exist, or nothing
+        can be written there.
 
     Examples
     --------
@@ -158,6 +163,10 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
     Traceback (most recent call last):
     ...
     stringstab.errors.StringStabError: output folder: expected a folder; '...a-file' is a file
+    >>> check_output_dir("/nonexistent-folder/run")
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: output folder: the folder '/nonexistent-folder' of '/nonexistent-folder/run' does not exist; create it first or choose another path
     """
     p = Path(path)
     if str(path) == "":
@@ -171,6 +180,9 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
         probe = probe.parent
     if probe.exists() and not probe.is_dir():
         raise StringStabError(f"{what}: {str(probe)!r} in {str(p)!r} is a file, not a folder")
+    if not p.exists() and not p.parent.exists():
+        raise StringStabError(f"{what}: the folder {str(p.parent)!r} of {str(p)!r} does not exist; "
+                              "create it first or choose another path")
     _probe_writable(probe, what)
     return p
 
@@ -351,6 +363,91 @@ def deferred_interrupt() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
+def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The manifest :data:`MANIFEST` of a folder a command wrote (None: none, or unreadable).
+
+    Parameters
+    ----------
+    folder : path-like
+        The folder.
+
+    Returns
+    -------
+    dict or None
+        The manifest (``command``, ``version``, ``files``, ``argv``, ...); None when there is
+        none or it cannot be read (an unreadable manifest protects nothing).
+    """
+    m = Path(folder) / MANIFEST
+    if not m.is_file():
+        return None
+    try:
+        doc = json.loads(m.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def claim_folder(folder: str | os.PathLike[str], *, command: str, what: str = "output folder") -> None:
+    """Refuse a folder whose manifest says another command wrote it (before any work).
+
+    Parameters
+    ----------
+    folder : path-like
+        The output folder (it may not exist yet).
+    command : str
+        The command that will write it (e.g. ``"sweep"``).
+    what : str, default "output folder"
+        What the folder is, as the first words of the error message.
+
+    Raises
+    ------
+    StringStabError
+        When :func:`read_manifest` names another command.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> write_manifest(root, command="region")
+    >>> claim_folder(root, command="sweep")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: output folder: '...' holds the outputs of 'stringstab region'; expected an empty folder or one written by 'stringstab sweep'; choose another folder
+    """
+    old = read_manifest(folder)
+    if old is not None and old.get("command") != command:
+        raise StringStabError(
+            f"{what}: {str(folder)!r} holds the outputs of 'stringstab {old.get('command')}'; "
+            f"expected an empty folder or one written by 'stringstab {command}'; "
+            "choose another folder"
+        )
+
+
+def write_manifest(folder: str | os.PathLike[str], *, command: str, files: Iterable[str] = (),
+                   extra: dict[str, Any] | None = None, what: str = "output folder") -> None:
+    """Write the folder's manifest: the command, the version, the files, the command line.
+
+    Parameters
+    ----------
+    folder : path-like
+        An existing folder.
+    command : str
+        The command that wrote it.
+    files : iterable of str, default ()
+        The files it wrote (relative paths), which its next run may replace.
+    extra : dict, optional
+        More entries (e.g. the policy an evaluation is of).
+    what : str, default "output folder"
+        What the folder is, for an error message.
+    """
+    from .._version import __version__
+
+    inv = _INVOCATION.get()
+    manifest = {"command": command, "version": __version__, "files": list(files),
+                **((inv() if callable(inv) else inv) or {}), **(extra or {})}
+    atomic_write_text(Path(folder) / MANIFEST, json.dumps(manifest, indent=1) + "\n", what=what)
+
+
 class OutputDir:
     """An output folder written all-or-nothing, replacing only its own earlier run.
 
@@ -363,7 +460,7 @@ class OutputDir:
     Parameters
     ----------
     path : path-like
-        The output folder (created, with its parents, when the run succeeds).
+        The output folder (created in its existing parent when the run succeeds).
     command : str
         Who writes it (e.g. ``"region"``); a folder whose manifest names another command is
         refused, so two different runs are never mixed in one folder.
@@ -400,13 +497,7 @@ class OutputDir:
         self._committed = False
         #: More manifest entries (e.g. the policy an evaluation is of): :meth:`record`.
         self.extra: dict[str, Any] = {}
-        old = self._read_manifest()
-        if old is not None and old.get("command") != command:
-            raise StringStabError(
-                f"{what}: {str(self.root)!r} holds the outputs of 'stringstab {old.get('command')}'; "
-                f"expected an empty folder or one written by 'stringstab {command}'; "
-                "choose another folder"
-            )
+        claim_folder(self.root, command=command, what=what)
 
     # -- manifest ---------------------------------------------------------------------------
     def record(self, **entries: Any) -> None:
@@ -418,20 +509,13 @@ class OutputDir:
         return self._read_manifest()
 
     def _read_manifest(self) -> dict[str, Any] | None:
-        m = self.root / MANIFEST
-        if not m.is_file():
-            return None
-        try:
-            doc = json.loads(m.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return None  # an unreadable manifest protects nothing; we will overwrite it
-        return doc if isinstance(doc, dict) else None
+        return read_manifest(self.root)
 
     # -- context ------------------------------------------------------------------------------
     def __enter__(self) -> OutputDir:
         try:
-            self._created = [q for q in (self.root, *self.root.parents) if not q.exists()]
-            self.root.mkdir(parents=True, exist_ok=True)
+            self._created = [self.root] if not self.root.exists() else []
+            self.root.mkdir(exist_ok=True)  # its parent exists (check_output_dir)
             self._staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.root))
         except OSError as e:
             raise StringStabError(
@@ -547,13 +631,8 @@ class OutputDir:
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.chmod(staging / name, mode)
                 os.replace(staging / name, dest)
-            from .._version import __version__
-
-            inv = _INVOCATION.get()
-            manifest = {"command": self.command, "version": __version__, "files": new,
-                        **((inv() if callable(inv) else inv) or {}), **self.extra}
-            atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
-                              what=self.what)
+            write_manifest(self.root, command=self.command, files=new, extra=self.extra,
+                           what=self.what)
         except OSError as e:
             raise StringStabError(
                 f"{self.what}: cannot move the outputs into {str(self.root)!r} ({_reason(e)})"

@@ -39,7 +39,7 @@ from ..io import atomic_path, atomic_write_text, check_output_dir, dumps_json
 from .config import TD3Config, config_from_dict
 from .policy import Policy
 
-__all__ = ["RUN_FORMAT", "TrainResult", "train"]
+__all__ = ["RESUMABLE_FIELDS", "RUN_FORMAT", "TrainResult", "refuse_other_config", "train"]
 
 #: Format tag of a run folder's ``run.json``.
 RUN_FORMAT = "stringstab-rl-run/1"
@@ -129,6 +129,49 @@ def _write_log(rows: list[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
+#: The fields a resumed run may change: the step budget and the checkpoint interval.
+RESUMABLE_FIELDS = ("total_steps", "checkpoint_every")
+
+
+def refuse_other_config(saved: TD3Config, config: TD3Config) -> None:
+    """Refuse to resume a checkpoint written with another configuration, naming what differs.
+
+    Parameters
+    ----------
+    saved : TD3Config
+        The checkpoint's configuration.
+    config : TD3Config
+        The one asked for now.
+
+    Raises
+    ------
+    StringStabError
+        When a field other than :data:`RESUMABLE_FIELDS` differs (or the class does): each
+        field with the checkpoint's value (expected) and the one given (found).
+
+    Examples
+    --------
+    >>> from stringstab.rl import config_for
+    >>> refuse_other_config(config_for("ddpg", seed=0), config_for("ddpg", seed=1, num_envs=4))
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: --resume: the checkpoint was written with another configuration; expected its seed = 0, num_envs = 8; got seed = 1, num_envs = 4 (only the step budget and the checkpoint interval may change on resume)
+    """
+    if type(saved) is not type(config):
+        raise StringStabError(f"--resume: the checkpoint is a {type(saved).__name__} run; expected "
+                              f"{type(saved).__name__}, got {type(config).__name__}")
+    differ = [f.name for f in dataclasses.fields(saved) if f.name not in RESUMABLE_FIELDS
+              and getattr(saved, f.name) != getattr(config, f.name)]
+    if differ:
+        def values(c: TD3Config) -> str:
+            return ", ".join(f"{n} = {getattr(c, n)!r}" for n in differ)
+
+        raise StringStabError(
+            "--resume: the checkpoint was written with another configuration; expected its "
+            f"{values(saved)}; got {values(config)} (only the step budget and the checkpoint "
+            "interval may change on resume)")
+
+
 def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
     """Before any work: a new run needs an empty or absent folder; a resumed one its own run.
 
@@ -145,17 +188,25 @@ def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
     ------
     StringStabError
         If ``out`` cannot be an output folder, a new run's folder has visible files in it, or a
-        resumed folder holds no run or a run of another ``algo``.
+        resumed folder holds no run, a run of another ``algo`` or a checkpoint of another
+        configuration (:func:`refuse_other_config`).
     """
     check_output_dir(out, what="--out")
     if resume:
-        from .checkpoint import read_json
+        from .checkpoint import CHECKPOINT_FORMAT, LATEST_FORMAT, read_json
 
         run = read_json(out / "run.json", fmt=RUN_FORMAT, what="--resume")
         if run.get("algo") != config.algo:
             raise StringStabError(
                 f"--resume: {str(out)!r} holds a run of --algo {run.get('algo')!r}; "
                 f"expected --algo {config.algo!r}")
+        latest = out / "checkpoint" / "latest.json"
+        if latest.is_file():  # the configuration, before any work (the tensors are read later)
+            name = str(read_json(latest, fmt=LATEST_FORMAT, what="--resume").get("checkpoint"))
+            state = out / "checkpoint" / name / "state.json"
+            if "/" not in name and ".." not in name and state.is_file():
+                doc = read_json(state, fmt=CHECKPOINT_FORMAT, what="--resume").get("config")
+                refuse_other_config(config_from_dict(doc, source="checkpoint config"), config)
     elif out.exists() and any(not p.name.startswith(".") for p in out.iterdir()):
         raise StringStabError(f"--out: {str(out)!r} is not empty; choose a new folder, or pass "
                               "--resume to continue the run in it")
@@ -265,12 +316,8 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         from .checkpoint import latest_checkpoint
 
         state, tensors = latest_checkpoint(out_path / "checkpoint")
-        saved = config_from_dict(state.get("config"), source="checkpoint config")
-        if saved.replace(total_steps=config.total_steps,
-                         checkpoint_every=config.checkpoint_every) != config:
-            raise StringStabError(
-                "--resume: the checkpoint was written with another configuration (only the step "
-                "budget and the checkpoint interval may change on resume)")
+        refuse_other_config(config_from_dict(state.get("config"), source="checkpoint config"),
+                            config)
         if not hasattr(envs, "load_state_dict"):
             raise StringStabError("resume: the environment has no load_state_dict()")
         agent.load_state(state["agent"], {k: torch.as_tensor(np.array(v))
