@@ -39,8 +39,12 @@ def test_check_output_file_cases(tmp_path: Path) -> None:
 
 
 def test_check_output_dir_cases(tmp_path: Path) -> None:
-    assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
+    assert check_output_dir(tmp_path / "a") == tmp_path / "a"
     assert not (tmp_path / "a").exists()  # nothing created by the check
+    # one rule with output files (issue 29): the parent must exist, nothing is created
+    with pytest.raises(StringStabError, match=r"the folder .*a' of .*b' does not exist"):
+        check_output_dir(tmp_path / "a" / "b")
+    assert not (tmp_path / "a").exists()
     f = tmp_path / "file"
     f.write_text("x")
     with pytest.raises(StringStabError, match=r"expected a folder; .* is a file"):

@@ -157,7 +157,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = _chosen(argv)
     parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)
-    from ..io.outputs import invocation
+    from ..io.manifest import invocation
     from ._provenance import provenance
 
     hook = sys.unraisablehook

@@ -7,7 +7,8 @@
 Parquet, NPZ) with one vectorised writer: the column model is :mod:`~stringstab.io.columns`,
 the renderers :mod:`~stringstab.io.table`, :mod:`~stringstab.io.text_formats` and
 :mod:`~stringstab.io.binary_formats`; :mod:`~stringstab.io.figures` saves a drawn figure in every
-format with its metadata.
+format with its metadata; :mod:`~stringstab.io.text_files` reads a user's text file as UTF-8 or
+refuses it in one line; :mod:`~stringstab.io.manifest` says which command wrote a folder.
 
 Every command checks its output paths with :func:`check_output_file` or :class:`OutputDir`
 *before* it starts work, and writes through :func:`atomic_write_text`,
@@ -27,16 +28,14 @@ from .gains import (
     parse_triple,
     read_gains,
 )
+from .manifest import MANIFEST, claim_folder, read_manifest
 from .outputs import (
-    MANIFEST,
     OutputDir,
     atomic_path,
     atomic_write_bytes,
     atomic_write_text,
     check_output_dir,
     check_output_file,
-    claim_folder,
-    read_manifest,
     write_manifest,
 )
 from .plain import dumps_json, to_plain

@@ -15,7 +15,7 @@ Three guarantees, for every command of the toolkit:
    the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A command whose outputs
    have fixed names may instead declare them (``owns=``): then those of its names this run did
    not write are deleted.  Every run writes the manifest: the command, the version, the files
-   and, from the command line (:func:`invocation`), the arguments and the inputs' hashes (a
+   and, from the command line (:func:`~stringstab.io.manifest.invocation`), the arguments and the inputs' hashes (a
    policy's hash and step count for an evaluation).  A failed run leaves the
    previous outputs untouched; a folder written by a *different* command is refused; files the
    toolkit did not write are never deleted.
@@ -24,7 +24,6 @@ Three guarantees, for every command of the toolkit:
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import json
 import os
 import shutil
@@ -35,24 +34,19 @@ from types import TracebackType
 from typing import Any
 
 from ..errors import StringStabError
+from .manifest import MANIFEST, claim_folder, manifest_doc, read_manifest
 
 __all__ = [
-    "MANIFEST",
     "OutputDir",
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
     "check_output_dir",
     "check_output_file",
-    "claim_folder",
     "deferred_interrupt",
-    "invocation",
-    "read_manifest",
     "write_manifest",
 ]
 
-#: Name of the file in which an :class:`OutputDir` lists what it wrote.
-MANIFEST = ".stringstab-manifest.json"
 _STAGING_PREFIX = ".stringstab-staging-"
 
 
@@ -295,40 +289,6 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "o
     return atomic_write_bytes(path, text.encode("utf-8"), what=what)
 
 
-#: What produced the outputs being written (the command line and its inputs' hashes), set by
-#: the command-line entry point (:func:`invocation`) and copied into every manifest.
-_INVOCATION: contextvars.ContextVar[Any] = contextvars.ContextVar(
-    "stringstab_invocation", default=None)
-
-
-@contextlib.contextmanager
-def invocation(doc: Any) -> Iterator[None]:
-    """Within the block, every :class:`OutputDir` manifest also records ``doc``.
-
-    Parameters
-    ----------
-    doc : dict or callable
-        JSON-serialisable entries, e.g. ``{"argv": [...], "inputs": {...}}``, or a callable
-        returning them (called when a manifest is written: hashing inputs only when needed).
-
-    Yields
-    ------
-    None
-        Control returns to the block; the record is dropped when it ends.
-
-    Examples
-    --------
-    >>> with invocation({"argv": ["stringstab", "demo"]}):
-    ...     _INVOCATION.get()["argv"][1]
-    'demo'
-    """
-    token = _INVOCATION.set(doc)
-    try:
-        yield
-    finally:
-        _INVOCATION.reset(token)
-
-
 @contextlib.contextmanager
 def deferred_interrupt() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) until the block is done, then raise KeyboardInterrupt.
@@ -363,69 +323,11 @@ def deferred_interrupt() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
-def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
-    """The manifest :data:`MANIFEST` of a folder a command wrote (None: none, or unreadable).
-
-    Parameters
-    ----------
-    folder : path-like
-        The folder.
-
-    Returns
-    -------
-    dict or None
-        The manifest (``command``, ``version``, ``files``, ``argv``, ...); None when there is
-        none or it cannot be read (an unreadable manifest protects nothing).
-    """
-    m = Path(folder) / MANIFEST
-    if not m.is_file():
-        return None
-    try:
-        doc = json.loads(m.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) else None
-
-
-def claim_folder(folder: str | os.PathLike[str], *, command: str, what: str = "output folder") -> None:
-    """Refuse a folder whose manifest says another command wrote it (before any work).
-
-    Parameters
-    ----------
-    folder : path-like
-        The output folder (it may not exist yet).
-    command : str
-        The command that will write it (e.g. ``"sweep"``).
-    what : str, default "output folder"
-        What the folder is, as the first words of the error message.
-
-    Raises
-    ------
-    StringStabError
-        When :func:`read_manifest` names another command.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> root = pathlib.Path(tempfile.mkdtemp())
-    >>> write_manifest(root, command="region")
-    >>> claim_folder(root, command="sweep")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: output folder: '...' holds the outputs of 'stringstab region'; expected an empty folder or one written by 'stringstab sweep'; choose another folder
-    """
-    old = read_manifest(folder)
-    if old is not None and old.get("command") != command:
-        raise StringStabError(
-            f"{what}: {str(folder)!r} holds the outputs of 'stringstab {old.get('command')}'; "
-            f"expected an empty folder or one written by 'stringstab {command}'; "
-            "choose another folder"
-        )
-
-
 def write_manifest(folder: str | os.PathLike[str], *, command: str, files: Iterable[str] = (),
                    extra: dict[str, Any] | None = None, what: str = "output folder") -> None:
-    """Write the folder's manifest: the command, the version, the files, the command line.
+    """Write a folder's manifest atomically (:func:`stringstab.io.manifest.manifest_doc`).
+
+    For a folder filled as it goes (a sweep's) rather than through :class:`OutputDir`.
 
     Parameters
     ----------
@@ -440,12 +342,8 @@ def write_manifest(folder: str | os.PathLike[str], *, command: str, files: Itera
     what : str, default "output folder"
         What the folder is, for an error message.
     """
-    from .._version import __version__
-
-    inv = _INVOCATION.get()
-    manifest = {"command": command, "version": __version__, "files": list(files),
-                **((inv() if callable(inv) else inv) or {}), **(extra or {})}
-    atomic_write_text(Path(folder) / MANIFEST, json.dumps(manifest, indent=1) + "\n", what=what)
+    doc = manifest_doc(command, files, extra)
+    atomic_write_text(Path(folder) / MANIFEST, json.dumps(doc, indent=1) + "\n", what=what)
 
 
 class OutputDir:
