@@ -215,6 +215,9 @@ def run(args: argparse.Namespace) -> int:
     from ..traffic.platoon import simulate
 
     t0 = time.perf_counter()
+    if getattr(args, "vehicle", None) is not None and not getattr(args, "from_identify", None):
+        raise StringStabError(f"--vehicle picks a fitted vehicle of --from IDENTIFY_JSON: expected "
+                              f"--from with it; got --vehicle {args.vehicle} without --from")
     if getattr(args, "from_identify", None):
         _from_identified(args)
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)

@@ -544,7 +544,8 @@ def _read_parquet(path: Path, source: str) -> GainTable:
     try:
         table = pq.read_table(path)
     except Exception as e:  # pyarrow raises its own ArrowInvalid / OSError types
-        raise StringStabError(f"{source}: not a readable Parquet file ({e})") from e
+        raise StringStabError(f"{source}: not a readable Parquet file; expected Parquet columns "
+                              f"k_x, k_v, k_a [, t, vehicle] ({e})") from e
     arrays = {name: np.asarray(table.column(name).to_numpy(zero_copy_only=False))
               for name in table.column_names}
     if not arrays:
