@@ -59,7 +59,8 @@ def add_parser(sub: Any) -> None:
         ),
     )
     v.add_argument("--jerk-limit", "-J", nargs="+", required=True, metavar="J",
-                   help="jerk limits J in m/s^3 (each finite and > 0)")
+                   help="jerk limits J in m/s^3 (each > 0 and at most 1e6; one above "
+                        "(a_max - a_min)/T, 30 at the defaults, never binds: a warning)")
     v.add_argument("--followers", "-N", type=int, default=8, metavar="N",
                    help="followers per platoon (the paper uses 4, 6, 8; default 8)")
     v.add_argument("--leader", nargs="+", default=["udds"], metavar="SPEC",
