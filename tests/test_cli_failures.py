@@ -93,10 +93,10 @@ def test_ctrl_c_is_one_line_exit_130_and_no_output_folder(capsys, tmp_path, monk
         raise KeyboardInterrupt
 
     monkeypatch.setattr(stringstab.regions, "region_map", interrupted)
-    out = tmp_path / "maps"
+    out = tmp_path / "new" / "maps"
     _one_line(capsys, ["region", "--fix", "k_a=0.5", "--n", "5", "--out", str(out)], 130,
               "stringstab region: interrupted; nothing partial was written")
-    assert not out.exists()
+    assert not out.exists() and not out.parent.exists()
 
 
 def test_ctrl_c_while_writing_keeps_the_old_run_whole(capsys, tmp_path, monkeypatch):

@@ -3,8 +3,9 @@
 The cases a user hit (the issue's *Why*): a 100 m/s leader trained on with exit 0, a 2-sample
 leader simulated ("max m_p = n/a"), ``hcfs verify -J 1e9`` without a note, a sweep whose workers
 were killed for memory, a sweep replacing a region map's report, ``region --out a/b/c`` creating
-folders the docs say it refuses, ``compare --reference zzz`` refused after the work, a refused
-``--resume`` that did not say why.  Every refusal is one line on stderr, exit 2, nothing written.
+folders the docs said it refuses (now one rule: created, for files too), ``compare --reference zzz`` refused after the work, a refused
+``--resume`` that did not say why.  Every refusal is one line on stderr, exit 2, nothing written
+(and no folder created: an output's missing folders are created when the run succeeds).
 """
 
 from __future__ import annotations
@@ -285,28 +286,43 @@ def test_sweep_refuses_a_folder_region_wrote_and_region_a_sweep_folder(tmp_path,
 
 
 @pytest.mark.parametrize("argv", [
-    ["region", "--fix", "k_a=0.5", "--n", "5", "--out", "{O}"],
-    ["simulate", "--no-figures", "--out", "{O}"],
-    ["train", "--algo", "ddpg", "--steps", "64", "--out", "{O}"],
-    ["evaluate", "{RUN}", "--platoon", "none", "--out", "{O}"],
-    ["compare", "{RUN}", "--baselines", "none", "--out", "{O}"],
-    ["hcfs", "verify", "-J", "2.5", "--policy", "stand-in", "--out", "{O}"],
-    ["hcfs", "train", "--steps", "64", "--out", "{O}"],
-    ["identify", "{LOG}", "--out", "{O}"],
-    ["sweep", "{SPEC}", "--out", "{O}"],
-    ["demo", "--only", "certify", "--out", "{O}"],
-    ["tune", "0.9,-0.5,1.1", "--report", "{O}"],
+    ["region", "--fix", "k_a=0.5", "--n", "5", "--no-progress", "--format", "png", "--out", "{O}"],
+    ["simulate", "--leader", "sinusoid:omega=0.5", "--duration", "12", "--followers", "1",
+     "--no-figures", "--out", "{O}"],
     ["certify", "1.2,0.5,0.6", "--out", "{O}.json"],
     ["derive", "--out", "{O}.json"],
+    ["tune", "0.9,-0.5,1.1", "--out", "{O}.csv"],
+], ids=lambda a: a[0])
+def test_every_output_creates_its_missing_folders_on_success(argv, tmp_path, capsys):
+    """One rule for files and folders (docs/conventions.md): ``--out a/b/c`` creates a/b."""
+    out = tmp_path / "a" / "b" / "c"
+    assert main([a.format(O=out) for a in argv]) in (0, 1), capsys.readouterr().err
+    made = [p for p in (out, out.with_suffix(".json"), out.with_suffix(".csv")) if p.exists()]
+    assert len(made) == 1 and any(made[0].iterdir() if made[0].is_dir() else [made[0]])
+
+
+@pytest.mark.parametrize("argv", [
+    ["region", "--fix", "k_a=0.5", "--n", "5", "--tau", "-1", "--out", "{O}"],
+    ["simulate", "--tau", "-1", "--out", "{O}"],
+    ["train", "--algo", "ddpg", "--steps", "0", "--out", "{O}"],
+    ["evaluate", "{RUN}", "--platoon", "-1", "--out", "{O}"],
+    ["compare", "{RUN}", "--baselines", "zzz", "--out", "{O}"],
+    ["hcfs", "verify", "-J", "-1", "--out", "{O}"],
+    ["hcfs", "train", "--steps", "0", "--out", "{O}"],
+    ["identify", "{LOG}", "--bootstrap", "-1", "--out", "{O}"],
+    ["sweep", "{SPEC}", "--retries", "-1", "--out", "{O}"],
+    ["demo", "--only", "certify", "--v-max", "-1", "--out", "{O}"],
+    ["tune", "0.9,-0.5,1.1", "--tau", "-1", "--report", "{O}"],
+    ["certify", "1.2,0.5,0.6", "--tau", "-1", "--out", "{O}.json"],
+    ["derive", "--sample-time", "-1", "--out", "{O}.json"],
 ], ids=lambda a: " ".join(a[:2]))
-def test_every_output_folder_needs_an_existing_parent(argv, run, tmp_path, capsys):
-    """One rule (docs/conventions.md): an output is created in an existing folder, never a tree."""
+def test_a_refused_run_creates_no_folder(argv, run, tmp_path, capsys):
+    """The missing folders of an output are created only when the run succeeds."""
     log = tmp_path / "log.csv"
     log.write_text("t,v0,v1,gap1\n0,1,1,1\n")
     spec = _spec(tmp_path / "s.toml", "probe")
     out = tmp_path / "a" / "b" / "c"
-    _refused(capsys, [a.format(O=out, RUN=run, LOG=log, SPEC=spec) for a in argv],
-             f"the folder {str(out.parent)!r} of ")
+    _refused(capsys, [a.format(O=out, RUN=run, LOG=log, SPEC=spec) for a in argv], "")
     assert not (tmp_path / "a").exists()
 
 

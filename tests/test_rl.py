@@ -300,7 +300,6 @@ def test_tampered_and_truncated_files_are_refused(tmp_path):
 # --------------------------------------------------------------------------- command line
 def test_cli_train_evaluate_compare(tmp_path, capsys):
     run = tmp_path / "runs" / "idl"
-    run.parent.mkdir()  # an output folder's parent must exist (issue 29)
     code = main(["train", "--algo", "idl", "--steps", "64", "--seed", "1", "--out", str(run),
                  "--num-envs", "4", "--no-progress"])
     assert code == 0

@@ -336,7 +336,7 @@ def check_output(args: Any) -> Path | None:
                 f"--format {args.format} writes a binary file; expected --out FILE, got none"
             )
         return None
-    return check_output_file(args.out, what="--out (expected a file path in an existing directory)")
+    return check_output_file(args.out, what="--out")
 
 
 #: The format a known ``--out`` extension names.

@@ -3,11 +3,13 @@
 Three guarantees, for every command of the toolkit:
 
 1. **Checked first.**  :func:`check_output_file` and :func:`check_output_dir` (and
-   :class:`OutputDir`, which calls the latter) refuse, with one sentence, an output path whose
-   folder does not exist, a folder where a file is wanted and the reverse, and a place where
-   nothing can be written — *before* any computation, so a long run never ends in a traceback.
-   Writability is probed by creating (and removing) a temporary file, which is the only test that
-   is right for root, ACLs and read-only file systems alike.
+   :class:`OutputDir`, which calls the latter) refuse, with one sentence, a folder where a file
+   is wanted and the reverse, a path through a file, and a place where nothing can be written —
+   *before* any computation, so a long run never ends in a traceback.  One rule for files and
+   folders alike: the missing folders on an output's path are created when the run succeeds
+   (never when it fails).  Writability is probed by creating (and removing) a temporary file in
+   the nearest existing folder, which is the only test that is right for root, ACLs and read-only
+   file systems alike.
 2. **Complete or absent.**  Files are written to a temporary name in the same folder and renamed
    into place (``os.replace``, atomic on POSIX), so a reader never sees half a file.
 3. **One run per folder.**  An :class:`OutputDir` writes every file of a run into a staging folder
@@ -76,9 +78,10 @@ def _probe_writable(folder: Path, what: str) -> None:
 def check_output_file(path: str | os.PathLike[str], *, what: str = "output file") -> Path:
     """Check that a file can be written at ``path``, before any work is done.
 
-    The parent folder must exist (it is not created: a mistyped folder name should be an error,
-    not a new folder) and be writable; ``path`` itself must not be a folder. Writability is
-    probed by creating and removing a temporary file in the parent folder.
+    ``path`` must not be a folder, and the nearest existing folder on its path must be writable
+    (probed by creating and removing a temporary file there).  Nothing is created: the missing
+    folders are created when the file is written (:func:`atomic_path`), as an output folder's
+    are (:func:`check_output_dir`): one rule for every command.
 
     Parameters
     ----------
@@ -99,36 +102,36 @@ def check_output_file(path: str | os.PathLike[str], *, what: str = "output file"
 
     Examples
     --------
-    >>> check_output_file("/nonexistent-folder/x.json")
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "a-file"
+    >>> _ = f.write_text("x")
+    >>> check_output_file(f / "x.json")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    stringstab.errors.StringStabError: output file: the folder '/nonexistent-folder' of '/nonexistent-folder/x.json' does not exist; create it first or choose another path
+    stringstab.errors.StringStabError: output file: '...a-file' in '...a-file/x.json' is a file, not a folder
     """
     p = Path(path)
     if str(path) == "" or p.name in ("", ".", ".."):
         raise StringStabError(f"{what}: expected a file name; got {str(path)!r}")
     if p.is_dir():
         raise StringStabError(f"{what}: expected a file; {str(p)!r} is a folder")
-    parent = p.parent
-    if not parent.exists():
-        raise StringStabError(
-            f"{what}: the folder {str(parent)!r} of {str(p)!r} does not exist; "
-            "create it first or choose another path"
-        )
-    if not parent.is_dir():
-        raise StringStabError(f"{what}: {str(parent)!r} in {str(p)!r} is a file, not a folder")
+    probe = p.parent
+    while not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise StringStabError(f"{what}: {str(probe)!r} in {str(p)!r} is a file, not a folder")
     if p.exists() and not p.is_file():
         raise StringStabError(f"{what}: expected a regular file; {str(p)!r} is something else")
-    _probe_writable(parent, what)
+    _probe_writable(probe, what)
     return p
 
 
 def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Path:
-    """Check that a folder can be written (or created in its existing parent) at ``path``.
+    """Check that a folder can be written (or created, with its parents) at ``path``.
 
-    Nothing is created, and the folder's parent must exist, as an output file's folder must
-    (:func:`check_output_file`): a mistyped path is an error, not a tree of new folders.  The
-    folder (or its parent) must be writable (probed with a temporary file, removed at once).
+    Nothing is created: the nearest existing ancestor must be a writable folder (probed with a
+    temporary file, removed at once).  The missing folders are created when the run succeeds,
+    as an output file's are (:func:`check_output_file`): one rule for every command.
 
     Parameters
     ----------
@@ -145,8 +148,7 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
     Raises
     ------
     StringStabError
-        When ``path`` (or an ancestor) is a file, its parent folder does not exist, or nothing
-        can be written there.
+        When ``path`` (or an ancestor) is a file, or nothing can be written there.
 
     Examples
     --------
@@ -157,10 +159,6 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
     Traceback (most recent call last):
     ...
     stringstab.errors.StringStabError: output folder: expected a folder; '...a-file' is a file
-    >>> check_output_dir("/nonexistent-folder/run")
-    Traceback (most recent call last):
-    ...
-    stringstab.errors.StringStabError: output folder: the folder '/nonexistent-folder' of '/nonexistent-folder/run' does not exist; create it first or choose another path
     """
     p = Path(path)
     if str(path) == "":
@@ -174,9 +172,6 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
         probe = probe.parent
     if probe.exists() and not probe.is_dir():
         raise StringStabError(f"{what}: {str(probe)!r} in {str(p)!r} is a file, not a folder")
-    if not p.exists() and not p.parent.exists():
-        raise StringStabError(f"{what}: the folder {str(p.parent)!r} of {str(p)!r} does not exist; "
-                              "create it first or choose another path")
     _probe_writable(probe, what)
     return p
 
@@ -192,7 +187,8 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
     Parameters
     ----------
     path : str or path-like
-        The final file; its folder must exist (the temporary file is created there).
+        The final file; its missing folders are created (the temporary file is created there)
+        and removed again if the block fails.
     what : str, default "output file"
         What the file is, as the first words of an error message.
 
@@ -217,9 +213,12 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
     [0, 1, 2]
     """
     p = Path(path)
+    created = [q for q in p.parents if not q.exists()]
     try:
+        p.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=f".tmp{p.suffix}", dir=p.parent)
     except OSError as e:
+        _remove_empty(created)
         raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
     os.close(fd)
     tmp_path = Path(tmp)
@@ -229,10 +228,19 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
         os.replace(tmp_path, p)
     except OSError as e:
         tmp_path.unlink(missing_ok=True)
+        _remove_empty(created)
         raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
     except BaseException:
         tmp_path.unlink(missing_ok=True)
+        _remove_empty(created)
         raise
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove the folders a failed write created (deepest first; only if still empty)."""
+    for q in folders:  # Path.parents order: deepest first
+        with contextlib.suppress(OSError):
+            q.rmdir()
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str = "output file") -> Path:
@@ -358,7 +366,7 @@ class OutputDir:
     Parameters
     ----------
     path : path-like
-        The output folder (created in its existing parent when the run succeeds).
+        The output folder (created, with its parents, when the run succeeds).
     command : str
         Who writes it (e.g. ``"region"``); a folder whose manifest names another command is
         refused, so two different runs are never mixed in one folder.
@@ -412,8 +420,8 @@ class OutputDir:
     # -- context ------------------------------------------------------------------------------
     def __enter__(self) -> OutputDir:
         try:
-            self._created = [self.root] if not self.root.exists() else []
-            self.root.mkdir(exist_ok=True)  # its parent exists (check_output_dir)
+            self._created = [q for q in (self.root, *self.root.parents) if not q.exists()]
+            self.root.mkdir(parents=True, exist_ok=True)
             self._staging = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=self.root))
         except OSError as e:
             raise StringStabError(

@@ -178,7 +178,6 @@ def _train(s: dict[str, Any], folder: Path) -> tuple[dict[str, Any], dict[str, P
     from ..rl.evaluate import evaluate
 
     cfg = config_from_dict({k: v for k, v in s.items() if k != "paper"}, source="sweep point")
-    folder.mkdir(parents=True, exist_ok=True)  # the point's own folder, inside the sweep's
     run = folder / "run"
     resume = (run / "run.json").is_file() and (run / "checkpoint" / "latest.json").is_file()
     if run.exists() and not resume:  # an attempt killed before its first checkpoint
