@@ -136,6 +136,24 @@ class _Alarm:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+def _warm_imports() -> None:
+    """Import the heavy libraries once, before any alarm can fire.
+
+    Every example runs in this one process: a Ctrl-C landing inside a first ``import torch``
+    (several seconds under load) leaves half-imported submodules behind, which breaks every later
+    import of torch in the process — an artefact of reusing the process, not of the command
+    (run as ``stringstab``, an interrupted import ends the process with exit 130).
+    """
+    import importlib
+
+    for name in ("torch", "matplotlib.pyplot", "gymnasium", "sympy", "scipy.signal", "casadi",
+                 "distributed", "pyarrow.parquet", "control"):
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            pass
+
+
 def _staging_left(root: Path) -> list[Path]:
     return [p for p in root.rglob(".stringstab-staging-*")]
 
@@ -148,6 +166,7 @@ def test_random_command_lines_fail_as_one_sentence(argv, payload, tmp_path_facto
                                                     monkeypatch):
     from stringstab.cli import main
 
+    _warm_imports()  # (cached by Python after the first example)
     root = tmp_path_factory.mktemp("fuzz")
     monkeypatch.chdir(root)  # defaults such as demo's ./demo-out land here
     (root / "in").mkdir()

@@ -44,6 +44,32 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _check_reference(reference: str | None, runs: list[str], baselines: list[str]) -> None:
+    """Refuse a ``--reference`` that is none of the strategies, from the runs' ``run.json``.
+
+    Reading ``run.json`` costs milliseconds (loading a policy imports torch), so a typo is
+    refused at once; a run folder whose ``run.json`` cannot be read is left to
+    :func:`stringstab.rl.runs.open_run`, which says what is wrong with it.
+    """
+    from pathlib import Path
+
+    from ..rl.checkpoint import read_json
+    from ..rl.train import RUN_FORMAT
+
+    if reference is None:
+        return
+    algos = set()
+    for r in runs:
+        try:
+            algos.add(str(read_json(Path(r) / "run.json", fmt=RUN_FORMAT, what="run folder")["algo"]))
+        except (StringStabError, KeyError):
+            return
+    strategies = sorted(algos | set(baselines))
+    if reference not in strategies:
+        raise StringStabError(f"--reference {reference!r} is not among the strategies {strategies}; "
+                              "expected the --algo of a RUN or a baseline of --baselines")
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``.
 
@@ -72,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
     bad = [b for b in base if b not in BASELINES]
     if bad:
         raise StringStabError(f"--baselines: expected names among {', '.join(BASELINES)}; got {bad}")
+    _check_reference(args.reference, args.runs, base)  # at once: before loading any policy
     opened = [open_run(r) for r in args.runs]
     params = {(p.info["tau"], p.info["delta"], p.info["headway"], p.info["dt"]) for _, p in opened}
     if len(params) != 1:
@@ -79,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     tau, delta, headway, dt = params.pop()
     strategies = sorted({pol.algo for _, pol in opened} | set(base))
     ref = args.reference or ("idl" if "idl" in strategies else None)
-    if ref is not None and ref not in strategies:  # refused before any evaluation
+    if ref is not None and ref not in strategies:  # (a run.json that lied about its algo)
         raise StringStabError(f"--reference {ref!r} is not among the strategies {strategies}; "
                               "expected the --algo of a RUN or a baseline of --baselines")
     leaders, desc = test_leaders(args.leaders, dt=dt)

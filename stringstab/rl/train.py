@@ -432,6 +432,7 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
     else:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
+    interrupt.hold()  # the last outputs: a further Ctrl-C would leave a folder without its summary
     meter.close()
     seconds = time.perf_counter() - t_start
     rep_s = (float(repair.stats["seconds"]) - rep0) if repair is not None else 0.0
@@ -448,7 +449,11 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
 
 
 class _StepInterrupt:
-    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only."""
+    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only.
+
+    Once the loop is over (:meth:`hold`), every Ctrl-C is recorded: the final checkpoint, log
+    and summary are written whole, so an interrupted run's folder is always resumable.
+    """
 
     def __init__(self, active: bool = True) -> None:
         import signal
@@ -464,6 +469,16 @@ class _StepInterrupt:
 
         self.caught = True
         signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    def _record(self, signum: int, frame: Any) -> None:
+        self.caught = True
+
+    def hold(self) -> None:
+        """From now on record every Ctrl-C (the last checkpoint, log and summary take a moment)."""
+        import signal
+
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._record)
 
     def restore(self) -> None:
         import signal
