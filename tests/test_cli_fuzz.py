@@ -146,8 +146,9 @@ def _warm_imports() -> None:
     """
     import importlib
 
-    for name in ("torch", "matplotlib.pyplot", "gymnasium", "sympy", "scipy.signal", "casadi",
-                 "distributed", "pyarrow.parquet", "control"):
+    for name in ("torch", "torch._dynamo", "torch.optim", "safetensors.numpy", "matplotlib.pyplot",
+                 "gymnasium", "sympy", "scipy.signal", "casadi", "distributed", "pyarrow.parquet",
+                 "control"):
         try:
             importlib.import_module(name)
         except ImportError:
