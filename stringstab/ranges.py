@@ -14,7 +14,9 @@ gain k         \|k\| <= 10        \|k\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s
 τ              (0, 2] s          > 100 s       actuator lags are 0.1-1 s
 δ              [0, 2] s          > 100 s       V2V delays are 0.01-0.5 s
 T*             [0, 5] s          > 100 s       time headways are 0.3-3 s
-H              (0, 1] s          > 100 s       control periods are 0.01-0.2 s
+H              [1e-3, 1] s       < 1e-4 s,     control periods are 0.01-0.2 s; the sampled
+                                 > 100 s       loop's order grows as δ/H (H = 1e-300 s
+                                               divided by zero, 1e-8 s ran for ever)
 duration       <= 1 day          > 1 year      a run, an episode, a cycle
 jerk limit J   <= 30 m/s³        > 1e6 m/s³    HCFS: 2 a_max / T = 30 m/s³ is what the
                                                ±3 m/s² bounds alone guarantee at T = 0.2 s
@@ -37,8 +39,8 @@ from typing import Any
 
 from .errors import StringStabError
 
-__all__ = ["COUNTS", "LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "MIN_LEADER_SECONDS", "RANGES",
-           "check_count", "check_magnitude", "count_warning", "sensible_warning"]
+__all__ = ["COUNTS", "FLOORS", "LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "MIN_LEADER_SECONDS",
+           "RANGES", "check_count", "check_magnitude", "count_warning", "sensible_warning"]
 
 #: A leader (or a speed limit) faster than this, m/s (252 km/h), is no road vehicle: refused.
 LEADER_SPEED_ABSURD = 70.0
@@ -61,6 +63,11 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "ttc": (10.0, 3600.0, " s", "TTC* threshold"),
     "weight": (1000.0, 1e6, "", "weight"),
     "margin": (1.0, 1e6, "", "margin"),
+}
+
+#: name -> (sensible lower bound, refused below): the magnitudes that also have a floor.
+FLOORS: dict[str, tuple[float, float]] = {
+    "sample_time": (1e-3, 1e-4),
 }
 
 #: name -> (sensible upper bound, largest accepted, what is counted, why the largest)
@@ -118,6 +125,10 @@ def check_magnitude(kind: str, value: Any, *, name: str | None = None) -> float:
         raise StringStabError(
             f"{name or what} = {x:g}{unit} is far outside the physically meaningful range "
             f"(sensible: {_range(kind)}; refused above {absurd:g}{unit})")
+    if kind in FLOORS and 0 < abs(x) < FLOORS[kind][1]:
+        raise StringStabError(
+            f"{name or what} = {x:g}{unit} is far outside the physically meaningful range "
+            f"(sensible: {_range(kind)}; refused below {FLOORS[kind][1]:g}{unit})")
     return x
 
 
@@ -148,7 +159,8 @@ def sensible_warning(kind: str, value: Any, *, name: str | None = None) -> str |
     """
     sensible, _, unit, what = RANGES[kind]
     x = float(value)
-    if not math.isfinite(x) or abs(x) <= sensible:
+    low = FLOORS.get(kind, (0.0, 0.0))[0]
+    if not math.isfinite(x) or low <= abs(x) <= sensible or x == 0:
         return None
     extra = "; the IDL paper uses [-2, 2]" if kind == "gain" else ""
     return (f"{name or what} = {x:g}{unit} is outside the sensible range ({_range(kind)}{extra}); "
@@ -224,4 +236,6 @@ def count_warning(kind: str, value: int, *, name: str) -> str | None:
 
 def _range(kind: str) -> str:
     sensible, _, unit, _ = RANGES[kind]
+    if kind in FLOORS:
+        return f"{FLOORS[kind][0]:g} to {sensible:g}{unit}"
     return f"|k| up to {sensible:g}" if kind == "gain" else f"up to {sensible:g}{unit}"

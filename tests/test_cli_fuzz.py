@@ -379,17 +379,18 @@ FLOATS = ["nan", "inf", "-1", "1e300"]
 INTS = ["nan", "inf", "-1", HUGE_INT]
 GAINS = ["nan,0.5,0.6", "inf,0.5,0.6", "1e300,0.5,0.6"]  # a negative gain is valid
 A_MIN = ["nan", "-inf", "1", "-1e300"]  # a braking limit is negative
+SAMPLE = [*FLOATS, "1e-300"]  # a sample time also has a floor (1e-300 divided by zero)
 #: Every numeric flag of every command (sumo's own are listed in SUMO_NUMERIC) and its bad values.
 NUMERIC = {
-    "derive": {"--delay-order": INTS, "--sample-time": FLOATS,
+    "derive": {"--delay-order": INTS, "--sample-time": SAMPLE,
                "--substitute": [f"tau={v}" for v in FLOATS]},
     "certify": {"K_X,K_V,K_A": GAINS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
-                "--sample-time": FLOATS, "--pade-order": INTS},
+                "--sample-time": SAMPLE, "--pade-order": INTS},
     "region": {"--fix": ["k_a=nan", "k_a=inf", "k_a=1e300"], "--range": ["nan,2", "-inf,2", "-1e300,2"],
                "--n": INTS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
-               "--sample-time": FLOATS, "--dpi": INTS, "--workers": INTS},
+               "--sample-time": SAMPLE, "--dpi": INTS, "--workers": INTS},
     "tune": {"K_X,K_V,K_A": GAINS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
-             "--sample-time": FLOATS, "--bounds": ["nan,2", "-inf,2", "-1e300,2"],
+             "--sample-time": SAMPLE, "--bounds": ["nan,2", "-inf,2", "-1e300,2"],
              "--weights": [f"{v},1,1" for v in FLOATS], "--r0": FLOATS, "--grid": INTS,
              "--max-iter": INTS, "--hurwitz-margin": FLOATS, "--eps": FLOATS},
     "simulate": {"--followers": INTS, "--gains": GAINS, "--vehicle": INTS, "--tau": FLOATS,
@@ -405,7 +406,7 @@ NUMERIC = {
                     "--a-max": FLOATS},
     "hcfs train": {"--steps": INTS, "--seed": INTS, "--platoons": INTS, "--followers": INTS,
                    "--episode-seconds": FLOATS},
-    "identify": {"--sample-time": FLOATS, "--bootstrap": INTS, "--block": FLOATS, "--starts": INTS,
+    "identify": {"--sample-time": SAMPLE, "--bootstrap": INTS, "--block": FLOATS, "--starts": INTS,
                  "--seed": INTS, "--min-segment": FLOATS},
     "sweep": {"--workers": INTS, "--retries": INTS},
     "demo": {"--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS},
