@@ -29,6 +29,10 @@ def _one_line(capsys, argv, code, starts, match=""):
     (["certify", "1,1,1", "--tau", "1e300"], "actuator lag tau = 1e+300 s is far outside"),
     (["certify", "1,1,1", "--tau", "0.1:1e200"], "actuator lag tau = 1e+200 s"),
     (["certify", "1,1,1", "--sample-time", "1e6"], "--sample-time = 1e+06 s is far outside"),
+    (["certify", "1.2,0.5,0.6", "--sample-time", "1e-300"],
+     "--sample-time = 1e-300 s is far outside the physically meaningful range (sensible: 0.001 to "
+     "1 s; refused below 0.0001 s)"),
+    (["tune", "0.9,-0.5,1.1", "--sample-time", "5e-5"], "--sample-time = 5e-05 s is far outside"),
     (["certify", "1,1,1", "--delta", "1e5"], "communication delay delta = 100000 s"),
     (["tune", "7,1,1", "--method", "both"], "expected K0 within [-6, 6]"),
     (["tune", "0.9,-0.5,1.1", "--bounds", "-1e308,1e308"], "--bounds = -1e+308 is far outside"),
@@ -67,6 +71,28 @@ def test_sensible_range_warnings(capsys):
     err = capsys.readouterr().err
     assert rc in (0, 1)
     assert "stringstab certify: warning: --tau = 3 s is outside the sensible range (up to 2 s)" in err
+
+
+def test_a_sample_time_between_the_floors_is_warned_and_certified(capsys):
+    """1e-4 <= H < 1e-3 s runs (the certificate answers) with a warning naming the range."""
+    rc = main(["certify", "1.2,0.5,0.6", "--sample-time", "5e-4", "--format", "json"])
+    out, err = capsys.readouterr()
+    assert rc in (0, 1) and '"verdict"' in out
+    assert ("stringstab certify: warning: --sample-time = 0.0005 s is outside the sensible range "
+            "(0.001 to 1 s)") in err
+
+
+@pytest.mark.parametrize("value", [1e-300, 1e-8, 9.9e-5])
+def test_the_library_refuses_a_sample_time_below_the_floor(value):
+    """The library's way in holds the same floor as the command line (1e-300 divided by zero)."""
+    from stringstab.certify.api import Loop
+    from stringstab.params import sample_time
+
+    with pytest.raises(StringStabError, match="refused below 0.0001 s"):
+        sample_time(value)
+    with pytest.raises(StringStabError, match="refused below 0.0001 s"):
+        Loop.of(0.1, 0.2, 1.1, sample_time=value)
+    assert sample_time(1e-4) == 1e-4
 
 
 def test_region_grid_too_big_is_refused_with_the_estimate(capsys, tmp_path):
