@@ -31,13 +31,22 @@ satisfies |m| ≤ 1e-6 (m → Ψ3/k_x² as ω → 0, where |Γ| → 1; the plain
     ``--n-robust-sampled`` triples (it is the slow one), sampled at Δt = 0.1 s with
     heterogeneous lags; each as ms per triple and as the ratio to (a), with the verdict counts.
 
-(a) and (d) are timed as the best of ``--repeat`` full runs (each takes about a second, so one
+(e) the reaction delay θ_r (issue 25), in the same run, on the same triples: ``certify_batch``
+    and ``check`` with ``reaction_delay`` = 0.1, 0.2, 0.5 s (the quasi-polynomial certificate,
+    :mod:`stringstab.certify.reaction`) as ratios to (a) and to the θ_r = 0 ``check`` (target:
+    ≤ 10×), and ``reaction_delay=0.0`` (today's code path) as a ratio to (a) (target: 1×).
+    ``--compare-with DIR`` also times (a) of another checkout (e.g. ``/work/main``) in fresh
+    processes alternated with this one's, the same triples, medians compared: the θ_r = 0 path's
+    cost against the code before θ_r existed.
+
+(a), (d) and (e) are timed as the best of ``--repeat`` full runs (each takes about a second, so one
 run is at the mercy of other load); (b) once, over all its triples.  The machine load
 (``os.getloadavg()``) is printed before and after.  Prints its figures; asserts nothing about
 time.  Examples::
 
     python analysis/bench_certify.py --n 10000 --seed 0 --pade-subset 1000
     python analysis/bench_certify.py --n 5000 --parts a,d        # the loops only, a minute
+    python analysis/bench_certify.py --n 20000 --parts a,e --compare-with /work/main   # θ_r
 """
 
 from __future__ import annotations
@@ -160,6 +169,67 @@ def other_loops(K, prm, ta, repeat, n_robust_sampled):
         print(f"| {name} ({n} triples) | {t * 1e3:.4f} | {t / ta:.2f} | {counts} |")
 
 
+#: θ_r values of (e), s.
+THETAS = (0.1, 0.2, 0.5)
+
+
+def reaction_part(K, prm, ta, repeat):
+    """(e): the certificate with a reaction delay, per triple, as ratios to θ_r = 0."""
+    # the baseline again, warmed up like the others (the first runs of (a) pay for caches)
+    ta = min(ta, best_of(lambda: certify_batch(*K.T, **prm), repeat) / len(K))
+    tc = best_of(lambda: check(*K.T, **prm), repeat) / len(K)
+    print(f"\n(e) the reaction delay θ_r on the same triples ({os.getloadavg()[0]:.2f} load): "
+          f"µs per triple, best of {repeat}")
+    print("| θ_r (s) | certify_batch µs | ratio to (a) | check µs | ratio to θ_r = 0 check "
+          "| certified | not_certified | inconclusive |")
+    print("|---|---|---|---|---|---|---|---|")
+    print(f"| 0 (a, baseline) | {ta * 1e6:.1f} | 1.00 | {tc * 1e6:.1f} | 1.00 | | | |")
+    t0 = best_of(lambda: certify_batch(*K.T, **prm, reaction_delay=0.0), repeat) / len(K)
+    print(f"| 0.0 given (today's path) | {t0 * 1e6:.1f} | {t0 / ta:.2f} | | | | | |")
+    for th in THETAS:
+        tb = best_of(lambda th=th: certify_batch(*K.T, **prm, reaction_delay=th), repeat) / len(K)
+        tk = best_of(lambda th=th: check(*K.T, **prm, reaction_delay=th), repeat) / len(K)
+        v = certify_batch(*K.T, **prm, reaction_delay=th).verdict
+        counts = " | ".join(str(int(np.count_nonzero(v == x)))
+                            for x in ("certified", "not_certified", "inconclusive"))
+        print(f"| {th:g} | {tb * 1e6:.1f} | {tb / ta:.2f} | {tk * 1e6:.1f} | {tc and tk / tc:.2f} "
+              f"| {counts} |")
+
+
+_TIME_A = """
+import sys, time, numpy as np
+sys.path.insert(0, {src!r})
+from stringstab.certify.api import certify_batch
+K = np.random.default_rng({seed}).uniform(-2.0, 2.0, size=({n}, 3))
+certify_batch([1.0], [1.0], [0.0], **{prm!r})
+best = float("inf")
+for _ in range({repeat}):
+    t0 = time.perf_counter(); certify_batch(*K.T, **{prm!r}); best = min(best, time.perf_counter() - t0)
+print(best / {n})
+"""
+
+
+def compare_part(other: str, args, prm) -> None:
+    """(e): (a) of this checkout and of ``other``, in fresh processes, alternated."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    here = str(Path(__file__).resolve().parents[1])
+    runs: dict[str, list[float]] = {here: [], other: []}
+    for _ in range(5):
+        for src in (other, here):
+            code = _TIME_A.format(src=src, seed=args.seed, n=args.n, prm=prm, repeat=args.repeat)
+            out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                 check=True)
+            runs[src].append(float(out.stdout.strip().splitlines()[-1]))
+    a, b = np.median(runs[here]), np.median(runs[other])
+    print(f"\n(e) θ_r = 0 path against {other} ({os.getloadavg()[0]:.2f} load), certify_batch on "
+          f"the same {args.n} triples, 5 alternated fresh processes, medians: this checkout "
+          f"{a * 1e6:.1f} µs/triple, {other} {b * 1e6:.1f} µs/triple, ratio {a / b:.3f} "
+          f"(per run: {', '.join(f'{x / y:.2f}' for x, y in zip(runs[here], runs[other]))})")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=10_000, help="number of random triples (default 10^4)")
@@ -175,8 +245,11 @@ def main(argv=None):
     ap.add_argument("--tau", type=float, default=DEFAULT_TAU)
     ap.add_argument("--delta", type=float, default=DEFAULT_DELTA)
     ap.add_argument("--headway", type=float, default=DEFAULT_HEADWAY)
-    ap.add_argument("--parts", default="a,b,c,d",
-                    help="which of (a), (b), (c), (d) to run, e.g. a,d (default: all; (a) always)")
+    ap.add_argument("--parts", default="a,b,c,d,e",
+                    help="which of (a)-(e) to run, e.g. a,d (default: all; (a) always)")
+    ap.add_argument("--compare-with", metavar="DIR",
+                    help="(e): also time (a) of the checkout DIR (e.g. /work/main) in alternated "
+                         "fresh processes")
     ap.add_argument("--n-robust-sampled", type=int, default=500,
                     help="triples for the robust sampled certificate in (d) (default 500)")
     args = ap.parse_args(argv)
@@ -205,6 +278,10 @@ def main(argv=None):
 
     if "d" in parts:
         other_loops(K, prm, ta, args.repeat, args.n_robust_sampled)
+    if "e" in parts:
+        reaction_part(K, prm, ta, args.repeat)
+        if args.compare_with:
+            compare_part(args.compare_with, args, prm)
     if "b" in parts:
         pade_part(K, b, ta, args, rng)
     if "c" in parts:

@@ -1,6 +1,6 @@
 """Benchmark of ``stringstab identify``: identification time per vehicle-hour of data.
 
-For each follower of a log (the shared OpenACC ACC file when present, else a simulated 10-min
+For each follower of a log (the OpenACC ACC log shipped in stringstab/data/openacc, else a simulated 10-min
 platoon of 5 followers), measured in the same run:
 
 * **baseline** — one closed-loop simulation of the same data by the toolkit's simulator:
@@ -38,13 +38,11 @@ from stringstab.identify import (
 )
 from stringstab.identify.closed_loop import FollowerModel
 from stringstab.identify.core import block_counts
+from stringstab.identify.logs import example_log
 from stringstab.traffic import LinearController, from_speed, simulate
 
-#: ../shared/data/openacc beside the repository (or two levels up from a worktree /work/wt/NAME)
-SHARED = next((p for p in (Path(__file__).resolve().parents[k].parent / "shared/data/openacc/"
-                           "zalazone_acc_short_dynamic_part1.csv" for k in (1, 2)) if p.is_file()),
-              Path(__file__).resolve().parents[1].parent / "shared/data/openacc/"
-              "zalazone_acc_short_dynamic_part1.csv")
+#: The OpenACC ACC log shipped with the package (stringstab/data/openacc/README.md)
+SHARED = example_log("acc")
 
 
 def _log(path: Path | None):
@@ -72,7 +70,7 @@ def _best(repeat: int, fn, *args, **kwargs) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--log", type=Path, default=SHARED, help="the log (default: the shared ACC file)")
+    ap.add_argument("--log", type=Path, default=SHARED, help="the log (default: the shipped OpenACC ACC log)")
     ap.add_argument("--starts", type=int, default=4)
     ap.add_argument("--bootstrap", type=int, default=10)
     ap.add_argument("--repeat", type=int, default=3, help="best of N for the single simulations")

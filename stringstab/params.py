@@ -7,7 +7,10 @@ The three parameters of the IDL paper's vehicle model (eqs 3-9):
 ``delta``
     communication delay δ in seconds on the predecessor's acceleration, ≥ 0 (eq 4);
 ``headway``
-    desired time headway T* in seconds, ≥ 0 (eq 3).
+    desired time headway T* in seconds, ≥ 0 (eq 3);
+``reaction_delay``
+    reaction (actuation) delay θ_r in seconds, ≥ 0, on the whole command (issue 25:
+    τ a' = u(t − θ_r) − a); 0 by default, today's model, and then left out of every output.
 
 Each may also be uncertain: an interval ``(lo, hi)`` (or ``"LO:HI"`` on the command line),
 and the three intervals form a :class:`Box` (the robust certificate,
@@ -43,6 +46,7 @@ __all__ = [
     "as_interval",
     "check_box",
     "check_params",
+    "check_reaction_delay",
     "count",
     "parameter_model",
     "parse_interval",
@@ -60,12 +64,17 @@ Interval = tuple[float, float]
 
 @dataclass(frozen=True)
 class Params:
-    """Model parameters τ, δ, T* (IDL paper eqs 3-9), validated on construction.
+    """Model parameters τ, δ, T* (IDL paper eqs 3-9) and θ_r (issue 25), validated on construction.
+
+    ``reaction_delay`` (θ_r) is left out of the repr and of :meth:`as_dict` when it is 0, so
+    every output of a θ_r = 0 model is what it was before θ_r existed.
 
     Examples
     --------
     >>> Params(tau=0.1, delta=0.2, headway=1.1)
     Params(tau=0.1, delta=0.2, headway=1.1)
+    >>> Params(tau=0.1, delta=0.2, headway=1.1, reaction_delay=0.3)
+    Params(tau=0.1, delta=0.2, headway=1.1, reaction_delay=0.3)
     >>> Params(tau=-0.1, delta=0.2, headway=1.1)
     Traceback (most recent call last):
     ...
@@ -75,16 +84,25 @@ class Params:
     tau: float = DEFAULT_TAU
     delta: float = DEFAULT_DELTA
     headway: float = DEFAULT_HEADWAY
+    reaction_delay: float = 0.0
 
     def __post_init__(self) -> None:
         # checked once, here, and kept as the floats checked (so Params("0.1", ...) holds 0.1)
         for name, value in zip(("tau", "delta", "headway"),
                                check_params(self.tau, self.delta, self.headway)):
             object.__setattr__(self, name, value)
+        object.__setattr__(self, "reaction_delay", check_reaction_delay(self.reaction_delay))
+
+    def __repr__(self) -> str:
+        extra = f", reaction_delay={self.reaction_delay!r}" if self.reaction_delay else ""
+        return f"Params(tau={self.tau!r}, delta={self.delta!r}, headway={self.headway!r}{extra})"
 
     def as_dict(self) -> dict[str, float]:
-        """The parameters as a plain dict (for JSON and file metadata)."""
-        return {"tau": float(self.tau), "delta": float(self.delta), "headway": float(self.headway)}
+        """The parameters as a plain dict (for JSON and file metadata); θ_r only when > 0."""
+        out = {"tau": float(self.tau), "delta": float(self.delta), "headway": float(self.headway)}
+        if self.reaction_delay:
+            out["reaction_delay"] = float(self.reaction_delay)
+        return out
 
 
 def positive(name: str, value: Any, *, allow_zero: bool = False, unit: str = "") -> float:
@@ -217,6 +235,42 @@ def check_params(tau: Any, delta: Any, headway: Any) -> tuple[float, float, floa
     for kind, x in (("tau", t), ("delta", d), ("headway", h)):
         check_magnitude(kind, x)
     return t, d, h
+
+
+def check_reaction_delay(value: Any, name: str = "reaction_delay (reaction delay θ_r)") -> float:
+    """The reaction (actuation) delay θ_r as a float: finite, ≥ 0 s and ≤ 100 s.
+
+    The one check of θ_r (issue 25), behind :class:`Params` and :class:`Box`; the bound is
+    :data:`stringstab.ranges.RANGES` ``["reaction_delay"]``.
+
+    Parameters
+    ----------
+    value : object
+        θ_r in s (anything ``float()`` accepts).
+    name : str
+        What the value is called in the message.
+
+    Returns
+    -------
+    float
+        θ_r.
+
+    Raises
+    ------
+    StringStabError
+        Saying what was expected and what was found.
+
+    Examples
+    --------
+    >>> check_reaction_delay("0.2")
+    0.2
+    >>> check_reaction_delay(-0.1)
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: reaction_delay (reaction delay θ_r) must be a finite number >= 0 s; got -0.1
+    """
+    return check_magnitude("reaction_delay", positive(name, value, allow_zero=True, unit=" s"),
+                           name=name)
 
 
 def as_gains(
@@ -389,6 +443,9 @@ def as_interval(value: Any, name: str = "value") -> Interval:
 class Box:
     """A box of model parameters, each a ``(lo, hi)`` interval in seconds.
 
+    ``reaction_delay`` (θ_r, issue 25) is (0, 0) by default and then left out of the repr and
+    of :meth:`as_dict`.
+
     Examples
     --------
     >>> Box((0.1, 0.5), (0.2, 0.2), (1.1, 1.1)).is_point
@@ -402,11 +459,13 @@ class Box:
     tau: Interval
     delta: Interval
     headway: Interval
+    reaction_delay: Interval = (0.0, 0.0)
 
     def __post_init__(self) -> None:
         for name, (lo, hi) in (("tau (actuator lag)", self.tau),
                                ("delta (communication delay)", self.delta),
-                               ("headway (desired time headway T*)", self.headway)):
+                               ("headway (desired time headway T*)", self.headway),
+                               ("reaction_delay (reaction delay θ_r)", self.reaction_delay)):
             if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
                 raise StringStabError(f"{name} interval must be finite with lo <= hi; got [{lo}, {hi}]")
         if not self.tau[0] > 0:
@@ -419,13 +478,24 @@ class Box:
             raise StringStabError(
                 f"headway (desired time headway T*) interval must be >= 0 s; "
                 f"got [{self.headway[0]}, {self.headway[1]}]")
-        for kind, (_, hi) in (("tau", self.tau), ("delta", self.delta), ("headway", self.headway)):
+        if self.reaction_delay[0] < 0:
+            raise StringStabError(
+                f"reaction_delay (reaction delay θ_r) interval must be >= 0 s; "
+                f"got [{self.reaction_delay[0]}, {self.reaction_delay[1]}]")
+        for kind, (_, hi) in (("tau", self.tau), ("delta", self.delta), ("headway", self.headway),
+                              ("reaction_delay", self.reaction_delay)):
             check_magnitude(kind, hi)
+
+    def __repr__(self) -> str:
+        extra = (f", reaction_delay={self.reaction_delay!r}"
+                 if self.reaction_delay != (0.0, 0.0) else "")
+        return f"Box(tau={self.tau!r}, delta={self.delta!r}, headway={self.headway!r}{extra})"
 
     @property
     def is_point(self) -> bool:
         """Every interval is a single value."""
-        return all(lo == hi for lo, hi in (self.tau, self.delta, self.headway))
+        return all(lo == hi for lo, hi in (self.tau, self.delta, self.headway,
+                                           self.reaction_delay))
 
     def centre(self) -> Params:
         """The member at the box's centre: each parameter at the middle of its interval.
@@ -433,14 +503,21 @@ class Box:
         Returns
         -------
         Params
-            τ, δ, T* at (lo + hi)/2 (the point itself for a point box).
+            τ, δ, T* (and θ_r) at (lo + hi)/2 (the point itself for a point box).
         """
         (t0, t1), (d0, d1), (h0, h1) = self.tau, self.delta, self.headway
-        return Params(0.5 * (t0 + t1), 0.5 * (d0 + d1), 0.5 * (h0 + h1))
+        r0, r1 = self.reaction_delay
+        return Params(0.5 * (t0 + t1), 0.5 * (d0 + d1), 0.5 * (h0 + h1), 0.5 * (r0 + r1))
 
     def as_dict(self) -> dict[str, list[float]]:
-        """``{"tau": [lo, hi], "delta": [lo, hi], "headway": [lo, hi]}`` (for JSON)."""
-        return {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}
+        """``{"tau": [lo, hi], "delta": [lo, hi], "headway": [lo, hi]}`` (for JSON).
+
+        With ``"reaction_delay": [lo, hi]`` too when θ_r is not (0, 0).
+        """
+        out = {"tau": list(self.tau), "delta": list(self.delta), "headway": list(self.headway)}
+        if self.reaction_delay != (0.0, 0.0):
+            out["reaction_delay"] = list(self.reaction_delay)
+        return out
 
     def columns(self, n: int) -> dict[str, npt.NDArray[np.float64]]:
         """``tau_lo, tau_hi, delta_lo, ...``: the box repeated on ``n`` result rows.
@@ -476,13 +553,13 @@ class Box:
             return p
         # the point box of parameters already checked (by Params): not checked again
         box = object.__new__(cls)
-        for name in ("tau", "delta", "headway"):
+        for name in ("tau", "delta", "headway", "reaction_delay"):
             v = getattr(p, name)
             object.__setattr__(box, name, (v, v))
         return box
 
 
-def check_box(tau: Any, delta: Any, headway: Any) -> Box:
+def check_box(tau: Any, delta: Any, headway: Any, reaction_delay: Any = 0.0) -> Box:
     """Validate three numbers, pairs or ``"LO:HI"`` strings into a :class:`Box`.
 
     Parameters
@@ -493,6 +570,8 @@ def check_box(tau: Any, delta: Any, headway: Any) -> Box:
         Communication delay δ or its interval, s.
     headway : float, (float, float) or str
         Desired time headway T* or its interval, s.
+    reaction_delay : float, (float, float) or str
+        Reaction delay θ_r or its interval, s (default 0).
 
     Returns
     -------
@@ -513,7 +592,7 @@ def check_box(tau: Any, delta: Any, headway: Any) -> Box:
     stringstab.errors.StringStabError: delta (communication delay) interval must be >= 0 s; got [-0.1, 0.2]
     """
     return Box(as_interval(tau, "tau"), as_interval(delta, "delta"),
-               as_interval(headway, "headway"))
+               as_interval(headway, "headway"), as_interval(reaction_delay, "reaction_delay"))
 
 
 def _is_number(v: Any) -> bool:
@@ -521,8 +600,8 @@ def _is_number(v: Any) -> bool:
         isinstance(v, np.ndarray) and v.ndim == 0)
 
 
-def parameter_model(tau: Any, delta: Any, headway: Any) -> Params | Box:
-    """:class:`Params` when τ, δ, T* are numbers (or intervals of one point), else a :class:`Box`.
+def parameter_model(tau: Any, delta: Any, headway: Any, reaction_delay: Any = 0.0) -> Params | Box:
+    """:class:`Params` when τ, δ, T* (θ_r) are numbers (or intervals of one point), else a :class:`Box`.
 
     Numbers are checked by :func:`check_params` (so their errors are the point ones); any
     interval (``(lo, hi)`` or ``"LO:HI"``) makes the whole a box, checked by :func:`check_box`.
@@ -535,6 +614,8 @@ def parameter_model(tau: Any, delta: Any, headway: Any) -> Params | Box:
         Communication delay δ or its interval, s.
     headway : float, (float, float) or str
         Desired time headway T* or its interval, s.
+    reaction_delay : float, (float, float) or str
+        Reaction delay θ_r or its interval, s (default 0: today's model).
 
     Returns
     -------
@@ -555,9 +636,9 @@ def parameter_model(tau: Any, delta: Any, headway: Any) -> Params | Box:
     >>> parameter_model("0.1:0.3", 0.2, 1.1)
     Box(tau=(0.1, 0.3), delta=(0.2, 0.2), headway=(1.1, 1.1))
     """
-    if all(_is_number(v) for v in (tau, delta, headway)):
-        return Params(tau, delta, headway)
-    box = check_box(tau, delta, headway)
+    if all(_is_number(v) for v in (tau, delta, headway, reaction_delay)):
+        return Params(tau, delta, headway, reaction_delay)
+    box = check_box(tau, delta, headway, reaction_delay)
     if box.is_point:
-        return Params(box.tau[0], box.delta[0], box.headway[0])
+        return Params(box.tau[0], box.delta[0], box.headway[0], box.reaction_delay[0])
     return box

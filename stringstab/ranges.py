@@ -14,6 +14,8 @@ gain k         \|k\| <= 10        \|k\| > 1e6    IDL Table 2: [−2, 2]; 1e6 1/s
 τ              (0, 2] s          > 100 s       actuator lags are 0.1-1 s
 δ              [0, 2] s          > 100 s       V2V delays are 0.01-0.5 s
 T*             [0, 5] s          > 100 s       time headways are 0.3-3 s
+θ_r            [0, 2] s          > 100 s       reaction/actuation delays: ACC 0.1-0.6 s,
+                                               drivers 0.5-1.5 s
 H              [1e-3, 1] s       < 1e-4 s,     control periods are 0.01-0.2 s; the sampled
                                  > 100 s       loop's order grows as δ/H (H = 1e-300 s
                                                divided by zero, 1e-8 s ran for ever)
@@ -39,8 +41,9 @@ from typing import Any
 
 from .errors import StringStabError
 
-__all__ = ["COUNTS", "FLOORS", "LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "MIN_LEADER_SECONDS",
-           "RANGES", "check_count", "check_magnitude", "count_warning", "sensible_warning"]
+__all__ = ["COUNTS", "FLOORS", "LEADER_ACCEL_ABSURD", "LEADER_SPEED_ABSURD", "METRIC_RANGES",
+           "MIN_LEADER_SECONDS", "RANGES", "check_count", "check_magnitude", "count_warning",
+           "metric_caveat", "sensible_warning"]
 
 #: A leader (or a speed limit) faster than this, m/s (252 km/h), is no road vehicle: refused.
 LEADER_SPEED_ABSURD = 70.0
@@ -56,6 +59,7 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "tau": (2.0, 100.0, " s", "actuator lag tau"),
     "delta": (2.0, 100.0, " s", "communication delay delta"),
     "headway": (5.0, 100.0, " s", "time headway T*"),
+    "reaction_delay": (2.0, 100.0, " s", "reaction delay theta_r"),
     "sample_time": (1.0, 100.0, " s", "sample time H"),
     "duration": (86_400.0, 3.2e7, " s", "duration"),
     "jerk": (30.0, 1e6, " m/s³", "jerk limit J"),
@@ -94,8 +98,8 @@ def check_magnitude(kind: str, value: Any, *, name: str | None = None) -> float:
     Parameters
     ----------
     kind : str
-        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``, ``sample_time``,
-        ``duration``).
+        A key of :data:`RANGES` (``gain``, ``tau``, ``delta``, ``headway``,
+        ``reaction_delay``, ``sample_time``, ``duration``).
     value : float
         The number (already checked finite by the caller's own parser; NaN is refused too).
     name : str, optional
@@ -239,3 +243,55 @@ def _range(kind: str) -> str:
     if kind in FLOORS:
         return f"{FLOORS[kind][0]:g} to {sensible:g}{unit}"
     return f"|k| up to {sensible:g}" if kind == "gain" else f"up to {sensible:g}{unit}"
+
+
+#: The sensible range of each reported metric: name -> (lo, hi, unit, what a value outside means).
+#: A number outside is printed with :func:`metric_caveat` beside it (docs/conventions.md).
+METRIC_RANGES: dict[str, tuple[float, float, str, str]] = {
+    "M_effi": (0.0, math.inf, "s", "a negative mean time headway means some moment has a "
+               "negative gap (a collision or an overlap), so it measures no efficiency"),
+    "max_m_p": (0.0, 10.0, "", "a predecessor that barely accelerates makes the energy ratio "
+                "meaningless"),
+    "M_lss": (0.0, 10.0, "", "a predecessor that barely accelerates makes the energy ratio "
+              "meaningless"),
+    "TIT": (0.0, math.inf, "s²", "a time integral of positive terms cannot be negative"),
+    "M_CI": (0.0, 60.0, "m²/s⁶", "beyond the top of the IDL paper's Fig. 11 ranges"),
+    "m_fss": (0.0, 1.0, "", "a share lies in [0, 1]"),
+    "certified_row_share": (0.0, 1.0, "", "a share lies in [0, 1]"),
+}
+
+
+def metric_caveat(name: str, value: Any) -> str:
+    """What to print beside a metric outside its sensible range ("" inside it or unknown).
+
+    Parameters
+    ----------
+    name : str
+        The metric's key (``"M_effi"``, ``"max_m_p"``, ...; see :data:`METRIC_RANGES`).
+    value : float or None
+        Its value (None, non-numbers and names without a range give "").
+
+    Returns
+    -------
+    str
+        ``""`` or a parenthesised caveat naming the range, e.g. ``"(outside the sensible
+        range [0, 10] s: ...)"``.
+
+    Examples
+    --------
+    >>> metric_caveat("M_effi", 1.47)
+    ''
+    >>> metric_caveat("M_effi", -20.1)[:46]
+    '(outside the sensible range [0, ∞] s: a negati'
+    """
+    if name not in METRIC_RANGES or isinstance(value, bool):
+        return ""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return ""
+    lo, hi, unit, why = METRIC_RANGES[name]
+    if not math.isfinite(x) or lo <= x <= hi:
+        return ""
+    top = "∞" if math.isinf(hi) else f"{hi:g}"
+    return f"(outside the sensible range [{lo:g}, {top}]{' ' + unit if unit else ''}: {why})"

@@ -155,7 +155,7 @@ def test_batch_equals_single_and_summary():
     s = b.summary()
     assert s["n"] == 200
     assert s["certified"] + s["not_certified"] + s["inconclusive"] == 200
-    assert_allclose(s["m_fss"], np.mean(b.verdict == "certified"), rtol=0, atol=0)
+    assert_allclose(s["certified_row_share"], np.mean(b.verdict == "certified"), rtol=0, atol=0)
     assert len(b.records()) == 200
 
 

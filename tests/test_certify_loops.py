@@ -167,7 +167,7 @@ def test_sampled_rows_columns_and_summary_carry_the_sample_time_and_the_box():
     assert rows[1]["verdict"] == "not_certified" and rows[1]["peak_omega"] > 0
     assert_allclose(rows[1]["peak_omega"] * 0.1, rows[1]["peak_theta"], rtol=1e-12)
     s = b.summary()
-    assert s["sample_time"] == 0.1 and s["box"]["tau"] == [0.1, 0.1] and s["m_fss"] == 0.5
+    assert s["sample_time"] == 0.1 and s["box"]["tau"] == [0.1, 0.1] and s["certified_row_share"] == 0.5
     json.dumps(rows)  # plain JSON
 
 
@@ -191,7 +191,7 @@ def test_robust_rows_columns_and_summary_carry_the_box():
 def test_continuous_point_outputs_are_unchanged():
     b = certify_batch([1.2], [0.5], [0.6], **P)
     assert "sample_time" not in b.columns() and "box" not in b.columns()
-    assert set(b.summary()) == {"n", "certified", "not_certified", "inconclusive", "m_fss"}
+    assert set(b.summary()) == {"n", "certified", "not_certified", "inconclusive", "certified_row_share"}
 
 
 # --------------------------------------------------------------------------- bad input

@@ -23,7 +23,7 @@ UNSTABLE = "-0.5,1,1"
 RESULT_KEYS = {"k_x", "k_v", "k_a", "hurwitz", "verdict", "type", "sup_gain", "peak_omega",
                "margin", "hurwitz_margin", "taylor_derived", "taylor_printed", "method"}
 TAYLOR_KEYS = {"psi1", "psi2", "psi3", "lambda", "verdict", "type"}
-SUMMARY_KEYS = {"n", "certified", "not_certified", "inconclusive", "m_fss"}
+SUMMARY_KEYS = {"n", "certified", "not_certified", "inconclusive", "certified_row_share"}
 
 
 def _sweep(k, tau=TAU, delta=DELTA, headway=HEADWAY):
@@ -149,7 +149,7 @@ def test_exit_1_and_verdicts_against_a_sweep(capsys):
     assert unstable["verdict"] == "not_certified" and unstable["hurwitz"] is False
     assert unstable["sup_gain"] is None  # ‖Γ‖∞ = ∞ is JSON null
     assert doc["summary"] == {"n": 4, "certified": 2, "not_certified": 2, "inconclusive": 0,
-                              "m_fss": 0.5}
+                              "certified_row_share": 0.5}
 
 
 def test_negative_triples_are_positionals(capsys):

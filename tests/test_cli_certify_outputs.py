@@ -39,7 +39,7 @@ def test_parquet_keeps_types_and_params(tmp_path, capsys):
     assert t.column("sup_gain").to_pylist()[2] == float("inf")
     assert t.column("taylor_printed_verdict").to_pylist()[1] == "stable"
     assert json.loads(t.schema.metadata[b"stringstab.params"])["tau"] == 0.1
-    assert json.loads(t.schema.metadata[b"stringstab.summary"])["m_fss"] == pytest.approx(1 / 3)
+    assert json.loads(t.schema.metadata[b"stringstab.summary"])["certified_row_share"] == pytest.approx(1 / 3)
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -88,9 +88,9 @@ def test_the_library_refuses_a_sample_time_below_the_floor(value):
     from stringstab.certify.api import Loop
     from stringstab.params import sample_time
 
-    with pytest.raises(StringStabError, match="refused below 0.0001 s"):
+    with pytest.raises(StringStabError, match=r"refused below 0\.0001 s"):
         sample_time(value)
-    with pytest.raises(StringStabError, match="refused below 0.0001 s"):
+    with pytest.raises(StringStabError, match=r"refused below 0\.0001 s"):
         Loop.of(0.1, 0.2, 1.1, sample_time=value)
     assert sample_time(1e-4) == 1e-4
 

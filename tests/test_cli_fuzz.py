@@ -382,10 +382,10 @@ A_MIN = ["nan", "-inf", "1", "-1e300"]  # a braking limit is negative
 SAMPLE = [*FLOATS, "1e-300"]  # a sample time also has a floor (1e-300 divided by zero)
 #: Every numeric flag of every command (sumo's own are listed in SUMO_NUMERIC) and its bad values.
 NUMERIC = {
-    "derive": {"--delay-order": INTS, "--sample-time": SAMPLE,
-               "--substitute": [f"tau={v}" for v in FLOATS]},
+    "derive": {"--delay-order": INTS, "--sample-time": SAMPLE, "--reaction-delay": FLOATS,
+               "--substitute": [f"{k}={v}" for k in ("tau", "reaction_delay") for v in FLOATS]},
     "certify": {"K_X,K_V,K_A": GAINS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
-                "--sample-time": SAMPLE, "--pade-order": INTS},
+                "--sample-time": SAMPLE, "--pade-order": INTS, "--reaction-delay": FLOATS},
     "region": {"--fix": ["k_a=nan", "k_a=inf", "k_a=1e300"], "--range": ["nan,2", "-inf,2", "-1e300,2"],
                "--n": INTS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
                "--sample-time": SAMPLE, "--dpi": INTS, "--workers": INTS},
@@ -413,9 +413,11 @@ NUMERIC = {
 }
 #: sumo's numeric flags: cli/sumo.py is another engineer's (issue 29 item 4); not fuzzed here.
 SUMO_NUMERIC = {"sumo check": {"--followers", "--gains", "--tau", "--delta", "--headway", "--standstill",
-                               "--length", "--dt", "--duration", "--hold", "--tolerance"},
+                               "--length", "--dt", "--duration", "--hold", "--tolerance",
+                               "--v-max", "--a-min", "--a-max"},
                 "sumo run": {"--followers", "--gains", "--tau", "--delta", "--headway", "--standstill",
-                             "--length", "--dt", "--duration", "--hold", "--steps"},
+                             "--length", "--dt", "--duration", "--hold", "--steps", "--v-max",
+                             "--a-min", "--a-max"},
                 "sumo cacc": {"--followers", "--duration", "--dt"}}
 #: The other value-taking options: file arguments (FILE_ARGUMENTS), names and text.
 NOT_NUMERIC = {"--out", "--file", "--from", "--overlay", "--report", "--leader", "--leaders",

@@ -11,6 +11,7 @@ folders the docs said it refuses (now one rule: created, for files too), ``compa
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -47,7 +48,7 @@ def run(tmp_path_factory):
 
 # --------------------------------------------------------------------------- undecodable files
 def test_read_text_names_the_first_byte_that_is_not_utf8(tmp_path):
-    from stringstab.io.text_files import read_text
+    from stringstab.io.text_input import read_text
 
     p = tmp_path / "f.csv"
     cases = {  # payload -> what the message says (offsets counted by hand)
@@ -67,15 +68,47 @@ def test_read_text_names_the_first_byte_that_is_not_utf8(tmp_path):
     assert read_text(p, label="x", expected="y") == "t,v\n0,1\n"
 
 
-def test_decoding_finds_the_offset_of_a_bad_byte_past_a_chunk_boundary(tmp_path):
-    from stringstab.io.text_files import decoding
+def test_a_streamed_file_names_the_offset_of_a_bad_byte_past_a_chunk_boundary(tmp_path):
+    import gzip
+
+    from stringstab.io.text_input import open_text
 
     p = tmp_path / "big.csv"
     # 1 + 2 x 700000 bytes of text ('a', then two-byte characters straddling the 1 MiB chunks)
-    p.write_bytes(b"a" + "é".encode() * 700_000 + b"\xff")
-    with pytest.raises(StringStabError, match=r"first at byte offset 1400001\)"):
-        with decoding(p, label="NGSIM file", expected="an NGSIM file"):
-            p.read_text(encoding="utf-8")
+    data = b"a" + "é".encode() * 700_000 + b"\n\xff"
+    p.write_bytes(data)
+    g = tmp_path / "big.gz"  # the same text compressed: the offset counts decompressed bytes
+    g.write_bytes(gzip.compress(data))
+    for f, of in ((p, ")"), (g, " of the decompressed data)")):
+        with pytest.raises(StringStabError, match=re.escape(f"first at byte offset 1400002{of}")):
+            with open_text(f, label="NGSIM file", expected="an NGSIM file") as fh:
+                assert next(iter(fh)).startswith("aé")  # the first line is text
+                list(fh)
+
+
+def test_the_one_reader_refuses_nul_bytes_folders_and_missing_files_in_every_form(tmp_path):
+    """Plain or gzip (recognised by content, whatever the name), the same refusals."""
+    import gzip
+
+    from stringstab.io.text_input import open_text, read_text
+
+    plain, packed = tmp_path / "a.csv", tmp_path / "a.csv.txt"  # a gzip file not named .gz
+    for payload, says in ((b"t,v\n0,1\x00\n", "a NUL byte at offset 7, which no text file holds"),
+                          (b"t,v\n0,caf\xe9\n", "not UTF-8 text (first at byte offset 9")):
+        plain.write_bytes(payload)
+        packed.write_bytes(gzip.compress(payload))
+        for f in (plain, packed):
+            for read in (lambda f: read_text(f, label=f"leader CSV {f.name!r}", expected="CSV"),
+                         lambda f: list(open_text(f, label=f"leader CSV {f.name!r}", expected="CSV"))):
+                with pytest.raises(StringStabError) as e:
+                    read(f)
+                assert says in str(e.value) and f.name in str(e.value), str(e.value)
+    packed.write_bytes(gzip.compress(b"t,v\n0,1\n"))
+    assert read_text(packed, label="x", expected="y") == "t,v\n0,1\n"
+    for f, says in ((tmp_path, "x: expected y; got a folder"),
+                    (tmp_path / "none.csv", "x: cannot read it (No such file or directory); expected y")):
+        with pytest.raises(StringStabError, match=re.escape(says)):
+            read_text(f, label="x", expected="y")
 
 
 def test_gains_from_binary_standard_input_are_refused(capsys, monkeypatch):

@@ -308,7 +308,7 @@ RECORDS = [
      "sup_gain": None, "margin": float("-inf"), "taylor_derived": {"verdict": "unstable", "psi3": -1.0}},
 ]
 PARAMS = {"tau": 0.1, "delta": 0.2, "headway": 1.1, "method": "exact"}
-SUMMARY = {"n": 2, "certified": 1, "not_certified": 1, "inconclusive": 0, "m_fss": 0.5}
+SUMMARY = {"n": 2, "certified": 1, "not_certified": 1, "inconclusive": 0, "certified_row_share": 0.5}
 
 
 def test_format_json_is_strict_json():

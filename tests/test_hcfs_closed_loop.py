@@ -136,16 +136,19 @@ def test_plots_return_what_they_drew(ver):
         arts = plot_jerk(run, i, ax=axes[1])
         # the followers, ±J, and ±2a_max/T only when the jerk comes near it (not here)
         assert len(arts) == 3 and arts[1].get_ydata()[0] == pytest.approx(5.0)
-        assert "2a_max/T = 30 off scale" in axes[1].get_title()
+        assert "frames above J" in axes[1].get_title(loc="right")  # the count, in words
         img = plot_switching(run, i, ax=axes[2])
         assert img.get_array().shape == (4, run.t.size)
         assert "stand-in policy" in axes[0].get_title() or "HCFS" in axes[0].get_title()
     finally:
         plt.close(fig)
     fig2, axes2 = plot_figure(run, 5.0, "jerk")
-    try:
-        assert len(axes2) == 4
-        assert [ax.get_title().split(":")[0] for ax in axes2][:2] == ["CACC alone", "stand-in policy alone"]
+    try:  # a panel per follower (rows) and mode (columns), not the followers on top of each other
+        assert len(axes2) == 4 * run.n_followers
+        assert [ax.get_title(loc="left").split("\n")[0] for ax in axes2][:2] == [
+            "CACC alone", "stand-in policy alone"]
+        assert all(len(ax.get_lines()) == 3 for ax in axes2)  # one follower, +J, −J
+        assert "2a_max/T = 30 m/s³, beyond every panel's scale" in fig2.get_suptitle()
     finally:
         plt.close(fig2)
     with pytest.raises(StringStabError, match="no configuration"):

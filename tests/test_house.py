@@ -289,6 +289,7 @@ LONG_MODULES = {
     "stringstab/io/gains.py": "reading gain triples K = [k_x, k_v, k_a]: every format, one reader",
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
+    "stringstab/params.py": "the model's parameters τ, δ, T*, θ_r: points, intervals, boxes, checked",
 }
 
 

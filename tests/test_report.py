@@ -60,6 +60,71 @@ def test_markdown_block_headings_nest(tmp_path):
     assert "### Title" in md and "#### Sub" in md and "\n# not a heading" in md
 
 
+#: Source that must never show in a rendered report: TeX commands, dollars, TeX's braced sub- and
+#: superscripts, SymPy's powers and products (``k_a*s**2*exp(-delta*s)``).
+RAW_SOURCE = re.compile(r"\\[A-Za-z]{2,}|\$|[_^]\{|\*\*|\b[a-z]\w*\*[a-z(]|\bexp\(")
+
+
+def _rendered(html):
+    """Lay the page out with WeasyPrint (a real HTML/CSS engine): the images it drew with a
+    non-zero natural size, the number of <img> tags, the text a reader sees, and its warnings."""
+    import logging
+
+    try:
+        import weasyprint
+        from weasyprint.formatting_structure import boxes
+    except (ImportError, OSError) as e:  # OSError: the system's Pango is missing
+        pytest.skip(f"WeasyPrint (the 'test' extra, with the system's Pango) is needed to render "
+                    f"the report: {e}")
+    records = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            records.append(record.getMessage())
+
+    handler = Keep(level=logging.WARNING)
+    logging.getLogger("weasyprint").addHandler(handler)
+    try:
+        doc = weasyprint.HTML(string=html).render()
+    finally:
+        logging.getLogger("weasyprint").removeHandler(handler)
+
+    def walk(box):
+        yield box
+        for child in getattr(box, "children", None) or []:
+            yield from walk(child)
+
+    drawn, texts = [], []
+    for page in doc.pages:
+        for box in walk(page._page_box):
+            if isinstance(box, boxes.ReplacedBox):
+                w, h, _ = box.replacement.get_intrinsic_size(1, 16)
+                drawn.append((w or 0) > 0 and (h or 0) > 0 and box.width > 0 and box.height > 0)
+            elif isinstance(box, boxes.TextBox):
+                texts.append(box.text)
+    n_img = len(re.findall(r"<img\b", html))
+    return drawn, n_img, " ".join(texts), [m for m in records if "image" in m.lower()]
+
+
+def _assert_reads_well(html):
+    drawn, n_img, text, failures = _rendered(html)
+    assert failures == [], failures  # no image failed to load
+    assert len(drawn) == n_img and all(drawn), (len(drawn), n_img)  # every <img> drawn, sized
+    raw = sorted({m.group(0) for m in RAW_SOURCE.finditer(text)})
+    assert not raw, f"raw TeX/SymPy source in the rendered text: {raw}"
+    return text
+
+
+def test_the_render_check_can_fail():
+    """The check catches a broken figure, a formula left as TeX and SymPy source."""
+    html = ('<p>Γ(s) = k_a*s**2*exp(-delta*s) and $\\Gamma$ and a_{i-1}</p>'
+            '<img alt="fig" src="data:image/png;base64,AAAA">')
+    drawn, n_img, text, failures = _rendered(html)
+    assert failures and len(drawn) < n_img
+    assert {m.group(0) for m in RAW_SOURCE.finditer(text)} >= {"**", "$", "\\Gamma", "_{",
+                                                                "exp(", "k_a*s"}
+
+
 def test_demo_writes_the_report(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out), "--only", "derive", "--only", "certify",
@@ -67,12 +132,26 @@ def test_demo_writes_the_report(tmp_path, capsys):
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "## The findings at a glance" in md
     assert "| the paper's printed formulas match the model | **no** |" in md
+    assert "eq 11 (denominator of Γ(s))" in md and "Proposition 1 (logic)" in md
+    assert "(proposition1)" not in md and "triple(s)" not in md
     assert "0.9, -0.5, 1.1" in md  # the triple the printed Proposition 1 misjudges
+    assert "certified_row_share = 0.771" in md and "m_fss = 0.771" not in md
+    assert "$$\\Gamma(s) = \\frac{" in md  # Γ(s) as TeX, typeset in the HTML
     assert "tune/tune_moves.png" in md and "`stringstab demo (called from Python with" in md
     html = (out / "report.html").read_text(encoding="utf-8")
     data, other = _embedded(html)
-    assert other == [] and data == [(out / "tune" / "tune_moves.png").read_bytes()]
+    figures = [d for d in data if d.startswith(b"\x89PNG")]
+    formulas = [d for d in data if d.startswith(b"<?xml")]
+    assert other == [] and figures == [(out / "tune" / "tune_moves.png").read_bytes()]
+    assert len(formulas) >= 10 and all(b"<svg" in f for f in formulas)
+    assert not re.search(r'(src|href)="https?://', html)  # nothing loaded from the network
     assert "report.html" in capsys.readouterr().out
+    text = _assert_reads_well(html)
+    assert "Γ(s) =" not in text  # the formula is an image, not SymPy text
+    # a repair the exact certificate does not certify is never called "repaired"
+    rows = [line for line in md.splitlines() if line.startswith("| region-growing |")]
+    assert rows and all(("| no | repaired |" not in r) for r in rows)
+    assert any("| no | moved_not_certified |" in r for r in rows)
 
 
 def test_region_command_report(tmp_path, capsys):
@@ -81,9 +160,11 @@ def test_region_command_report(tmp_path, capsys):
     md = (out / "report.md").read_text(encoding="utf-8")
     pngs = sorted(p.name for p in out.glob("*.png"))
     assert pngs and all(f"]({p})" in md for p in pngs)
-    data, other = _embedded((out / "report.html").read_text(encoding="utf-8"))
+    html = (out / "report.html").read_text(encoding="utf-8")
+    data, other = _embedded(html)
     assert other == [] and sorted(data) == sorted((out / p).read_bytes() for p in pngs)
     assert "exact vs taylor agree on every decided point" in md
+    _assert_reads_well(html)
 
 
 @pytest.mark.parametrize("name", ["region_class_exact.png", "platoon.png", "fig9_ttc.png", "fit_1.png",

@@ -80,6 +80,20 @@ def test_ctrl_c_stops_sumo_and_writes_nothing(monkeypatch, capsys, tmp_path):
 def test_missing_vehicle_ids(capsys, tmp_path):
     out = tmp_path / "run"
     _bad(["sumo", "run", "--sumocfg", SCENARIO, "--controlled", "c1,nobody", "--steps", "200",
+          "--out", str(out)], "no vehicle 'nobody' in the route files of onramp.sumocfg", capsys,
+         out)
+    # route files SUMO reads but stringstab does not (gzip): the ids are checked at the end
+    import gzip
+    import shutil
+
+    scen = tmp_path / "scen"
+    shutil.copytree(os.path.dirname(SCENARIO), scen)
+    routes = scen / "onramp.rou.xml"
+    (scen / "onramp.rou.xml.gz").write_bytes(gzip.compress(routes.read_bytes()))
+    routes.unlink()
+    cfg = scen / "onramp.sumocfg"
+    cfg.write_text(cfg.read_text().replace("onramp.rou.xml", "onramp.rou.xml.gz"))
+    _bad(["sumo", "run", "--sumocfg", str(cfg), "--controlled", "c1,nobody", "--steps", "200",
           "--out", str(out)], "nobody never appeared", capsys, out)
 
 

@@ -16,6 +16,13 @@ certificate answers with the verdicts of
 :mod:`~stringstab.certify.verdicts` and is sound by construction: "certified" means
 internally stable and ‖Γ‖_H∞ ≤ 1 with the exact delay.
 
+With a reaction delay θ_r > 0 on the whole command (issue 25) the continuous loop is certified
+by :mod:`~stringstab.certify.reaction`: the exact root count of the quasi-polynomial
+denominator (:mod:`~stringstab.certify.quasipolynomial`), the branch and bound on the margin
+with θ_r (:mod:`~stringstab.certify.margin_reaction`), its results
+(:mod:`~stringstab.certify.reaction_results`) and the reporting estimate of the rightmost root
+(:mod:`~stringstab.certify.rightmost`).
+
 Also here: the Padé cross-check (:mod:`~stringstab.certify.pade`, never a verdict), the
 branch and bound (:mod:`~stringstab.certify.branch_bound`), the margin g(ω) and its tail
 bound (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria

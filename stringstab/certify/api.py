@@ -118,10 +118,27 @@ class Loop:
             raise StringStabError(
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
+        # -- the reaction delay θ_r (issue 25): the continuous point loop only, until part 2
+        if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0):
+            lo, hi = self.model.reaction_delay
+            raise StringStabError(
+                "reaction_delay > 0 is certified in continuous time only so far; got "
+                f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a parameter "
+                "box" + (f" and sample_time={H!r}" if H is not None else ""))
+        theta = Box.of(self.model).reaction_delay[1]
+        if theta and H is not None:
+            raise StringStabError(
+                "reaction_delay > 0 is certified in continuous time only so far; got "
+                f"reaction_delay={theta:g} with sample_time={H!r}")
+        if theta and self.method == "pade":
+            raise StringStabError(
+                "method='pade' (python-control's cross-check) has no reaction delay; expected "
+                f"reaction_delay=0 with it; got reaction_delay={theta:g}")
 
     @classmethod
     def of(cls, tau: Any, delta: Any, headway: Any, sample_time: Any = None,
-           tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact") -> Loop:
+           tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact",
+           reaction_delay: Any = 0.0) -> Loop:
         """The loop a caller asks for, every value checked (the one place they are).
 
         Parameters
@@ -137,6 +154,9 @@ class Loop:
             Sampled box only: independent predecessor lag.
         method : {"exact", "pade"}
             The method of :func:`certify_batch`.
+        reaction_delay : float
+            θ_r ≥ 0 (s), the delay on the whole command (issue 25); > 0 is certified in
+            continuous time only so far (a sampled or box loop refuses it).
 
         Returns
         -------
@@ -155,7 +175,7 @@ class Loop:
         >>> Loop.of("0.1:0.3", 0.2, 1.1).kind
         'robust'
         """
-        model = parameter_model(tau, delta, headway)
+        model = parameter_model(tau, delta, headway, reaction_delay)
         H = None if sample_time is None else checked_sample_time(sample_time)
         loop = cls(model, H, tau_prev, heterogeneous, method)
         if tau_prev is None:
@@ -239,6 +259,11 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
 
         return sampled.check_kernel(kx, kv, ka, model, H, loop.predecessor_lag, n_grid=n_grid,
                                     max_rounds=max_rounds, max_intervals=max_intervals)
+    if model.reaction_delay:  # θ_r > 0 (issue 25): the quasi-polynomial certificate
+        from . import reaction
+
+        return reaction.check_kernel(kx, kv, ka, model, n_grid=n_grid or 64,
+                                     max_rounds=max_rounds, max_intervals=max_intervals)
     return continuous.check_kernel(kx, kv, ka, model, n_grid=n_grid or 64,
                                    max_rounds=max_rounds, max_intervals=max_intervals)
 
@@ -260,6 +285,12 @@ def _certify(
         return sampled.certify_kernel(
             kx, kv, ka, model, H, loop.predecessor_lag, progress=progress, chunk=chunk,
             n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    if model.reaction_delay:  # θ_r > 0 (issue 25): the quasi-polynomial certificate
+        from . import reaction
+
+        return reaction.certify_kernel(kx, kv, ka, model, progress=progress, chunk=chunk,
+                                       n_grid=n_grid or 64, max_rounds=max_rounds,
+                                       max_intervals=max_intervals)
     batch = continuous.certify_kernel(kx, kv, ka, model, progress=progress, chunk=chunk,
                                       n_grid=n_grid or 64, max_rounds=max_rounds,
                                       max_intervals=max_intervals)
@@ -279,6 +310,7 @@ def check(
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
     tau_prev: float | None = None, heterogeneous: bool = True,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
+    reaction_delay: Any = 0.0,
 ) -> Check:
     """The certificate's verdicts alone, for inner loops (e.g. gain repair).
 
@@ -303,6 +335,11 @@ def check(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
+    reaction_delay : float
+        θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
+        docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
+        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
+        far (with a sample time or a box: refused).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
 
@@ -322,7 +359,8 @@ def check(
     >>> c.verdict.tolist(), c.sample_time
     (['certified', 'not_certified'], 0.1)
     """
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous,
+                   reaction_delay=reaction_delay)
     return _check(loop, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                   max_intervals=max_intervals)
 
@@ -333,7 +371,7 @@ def certify_batch(
     *, tau: float, delta: float, headway: float, sample_time: None = None,
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: None = None, heterogeneous: bool = True,
+    tau_prev: None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> CertificateBatch: ...
 
 
@@ -343,7 +381,7 @@ def certify_batch(
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: float | None = None, heterogeneous: bool = True,
+    tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
 
 
@@ -352,7 +390,7 @@ def certify_batch(
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-    tau_prev: float | None = None, heterogeneous: bool = True,
+    tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
     """Certify many gain triples at once (exact delay, sound; see :mod:`stringstab.certify.continuous`).
 
@@ -378,6 +416,11 @@ def certify_batch(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
+    reaction_delay : float
+        θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
+        docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
+        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
+        far (with a sample time or a box: refused).
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -411,14 +454,15 @@ def certify_batch(
     >>> b = certify_batch([1.5, 0.9], [0.3, -0.5], [-0.1, 1.1], tau=0.1, delta=0.2, headway=1.1)
     >>> b.verdict.tolist()
     ['certified', 'not_certified']
-    >>> b.summary()["m_fss"]
+    >>> b.summary()["certified_row_share"]
     0.5
     >>> r = certify_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta="0.1:0.3",
     ...                   headway=1.1)
     >>> r.verdict.tolist(), r.summary()["box"]["tau"]
     (['certified', 'not_certified'], [0.1, 0.3])
     """
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
+                   reaction_delay)
     return _certify(loop, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
                     chunk=chunk, n_grid=n_grid, max_rounds=max_rounds,
                     max_intervals=max_intervals)
@@ -428,7 +472,7 @@ def certify_batch(
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
     sample_time: None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: None = None, heterogeneous: bool = True,
+    tau_prev: None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> Certificate: ...
 
 
@@ -436,14 +480,14 @@ def certify(
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: float | None = None, heterogeneous: bool = True,
+    tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> Certificate | SampledCertificate | RobustCertificate: ...
 
 
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
-    tau_prev: float | None = None, heterogeneous: bool = True,
+    tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
 ) -> Certificate | SampledCertificate | RobustCertificate:
     """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
 
@@ -464,6 +508,11 @@ def certify(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
+    reaction_delay : float
+        θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
+        docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
+        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
+        far (with a sample time or a box: refused).
     method, pade_order
         As for :func:`certify_batch`.
 
@@ -485,6 +534,7 @@ def certify(
     ('not_certified', 1.0911, 1.379, 0.1379)
     """
     one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
-    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method)
+    loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
+                   reaction_delay)
     return _certify(loop, *gains([k_x], [k_v], [k_a]), pade_order=pade_order, progress=False,
                     chunk=4096, n_grid=None, max_rounds=30, max_intervals=1024)[0]

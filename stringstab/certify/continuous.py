@@ -53,6 +53,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..derive import generated as _gen
+from ..errors import StringStabError
 from ..io import TableColumn, columns_from_records
 from ..params import Params
 from . import margin as _margin
@@ -64,7 +65,7 @@ from .criteria import (
     hurwitz_margin_kernel,
     taylor_criteria_kernel,
 )
-from .excess import EXCESS_SEARCH, col
+from .excess import EXCESS_SEARCH, col, excess_squared
 from .excess import violation_peak as _violation_peak
 from .frequency import gain_squared
 from .verdicts import (
@@ -382,10 +383,10 @@ class CertificateBatch(BatchResult):
         return cols
 
     def summary(self) -> dict[str, Any]:
-        """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27).
+        """Counts per verdict and ``certified_row_share``, the share of rows certified (a fraction).
 
-        ``m_fss`` is eq 27's M_fss without its ×100 % (docs/conventions.md): every M_fss of
-        the toolkit is a fraction.
+        Each row counts once; m_fss (IDL eq 27) weighs each gain by the time it is in force and
+        is computed where time is known (``simulate``, ``evaluate``; docs/conventions.md).
         """
         return super().summary()
 
@@ -424,12 +425,60 @@ def check_kernel(kx: Array, kv: Array, ka: Array, p: Params, *, n_grid: int = 64
     Check
         Verdicts, internal stability, min g found and where.
     """
+    _theta_zero(p)
     hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
     ex = _exact_chunk(kx, kv, ka, p.tau, p.delta, p.headway, n_grid=n_grid,
                       max_rounds=max_rounds, max_intervals=max_intervals, refine=~hz_fail)
     v = ex.verdict.copy()
-    v[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
+    v[~hz_sure] = _unsure_verdict(v[~hz_sure], hz_fail[~hz_sure])
     return Check(names(v), hz_sure, ex.margin, ex.worst_omega)
+
+
+def _theta_zero(p: Params) -> None:
+    """Refuse θ_r > 0: this is the θ_r = 0 kernel (the way in sends θ_r > 0 to ``reaction``)."""
+    if p.reaction_delay:
+        raise StringStabError(
+            "stringstab.certify.continuous certifies reaction_delay = 0 only; expected "
+            f"stringstab.certify.reaction (chosen by stringstab.certify.api) for {p!r}")
+
+
+def _unsure_verdict(v: npt.NDArray[np.int8], fail: npt.NDArray[np.bool_]) -> npt.NDArray[np.int8]:
+    """The verdict of rows not surely Hurwitz.
+
+    Not certified when surely not Hurwitz, and also within the Hurwitz band when the branch
+    and bound proved g(ω) < 0 somewhere (issue 29 item 7: ‖Γ‖∞ ≥ |Γ(jω)| > 1, or ∞, so not
+    string stable either way); else inconclusive.
+    """
+    return np.where(fail | (v == NOT_CERTIFIED), NOT_CERTIFIED, INCONCLUSIVE).astype(np.int8)
+
+
+def _band_excess(kx: Array, kv: Array, ka: Array, p: Params, witness: Array,
+                 Om: Array) -> tuple[Array, Array]:
+    """|Γ(jω)| − 1 > 0 where g(ω) < 0 was proven, for rows in the Hurwitz band (issue 29 item 7).
+
+    The largest finite excess (cancellation-free, :func:`stringstab.certify.excess.excess_squared`)
+    at the branch and bound's witness and on a short logarithmic grid near ω = 0 (a witness at
+    ω = 0 is Ψ3 < 0: the excess lives at small ω); the L∞ peak itself may be a pole on the axis.
+    """
+    W = np.concatenate([witness[:, None], Om[:, None] * np.logspace(-8.0, -1.0, 57)[None, :]],
+                       axis=1)
+    e2 = excess_squared(W, col(kx), col(kv), col(ka), p.tau, p.delta, p.headway)
+    e2 = np.where(np.isfinite(e2), e2, -np.inf)
+    j = np.argmax(e2, axis=1)
+    rows = np.arange(kx.size)
+    best = e2[rows, j]
+    e1 = best / (1.0 + np.sqrt(1.0 + np.maximum(best, 0.0)))
+    return np.where(np.isfinite(e1), e1, np.inf), W[rows, j]
+
+
+def _agreeing_margin(hm: Array, sure: npt.NDArray[np.bool_]) -> Array:
+    """``hurwitz_margin`` in sign agreement with ``hurwitz`` (issue 29 item 7).
+
+    > 0 only where surely Hurwitz (NaN there if the eigenvalues say otherwise), else ≤ 0 (a
+    root on the axis within round-off, 2e-16 from the eigenvalues, is reported as 0).
+    """
+    with np.errstate(invalid="ignore"):
+        return np.where(sure, np.where(hm > 0, hm, np.nan), np.where(hm > 0, 0.0, hm))
 
 
 def certify_kernel(
@@ -470,9 +519,11 @@ def certify_kernel(
     peak_w = np.empty(n)
     worst_w = np.empty(n)
 
+    _theta_zero(p)
     # internal stability, with an inconclusive band around the boundary
     hz_sure, hz_fail = hurwitz_bands_kernel(kx, kv, tau=p.tau, headway=p.headway)
-    hz_margin = hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway)
+    hz_margin = _agreeing_margin(hurwitz_margin_kernel(kx, kv, tau=p.tau, headway=p.headway),
+                                 hz_sure)
 
     for sl in chunks(n, chunk, progress=progress):
         ex = _exact_chunk(kx[sl], kv[sl], ka[sl], p.tau, p.delta, p.headway,
@@ -490,7 +541,9 @@ def certify_kernel(
                 ex.grid_omega[need], ex.grid_g[need], ex.worst_omega[need],
             )
 
-    verdict[~hz_sure] = np.where(hz_fail[~hz_sure], NOT_CERTIFIED, INCONCLUSIVE)
+    verdict[~hz_sure] = _unsure_verdict(verdict[~hz_sure], hz_fail[~hz_sure])
+    # rows in the Hurwitz band proven not string stable by g < 0 (their excess is reported)
+    band_viol = ~hz_sure & ~hz_fail & (verdict == NOT_CERTIFIED)
     # certified ⇒ sup |Γ| = 1 exactly, at ω = 0 (Γ(0) = 1 for k_x ≠ 0)
     cert = verdict == CERTIFIED
     sup[cert] = np.maximum(sup[cert], 1.0)
@@ -509,7 +562,11 @@ def certify_kernel(
         excess[viol] = np.where(take, e1, excess[viol])
         peak_w[viol] = np.where(take, w_e, peak_w[viol])
         sup[viol] = np.where(take, 1.0 + e1, sup[viol])
-    excess = np.where(hz_sure, excess, np.inf)
+    bv = np.flatnonzero(band_viol)
+    if bv.size:  # a pole may sit on the axis: the excess at the proven witness of g < 0
+        excess[bv], peak_w[bv] = _band_excess(kx[bv], kv[bv], ka[bv], p, worst_w[bv],
+                                              omega_max[bv])
+    excess = np.where(hz_sure | band_viol, excess, np.inf)
     hinf = np.where(hz_sure, sup, np.inf)
     td = taylor_criteria_kernel(kx, kv, ka, tau=p.tau, delta=p.delta, headway=p.headway,
                                 source="derived")

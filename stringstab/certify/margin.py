@@ -54,6 +54,7 @@ __all__ = [
     "gradient",
     "local_minima",
     "newton_terms",
+    "quartic_tail_bound",
     "separable",
     "tail_bound",
     "tail_coefficients",
@@ -455,7 +456,34 @@ def tail_bound(t2: ArrayLike, a: ArrayLike, b: ArrayLike, cx: ArrayLike, cv: Arr
     >>> bool(np.all(g(w, 0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1) > 0))
     True
     """
-    A, B, C = tail_coefficients(t2, a, b, cx, cv)
+    return quartic_tail_bound(*tail_coefficients(t2, a, b, cx, cv))
+
+
+def quartic_tail_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
+    """Ω ≥ the positive root of L(ω) = ω⁴ − Aω² − Bω − C (A, B, C ≥ 0), so L > 0 beyond Ω.
+
+    The quartic minorant of :func:`tail_bound` (and of the reaction-delay margin,
+    :mod:`stringstab.certify.margin_reaction`): Newton's method from Fujiwara's bound
+    (:func:`fujiwara_bound`) decreases monotonically to the one positive root (L is convex
+    beyond it), and every iterate is ≥ it, so the iteration may stop at any step.
+
+    Parameters
+    ----------
+    A, B, C : array_like
+        Non-negative coefficients of the minorant (e.g. :func:`tail_coefficients`).
+
+    Returns
+    -------
+    ndarray
+        Ω ≥ 1e-3, elementwise.
+
+    Examples
+    --------
+    >>> W = quartic_tail_bound(4.0, 0.0, 0.0)  # ω⁴ − 4ω² = 0 at ω = 2
+    >>> bool(2.0 <= float(W) < 2.0 + 1e-5)
+    True
+    """
+    A, B, C = (np.asarray(v, dtype=float) for v in (A, B, C))
     w = np.maximum(fujiwara_bound(A, B, C), 1e-3)
     for _ in range(30):
         L = ((w * w - A) * w - B) * w - C

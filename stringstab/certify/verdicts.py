@@ -7,7 +7,7 @@ shape:
 
 * a *batch* (one array per field, one row per gain triple) that owns its columns
   (``columns()``, written by :func:`stringstab.io.write_results`), its rows (``records()``)
-  and its totals (``summary()``: counts per verdict and m_fss, IDL eq 27), and
+  and its totals (``summary()``: counts per verdict and the share of rows certified), and
 * a *single* result (one triple; ``batch[i]``) whose ``as_dict()`` is that triple's row.
 
 :class:`BatchResult` and :class:`SingleResult` implement this protocol once; :class:`Check`
@@ -198,7 +198,12 @@ def num(x: float) -> float | None:
 
 
 def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
-    """``n``, the count of each verdict and ``m_fss`` = certified / n (IDL eq 27, a fraction).
+    """``n``, the count of each verdict and ``certified_row_share`` = certified / n (a fraction).
+
+    The share of *rows* certified: each row counts once, however long its gains were in force.
+    It is not m_fss (IDL eq 27, the share of vehicle-moments, which weighs each gain by the
+    time it was in force; ``stringstab simulate --gains-file``): the two coincide only for rows
+    sampled at one uniform step (docs/conventions.md).
 
     Parameters
     ----------
@@ -208,16 +213,17 @@ def verdict_summary(verdict: npt.NDArray[np.str_]) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``n``, one count per verdict and ``m_fss`` (NaN when ``n`` is 0).
+        ``n``, one count per verdict and ``certified_row_share`` (NaN when ``n`` is 0).
 
     Examples
     --------
     >>> verdict_summary(np.array(["certified", "inconclusive"]))
-    {'n': 2, 'certified': 1, 'not_certified': 0, 'inconclusive': 1, 'm_fss': 0.5}
+    {'n': 2, 'certified': 1, 'not_certified': 0, 'inconclusive': 1, 'certified_row_share': 0.5}
     """
     n = int(np.size(verdict))
     counts = {v.value: int(np.count_nonzero(verdict == v)) for v in VERDICTS}
-    return {"n": n, **counts, "m_fss": counts[Verdict.CERTIFIED.value] / n if n else float("nan")}
+    return {"n": n, **counts,
+            "certified_row_share": counts[Verdict.CERTIFIED.value] / n if n else float("nan")}
 
 
 def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
@@ -375,7 +381,7 @@ class BatchResult:
         return {}
 
     def summary(self) -> dict[str, Any]:
-        """Counts per verdict and m_fss, the share certified as a fraction in [0, 1] (IDL eq 27)."""
+        """Counts per verdict and ``certified_row_share``, the share of rows certified (a fraction)."""
         return {**verdict_summary(self.verdict), **self.summary_extra()}
 
 

@@ -29,6 +29,7 @@ from ..params import (
     positive,
 )
 from ..ranges import check_magnitude, sensible_warning
+from ._outcome import command_name
 
 __all__ = [
     "NEGATIVE_NUMBER",
@@ -175,6 +176,9 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
         H > 0) or beyond the physical bound.
     """
     values = (args.tau, args.delta, args.headway)
+    # the reaction delay θ_r of the commands that take --reaction-delay (issue 25)
+    theta = getattr(args, "reaction_delay", None)
+    values += () if theta is None else (theta,)
     if any(":" in str(v) for v in values):
         model: Params | Box = parameter_model(*(str(v) for v in values))
     else:  # numbers: the point checks and messages ('tau ... must be ... > 0 s; got '0'')
@@ -186,7 +190,8 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     box = Box.of(model)
     warn_beyond_sensible(args, [("tau", box.tau[1], "--tau"), ("delta", box.delta[1], "--delta"),
                                 ("headway", box.headway[1], "--headway"),
-                                ("sample_time", H, "--sample-time")])
+                                ("sample_time", H, "--sample-time"),
+                                ("reaction_delay", box.reaction_delay[1], "--reaction-delay")])
     return model, H
 
 
@@ -561,8 +566,6 @@ def checked_leaders(args: Any, leaders: Any, limits: Any, *,
             text = w if len(leaders) == 1 else f"{leader.name}: {w}"
             if text not in out:
                 out.append(text)
-    command = getattr(args, "command", "")
-    sub = getattr(args, "hcfs_command", None)
     for w in out:
-        print(f"stringstab {command}{' ' + sub if sub else ''}: warning: {w}", file=sys.stderr)
+        print(f"{command_name(args)}: warning: {w}", file=sys.stderr)
     return out

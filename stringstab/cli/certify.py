@@ -18,7 +18,7 @@ import warnings
 from typing import Any
 
 from ..errors import StringStabError, show
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
 from ._common import (
     add_gain_arguments,
     add_model_arguments,
@@ -54,6 +54,7 @@ examples:
   stringstab certify 0.9,-0.5,1.1 --method pade         # also python-control's Padé numbers
   stringstab certify 1.2,0.5,0.6 --sample-time 0.1       # the loop sampled every 0.1 s (ZOH)
   stringstab certify 1.2,0.5,0.6 --tau 0.1:0.5 --delta 0.1:0.3   # every τ, δ in the box
+  stringstab certify 1.2,0.5,0.6 --reaction-delay 0.2   # the command applied 0.2 s late
 
 input files: CSV with a header k_x,k_v,k_a (a gain time series adds t and
 optionally vehicle), JSON (a list of {{"k_x","k_v","k_a"}} objects or of triples,
@@ -96,6 +97,9 @@ def add_parser(sub: Any) -> None:
     )
     add_gain_arguments(p)
     add_model_arguments(p)
+    p.add_argument("--reaction-delay", metavar="SECONDS",
+                   help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
+                        "(τ a' = u(t − θ_r) − a); continuous time only so far (default: 0)")
     p.add_argument("--method", choices=("exact", "pade"), default="exact",
                    help="exact: the sound certificate (default); pade: the same, plus "
                         "python-control's Padé + norm('inf') numbers, warning where they disagree")
@@ -168,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
     loop = Loop(model, H, method=args.method)
     out = check_output(args)
     if getattr(args, "from_identify", None):
-        return _run_identified(args, out, H)
+        return _run_identified(args, out, H, Box.of(model).reaction_delay[0])
     table = gains_from_args(args)
     check_horizon(H, table)
     from ..memory import refuse_if_too_big
@@ -191,6 +195,9 @@ def run(args: argparse.Namespace) -> int:
     if loop.kind == "continuous":
         params: dict[str, Any] = {"tau": model.tau, "delta": model.delta,
                                   "headway": model.headway, "method": args.method}
+        if model.reaction_delay:  # θ_r > 0 only (a θ_r = 0 run writes what it always did)
+            params = {**dict(list(params.items())[:3]), "reaction_delay": model.reaction_delay,
+                      "method": args.method}
     else:
         params = {**shown_params(model, H), "method": args.method}
     if args.method == "pade":
@@ -215,7 +222,7 @@ def _for_table(params: dict[str, Any]) -> dict[str, Any]:
     return {k: f"{v[0]:g}:{v[1]:g}" if isinstance(v, list) else v for k, v in params.items()}
 
 
-def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
+def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: float) -> int:
     """``certify --from identify.json``: each fitted vehicle at its own τ, δ, T* (or the intervals given)."""
     from ..certify.api import Loop
     from ..identify.report import read_identified
@@ -229,7 +236,8 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None) -> int:
     for r in rows:
         from ..params import parameter_model
 
-        loop = Loop(parameter_model(*(given.get(k, r[k]) for k in ("tau", "delta", "headway"))), H)
+        tau, delta, headway = (given.get(k, r[k]) for k in ("tau", "delta", "headway"))
+        loop = Loop(parameter_model(tau, delta, headway, theta), H)
         b = loop.certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]])
         c: dict[str, Any] = b.records()[0]
         rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}

@@ -88,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from ..io import OutputDir
+    from ..rl.compare import format_m_fss
     from ..rl.evaluate import BASELINES, evaluate, platoon_test
     from ..rl.report import write_comparison
     from ..rl.runs import open_run, test_leaders
@@ -131,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
             groups.setdefault(pol.algo, []).append(ev)
             print(f"{info['folder']} ({pol.algo}): TIT {ev.summary['TIT']:.3f}, "
                   f"M_CI {ev.summary['M_CI']:.3f}, collisions {ev.summary['collisions']}, "
-                  f"m_fss = {ev.summary['m_fss'] if ev.summary['m_fss'] is not None else 'n/a'}")
+                  f"m_fss = {format_m_fss(ev.summary['m_fss'])}")
             if args.platoon and pol.algo not in platoons:
                 platoons[pol.algo] = {"run": info["folder"], "tests": [platoon_test(
                     pol, 10, dt=dt, **kw)]}

@@ -38,13 +38,41 @@ def _step_derive(out: Path, log: Log) -> dict[str, Any]:
     atomic_write_text(out / "derive.json", d.json())
     atomic_write_text(out / "derive.tex", d.latex())
     atomic_write_text(out / "derive.txt", d.text())
-    wrong = [f"eq {e['equation']} ({e['key']})" for e in doc["errata"] if not e["matches"]]
+    wrong = [_errata_label(e) for e in doc["errata"] if not e["matches"]]
     log(f"derived Γ(s) = {doc['gamma']}")
     log(f"errata: {len(wrong)} printed formulas differ from the derivation: {', '.join(wrong)}")
     return {"files": ["derive.json", "derive.tex", "derive.txt"], "errata": wrong,
-            "gamma": doc["gamma"],
-            "errata_table": [{k: e[k] for k in ("equation", "name", "matches", "explanation")}
+            "gamma": doc["gamma"], "gamma_latex": _gamma_latex(d.exprs["gamma"]),
+            "errata_table": [{**{k: e[k] for k in ("equation", "name", "matches", "explanation")},
+                              "label": _errata_label(e),
+                              "tex": d.labels.get(e["key"], ("", ""))[1]}
                              for e in doc["errata"]]}
+
+
+def _errata_label(e: dict[str, Any]) -> str:
+    """How a printed formula is named for a reader: ``eq 11 (denominator of Γ(s))``.
+
+    Parameters
+    ----------
+    e : dict
+        One erratum (:meth:`stringstab.derive.errata.Erratum.as_dict`).
+
+    Returns
+    -------
+    str
+        ``eq N (name)`` for a numbered equation, the name alone otherwise (``Proposition 1
+        (logic)``).
+    """
+    eq = str(e["equation"])
+    return f"eq {eq} ({e['name']})" if eq.isdigit() else str(e["name"])
+
+
+def _gamma_latex(gamma: Any) -> str:
+    """Γ(s) in TeX, T* written as such (the derivation's symbol is ``headway``)."""
+    import sympy as sp
+
+    subs = {x: sp.Symbol("T^*") for x in gamma.free_symbols if x.name == "headway"}
+    return r"\Gamma(s) = " + sp.latex(gamma.subs(subs))
 
 
 #: Paper-style gain triples for the certify step: the two of ``stringstab certify --help``,
@@ -86,7 +114,8 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     for i in np.flatnonzero(~roll.certified).tolist():
         first_bad.setdefault(str(g.vehicle[i]), float(g.t[i]))
     log(f"gain time series ({ROLLOUT.name}): {s['certified']} of {s['n']} rows certified "
-        f"(m_fss = {s['m_fss']:.3f}); first uncertified t per vehicle: {first_bad}")
+        f"(certified_row_share = {s['certified_row_share']:.3f}, each row counted once); first "
+        f"uncertified t per vehicle: {first_bad}")
     return {
         "files": files,
         "params": params,
@@ -192,9 +221,9 @@ def _step_tune(out: Path, log: Log) -> dict[str, Any]:
     summary: dict[str, Any] = {}
     for method in dict.fromkeys(r["method"] for r in records):
         rs = [r for r in records if r["method"] == method]
-        moved = [r["distance"] for r in rs if r["status"] == "repaired"]
+        moved = [r["distance"] for r in rs if r["status"] in ("repaired", "moved_not_certified")]
         summary[method] = {"n": len(rs), "certified": sum(r["certified"] for r in rs),
-                           "repaired": len(moved),
+                           "repaired": sum(r["status"] == "repaired" for r in rs),
                            "median_distance_moved": float(np.median(moved)) if moved else 0.0}
     params = {**PARAMS, "method": "both"}
     columns = columns_from_records(records)

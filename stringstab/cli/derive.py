@@ -57,6 +57,11 @@ def add_parser(sub: Any) -> None:
         metavar="N|exact",
         help="Taylor order of e^{-δs} used for Ψ (default: exact delay; the paper's Ψ1 is 3)",
     )
+    p.add_argument("--reaction-delay", metavar="SECONDS",
+                   help="derive the loop with a reaction delay θ_r on the whole command (issue 25): "
+                        "Γ(s) with its quasi-polynomial denominator, g_θ(ω), Ψ with θ_r and the "
+                        "Taylor route's (wrong) Hurwitz tests; the same as --substitute "
+                        "reaction_delay=SECONDS")
     p.add_argument("--sample-time", metavar="H",
                    help="derive the sampled-data loop with period H s instead (H(z), Δ(z), Schur "
                         "conditions); --substitute may also set tau_prev")
@@ -80,7 +85,8 @@ def _delay_order(text: str) -> int | None:
 
 #: The range (:data:`stringstab.ranges.RANGES`) of each symbol ``--substitute`` may set.
 _SUBSTITUTE_KINDS = {"tau": "tau", "tau_prev": "tau", "delta": "delta", "headway": "headway",
-                     "k_x": "gain", "k_v": "gain", "k_a": "gain"}
+                     "reaction_delay": "reaction_delay", "k_x": "gain", "k_v": "gain",
+                     "k_a": "gain"}
 
 
 def _check_substitutions(args: argparse.Namespace) -> None:
@@ -126,6 +132,16 @@ def run(args: argparse.Namespace) -> int:
 
     delay_order = _delay_order(args.delay_order)
     _check_substitutions(args)
+    theta = getattr(args, "reaction_delay", None)
+    if theta is not None:  # θ_r (issue 25): checked as certify checks it, then substituted
+        from ..params import check_reaction_delay
+
+        check_reaction_delay(theta, "--reaction-delay (reaction delay θ_r)")
+        if args.sample_time is not None:
+            raise StringStabError(
+                "reaction_delay > 0 is derived in continuous time only so far; expected no "
+                f"--sample-time with --reaction-delay; got --sample-time {args.sample_time}")
+        args.substitute = ",".join(x for x in (args.substitute, f"reaction_delay={theta}") if x)
     H = None
     if args.sample_time is not None:
         from ..ranges import check_magnitude

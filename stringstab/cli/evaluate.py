@@ -123,15 +123,21 @@ def run(args: argparse.Namespace) -> int:
                                  command=command_line(args), verdict=verdict, passed=passed,
                                  started=t0).write(out)
     print(f"evaluated {info['folder']} ({policy.algo}) on {s['episodes']} held-out episodes ({desc})")
-    fss = "n/a" if s["m_fss"] is None else f"{s['m_fss']:.4g}"
+    from ..ranges import metric_caveat
+    from ..rl.compare import format_m_fss
+
+    fss = format_m_fss(s["m_fss"])
     mlss = "n/a" if s["M_lss"] is None else f"{s['M_lss']:.3f}"
     if s.get("m_fss_sampled") is not None:
         fss += f" (sampled-data at dt={p['dt']} s: {s['m_fss_sampled']:.4g})"
     print(f"m_fss = {fss} of {s.get('n_gains', 0)} executed gains, collisions {s['collisions']}, "
           f"TIT {s['TIT']:.3f}, M_CI {s['M_CI']:.3f}, M_effi {s['M_effi']:.3f}, M_lss {mlss}")
+    for k in ("TIT", "M_CI", "M_effi", "M_lss"):
+        if metric_caveat(k, s.get(k)):
+            print(f"note: {k} = {s[k]:.3g} {metric_caveat(k, s[k])}")
     for q in platoons:
         print(f"platoon of {q['n']}: max m_p {q['max_m_p']:.3f}, collisions {q['collisions']}, "
-              f"m_fss = {q['m_fss'] if q['m_fss'] is not None else 'n/a'}")
+              f"m_fss = {format_m_fss(q['m_fss'])}")
     print(f"verdict: {verdict}")
     print(f"wrote {', '.join(files)} to {out.root}/")
     return 0 if passed else 1

@@ -22,7 +22,8 @@ __all__ = ["add_parser", "run"]
 
 _EPILOG = """\
 examples:
-  stringstab identify ../shared/data/openacc/zalazone_acc_short_dynamic_part1.csv --out runs/acc
+  stringstab identify --example acc --out runs/acc                    # a shipped OpenACC log
+  stringstab identify stringstab/data/openacc/zalazone_human_handling_part22.csv.gz --out runs/human
   stringstab identify platoon.csv --model cacc --bootstrap 200 --out runs/cacc
   stringstab identify log.csv --sample-time 0.1 --out runs/sampled   # certify the 10 Hz loop
   stringstab certify --from runs/acc/identify.json                    # re-certify the fits
@@ -32,7 +33,9 @@ log formats: OpenACC (metadata lines, Time, Speedk, Ek, Nk, ..., IVSk); CSV with
 t,v_lead,v,gap (one follower), t,v0,v1,gap1,v2,gap2,... (a platoon) or a long table
 vehicle,t,v,gap (platoon order, leader first); optional a columns (needed by --model cacc);
 units SI unless the header says '[km/h]'; an NGSIM US-101/I-80 trajectory file (its
-leader-follower pairs). Missing cells split the record; nothing is interpolated.
+leader-follower pairs); any of them gzip-compressed (.csv.gz). Missing cells split the record;
+nothing is interpolated. --example acc|human: the two OpenACC logs shipped in
+stringstab/data/openacc/ (JRC, CC BY 4.0; cite Makridis et al. 2021, see the README there).
 
 See docs/identify.md.
 """
@@ -59,7 +62,11 @@ def add_parser(sub: Any) -> None:
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("log", metavar="LOG", help="the recorded platoon (OpenACC, CSV or NGSIM file)")
+    p.add_argument("log", metavar="LOG", nargs="?",
+                   help="the recorded platoon (OpenACC, CSV or NGSIM file, plain or .gz)")
+    p.add_argument("--example", choices=("acc", "human"),
+                   help="instead of LOG, a shipped OpenACC log: acc (6 cars on factory ACC) or "
+                        "human (11 cars driven by people)")
     p.add_argument("--model", choices=("acc", "cacc"), default="acc",
                    help="acc: k_a = 0 (default); cacc: also k_a and δ (needs the predecessor's acceleration)")
     p.add_argument("--sample-time", metavar="H",
@@ -121,8 +128,13 @@ def run(args: argparse.Namespace) -> int:
                             ("duration", min_seg, "--min-segment")):
         if v is not None:
             check_magnitude(kind, v, name=option)
+    if (args.log is None) == (args.example is None):
+        raise StringStabError("expected a log file LOG or --example acc|human (one of the two); "
+                              f"got {'both' if args.log else 'neither'}")
     out = OutputDir(args.out, command="identify", what="--out")
-    logs = read_logs(args.log, min_duration=min_seg)
+    from ..identify.logs import example_log
+
+    logs = read_logs(args.log or example_log(args.example), min_duration=min_seg)
     warn_beyond_sensible(args, [("sample_time", H, "--sample-time"), ("refits", B, "--bootstrap"),
                                 ("starts", starts, "--starts")])
     from ..identify import identify

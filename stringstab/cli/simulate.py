@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from typing import Any
 
 import numpy as np
@@ -21,7 +20,7 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import check_params
-from ..ranges import check_magnitude
+from ..ranges import check_magnitude, metric_caveat
 from ._common import (
     add_limit_arguments,
     add_vehicle_arguments,
@@ -30,8 +29,9 @@ from ._common import (
     limits_from_args,
     warn_beyond_sensible,
 )
+from ._outcome import collision_status
 
-__all__ = ["DEFAULT_GAINS", "add_parser", "parse_gains", "run"]
+__all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "run"]
 
 #: A certified triple at the default τ, δ, T* (internally stable, sup_ω |Γ(jω)| = 1 at ω = 0).
 DEFAULT_GAINS = "1.2,0.5,0.6"
@@ -282,12 +282,29 @@ def run(args: argparse.Namespace) -> int:
           f"M_CI = {_fmt(metrics.get('M_CI'), '.4g', ' m²/s⁶')}, "
           f"M_effi = {_fmt(metrics.get('M_effi'), '.3f', ' s')}, "
           f"m_fss = {_fmt(metrics['m_fss'], '.3f')} (share of vehicle-moments certified)")
+    for k in ("max_m_p", "M_lss", "TIT", "M_CI", "M_effi"):
+        if metric_caveat(k, metrics.get(k)):
+            print(f"note: {k} = {metrics[k]:.3g} {metric_caveat(k, metrics[k])}")
     print(f"wrote {', '.join(files.values())} to {out.root}/")
-    if metrics["collisions"]:
-        first = np.asarray(result.first_collision_time, dtype=float).ravel()
-        who = int(np.nanargmin(first)) + 1
-        print(f"stringstab simulate: warning: {metrics['collisions']} collision(s): follower {who} "
-              f"first reached its predecessor at t = {float(np.nanmin(first)):.4g} s (m_fss = "
-              f"{_fmt(metrics['m_fss'], '.3f')}); exit status 1", file=sys.stderr)
-        return 1
-    return 0
+    return collision_status(args, metrics["collisions"], first_collision(result),
+                            metrics["m_fss"])
+
+
+def first_collision(result: Any) -> str:
+    """Who of a simulated platoon collided first, and when (for the collision warning).
+
+    Parameters
+    ----------
+    result : PlatoonResult
+        A run with at least one collision (its ``first_collision_time`` per follower, s).
+
+    Returns
+    -------
+    str
+        ``"follower I first reached its predecessor at t = T s"`` (or ``""`` without one).
+    """
+    first = np.asarray(result.first_collision_time, dtype=float).ravel()
+    if not np.isfinite(first).any():
+        return ""
+    who = int(np.nanargmin(first)) + 1
+    return f"follower {who} first reached its predecessor at t = {float(np.nanmin(first)):.4g} s"

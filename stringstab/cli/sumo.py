@@ -4,7 +4,10 @@
   differences in acceleration, speed, gap and m_p; exit 1 above the tolerance (1e-3);
 * ``sumo run`` — a platoon (fixed gains, a gain file or a trained policy) driven in SUMO,
   writing what ``stringstab simulate`` writes; or, with ``--sumocfg``, named vehicles of an
-  existing scenario driven by the controller, each following whatever SUMO says leads it;
+  existing scenario driven by the controller, each following whatever SUMO says leads it.
+  Exit 1 (outputs written, one warning line each) when a vehicle collided, as ``simulate``,
+  or when a controlled vehicle of the scenario never had a leader (the controller never drove
+  it);
 * ``sumo cacc`` — SUMO's own CACC vType: per-mode equivalent linear gains, their certificates
   (continuous and sampled) and the amplification SUMO measures along a 10-vehicle platoon.
 
@@ -31,7 +34,7 @@ HELP = "run certified and learned controllers inside Eclipse SUMO (check, run, c
 
 def _case_arguments(p: argparse.ArgumentParser, *, policy: bool) -> None:
     from ..constants import DT
-    from ._common import add_vehicle_arguments
+    from ._common import add_limit_arguments, add_vehicle_arguments
     from .simulate import DEFAULT_GAINS
 
     p.add_argument("--leader", default="udds", metavar="SPEC",
@@ -56,6 +59,7 @@ def _case_arguments(p: argparse.ArgumentParser, *, policy: bool) -> None:
                    help="then hold the leader's final speed S seconds")
     p.add_argument("--api", choices=("libsumo", "traci"), default="libsumo",
                    help="libsumo in this process (default) or TraCI to a SUMO subprocess on 127.0.0.1")
+    add_limit_arguments(p)  # the followers' limits, as simulate's
 
 
 def add_parser(sub: Any) -> None:
@@ -92,7 +96,9 @@ def add_parser(sub: Any) -> None:
                     "M_CI, M_effi, m_fss, collisions) and figures as 'stringstab simulate' does. "
                     "With --sumocfg FILE --controlled ID,...: those vehicles of the scenario are "
                     "driven by the controller, each following the vehicle SUMO reports as its "
-                    "leader at every step, and the rest of the traffic is SUMO's.")
+                    "leader at every step, and the rest of the traffic is SUMO's. Exit 0; 1 when "
+                    "a vehicle collided or a controlled vehicle never had a leader (outputs "
+                    "written, a warning says which); 2 on bad input.")
     _case_arguments(r, policy=True)
     r.add_argument("--sumocfg", metavar="FILE",
                    help="an existing scenario (its step-length must be --dt and it must use "
@@ -156,12 +162,15 @@ def _number(name: str, v: float | None, *, zero: bool = False) -> None:
         raise StringStabError(f"--{name} must be a finite number {'>=' if zero else '>'} 0; got {show(v)}")
 
 
-def _case(args: argparse.Namespace) -> dict[str, Any]:
-    """Leader, controller, τ, δ, T*, dt of a case; with ``--policy`` the policy's own."""
+def _case(args: argparse.Namespace, *, leader: bool = True) -> dict[str, Any]:
+    """Leader, controller, τ, δ, T*, dt, limits of a case; with ``--policy`` the policy's own.
+
+    Without ``leader`` (a scenario of SUMO's: its own traffic leads) no leader is built.
+    """
     from ..constants import DT
     from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, check_params
     from ..traffic.leaders import leader_by_name
-    from ..traffic.limits import check_leader
+    from ._common import checked_leaders, limits_from_args
     from .simulate import parse_gains
 
     for name in ("standstill", "length", "dt", "duration", "tau", "delta", "headway", "hold"):
@@ -200,8 +209,11 @@ def _case(args: argparse.Namespace) -> dict[str, Any]:
             f"--dt {dt:g} s is longer than the actuator lag tau = {tau:g} s or the delay "
             f"delta = {delta:g} s: the run would not be the loop the certificate describes; "
             f"expected --dt <= {limit:g} s")
-    leader = leader_by_name(args.leader, dt=dt, duration=args.duration).hold(args.hold)
-    warnings = check_leader(leader)
+    limits = limits_from_args(args)
+    lead, warnings = None, []
+    if leader:
+        lead = leader_by_name(args.leader, dt=dt, duration=args.duration).hold(args.hold)
+        warnings = checked_leaders(args, [lead], limits)  # printed on stderr
     if policy is not None:
         from ..rl.evaluate import controller_for
 
@@ -225,8 +237,9 @@ def _case(args: argparse.Namespace) -> dict[str, Any]:
         controller = LinearController(*parse_gains(args.gains or DEFAULT_GAINS), headway=headway,
                                       standstill=args.standstill)
         label = f"K=({args.gains or DEFAULT_GAINS})"
-    return {"leader": leader, "controller": controller, "tau": tau, "delta": delta,
-            "headway": headway, "dt": dt, "warnings": warnings, "label": label, **info}
+    return {"leader": lead, "controller": controller, "tau": tau, "delta": delta,
+            "headway": headway, "dt": dt, "limits": limits, "warnings": warnings, "label": label,
+            **info}
 
 
 def run_check(args: argparse.Namespace) -> int:
@@ -250,11 +263,9 @@ def run_check(args: argparse.Namespace) -> int:
     _number("tolerance", args.tolerance)
     target = check_output_file(args.json, what="--json") if args.json else None
     case = _case(args)
-    for w in case["warnings"]:
-        print(f"stringstab sumo check: warning: {w}", file=sys.stderr)
     res = agreement(case["leader"], case["controller"], args.followers, tau=case["tau"],
                     delta=case["delta"], api=args.api, length=args.length,
-                    tolerance=args.tolerance, progress=True)
+                    limits=case["limits"], tolerance=args.tolerance, progress=True)
     d, de = res["differences"], res["differences_exact_positions"]
     lead = case["leader"]
     print(f"sumo check: {lead.name} ({lead.duration:g} s, dt = {case['dt']:g} s), "
@@ -294,12 +305,15 @@ def run_platoon(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        Exit code: 0 when the run was written; bad input raises
-        :class:`~stringstab.errors.StringStabError` (exit 2 from
-        :func:`stringstab.cli.main`).
+        Exit code: 0 when the run was written without collision; 1 when a vehicle collided
+        or (``--sumocfg``) a controlled vehicle never had a leader, the outputs written and a
+        warning printed; bad input raises :class:`~stringstab.errors.StringStabError`
+        (exit 2 from :func:`stringstab.cli.main`).
     """
     from ..io import OutputDir
     from ..traffic.output import RUN_FILES, run_document, write_run
+    from ._outcome import collision_status
+    from .simulate import first_collision
 
     if (args.sumocfg is None) != (args.controlled is None):
         raise StringStabError("--sumocfg and --controlled go together; expected both or neither, "
@@ -309,13 +323,11 @@ def run_platoon(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     out = OutputDir(args.out, command="sumo run", owns=RUN_FILES, what="--out")
     case = _case(args)
-    for w in case["warnings"]:
-        print(f"stringstab sumo run: warning: {w}", file=sys.stderr)
     from ..sumo.platoon import cosimulate
 
     leader, controller = case["leader"], case["controller"]
     result = cosimulate(leader, controller, args.followers, tau=case["tau"], delta=case["delta"],
-                        api=args.api, length=args.length, progress=True)
+                        api=args.api, limits=case["limits"], length=args.length, progress=True)
     warnings = list(case["warnings"])
     over = float(result.params["sumo_speed_override"])
     if over > 1e-9:
@@ -350,7 +362,7 @@ def run_platoon(args: argparse.Namespace) -> int:
         print(f"executed gains: m_fss = {e['m_fss']:.4g} certified (exact), "
               f"{e['m_fss_sampled']:.4g} (sampled-data at dt = {case['dt']:g} s) of {e['n']}")
     print(f"wrote {', '.join(files.values())} to {out.root}/")
-    return 0
+    return collision_status(args, doc["collisions"], first_collision(result), doc["m_fss"])
 
 
 def _print_summary(head: str, doc: dict[str, Any]) -> None:
@@ -375,6 +387,7 @@ def _run_scenario(args: argparse.Namespace) -> int:
 
     from ..io import OutputDir, write_results
     from ..sumo.inscenario import run_scenario
+    from ._outcome import collision_status
 
     t0 = time.perf_counter()
     if args.steps is not None and args.steps < 1:
@@ -383,10 +396,10 @@ def _run_scenario(args: argparse.Namespace) -> int:
     if not all(ids):
         raise StringStabError(f"--controlled: expected vehicle ids ID,ID,...; got {args.controlled!r}")
     out = OutputDir(args.out, command="sumo run", owns=SCENARIO_FILES, what="--out")
-    case = _case(args)
+    case = _case(args, leader=False)
     res = run_scenario(args.sumocfg, ids, case["controller"], dt=case["dt"], tau=case["tau"],
                        delta=case["delta"], api=args.api, steps=args.steps,
-                       progress=args.steps is not None)
+                       limits=case["limits"], progress=args.steps is not None)
     cols = dict(res.columns)
     cols["vehicle"] = np.array([res.ids[j] for j in cols["vehicle"]], dtype=object)
     doc = {"run": {"sumocfg": str(args.sumocfg), "controlled": res.ids, "dt": case["dt"],
@@ -411,7 +424,35 @@ def _run_scenario(args: argparse.Namespace) -> int:
         print(f"executed gains: m_fss = {s['m_fss']:.4g} certified (exact), "
               f"{s['m_fss_sampled']:.4g} (sampled-data at dt = {case['dt']:g} s) of {s['n_gains']}")
     print(f"wrote {', '.join(SCENARIO_FILES)} to {out.root}/")
-    return 0
+    return max(_without_leader(args, s), collision_status(
+        args, s["collisions"], _first_scenario_collision(res), s.get("m_fss")))
+
+
+def _without_leader(args: argparse.Namespace, summary: dict[str, Any]) -> int:
+    """1 with a warning per controlled vehicle that never had a leader (never driven), else 0."""
+    from ..sumo.inscenario import LOOKAHEAD
+    from ._outcome import command_name
+
+    steps = {v["vehicle"]: v["steps_present"] for v in summary["vehicles"]}
+    for vid in summary["without_leader"]:
+        print(f"{command_name(args)}: warning: vehicle {vid!r} never had a leader within "
+              f"{LOOKAHEAD:g} m in its {steps[vid]} steps, so SUMO's own model drove it "
+              "throughout and the controller was never exercised; exit status 1",
+              file=sys.stderr)
+    return 1 if summary["without_leader"] else 0
+
+
+def _first_scenario_collision(res: Any) -> str:
+    """Which controlled vehicle first reached its leader, and when (empty without collision)."""
+    c = res.columns
+    if not c["t"].size:
+        return ""
+    hit = np.flatnonzero((c["controlled"] == 1) & (c["gap"] <= 0))
+    if not hit.size:
+        return ""
+    k = int(hit[0])
+    return (f"vehicle {res.ids[int(c['vehicle'][k])]!r} first reached its leader "
+            f"{str(c['leader'][k])!r} at t = {float(c['t'][k]):.4g} s")
 
 
 SWITCHING_NOTE = (

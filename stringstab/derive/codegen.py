@@ -498,6 +498,10 @@ def _source() -> str:
         "denominator_abs2_coefficients", gain_args, sp.Poly(d_abs2, x).all_coeffs(),
         "Coefficients of |D(jω)|² as a polynomial in x = ω², highest power first.",
     ))
+    # ---- the reaction delay θ_r (issue 25): stringstab.derive.codegen_reaction
+    from .codegen_reaction import reaction_blocks
+
+    blocks.extend(reaction_blocks(_function))
     # two blank lines between top-level statements (PEP 8)
     return _HEADER + "\n" + "\n\n\n".join(b.strip("\n") for b in blocks) + "\n"
 

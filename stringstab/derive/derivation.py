@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
-__all__ = ["Derivation", "derivation", "sampled_derivation"]
+__all__ = ["Derivation", "derivation", "reaction_derivation", "sampled_derivation"]
 
 _LABELS = {
     "gamma": ("Γ(s)", r"\Gamma(s)"),
@@ -40,6 +40,22 @@ _SAMPLED_LABELS = {
     "dc_margin": ("c2 (θ² coefficient of |D|² - |N|²; H² φ1⁴ Ψ3 when tau_prev = tau)", r"c_2"),
 }
 
+
+_REACTION_LABELS = {
+    "gamma": ("Γ(s)", r"\Gamma(s)"),
+    "gamma_numerator": ("N(s)", r"N(s)"),
+    "gamma_denominator": ("D(s) = P(s) + exp(-reaction_delay*s) Q(s)", r"D(s)"),
+    "denominator_P": ("P(s)", r"P(s)"),
+    "denominator_Q": ("Q(s)", r"Q(s)"),
+    "margin": ("g_θ(ω) = (|D(jω)|² - |N(jω)|²)/ω²", r"g_\theta(\omega)"),
+    "psi1": ("Ψ1 (with θ_r)", r"\Psi_1"),
+    "psi2": ("Ψ2 (with θ_r)", r"\Psi_2"),
+    "psi3": ("Ψ3 (with θ_r)", r"\Psi_3"),
+    "lambda": ("Λ (with θ_r)", r"\Lambda"),
+    "taylor1_hurwitz": ("Taylor route, exp(-θ_r s) ≈ 1 - θ_r s: Hurwitz (each > 0; NOT a certificate)",
+                        r"\text{Taylor}"),
+    "pade11_hurwitz": ("Padé(1,1) route: Hurwitz (each > 0; NOT a certificate)", r"\text{Pad\'e}"),
+}
 
 
 @dataclass(frozen=True)
@@ -94,6 +110,14 @@ def derivation(
     """
     from .symbolic import derive_all, parse_substitutions
 
+    if substitute and "reaction_delay" in substitute:  # θ_r (issue 25): its own derivation
+        from .symbolic import SUBSTITUTABLE
+
+        theta = parse_substitutions(substitute, {**SUBSTITUTABLE, "reaction_delay": _theta()})
+        if theta.get(_theta(), 0) != 0:
+            return reaction_derivation(substitute, delay_order, with_errata)
+        substitute = ",".join(x for x in substitute.split(",")
+                              if x.partition("=")[0].strip() != "reaction_delay")
     subs = parse_substitutions(substitute)
     exprs = derive_all(delay_order, subs)
     doc: dict[str, Any] = {}
@@ -113,6 +137,70 @@ def derivation(
         kw = {str(k): float(v) for k, v in subs.items() if str(k) in ("tau", "delta", "headway")}
         doc["errata"] = [e.as_dict() for e in errata(**kw)]
     return Derivation(exprs, doc)
+
+
+def _theta() -> Any:
+    from .reaction import reaction_delay
+
+    return reaction_delay
+
+
+def reaction_derivation(substitute: str | None = None, delay_order: int | None = None,
+                        with_errata: bool = False) -> Derivation:
+    """Derive the loop with a reaction delay θ_r (issue 25): ``derive --reaction-delay``.
+
+    Γ(s) with e^{−θ_r s} on the whole command, its quasi-polynomial denominator
+    D = P + e^{−θ_r s}Q, the margin g_θ(ω), Ψ1-Ψ3 and Λ with θ_r, and what the Taylor route
+    would test for internal stability (e^{−θ_r s} ≈ 1 − θ_r s, or Padé(1,1): Hurwitz
+    determinants of a cubic or quartic — not a certificate; docs/theory.md)
+    (:mod:`stringstab.derive.reaction`).
+
+    Parameters
+    ----------
+    substitute : str, optional
+        ``"tau=0.1,delta=0.2,headway=1.1,reaction_delay=0.2"``-style specialisation.
+    delay_order, with_errata
+        Refused: ``--delay-order`` and ``--errata`` are about the θ_r = 0 loop's Ψ.
+
+    Returns
+    -------
+    Derivation
+        With the keys of :func:`stringstab.derive.reaction.derive_reaction`.
+
+    Raises
+    ------
+    StringStabError
+        On a bad substitution, or with ``delay_order`` or ``with_errata``.
+
+    Examples
+    --------
+    >>> d = reaction_derivation("tau=0.1,delta=0.2,headway=1.1,reaction_delay=0.2")
+    >>> d.document["denominator_Q"]
+    'k_x + s*(k_v + 11*k_x/10)'
+    """
+    from ..errors import StringStabError
+    from .reaction import derive_reaction
+    from .symbolic import SUBSTITUTABLE, parse_substitutions
+
+    if delay_order is not None or with_errata:
+        raise StringStabError(
+            "--errata and --delay-order are about the θ_r = 0 loop's Ψ (IDL eqs 12-15); expected "
+            f"neither with a reaction delay; got {'--errata' if with_errata else '--delay-order'}")
+    subs = parse_substitutions(substitute, {**SUBSTITUTABLE, "reaction_delay": _theta()})
+    exprs = derive_reaction(subs)
+    doc: dict[str, Any] = {k: [str(v) for v in val] if isinstance(val, list) else str(val)
+                           for k, val in exprs.items()}
+    doc["symbols"] = ["k_x", "k_v", "k_a", "tau", "delta", "headway", "reaction_delay", "s", "omega"]
+    doc["substitute"] = {str(k): str(v) for k, v in subs.items()}
+    doc["conventions"] = {
+        "model": "tau a' = u(t - reaction_delay) - a: the whole command applied reaction_delay s late",
+        "psi": "Psi1, Psi2, Psi3 are the omega^4, omega^2, omega^0 coefficients of the margin g",
+        "stability": "D(s) is a quasi-polynomial (infinitely many roots): no finite set of "
+                     "conditions decides it; stringstab certify --reaction-delay counts its roots "
+                     "in Re s > 0 exactly (argument principle); the taylor1/pade11 conditions are "
+                     "what a Taylor or Pade(1,1) treatment would test, and can be wrong",
+    }
+    return Derivation(exprs, doc, dict(_REACTION_LABELS))
 
 
 _IMPACT_WORDS = {
@@ -139,11 +227,14 @@ def _text(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[st
         lines = [f"# stringstab derive --sample-time {doc['sample_time']}: the sampled-data loop "
                  "(zero-order hold, exact lag and delay), derived from the IDL model (eqs 3-9)",
                  f"# delay: {doc['delay']}"]
+    elif "reaction_delay" in doc.get("symbols", []):
+        lines = ["# stringstab derive: derived from the IDL model (eqs 3-9) with a reaction delay "
+                 "θ_r on the whole command (issue 25)"]
     else:
         lines = ["# stringstab derive: derived from the IDL model (eqs 3-9)"]
     if doc["substitute"]:
         unit = {"tau": " s", "tau_prev": " s", "delta": " s", "headway": " s",
-                "sample_time": " s", "k_x": " 1/s²", "k_v": " 1/s"}
+                "sample_time": " s", "k_x": " 1/s²", "k_v": " 1/s", "reaction_delay": " s"}
         lines.append("# substituted: " + ", ".join(f"{k}={v}{unit.get(k, '')}"
                                                     for k, v in doc["substitute"].items()))
     if "delay_order" in doc:
@@ -176,6 +267,7 @@ def _latex(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[s
     import sympy as sp
 
     syms = {sp.Symbol("headway", positive=True): sp.Symbol("T^*"),
+            sp.Symbol("reaction_delay", nonnegative=True): sp.Symbol(r"\theta_r"),
             sp.Symbol("sample_time", positive=True): sp.Symbol("H"),
             sp.Symbol("tau_prev", positive=True): sp.Symbol(r"\tau_p")}
     out = ["% stringstab derive --format latex (needs amsmath)", r"\begin{align*}"]
@@ -185,7 +277,8 @@ def _latex(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[s
         if isinstance(val, dict):
             rows.extend(sp.latex(sp.Symbol(k)) + " &= " + sp.latex(sp.sympify(v).subs(syms))
                         for k, v in val.items())
-        elif key in ("hurwitz", "schur_conditions", "schur_conditions_gains"):
+        elif key in ("hurwitz", "schur_conditions", "schur_conditions_gains", "taylor1_hurwitz",
+                     "pade11_hurwitz"):
             rows.append(tex + r" &:\ " + r",\quad ".join(sp.latex(v.subs(syms)) + " > 0" for v in val))
         elif isinstance(val, list):
             rows.append(

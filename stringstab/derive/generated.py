@@ -572,3 +572,197 @@ def denominator_abs2_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta:
         (k_v*k_v) - _x0 + _x1*k_v + _x2*(headway*headway),
         _x2,
     )
+
+
+#: Names of the coefficients returned by :func:`reaction_margin_coefficients`.
+REACTION_MARGIN_COEFFICIENTS = ('t2', 'a', 'b', 'cx', 'cv', 'r0', 'r2', 'r1')
+
+
+#: (name, trigonometric factor, power of ω) of each coefficient of g_θ.
+REACTION_MARGIN_BASIS = (('t2', '1', 4), ('a', '1', 2), ('b', '1', 0), ('cx', 'cos_delta', 0), ('cv', 'sin_delta', 1), ('r0', 'cos_reaction', 0), ('r2', 'cos_reaction', 2), ('r1', 'sin_reaction', 1))
+
+
+def reaction_margin_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """(t2, a, b, cx, cv, r0, r2, r1) of g_θ(ω) = t2 ω⁴ + a ω² + b + cx cos δω − cv ω sin δω + r0 cos θ_rω + r2 ω² cos θ_rω + r1 ω sin θ_rω (issue 25)."""
+    _x0 = 2*k_x
+    _x1 = _x0*headway
+    _x2 = 2*k_v
+    return (
+        (tau*tau),
+        1 - (k_a*k_a),
+        _x1*k_v + (k_x*k_x)*(headway*headway),
+        _x0*k_a,
+        _x2*k_a,
+        -_x0,
+        -_x1*tau - _x2*tau,
+        -_x1 - _x2 + 2*k_x*tau,
+    )
+
+
+def reaction_margin_coefficient_scales(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """Σ |term| of each coefficient of :func:`reaction_margin_coefficients` (round-off scales)."""
+    _x0 = 2*abs(k_x)
+    _x1 = 2*abs(k_v)
+    _x2 = _x0*headway
+    return (
+        (tau*tau),
+        1 + (k_a*k_a),
+        (k_x*k_x)*(headway*headway) + 2*headway*abs(k_v*k_x),
+        2*abs(k_a*k_x),
+        2*abs(k_a*k_v),
+        _x0,
+        _x1*tau + _x2*tau,
+        _x1 + _x2 + _x0*tau,
+    )
+
+
+def reaction_margin_and_scale(omega: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, r0: Any, r2: Any, r1: Any, s_t2: Any, s_a: Any, s_b: Any, s_cx: Any, s_cv: Any, s_r0: Any, s_r2: Any, s_r1: Any, delta: Any, reaction_delay: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(g_θ(ω), Σ |term of g_θ(ω)|·(1 + its angle)) from the coefficients and their scales."""
+    _x0 = (omega*omega)
+    _x1 = delta*omega
+    _x2 = reaction_delay*omega
+    _x3 = cos(_x2)
+    _x4 = _x0*_x0
+    _x5 = 1 + _x1
+    _x6 = 1 + _x2
+    return (
+        b + _x0*a + _x3*r0 + _x4*t2 + cx*cos(_x1) + _x0*_x3*r2 + r1*omega*sin(_x2) - cv*omega*sin(_x1),
+        s_b + _x0*s_a + _x4*s_t2 + _x5*s_cx + _x6*s_r0 + _x0*_x6*s_r2 + _x5*s_cv*omega + _x6*s_r1*omega,
+    )
+
+
+def reaction_margin_curvature_bound(r: Any, t2: Any, a: Any, b: Any, cx: Any, cv: Any, r0: Any, r2: Any, r1: Any, delta: Any, reaction_delay: Any) -> Any:
+    """M ≥ |g_θ''(ω)| for every ω in [0, r], from the coefficients."""
+    _x0 = abs(r2)
+    _x1 = (reaction_delay*reaction_delay)
+    _x2 = (delta*delta)
+    _x3 = abs(r1)
+    _x4 = abs(cv)
+    _x5 = (r*r)
+    return 2*_x0 + 2*abs(a) + _x1*abs(r0) + _x2*abs(cx) + 2*_x3*reaction_delay + 2*_x4*delta + 12*_x5*t2 + _x0*_x1*_x5 + _x1*_x3*r + _x2*_x4*r + 4*_x0*r*reaction_delay
+
+
+def reaction_gamma_parts(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(Re N(jω), Im N(jω), Re D(jω), Im D(jω)) of Γ = N/D with the reaction delay."""
+    _x0 = reaction_delay*omega
+    _x1 = sin(_x0)
+    _x2 = delta*omega
+    _x3 = (omega*omega)
+    _x4 = _x3*k_a
+    _x5 = _x4*sin(_x2)
+    _x6 = cos(_x0)
+    _x7 = _x4*cos(_x2)
+    _x8 = _x6*k_x
+    _x9 = k_v*omega
+    _x10 = _x8 + _x1*_x9
+    _x11 = _x1*k_x
+    _x12 = -_x11 + _x6*_x9
+    _x13 = headway*omega
+    return (
+        _x10 + _x1*_x5 - _x6*_x7,
+        _x12 + _x1*_x7 + _x5*_x6,
+        _x10 - _x3 + _x11*_x13,
+        _x12 + _x13*_x8 - _x3*omega*tau,
+    )
+
+
+def reaction_denominator_parts(omega: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any, cos: Any = _np_cos, sin: Any = _np_sin) -> tuple[Any, ...]:
+    """(Re D(jω), Im D(jω), S(ω)) of D = P + e^{−θ_r s}Q; S = Σ|p_k|ω^k + (1 + θ_rω)Σ|q_k|ω^k bounds the terms (and the angle's round-off)."""
+    _x0 = (omega*omega)
+    _x1 = reaction_delay*omega
+    _x2 = cos(_x1)
+    _x3 = _x2*k_x
+    _x4 = sin(_x1)
+    _x5 = k_v*omega
+    _x6 = _x4*k_x
+    _x7 = headway*omega
+    _x8 = _x0*omega*tau
+    _x9 = abs(k_x)
+    return (
+        _x3 - _x0 + _x4*_x5 + _x6*_x7,
+        -_x6 - _x8 + _x2*_x5 + _x3*_x7,
+        _x0 + _x8 + (1 + _x1)*(_x9 + omega*(_x9*headway + abs(k_v))),
+    )
+
+
+def reaction_denominator_slope_bound(r: Any, k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> Any:
+    """L ≥ |d D(jω)/dω| for every ω in [0, r]: Σ k|p_k| r^{k−1} + Σ k|q_k| r^{k−1} + θ_r Σ |q_k| r^k."""
+    _x0 = abs(k_x)
+    _x1 = _x0*reaction_delay
+    _x2 = abs(k_v)
+    return _x1 + _x2 + 2*r + _x0*headway + 3*tau*(r*r) + _x1*r*headway + _x2*r*reaction_delay
+
+
+#: How many of :func:`reaction_denominator_coefficients` belong to P(s).
+REACTION_DENOMINATOR_SPLIT = 4
+
+
+def reaction_denominator_coefficients(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """Coefficients of D = P + e^(−θ_r s)Q, highest power first: 4 of P, then 2 of Q."""
+    return (
+        tau,
+        1,
+        0,
+        0,
+        k_v + k_x*headway,
+        k_x,
+    )
+
+
+def psi_reaction(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """(Ψ1, Ψ2, Ψ3) with the reaction delay: the ω⁴, ω², ω⁰ coefficients of g_θ (eqs 12-14)."""
+    _q0 = (delta*delta)
+    _x0 = k_x/12
+    _x1 = (reaction_delay*reaction_delay*reaction_delay)/3
+    _x2 = (reaction_delay*reaction_delay)
+    _x3 = k_v*tau
+    _x4 = _x1*k_x
+    _x5 = headway*tau
+    _x6 = 2*k_v
+    _x7 = 2*k_x
+    return (
+        (tau*tau) + _x1*k_v + _x2*_x3 + _x4*headway - _x0*(_x2*_x2) - _x4*tau + _x0*k_a*(_q0*_q0) + _x2*_x5*k_x + _q0*k_a*k_v*delta/3,
+        1 - (k_a*k_a) - 2*_x3 + _x2*k_x - _x5*_x7 - _x6*reaction_delay - _q0*k_a*k_x - _x6*k_a*delta - _x7*reaction_delay*headway + 2*k_x*reaction_delay*tau,
+        -_x7 + _x7*k_a + (k_x*k_x)*(headway*headway) + _x7*k_v*headway,
+    )
+
+
+def reaction_taylor1_hurwitz(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """Hurwitz determinants of D with e^(−θ_r s) replaced by taylor1 (each > 0): the Taylor route's stability test, not a certificate."""
+    _x0 = k_v*reaction_delay
+    _x1 = k_x*headway
+    _x2 = (k_x*k_x)
+    _x3 = (reaction_delay*reaction_delay)
+    _x4 = -k_v + k_x*reaction_delay + k_x*tau + reaction_delay*(k_v*k_v) - k_x*headway + 2*_x0*_x1 + _x2*reaction_delay*(headway*headway) - _x2*_x3*headway - _x3*k_v*k_x
+    return (
+        1 - _x0 - _x1*reaction_delay,
+        -_x4,
+        -_x4*k_x,
+    )
+
+
+def reaction_pade11_hurwitz(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any, reaction_delay: Any) -> tuple[Any, ...]:
+    """Hurwitz determinants of D with e^(−θ_r s) replaced by pade11 (each > 0): the Taylor route's stability test, not a certificate."""
+    _x0 = 4*tau
+    _x1 = (reaction_delay*reaction_delay)
+    _x2 = _x1*k_v
+    _x3 = _x1*k_x
+    _x4 = k_v*reaction_delay
+    _x5 = k_x*headway
+    _x6 = _x5*reaction_delay
+    _x7 = 8*tau
+    _x8 = (k_v*k_v)
+    _x9 = 2*_x1
+    _x10 = (k_x*k_x)
+    _x11 = _x1*reaction_delay
+    _x12 = _x10*_x11
+    _x13 = _x10*(headway*headway)
+    _x14 = _x7*reaction_delay
+    _x15 = k_x*tau
+    _x16 = -4*_x4 - 4*_x6 + 4*_x3 + _x12*tau + _x13*_x14 + _x13*_x9 + _x14*_x8 + _x8*_x9 - _x12*headway - _x5*_x7 - _x7*k_v - 6*_x15*_x2 + 4*_x2*_x5 + 8*k_x*(tau*tau) + 12*_x15*reaction_delay - _x11*k_v*k_x + 16*_x4*_x5*tau - 6*_x1*_x10*headway*tau
+    return (
+        tau + reaction_delay/2,
+        reaction_delay/2 - _x2/4 + _x0/4 - _x0*_x4/4 - _x0*_x6/4 - _x3*headway/4 + _x3*tau/4,
+        -_x16/8,
+        -_x16*k_x/8,
+    )

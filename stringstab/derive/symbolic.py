@@ -568,7 +568,7 @@ def parse_substitutions(text: str | None,
             ) from e
         if name in ("tau", "tau_prev") and not v > 0:
             raise StringStabError(f"{name} (actuator lag) must be > 0 s; got {value!r}")
-        if name in ("delta", "headway") and v < 0:
+        if name in ("delta", "headway", "reaction_delay") and v < 0:
             raise StringStabError(f"{name} must be >= 0 s; got {value!r}")
         out[names[name]] = v
     return out

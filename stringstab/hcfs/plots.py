@@ -14,7 +14,8 @@ import numpy as np
 from ..plots.traffic import plot_vehicles
 from .simulate import HCFSRun
 
-__all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_learning", "plot_speed", "plot_switching"]
+__all__ = ["MODE_TITLES", "plot_figure", "plot_jerk", "plot_jerk_grid", "plot_learning", "plot_speed",
+           "plot_switching"]
 
 #: Panel titles of the modes; the policy's label says whether it is a DDPG or a stand-in.
 MODE_TITLES = {
@@ -67,16 +68,24 @@ def plot_speed(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     ax.set_ylabel("speed v (m/s)")
     ax.set_title(_title(run, i), fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)  # beside, never on, the curves
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
     return [lead, lc]
+
+
+def _jerk(run: HCFSRun, i: int) -> Any:
+    """Jerk (a_k − a_{k−1})/T of every follower's command in configuration ``i``, m/s³."""
+    a0 = run.params["initial_accel"]
+    out = np.concatenate([np.full((run.n_followers, 1), a0), run.output[i]], axis=-1)
+    return np.diff(out, axis=-1) / run.dt
 
 
 def plot_jerk(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
     """Jerk (a_k − a_{k−1})/T of every follower's command, with ±J drawn (Fig. 5).
 
     Every frame is drawn (no decimation), so single-frame spikes show.  The scale fits the data
-    and ±J; the paper's ±2a_max/T (which the acceleration bounds guarantee alone) is drawn only
-    when the data reach it, and named in the title otherwise, so it does not squash the data.
+    and ±J; the bound 2a_max/T that the acceleration limits give alone is drawn only when the
+    data reach it (otherwise :func:`plot_figure` says in a note how far off the scale it is).
+    The largest |jerk| and the frames above J are written in the panel.
 
     Parameters
     ----------
@@ -93,28 +102,90 @@ def plot_jerk(run: HCFSRun, i: int, *, ax: Any = None) -> list[Any]:
         [followers LineCollection, +J line, −J line, and the ±2a_max/T lines when drawn].
     """
     ax = _ax(ax)
-    a0 = run.params["initial_accel"]
-    out = np.concatenate([np.full((run.n_followers, 1), a0), run.output[i]], axis=-1)
-    jerk = np.diff(out, axis=-1) / run.dt
+    jerk = _jerk(run, i)
     lc = plot_vehicles(run.t, jerk, ax=ax, first_position=1, n_positions=run.n_followers,
                        max_points=run.t.size)["lines"]
+    lines = _jerk_limits(ax, run, i, float(np.abs(jerk).max()))
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("jerk (m/s³)")
+    ax.set_title(_title(run, i), fontsize=9, loc="left")
+    _jerk_note(ax, run, i, jerk)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    return [lc, *lines]
+
+
+def _jerk_limits(ax: Any, run: HCFSRun, i: int, peak: float) -> list[Any]:
+    """±J (and ±2a_max/T when the data reach 80 % of it) and a y-range holding the data."""
     J = run.configs[i].jerk_limit
     paper = 2.0 * run.params["accel_max"] / run.dt
-    lines = [ax.axhline(s * J, color="r", ls="--", lw=1.0, label="±J" if s > 0 else None)
+    lines = [ax.axhline(s * J, color="r", ls="--", lw=1.0, label=f"±J = ±{J:g} m/s³" if s > 0 else None)
              for s in (1, -1)]
-    peak = float(np.abs(jerk).max())
     if peak >= 0.8 * paper:
         lines += [ax.axhline(s * paper, color="0.5", ls=":", lw=1.0,
                              label="±2a_max/T" if s > 0 else None) for s in (1, -1)]
-    m = max(peak, J, paper if peak >= 0.8 * paper else 0.0) * 1.15
+    m = max(peak, J, paper if peak >= 0.8 * paper else 0.0) * 1.3
     ax.set_ylim(-m, m)
-    ax.set_xlabel("time t (s)")
-    ax.set_ylabel("jerk (m/s³)")
-    off = "" if peak >= 0.8 * paper else f"; 2a_max/T = {paper:g} off scale"
-    ax.set_title(f"{_title(run, i)}: max |jerk| = {peak:.3g}, J = {J:g}{off}", fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
-    return [lc, *lines]
+    return lines
+
+
+def _jerk_note(ax: Any, run: HCFSRun, i: int, jerk: Any, *, short: bool = False,
+               head: str = "") -> None:
+    """Say the largest |jerk| and the frames above J in the panel's title (under ``head``)."""
+    J = run.configs[i].jerk_limit
+    above = int(np.count_nonzero(np.abs(jerk) > J * (1 + 1e-9)))
+    peak = float(np.abs(jerk).max())
+    frames = "frame" if above == 1 else "frames"
+    text = (f"max {peak:.3g} m/s³; {above:,} {frames} > J" if short
+            else f"max |jerk| {peak:.3g} m/s³; {above:,} of {jerk.size:,} frames above J")
+    if head:
+        ax.set_title(f"{head}\n{text}", fontsize=8, loc="left")
+    else:
+        ax.set_title(text, fontsize=8, loc="right", color="#B00000" if above else "0.25")
+
+
+def plot_jerk_grid(run: HCFSRun, idx: Sequence[int], *, fig: Any) -> list[Any]:
+    """Jerk of each follower in its own panel: a row per follower, a column per mode.
+
+    With many followers over a long run, one panel per mode would overplot them; here each
+    panel holds one follower's every frame, ±J, and (written inside) its largest |jerk| and
+    frames above J.  The columns share their y scale.
+
+    Parameters
+    ----------
+    run : HCFSRun
+        The verified run.
+    idx : sequence of int
+        The configurations (modes at one J) to draw, one column each.
+    fig : matplotlib Figure
+        Where to draw.
+
+    Returns
+    -------
+    list of Axes
+        The panels, row by row.
+    """
+    import textwrap
+
+    N = run.n_followers
+    axes = np.atleast_2d(fig.subplots(N, len(idx), sharex=True, sharey="col", squeeze=False))
+    for col, i in enumerate(idx):
+        jerk = _jerk(run, i)
+        peak = float(np.abs(jerk).max())
+        for row in range(N):
+            ax = axes[row, col]
+            ax.plot(run.t, jerk[row], color="#0072B2", lw=0.6)
+            _jerk_limits(ax, run, i, peak)
+            _jerk_note(ax, run, i, jerk[row:row + 1], short=True,
+                       head=textwrap.fill(_title(run, i), 40) if row == 0 else "")
+            ax.grid(alpha=0.3)
+            ax.tick_params(labelsize=8)
+            if col == 0:
+                ax.set_ylabel(f"follower {row + 1}", fontsize=8)
+        axes[-1, col].set_xlabel("time t (s)", fontsize=9)
+    axes[0, 0].legend(loc="lower right", fontsize=8, framealpha=0.9)
+    fig.supylabel("jerk (m/s³), one panel per follower", fontsize=9)
+    return list(axes.ravel())
 
 
 def plot_switching(run: HCFSRun, i: int, *, ax: Any = None) -> Any:
@@ -202,8 +273,9 @@ def plot_figure(run: HCFSRun, jerk_limit: float, kind: str, *, fig: Any = None) 
     jerk_limit : float
         J, m/s³.
     kind : {"speed", "jerk", "switching"}
-        :func:`plot_speed`, :func:`plot_jerk` (every mode) or :func:`plot_switching` (the HCFS
-        modes).
+        :func:`plot_speed`, the jerk (every mode; one panel per follower and mode,
+        :func:`plot_jerk_grid`, when there are several followers, else :func:`plot_jerk`) or
+        :func:`plot_switching` (the HCFS modes).
     fig : matplotlib Figure, optional
         Where to draw.
 
@@ -220,10 +292,23 @@ def plot_figure(run: HCFSRun, jerk_limit: float, kind: str, *, fig: Any = None) 
            and (kind != "switching" or c.mode in ("paper", "safe"))]
     if not idx:
         raise StringStabError(f"the run has no configuration at J={jerk_limit!r} for a {kind} figure")
+    paper = 2.0 * run.params["accel_max"] / run.dt
+    grid = kind == "jerk" and run.n_followers > 1
     if fig is None:
         import matplotlib.pyplot as plt
 
-        fig = plt.figure(figsize=(11, 2.6 * len(idx) + 0.6), layout="constrained")
+        size = ((3.0 * len(idx) + 1.4, 1.3 * run.n_followers + 1.4) if grid
+                else (11, 2.6 * len(idx) + 0.6))
+        fig = plt.figure(figsize=size, layout="constrained")
+    title = f"{run.leader.name}, {run.n_followers} followers, J = {jerk_limit:g} m/s³"
+    if grid:
+        axes = plot_jerk_grid(run, idx, fig=fig)
+        peak = max(float(np.abs(_jerk(run, i)).max()) for i in idx)
+        if peak < 0.8 * paper:
+            title += (f"\nthe acceleration limits alone bound the jerk by 2a_max/T = {paper:g} m/s³, "
+                      "beyond every panel's scale")
+        fig.suptitle(title, fontsize=10)
+        return fig, axes
     axes = list(np.atleast_1d(fig.subplots(len(idx), 1, sharex=True)))
     drawn = [draw[kind](run, i, ax=ax) for ax, i in zip(axes, idx)]
     for ax in axes[:-1]:
@@ -234,5 +319,8 @@ def plot_figure(run: HCFSRun, jerk_limit: float, kind: str, *, fig: Any = None) 
     else:  # the followers' colours: their position in the platoon
         cb = fig.colorbar(drawn[0][1 if kind == "speed" else 0], ax=axes, shrink=0.9, pad=0.01)
         cb.set_label("follower (position in the platoon)")
-    fig.suptitle(f"{run.leader.name}, {run.n_followers} followers, J = {jerk_limit:g} m/s³")
+    if kind == "jerk" and max(float(np.abs(_jerk(run, i)).max()) for i in idx) < 0.8 * paper:
+        title += (f"\nthe acceleration limits alone bound the jerk by 2a_max/T = {paper:g} m/s³, "
+                  "beyond every panel's scale")
+    fig.suptitle(title, fontsize=10)
     return fig, axes

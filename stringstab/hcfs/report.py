@@ -26,13 +26,13 @@ THEOREM: dict[str, Any] = {
         "P2": "|a2_k - a2_(k-1)| <= J T  (CACC candidate rate-limited)",
         "P3": "a1_(k-1) = a2_(k-1)  ('under the framework of HCFS', used in the proof's eq 19)",
     },
-    "conclusion": "|a_k - a_(k-1)| <= J T for the hybrid output a of eqs 13-14, "
+    "conclusion": "|aₖ - a_(k-1)| <= J T for the hybrid output a of eqs 13-14, "
                   "a_(k-1) being the previous hybrid output",
-    "bound": "under P1 and P2 alone: |a_k - a_(k-1)| <= J T + |lambda_k - lambda_(k-1)| "
-             "|a1_(k-1) - a2_(k-1)|, with |lambda_k - lambda_(k-1)| = 0 (no switch at k-1 or k), "
+    "bound": "under P1 and P2 alone: |aₖ - a_(k-1)| <= J T + |lambdaₖ - lambda_(k-1)| "
+             "|a1_(k-1) - a2_(k-1)|, with |lambdaₖ - lambda_(k-1)| = 0 (no switch at k-1 or k), "
              "1 - beta (switch at k), beta (switch at k-1 only), |1 - 2 beta| (both); attained",
-    "safe_variant": "a_k = clip(eq-13 output, a_(k-1) - J T, a_(k-1) + J T): "
-                    "|a_k - a_(k-1)| <= J T under P1 and P2 alone",
+    "safe_variant": "aₖ = clip(eq-13 output, a_(k-1) - J T, a_(k-1) + J T): "
+                    "|aₖ - a_(k-1)| <= J T under P1 and P2 alone",
     "tolerance": "every inequality is read up to 1e-9 m/s^2 (float rounding is ~1e-15)",
 }
 
@@ -132,8 +132,8 @@ def report_markdown(ver: Verification, *, command: str | None = None,
     add("# HCFS jerk theorem: closed-loop verification\n")
     if ver.ok:
         add("**No frame falsifies the theorem where its premises P1-P3 hold, none exceeds the bound "
-            "J T + |Δλ|·|a1_{k−1} − a2_{k−1}| where P1 and P2 hold, and the jerk-safe variant keeps "
-            "|a_k − a_{k−1}| ≤ J T everywhere (exit 0).**\n")
+            "J T + |Δλ|·|a1ₖ₋₁ − a2ₖ₋₁| where P1 and P2 hold, and the jerk-safe variant keeps "
+            "|aₖ − aₖ₋₁| ≤ J T everywhere (exit 0).**\n")
     else:
         add(f"**{len(ver.violations)} frame(s) falsify a guarantee (exit 1); they are listed below.**\n")
     if p["policy_is_stand_in"]:
@@ -144,13 +144,13 @@ def report_markdown(ver: Verification, *, command: str | None = None,
         add(f"* **{k}**: `{v}`")
     add(f"* **Conclusion**: `{THEOREM['conclusion']}`\n")
     add("What holds (proof in docs/hcfs.md): under P1 and P2 alone,\n")
-    add("    |a_k − a_{k−1}| ≤ J T + |λ_k − λ_{k−1}| · |a1_{k−1} − a2_{k−1}|,\n")
+    add("    |aₖ − aₖ₋₁| ≤ J T + |λₖ − λₖ₋₁| · |a1ₖ₋₁ − a2ₖ₋₁|,\n")
     b = ver.beta
     wc = weight_change([False, True, False, True], [False, False, True, True], b)
-    add(f"with |λ_k − λ_{{k−1}}| = {wc[0]:g} (no switch at k−1 or k), {wc[1]:g} (the frame after a "
+    add(f"with |λₖ − λₖ₋₁| = {wc[0]:g} (no switch at k−1 or k), {wc[1]:g} (the frame after a "
         f"switch), {wc[2]:g} (a switch at k), {wc[3]:g} (switches at both) for β = {b:g}; the bound "
         "is attained.  P3 removes the second term: the theorem is true, and fails without P3.  The "
-        "jerk-safe variant clips the eq-13 output into a_{k−1} ± J T and needs only P1 and P2.  "
+        "jerk-safe variant clips the eq-13 output into aₖ₋₁ ± J T and needs only P1 and P2.  "
         f"Inequalities are read up to 10⁻⁹ m/s².\n")
     add("## Set-up\n")
     leaders = ", ".join(f"`{r.leader.name}` ({r.leader.duration:g} s)" for r in ver.runs)
@@ -167,10 +167,10 @@ def report_markdown(ver: Verification, *, command: str | None = None,
     add("Modes: `cacc` and `policy` apply one candidate; `paper` is HCFS by eqs 12-14; `safe` is "
         "HCFS with the jerk-safe variant.\n")
     add("## Results\n")
-    add("Totals over all followers and frames.  *max jerk* is max |a_k − a_{k−1}|/T of the "
-        "command; *P3 holds* counts frames with a1_{k−1} = a2_{k−1}; *C fails* counts frames with "
-        "|a_k − a_{k−1}| > J T; *viol.* frames falsifying a guarantee; *cex* counterexamples (P1, "
-        "P2 hold, P3 and C fail); *step/bound* the largest |a_k − a_{k−1}| / bound (≤ 1).\n")
+    add("Totals over all followers and frames.  *max jerk* is max |aₖ − aₖ₋₁|/T of the "
+        "command; *P3 holds* counts frames with a1ₖ₋₁ = a2ₖ₋₁; *C fails* counts frames with "
+        "|aₖ − aₖ₋₁| > J T; *viol.* frames falsifying a guarantee; *cex* counterexamples (P1, "
+        "P2 hold, P3 and C fail); *step/bound* the largest |aₖ − aₖ₋₁| / bound (≤ 1).\n")
     for r, rn in enumerate(ver.runs):
         add(f"### {rn.leader.name}, {rn.n_followers} followers\n")
         add("| mode | J | max jerk | max jerk / J | frames | P1 fails | P2 fails | P3 holds | "
@@ -199,7 +199,7 @@ def report_markdown(ver: Verification, *, command: str | None = None,
             add("")
     add("## Counterexamples (P3 dropped)\n")
     add(f"{len(ver.counterexamples)} frame(s) of the `paper` mode have P1 and P2 but not P3, and "
-        "|a_k − a_{k−1}| > J T.  *Smallest* means the smallest |a1_{k−1} − a2_{k−1}| (the amount "
+        "|aₖ − aₖ₋₁| > J T.  *Smallest* means the smallest |a1ₖ₋₁ − a2ₖ₋₁| (the amount "
         "by which P3 fails), then the smallest excess; every one lies within the bound.\n")
     sm = ver.smallest_counterexample
     if sm is not None:
@@ -218,7 +218,7 @@ def report_markdown(ver: Verification, *, command: str | None = None,
             f"gap={sm.gap_prev:.4g}, case='{case}')`): a1 = {a1.round(6).tolist()}, "
             f"a2 = {a2.round(6).tolist()}, DDPG chosen = {c.tolist()}: P1 and P2 hold with "
             f"equality and |a_1 − a_0| = J T + |Δλ|·{sm.gap_prev:.4g}.  Since this works for any "
-            "gap ≠ 0, no relaxation |a1_{k−1} − a2_{k−1}| ≤ ε of P3 with ε > 0 saves the "
+            "gap ≠ 0, no relaxation |a1ₖ₋₁ − a2ₖ₋₁| ≤ ε of P3 with ε > 0 saves the "
             "conclusion.\n")
     if ver.violations:
         add("## Frames falsifying a guarantee\n")
@@ -284,9 +284,12 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
         for r, J, names in figs:
             for kind, name in names.items():
                 n_panels = 4 if kind != "switching" else 2
-                fig = Figure(figsize=(11, 2.4 * n_panels + 0.6), layout="constrained")
+                n = ver.runs[r].n_followers  # jerk: a panel per follower and mode
+                height = 1.25 * n + 1.6 if kind == "jerk" and n > 1 else 2.2 * n_panels + 0.6
+                # 9 in at 110 dpi: 990 px, shown at full size in the report (text ≥ 8 pt)
+                fig = Figure(figsize=(9, height), layout="constrained")
                 plot_figure(ver.runs[r], J, kind, fig=fig)
-                fig.savefig(out.path(name), dpi=90)
+                fig.savefig(out.path(name), dpi=110)
                 files[name] = name
     out.write_json("report.json", report_dict(ver, command=command))
     files["json"] = "report.json"

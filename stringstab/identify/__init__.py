@@ -9,7 +9,8 @@
 * :mod:`~stringstab.identify.report` — the table, ``identify.json``, CSV/Parquet and figures.
 
 Readers of the logs: :func:`read_logs` (:func:`stringstab.io.platoon_logs.read_platoon_logs`
-with the NGSIM pair parser of :mod:`stringstab.traffic`).
+with the NGSIM pair parser of :mod:`stringstab.traffic`); :func:`example_log`: the two OpenACC
+logs shipped in ``stringstab/data/openacc/``.
 """
 
 from __future__ import annotations
@@ -19,10 +20,11 @@ from .closed_loop import FollowerModel, simulate_follower
 from .core import IdentifyResult, VehicleResult, identify, statement
 from .empirical import Empirical, empirical_transfer
 from .fit import BOUNDS, PARAMETERS, FitResult, FollowerData, fit_follower
-from .logs import read_logs
+from .logs import EXAMPLES, example_log, read_logs
 
 __all__ = [
     "BOUNDS",
+    "EXAMPLES",
     "PARAMETERS",
     "Empirical",
     "FitResult",
@@ -34,6 +36,7 @@ __all__ = [
     "VehicleResult",
     "clean_segments",
     "empirical_transfer",
+    "example_log",
     "fit_follower",
     "identify",
     "read_logs",

@@ -75,6 +75,9 @@ class Empirical:
         ε at the peak (module docstring).
     amplifies : str
         ``"yes"``, ``"no"`` or ``"undecided"`` (module docstring).
+    error : array or None
+        ε at every frequency (the normalised random error of |Ĝ|, module docstring; NaN or inf
+        where the coherence is 0), for error bars.
     """
 
     omega: Array
@@ -87,6 +90,7 @@ class Empirical:
     nperseg: int
     gain_error: float = math.nan
     amplifies: str = "undecided"
+    error: Array | None = None
 
 
 def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | list[Segment], dt: float,
@@ -159,4 +163,4 @@ def empirical_transfer(v_pred: Array, v: Array, segments: tuple[Segment, ...] | 
     ex = float(np.sum(omega[band] ** 2 * np.asarray(pxx)[band]))
     ey = float(np.sum(omega[band] ** 2 * np.asarray(pyy)[band]))
     energy = math.sqrt(ey / ex) if ex > 0 else math.nan
-    return Empirical(omega, G, C, gain, gw, p2p, energy, n, err, amplifies)
+    return Empirical(omega, G, C, gain, gw, p2p, energy, n, err, amplifies, np.asarray(eps, dtype=float))

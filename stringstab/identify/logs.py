@@ -4,6 +4,9 @@ The formats are read by :func:`stringstab.io.platoon_logs.read_platoon_logs` (th
 layer); NGSIM trajectory files are cut into leader–follower pairs by the parser the simulator
 already uses for its leaders (:func:`stringstab.traffic.load_ngsim_pairs`), which this module
 hands to the reader, so the I/O layer does not import the simulator.
+
+Two real logs ship with the package (``stringstab/data/openacc/``, the JRC's OpenACC database,
+CC BY 4.0: see the README there): :func:`example_log` gives their paths.
 """
 
 from __future__ import annotations
@@ -15,7 +18,47 @@ import numpy as np
 from ..errors import StringStabError, show
 from ..io.platoon_logs import PlatoonLog, read_platoon_logs
 
-__all__ = ["read_logs", "read_ngsim"]
+__all__ = ["EXAMPLES", "example_log", "read_logs", "read_ngsim"]
+
+#: The OpenACC logs shipped in ``stringstab/data/openacc/``: name -> (file, what it is).
+EXAMPLES: dict[str, tuple[str, str]] = {
+    "acc": ("zalazone_acc_short_dynamic_part1.csv.gz",
+            "OpenACC, ZalaZONE: 6 cars, every follower on its factory ACC (short setting)"),
+    "human": ("zalazone_human_handling_part22.csv.gz",
+              "OpenACC, ZalaZONE: 11 cars driven by people (handling track)"),
+}
+
+
+def example_log(name: str) -> Path:
+    """The path of a shipped example log (:data:`EXAMPLES`).
+
+    Parameters
+    ----------
+    name : {"acc", "human"}
+        Which log.
+
+    Returns
+    -------
+    Path
+        The file inside the installed package (a gzip-compressed OpenACC CSV).
+
+    Raises
+    ------
+    StringStabError
+        For another name, or when the package was installed without its data.
+
+    Examples
+    --------
+    >>> example_log("acc").name
+    'zalazone_acc_short_dynamic_part1.csv.gz'
+    """
+    if name not in EXAMPLES:
+        raise StringStabError(f"--example must be one of {', '.join(EXAMPLES)}; got {show(name)}")
+    path = Path(__file__).resolve().parents[1] / "data" / "openacc" / EXAMPLES[name][0]
+    if not path.is_file():
+        raise StringStabError(f"the example log {EXAMPLES[name][0]} is not in this installation "
+                              f"(expected {path}); reinstall stringstab with its package data")
+    return path
 
 
 def read_ngsim(path: Path, min_duration: float) -> list[PlatoonLog]:

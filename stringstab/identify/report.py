@@ -15,6 +15,7 @@ Files (all written through one :class:`stringstab.io.OutputDir`, all-or-nothing)
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -128,6 +129,21 @@ def _figure(w: float, h: float) -> Any:
     return Figure(figsize=(w, h), layout="constrained")
 
 
+def _num(x: float, name: str, at_bound: Sequence[str], unit: str = "") -> str:
+    """A fitted value as a reader should see it: 3 significant digits, solver noise as 0.
+
+    A value within 1e-6 of zero (a fit that ran onto the bound T* ≥ 0 returns 8.9e-08) is
+    printed ``0``; a parameter at a bound of the fit says so.
+    """
+    text = ("0" if abs(x) < 1e-6 else f"{x:.3g}") + (f" {unit}" if unit else "")
+    return text + (" (at its bound)" if name in at_bound else "")
+
+
+def _small(x: float, unit: str) -> str:
+    """An error as a title shows it: two digits, and "< 0.01" below the resolution of a log."""
+    return f"< 0.01 {unit}" if x < 0.01 else f"{x:.2g} {unit}"
+
+
 def _fig_fit(v: VehicleResult) -> Any:
     fig = _figure(9, 5.5)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
@@ -147,61 +163,93 @@ def _fig_fit(v: VehicleResult) -> Any:
     ax1.legend(fontsize=8)
     ax2.legend(fontsize=8)
     p = v.fit.params
-    ax1.set_title(f"{v.position} {v.name}: k_x={p['k_x']:.3g}, k_v={p['k_v']:.3g}, τ={p['tau']:.3g} s, "
-                  f"T*={p['headway']:.3g} s, l0={p['standstill']:.3g} m; RMSE {v.fit.rmse_speed:.3g} m/s, "
-                  f"{v.fit.rmse_gap:.3g} m", fontsize=9)
+    b = list(v.fit.at_bound)
+    ax1.set_title(f"follower {v.position} ({v.name}), fitted: k_x = {_num(p['k_x'], 'k_x', b, '1/s²')}, "
+                  f"k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, τ = {_num(p['tau'], 'tau', b, 's')}, "
+                  f"T* = {_num(p['headway'], 'headway', b, 's')}, "
+                  f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}\n"
+                  f"fit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
+                  f"{_small(v.fit.rmse_gap, 'm')}",
+                  fontsize=9)
     return fig
 
 
 def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
     from ..certify.frequency import gain
 
-    fig = _figure(7, 5.5)
+    fig = _figure(7, 5.8)
     ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 1))
     e = v.empirical
     p = v.fit.params
-    w = np.geomspace(max(float(e.omega[1]) if e.omega.size > 1 else 0.01, 1e-3), 10.0, 500)
+    peak_w = float(v.certificate.peak_omega)
+    sup = float(v.certificate.sup_gain)
+    w_data = float(e.omega[1]) if e.omega.size > 1 else 0.01
+    # from a decade below the model's peak (or the data) up: the model's whole shape is shown
+    w_lo = min(w_data, peak_w / 10 if math.isfinite(peak_w) and peak_w > 0 else w_data, 0.01)
+    w = np.geomspace(w_lo, 10.0, 600)
     ax1.loglog(w, gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
                        headway=p["headway"]), color="#D55E00", label="model |Γ(jω)| (continuous)")
+    if math.isfinite(sup) and math.isfinite(peak_w) and peak_w > 0:
+        ax1.plot([peak_w], [sup], "D", color="#D55E00", ms=6,
+                 label=f"model peak: sup|Γ| = {sup:.3g} at {peak_w:.2g} rad/s")
     m = (e.omega > 0) & (e.omega <= 10.0)
     good = m & (e.coherence >= 0.5)
-    ax1.loglog(e.omega[m], np.abs(e.transfer[m]), color="0.7", lw=0.8, label="empirical |Ĝ| (all)")
-    ax1.loglog(e.omega[good], np.abs(e.transfer[good]), "o", ms=3, color="k",
-               label="empirical |Ĝ| (coherence ≥ 0.5)")
+    mag = np.abs(e.transfer)
+    ax1.loglog(e.omega[m], mag[m], color="0.7", lw=0.8, label="empirical |Ĝ| (all)")
+    err = (np.asarray(e.error, dtype=float) if e.error is not None
+           else np.full(mag.shape, np.nan))
+    band = np.where(np.isfinite(err), 2 * err * mag, 0.0)
+    lower = np.minimum(band, 0.95 * mag)  # a log axis cannot show a bar reaching 0
+    ax1.errorbar(e.omega[good], mag[good], yerr=np.vstack([lower[good], band[good]]), fmt="o",
+                 ms=3, color="k", ecolor="0.35", elinewidth=0.8, capsize=1.5,
+                 label="empirical |Ĝ| ± 2ε (coherence ≥ 0.5)")
     ax1.axhline(1.0, color="0.3", lw=0.6, ls=":")
     from .empirical import OMEGA_MAX
 
     for ax in (ax1, ax2):
         ax.axvspan(OMEGA_MAX, 10.0, color="0.92", zorder=0)
-    ax1.text(OMEGA_MAX * 1.1, ax1.get_ylim()[0] * 1.5, "not used for the data's verdict\n(common-mode GPS error)",
-             fontsize=7, color="0.4")
+        if w_lo < w_data:
+            ax.axvspan(w_lo, w_data, color="0.96", zorder=0)
+    ax1.text(OMEGA_MAX * 1.1, 0.04, "not used for the data's verdict\n(common-mode GPS error)",
+             transform=ax1.get_xaxis_transform(), fontsize=8, color="0.35")
+    if w_lo < w_data:
+        ax1.text(w_lo * 1.1, 0.04, f"no data below\n{w_data:.2g} rad/s\n(log length)",
+                 transform=ax1.get_xaxis_transform(), fontsize=8, color="0.35")
     ax1.set_ylabel("|follower speed / predecessor speed|")
-    ax1.legend(fontsize=8)
-    ax1.set_title(f"{v.position} {v.name}: sup|Γ| = {float(v.certificate.sup_gain):.3g} ({v.certificate.verdict})"
+    ax1.legend(fontsize=8, loc="lower center")
+    ax1.set_title(f"follower {v.position} ({v.name}): {v.certificate.verdict}"
                   + ("" if H is None else f", certified sampled at H = {H:g} s"), fontsize=9)
     ax2.semilogx(e.omega[m], e.coherence[m], color="k", lw=0.8)
     ax2.axhline(0.5, color="0.3", lw=0.6, ls=":")
     ax2.set_ylim(0, 1.05)
+    ax2.set_xlim(w_lo, 10.0)
     ax2.set_ylabel("coherence")
     ax2.set_xlabel("ω (rad/s)")
     return fig
 
 
 def _fig_platoon(res: IdentifyResult) -> Any:
-    fig = _figure(7, 4)
+    import textwrap
+
+    fig = _figure(7, 4.2)
     ax = fig.add_subplot()
     x = np.arange(len(res.vehicles))
     sup = np.array([float(v.certificate.sup_gain) for v in res.vehicles])
     iv = np.array([v.interval("sup_gain") for v in res.vehicles]).reshape(-1, 2)
     lo = np.where(np.isfinite(iv[:, 0]), np.minimum(sup - iv[:, 0], sup - 0), 0.0)
     hi = np.where(np.isfinite(iv[:, 1]), iv[:, 1] - sup, 0.0)
-    ax.errorbar(x, sup, yerr=np.clip(np.vstack([lo, hi]), 0, None), fmt="o", color="#D55E00",
+    ax.errorbar(x - 0.08, sup, yerr=np.clip(np.vstack([lo, hi]), 0, None), fmt="o", color="#D55E00",
                 capsize=3, label="model sup|Γ| (5-95 % bootstrap)")
-    ax.plot(x, [v.empirical.gain for v in res.vehicles], "s", color="k", label="empirical max |Ĝ|")
+    g = np.array([v.empirical.gain for v in res.vehicles], dtype=float)
+    ge = np.array([v.empirical.gain_error for v in res.vehicles], dtype=float)
+    ax.errorbar(x + 0.08, g, yerr=np.where(np.isfinite(ge), 2 * ge * g, 0.0), fmt="s", color="k",
+                capsize=3, label="empirical max |Ĝ| ± 2ε")
     ax.plot(x, [v.empirical.energy for v in res.vehicles], "^", color="0.5", label="energy amplification")
     ax.axhline(1.0, color="0.3", lw=0.6, ls=":")
-    ax.set_xticks(x, [f"{v.position}\n{v.name[:12]}" for v in res.vehicles], fontsize=7)
-    ax.set_ylabel("amplification")
+    ax.set_xticks(x, [f"{v.position}\n" + textwrap.fill(v.name.replace("_", " "), 14)
+                      for v in res.vehicles], fontsize=8)
+    ax.set_ylabel("amplification (follower over predecessor)")
+    ax.set_title("along the platoon: above the dotted line at 1 a follower amplifies", fontsize=9)
     ax.legend(fontsize=8)
     return fig
 
@@ -232,7 +280,7 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
     from ..errors import StringStabError
 
     need = ("position", "name", "k_x", "k_v", "k_a", "tau", "delta", "headway", "standstill")
-    from ..io.text_files import read_text
+    from ..io.text_input import read_text
 
     expected = "an identify.json written by 'stringstab identify'"
     text = read_text(Path(path), label=f"--from {path!r}", expected=expected)

@@ -7,8 +7,8 @@
 Parquet, NPZ) with one vectorised writer: the column model is :mod:`~stringstab.io.columns`,
 the renderers :mod:`~stringstab.io.table`, :mod:`~stringstab.io.text_formats` and
 :mod:`~stringstab.io.binary_formats`; :mod:`~stringstab.io.figures` saves a drawn figure in every
-format with its metadata; :mod:`~stringstab.io.text_files` reads a user's text file as UTF-8 or
-refuses it in one line; :mod:`~stringstab.io.manifest` says which command wrote a folder.
+format with its metadata; :mod:`~stringstab.io.text_input` reads a user's text file
+(plain or gzip, by content) as UTF-8 or refuses it in one line; :mod:`~stringstab.io.manifest` says which command wrote a folder.
 
 Every command checks its output paths with :func:`check_output_file` or :class:`OutputDir`
 *before* it starts work, and writes through :func:`atomic_write_text`,

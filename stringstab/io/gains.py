@@ -45,7 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
-from .text_files import read_text, undecodable
+from .text_input import read_text, undecodable
 
 __all__ = [
     "GAIN_COLUMNS",

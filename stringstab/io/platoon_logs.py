@@ -30,7 +30,6 @@ is 3.6 times too large (km/h labelled as m/s) is refused with the ratio found.
 from __future__ import annotations
 
 import csv
-import io
 import math
 import re
 from collections.abc import Callable
@@ -42,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
-from .text_files import read_text
+from .text_input import open_text
 
 __all__ = ["SPEED_ABSURD", "PlatoonLog", "Segment", "clean_segments", "read_platoon_logs"]
 
@@ -224,9 +223,9 @@ def _cell(c: str) -> float:
 
 
 def _read_rows(path: Path) -> list[list[str]]:
-    text = read_text(path, label=_where(path),
-                     expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)")
-    return [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(c.strip() for c in r)]
+    with open_text(path, label=_where(path),  # plain or gzip-compressed (.csv.gz)
+                   expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)") as fh:
+        return [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
 
 
 def _numeric(rows: list[list[str]], ncol: int, path: Path, first_line: int) -> Array:
@@ -441,7 +440,8 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
     Parameters
     ----------
     path : path
-        The file; its format is recognised from its first lines (module docstring).
+        The file, plain or gzip-compressed (``.csv.gz``); its format is recognised from its
+        first lines (module docstring).
     min_duration : float
         For NGSIM files, the shortest leader–follower pair kept, s.
     ngsim : callable, optional

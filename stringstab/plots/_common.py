@@ -30,6 +30,7 @@ __all__ = [
     "PlotResult",
     "categorical",
     "legend_below",
+    "log_colorbar_ticks",
     "new_ax",
     "patch",
     "pct",
@@ -229,6 +230,30 @@ def legend_below(ax: Any, handles: list[Any], title: str | None = None, ncol: in
     return ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.12),
                      ncol=ncol, frameon=False, fontsize="small", title_fontsize="small",
                      columnspacing=1.2, handlelength=1.6)
+
+
+def log_colorbar_ticks(cb: Any) -> None:
+    """Label a logarithmic colourbar at 1, 2, 5 of every decade, as plain numbers.
+
+    Matplotlib's default labels a log colourbar at powers of ten only, so a scale from 1 to 12
+    reads "10⁰, 10¹" and nothing between; here it reads 1, 2, 5, 10.  A range under a decade
+    also gets its ends' neighbours (1.1, 1.2, 1.5, ... via the 1-9 subs when 1-2-5 gives fewer
+    than three ticks).
+
+    Parameters
+    ----------
+    cb : matplotlib Colorbar
+        A colourbar of a :class:`~matplotlib.colors.LogNorm` image.
+    """
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    lo, hi = cb.norm.vmin, cb.norm.vmax
+    subs: tuple[float, ...] = (1.0, 2.0, 5.0)
+    if np.count_nonzero([lo <= m * 10.0 ** e <= hi for e in range(-3, 6) for m in subs]) < 3:
+        subs = tuple(float(k) for k in range(1, 10))
+    cb.ax.yaxis.set_major_locator(LogLocator(base=10.0, subs=subs))
+    cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    cb.ax.yaxis.set_minor_formatter(NullFormatter())
 
 
 def patch(color: str, label: str) -> Any:

@@ -45,6 +45,7 @@ from ._common import (
     PlotResult,
     categorical,
     legend_below,
+    log_colorbar_ticks,
     new_ax,
     patch,
     pct,
@@ -298,6 +299,7 @@ def plot_sup_gain(
         # whole figure cell, taller than the square axes)
         cax = ax.inset_axes((1.04, 0.0, 0.045, 1.0))
         cb = ax.figure.colorbar(im, cax=cax, extend="max")
+        log_colorbar_ticks(cb)
         cb.set_label(tex)
     label_axes(ax, rmap)
     if title:

@@ -91,6 +91,26 @@ def plot_slices(
     return PlotResult.of({"fig": fig, "axes": used, "images": images, "values": coords[idx], "legend": leg})
 
 
+def _corner_ticks(ax: Any, a0: Any, a1: Any, a2: Any) -> None:
+    """Set at most 5 plain-number ticks per axis, one label at the corner the first two share.
+
+    At the view drawn (azimuth −125°) the smallest values of the first two axes meet at one
+    corner, so the second axis leaves its smallest label out there (the two would print
+    "−2.0−2.0").
+    """
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+
+    for k, (axis, a) in enumerate(((ax.xaxis, a0), (ax.yaxis, a1), (ax.zaxis, a2))):
+        lo, hi = float(a[0]), float(a[-1])
+        ticks = np.asarray(MaxNLocator(4, steps=[1, 2, 5, 10]).tick_values(lo, hi), dtype=float)
+        span = 1e-9 * max(abs(lo), abs(hi), 1.0)
+        ticks = ticks[(ticks >= lo - span) & (ticks <= hi + span)]
+        if k == 1:
+            ticks = ticks[ticks > lo + span]
+        axis.set_ticks(ticks)
+        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}".replace("-", "−")))
+
+
 def plot_region_3d(
     rmap: RegionMap, method: str = "exact", *, ax: Any = None, kind: str = "surface",
     max_points: int = 40_000, title: bool = True,
@@ -190,6 +210,7 @@ def plot_region_3d(
                                                  label=GAIN_LABELS[names[2]])
     for setter, a in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), (a0, a1, a2)):
         setter(a[0], a[-1])
+    _corner_ticks(ax, a0, a1, a2)
     ax.set_xlabel(GAIN_LABELS[names[0]])
     ax.set_ylabel(GAIN_LABELS[names[1]])
     ax.set_zlabel(GAIN_LABELS[names[2]])

@@ -124,7 +124,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     hw = pick(result.headway)
     N = gap.shape[0]
     if fig is None:
-        fig = plt.figure(figsize=(12, 7.5), layout="constrained")
+        fig = plt.figure(figsize=(9, 6.5), layout="constrained")
     axes = np.asarray(fig.subplots(2, 2, sharex=True)).ravel()
     panels = [
         (spd, 0, "speed v (m/s)"),
@@ -143,7 +143,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
     hdw = result.params.get("headway")
     if hdw is not None:
         axes[3].axhline(hdw, color="k", ls="--", lw=0.8, label=f"T* = {hdw:g} s")
-        axes[3].legend(loc="upper right")
+        axes[3].legend(loc="lower right")  # the clipping note takes the top
     finite = hw[np.isfinite(hw)]
     if finite.size:
         top = min(float(np.percentile(finite, 99.5)) * 1.1, 10.0)
@@ -153,7 +153,7 @@ def plot_platoon(result: Any, *, platoon: int = 0, fig: Any = None,
             axes[3].annotate(f"clipped: h up to {float(finite.max()):.3g} s "
                              f"(vehicle {k[0] + 1}, t = {float(result.t[k[1]]):.4g} s)",
                              xy=(0.01, 0.97), xycoords="axes fraction", ha="left", va="top",
-                             fontsize=8, color="0.25",
+                             fontsize=9, color="0.25",
                              bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9})
     cb = fig.colorbar(lc, ax=list(axes), shrink=0.8, pad=0.01)
     cb.set_label("position in platoon (0 = leader)")
@@ -187,6 +187,9 @@ def plot_damping_ratios(m_p: npt.ArrayLike, *, ax: Any = None, label: str | None
     pos = np.arange(1, mp.size + 1)
     (line,) = ax.plot(pos, mp, marker=marker, ms=3 if mp.size > 30 else 5, label=label)
     ref = ax.axhline(1.0, color="k", ls="--", lw=0.8)
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # positions are whole numbers
     ax.set_xlabel("follower position i")
     ax.set_ylabel("damping ratio m_p (follower / predecessor)")
     ax.grid(alpha=0.3)

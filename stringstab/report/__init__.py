@@ -5,7 +5,9 @@ has and writes it beside its other outputs.  The report says what was run (the e
 the parameters, the toolkit's version), gives every verdict, table and figure (each figure with a
 caption saying what to see in it) and the run's wall time.  One renderer turns it into Markdown
 (Jinja2 template) and the Markdown into HTML (Python-Markdown), with every figure embedded as
-base64, so the HTML needs neither the folder nor a network to be read.
+base64 and every formula (``$…$`` in the Markdown) typeset at build time as an embedded SVG
+(:mod:`stringstab.report.maths`), so the HTML needs neither the folder, nor a script, nor a
+network to be read.
 
 Building a report (the API the commands use)::
 

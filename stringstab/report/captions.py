@@ -54,13 +54,14 @@ CAPTIONS: list[tuple[str, str]] = [
      "speed, on each clean segment; the title gives the fitted parameters and the RMSE. The "
      "dashed curves tracking the black ones means the model explains the data."),
     ("transfer_*", "The fitted model's |Γ(jω)| (string stable where it stays below the dotted line "
-     "at 1) beside the data's own speed transfer |Ĝ(jω)| with its coherence; only coherent "
-     "points (black) below the grey band count for the data's verdict (above it common-mode GPS "
-     "error dominates). Agreement of the curve and the points means the verdict is the data's, "
-     "not only the model's."),
+     "at 1; its peak marked, the curve drawn from a decade below it) beside the data's own speed "
+     "transfer |Ĝ(jω)| with ± two standard errors and its coherence; only coherent points "
+     "(black) left of the grey band count for the data's verdict (in it common-mode GPS error "
+     "dominates), and the log holds no frequency below its first point (light band). Agreement "
+     "of the curve and the points means the verdict is the data's, not only the model's."),
     ("sup_gain.png", "Along the identified platoon: the model's sup|Γ| per follower with its 5-95 % "
-     "bootstrap interval, and the data's own amplification (max |Ĝ| and the energy ratio); "
-     "points above the dotted line at 1 amplify disturbances."),
+     "bootstrap interval, and the data's own amplification (max |Ĝ| ± two standard errors, and "
+     "the energy ratio); points above the dotted line at 1 amplify disturbances."),
     # tune
     ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
      "(square: certified, cross: not), over the certified region projected over the repaired "
@@ -72,16 +73,23 @@ CAPTIONS: list[tuple[str, str]] = [
      "(its theorem needs a1 = a2); the jerk-safe variant stays within it."),
     ("switching_*", "Which controller (DDPG or CACC) each follower uses over time, per mode."),
     # train / evaluate / compare
-    ("rolling_reward.png", "Training curve: rolling mean episode reward over environment steps."),
-    ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode and follower with its CDF; "
-     "mass left of 1 means disturbances shrink."),
+    ("rolling_reward.png", "Training curve (IDL Fig. 3): the return of each training episode (grey "
+     "dots) and its rolling mean over training episodes, with the paper's window of 10 and a "
+     "window of 100; a mean is drawn only where its window is full, and a window longer than the "
+     "run is named on the figure instead of drawn."),
+    ("fig6_mp.png", "IDL paper Fig. 6: histogram of m_p per episode (orange bars) with its CDF "
+     "(blue line, right axis), every episode drawn (the axis holds all values, so each CDF ends "
+     "at 1); mass left of the dashed line at 1 means disturbances shrink."),
     ("fig9_ttc.png", "IDL paper Fig. 9: distribution of the time to collision at closing "
-     "moments, on a log axis; the shaded range below TTC* is the safety-relevant one (counted "
-     "in TIT), and the legend gives each strategy's share there."),
-    ("fig11_jerk.png", "IDL paper Fig. 11: share of squared-jerk samples in each range per "
-     "strategy, counts on the bars (comfort: more mass in the low ranges is better)."),
-    ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy, with the "
-     "desired headway T*."),
+     "moments, on a log axis, as shares of all closing moments; the shaded range below TTC* is "
+     "the safety-relevant one (counted in TIT), and the legend gives each strategy's share there "
+     "and the share beyond the axis."),
+    ("fig11_jerk.png", "IDL paper Fig. 11: share of all squared-jerk samples in each of the "
+     "paper's ranges per strategy, and above its last range (> 60 m²/s⁶), counts on the bars, "
+     "so every sample is counted (comfort: more mass in the low ranges is better)."),
+    ("fig12_headway.png", "IDL paper Fig. 12: CDF of the time headway per strategy over all "
+     "samples, drawn from 0 to 3 s, with the desired headway T*; the legend gives the shares off "
+     "the axis."),
     ("gains_region.png", "The gains each strategy executed (coloured by strategy) over the "
      "certified region projected over the executed k_a values (certified at every one, at some, "
      "at none); the axes extend past the ±2 gain bounds so gains on a bound are visible."),

@@ -8,10 +8,12 @@ verification.  A command calls one function and writes the result::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..ranges import metric_caveat
 from .render import Report
 
 __all__ = ["compare_report", "evaluate_report", "identify_report", "region_report",
@@ -131,8 +133,11 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
     for w in doc.get("warnings", []):
         sec.verdict("leader", None, f"warning: {w}")
     m = rep.section("Metrics")
-    m.table([{"metric": k, "value": doc.get(k), "unit": u or "–", "meaning": what}
-             for k, what, u in METRICS if k in doc], caption="The IDL paper's metrics of this run.")
+    m.table([{"metric": k, "value": doc.get(k), "unit": u or "–",
+              "meaning": f"{what} {metric_caveat(k, doc.get(k))}".strip()}
+             for k, what, u in METRICS if k in doc],
+            caption="The IDL paper's metrics of this run (a value outside its sensible range "
+                    "says so in its meaning).")
     if doc.get("m_p"):
         m.table([["m_p", *doc["m_p"]]],
                 columns=["follower"] + [str(i + 1) for i in range(len(doc["m_p"]))],
@@ -289,8 +294,9 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     rows = []
     for v in res.vehicles:
         r = v.row()
-        rows.append({"pos": r["position"], "name": r["name"], "k_x": r["k_x"], "k_v": r["k_v"],
-                     "k_a": r["k_a"], "τ": r["tau"], "T*": r["headway"], "l0": r["standstill"],
+        rows.append({"pos": r["position"], "name": r["name"], "k_x": _denoise(r["k_x"]),
+                     "k_v": _denoise(r["k_v"]), "k_a": _denoise(r["k_a"]), "τ": _denoise(r["tau"]),
+                     "T*": _denoise(r["headway"]), "l0": _denoise(r["standstill"]),
                      "RMSE v": r["rmse_speed"], "RMSE gap": r["rmse_gap"], "sup|Γ|": r["sup_gain"],
                      "sup|Γ| 5 %": r["sup_gain_lo"], "sup|Γ| 95 %": r["sup_gain_hi"],
                      "verdict": r["verdict"], "certified share (%)": 100 * r["certified_share"],
@@ -312,12 +318,47 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
         units={"at ω": "rad/s"})
     notes = [f"{v.position} {v.name}: {n}" for v in res.vehicles for n in v.fit.notes + v.notes]
     notes += [f"skipped: {s}" for s in res.skipped]
-    if notes:
-        rep.section("Notes").text("\n".join(f"- {n}" for n in notes))
+    if notes:  # plain text: T* is a name, not emphasis
+        rep.section("Notes").text("\n".join(f"- {n}".replace("*", "\\*") for n in notes))
     figs = _pngs(Path(str(f)).name for f in files)
     if figs:
-        rep.section("Figures").figures(figs)
+        sec = rep.section("Figures")
+        for f in figs:
+            sec.figure(f, _identify_caption(res, f))
     return rep
+
+
+def _denoise(x: Any) -> Any:
+    """Show a fitted value as a table should: within 1e-6 of 0, it is 0.
+
+    A fit run onto the bound T* ≥ 0 returns 8.9e-08, which is solver noise, not a headway.
+    """
+    return 0.0 if isinstance(x, float) and abs(x) < 1e-6 else x
+
+
+def _identify_caption(res: Any, name: str) -> str:
+    """The caption of one identify figure: whose it is and its numbers, then what to see."""
+    from .captions import caption_for
+
+    for v in res.vehicles:
+        tag = f"{v.platoon}_{v.position}" if len(res.sources) > 1 else f"{v.position}"
+        if name in (f"fit_{tag}.png", f"transfer_{tag}.png"):
+            c = v.certificate
+            who = f"Follower {v.position} ({v.name}"
+            who += f", {v.platoon})" if len(res.sources) > 1 else ")"
+            if name.startswith("fit_"):
+                head = (f"{who}: speed RMSE {v.fit.rmse_speed:.2g} m/s, gap RMSE "
+                        f"{v.fit.rmse_gap:.2g} m over {len(v.segments)} clean segment"
+                        f"{'' if len(v.segments) == 1 else 's'}. ")
+            else:
+                e = v.empirical
+                data = (f"the data's max |Ĝ| = {e.gain:.3g} ± {2 * e.gain_error * e.gain:.2g} at "
+                        f"{e.gain_omega:.2g} rad/s (amplifies: {e.amplifies})"
+                        if math.isfinite(e.gain) else "no coherent frequency in the data")
+                head = (f"{who}: the model's sup|Γ| = {float(c.sup_gain):.3g} at "
+                        f"{float(c.peak_omega):.2g} rad/s ({c.verdict}); {data}. ")
+            return head + caption_for(name)
+    return caption_for(name)
 
 
 def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[str],

@@ -14,22 +14,30 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..ranges import metric_caveat
+from .maths import inline_tex
 from .render import Report, Section
 
 __all__ = ["demo_report"]
 
-_INTRO = """\
-This report checks two papers on car-following control with the stringstab toolkit, on bundled
+_INTRO = (
+    r"""This report checks two papers on car-following control with the stringstab toolkit, on bundled
 data. The **IDL paper** (Yi, Xu & Wang 2026, *Transportation Research Part C* 184:105541) lets a
-TD3 agent choose the gains K = (k_x, k_v, k_a) of the linear controller
-u = k_x Δp + k_v Δv + k_a a_{i−1}(t−δ) (its eq 4) and claims string stability from a Taylor
-approximation of the delay (its Proposition 1). The **HCFS paper** (IEEE T-ASE 2021) switches
-between a DDPG policy and CACC and proves a jerk bound. Read in order: what the model really
+TD3 agent choose the gains $K = (k_x, k_v, k_a)$ of the linear controller
+$u = k_x\,\Delta p + k_v\,\Delta v + k_a\,a_{i-1}(t-\delta)$ (its eq 4) and claims string
+stability from a Taylor approximation of the delay (its Proposition 1). The **HCFS paper**
+(IEEE T-ASE 2021) switches between a DDPG policy and CACC and proves a jerk bound. Read in order: what the model really
 gives (derive), which gains are truly string stable with the exact delay (certify, the region
 map), how uncertified gains are repaired (tune), what it means for a platoon (simulate), whether a
 trained IDL agent only ever executes certified gains (train), and whether the HCFS jerk theorem
 holds in closed loop (hcfs). A gain triple is *certified* when the closed loop is internally
-stable and ‖Γ‖_H∞ ≤ 1 with the exact delay e^{−δs}; "printed" means the paper's own formulas."""
+stable and $\Vert\Gamma\Vert_{\mathcal{H}_\infty} \leq 1$ with the exact delay $e^{-\delta s}$;
+"printed" means the paper's own formulas.""")
+
+
+def _plural(n: int, word: str) -> str:
+    """``1 triple``, ``2 triples``."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
 
 
 def _k(K: Any) -> str:
@@ -53,18 +61,26 @@ def _files(root: Path, step: str, summary: Mapping[str, Any], sub: str = "") -> 
 
 def _derive(rep: Report, s: Mapping[str, Any]) -> None:
     sec = rep.section("1. The model, derived (IDL eqs 3-15)",
-                      "SymPy derives the string-stability transfer function Γ(s) = A_i(s)/A_{i−1}(s) "
-                      "and the Taylor criteria Ψ1–Ψ3, Λ of the IDL paper from the vehicle model, "
-                      "then compares them term by term with the printed equations.")
-    if s.get("gamma"):
+                      "SymPy derives the string-stability transfer function "
+                      "$\\Gamma(s) = A_i(s)/A_{i-1}(s)$ (follower over predecessor acceleration) "
+                      "and the Taylor criteria $\\Psi_1$–$\\Psi_3$, $\\Lambda$ of the IDL paper "
+                      "from the vehicle model, then compares them term by term with the printed "
+                      "equations.")
+    if s.get("gamma_latex"):
+        sec.text(f"$${s['gamma_latex']}$$")
+    elif s.get("gamma"):
         sec.code(f"Γ(s) = {s['gamma']}")
     table = s.get("errata_table")
     if table:
-        sec.table([{"eq": e["equation"], "expression": e["name"],
-                    "printed = derived": e["matches"], "what differs": e["explanation"]}
+        sec.table([{"eq": e["equation"],
+                    "expression": f"${e['tex']}$" if e.get("tex") else e["name"],
+                    "printed = derived": e["matches"],
+                    "what differs": inline_tex(e["explanation"])}
                    for e in table], caption="The printed formulas against the derivation "
                                             "(`derive/derive.txt` has every expression).")
-    wrong = s.get("errata", [])
+        wrong = [e.get("label", e["name"]) for e in table if not e["matches"]]
+    else:
+        wrong = s.get("errata", [])
     sec.verdict("the paper's printed formulas match the model", not wrong,
                 f"{len(wrong)} differ: {', '.join(wrong)}" if wrong else "all match")
 
@@ -81,7 +97,7 @@ def _certify(rep: Report, s: Mapping[str, Any]) -> None:
         printed = t["taylor_printed"] == "stable"
         misled += printed and not exact
         rows.append({"K = (k_x, k_v, k_a)": _k(t["K"]), "exact verdict": t["verdict"],
-                     "sup_ω |Γ(jω)|": t.get("sup_gain"),
+                     "$\\sup_\\omega \\vert\\Gamma(j\\omega)\\vert$": t.get("sup_gain"),
                      "printed Proposition 1": t["taylor_printed"],
                      "agree": exact == printed})
     if rows:
@@ -89,15 +105,19 @@ def _certify(rep: Report, s: Mapping[str, Any]) -> None:
                                 "(`certify/triples.txt`); sup |Γ| > 1 means some frequency is "
                                 "amplified, inf that the loop is not internally stable.")
         sec.verdict("the printed Proposition 1 agrees with the exact certificate on these triples",
-                    misled == 0, f"{misled} triple(s) called stable by the paper's test are not "
-                                 "string stable" if misled else "no triple misjudged")
+                    misled == 0, f"{_plural(misled, 'triple')} called stable by the paper's test "
+                                 f"{'is' if misled == 1 else 'are'} not string stable" if misled
+                    else "no triple misjudged")
     r = s.get("rollout")
     if r:
         first = s.get("rollout_first_uncertified_t", {})
+        share = r.get("certified_row_share", r.get("m_fss"))
         sec.verdict("every gain of the bundled time series (a policy rollout) is certified",
                     r["certified"] == r["n"],
-                    f"{r['certified']} of {r['n']} rows certified (m_fss = {r['m_fss']:.3f}); first "
-                    "uncertified moment per vehicle: "
+                    f"{r['certified']} of {r['n']} rows certified (certified_row_share = "
+                    f"{share:.3f}: each row counted once, however long its gains hold; m_fss "
+                    "weighs them by time, see `simulate --gains-file`); first uncertified moment "
+                    "per vehicle: "
                     + (", ".join(f"vehicle {v} at t = {t:g} s" for v, t in first.items()) or "none"))
 
 
@@ -163,6 +183,11 @@ def _simulate(rep: Report, s: Mapping[str, Any], root: Path) -> None:
         sec.table(rows, caption="Platoon metrics (lower is better except m_fss).",
                   units={label: u for _, label, u in _SIM_METRICS if u})
     for name in ("certified", "cacc"):
+        for k, label, _ in _SIM_METRICS:
+            caveat = metric_caveat(k, s.get(name, {}).get(k))
+            if caveat:
+                sec.verdict(f"{name}: {label} = {s[name][k]:.3g}", None, caveat.strip("()"))
+    for name in ("certified", "cacc"):
         if name in s:
             mp = s[name]["max_m_p"]
             sec.verdict(f"{name}: every follower damps the disturbance (m_p < 1)",
@@ -202,9 +227,9 @@ def _train(rep: Report, s: Mapping[str, Any], root: Path) -> None:
 
 def _hcfs(rep: Report, s: Mapping[str, Any], root: Path) -> None:
     sec = rep.section("7. The HCFS jerk theorem in closed loop",
-                      "HCFS switches between its DDPG policy (a1) and CACC (a2) and proves "
-                      "|a_k − a_{k−1}| ≤ J T. The proof needs a1_{k−1} = a2_{k−1} (premise P3), "
-                      "which the switch does not ensure. The verification checks premises and "
+                      "HCFS switches between its DDPG policy ($a_1$) and CACC ($a_2$) and proves "
+                      "$\\vert a_k - a_{k-1}\\vert \\leq J\\,T$. The proof needs "
+                      "$a_{1,k-1} = a_{2,k-1}$ (premise P3), which the switch does not ensure. The verification checks premises and "
                       "conclusion at every frame, behind the paper's case 1 (UDDS at half speed, "
                       f"8 followers), J = 2.5 m/s³, with {s.get('policy', 'the bundled DDPG')}.")
     rows = []

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from .captions import caption_for
+from .maths import split_maths, typeset_html
 
 __all__ = ["Report", "Section", "command_line", "format_value"]
 
@@ -74,8 +75,13 @@ def _cell(text: str) -> str:
 
 
 def _plain(text: str) -> str:
-    """Plain text inside Markdown: an asterisk is a character (T*), not emphasis."""
-    return text.replace("\\*", "*").replace("*", "\\*")
+    """Plain text inside Markdown: an asterisk is a character (T*), not emphasis.
+
+    Formulas (``$…$``) and code are left as they are (``T^*`` in TeX is not escaped).
+    """
+    return "".join(src if tex is not None or src.startswith("`")
+                   else src.replace("\\*", "*").replace("*", "\\*")
+                   for src, tex, _ in split_maths(text))
 
 
 def command_line(args: Any = None) -> str:
@@ -437,7 +443,7 @@ class Report:
         text = self.markdown(wall_time=wall_time) if markdown is None else markdown
         conv = md_lib.Markdown(extensions=["tables", "fenced_code", "toc", "sane_lists"],
                                extension_configs={"toc": {"toc_depth": "2"}})
-        body = conv.convert(text)
+        body = typeset_html(text, conv.convert)  # formulas as SVG, typeset now
         body = _embed_images(body, Path(root))
         for word in ("yes", "no", "finding"):  # colour the verdicts' result cells
             body = body.replace(f"<td><strong>{word}</strong></td>",

@@ -30,7 +30,8 @@ MARKDOWN = """\
 {% endfor %}{% endfor %}
 """
 
-#: The HTML page: inline CSS, a contents list, the converted Markdown; nothing loaded from outside.
+#: The HTML page: inline CSS, a contents list, the converted Markdown (formulas already typeset as
+#: embedded SVG images, :mod:`stringstab.report.maths`); nothing loaded from outside.
 HTML = """\
 <!DOCTYPE html>
 <html lang="en">
@@ -44,7 +45,8 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans",
        max-width: 64rem; margin: 2rem auto; padding: 0 1.2rem; line-height: 1.5; color: #1b1b1b; }
 h1 { border-bottom: 2px solid #3f51b5; padding-bottom: .3rem; }
 h2 { border-bottom: 1px solid #ccc; padding-bottom: .2rem; margin-top: 2.4rem; }
-table { border-collapse: collapse; margin: .6rem 0 1.2rem; font-size: .92rem; }
+table { border-collapse: collapse; margin: .6rem 0 1.2rem; font-size: .92rem; display: block;
+        max-width: 100%; overflow-x: auto; }
 th, td { border: 1px solid #c8c8c8; padding: .25rem .55rem; text-align: left; vertical-align: top; }
 th { background: #eef0f8; }
 tr:nth-child(even) td { background: #fafafa; }
@@ -52,6 +54,8 @@ code, pre { font-family: ui-monospace, "DejaVu Sans Mono", monospace; font-size:
 pre { background: #f5f5f5; padding: .6rem; overflow-x: auto; }
 img { max-width: 100%; height: auto; display: block; margin: 1rem auto .3rem;
       border: 1px solid #e3e3e3; }
+img.math { display: inline; margin: 0; border: 0; max-width: none; }
+p.math { text-align: center; margin: .8rem 0; }
 p > em:only-child { color: #444; }
 td.yes { background: #e6f4ea !important; color: #1b5e20; }
 td.no { background: #fde8e8 !important; color: #b71c1c; }

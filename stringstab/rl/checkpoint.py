@@ -154,7 +154,7 @@ def read_json(path: str | os.PathLike[str], *, fmt: str, what: str) -> dict[str,
     StringStabError
         If the file is missing, not JSON, not an object, or has another format tag.
     """
-    from ..io.text_files import read_text
+    from ..io.text_input import read_text
 
     p = Path(path)
     if not p.exists():

@@ -17,7 +17,38 @@ import io
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["METRICS", "improvement", "table_csv", "table_markdown", "table_rows"]
+from ..ranges import metric_caveat
+
+__all__ = ["METRICS", "format_m_fss", "improvement", "table_csv", "table_markdown", "table_rows"]
+
+
+def format_m_fss(v: Any) -> str:
+    """m_fss as every output prints it: a strategy that executes no eq-4 gains has 0.
+
+    CACC and IDM execute no gains of the linear law (IDL eq 4), so none is certified: the
+    summary holds None (JSON ``null``), printed ``0 (no certified gains executed)`` on stdout,
+    in ``table.md`` and in the report alike.
+
+    Parameters
+    ----------
+    v : float, mapping with ``mean``/``std``, or None
+        The value.
+
+    Returns
+    -------
+    str
+        The text.
+
+    Examples
+    --------
+    >>> format_m_fss(None), format_m_fss(1.0), format_m_fss(0.98765)
+    ('0 (no certified gains executed)', '1', '0.9877')
+    """
+    if v is None:
+        return "0 (no certified gains executed)"
+    if isinstance(v, Mapping):
+        return f"{v['mean']:.3g} ± {v['std']:.2g}"
+    return f"{float(v):.4g}"
 
 #: (summary key, column title) of Table 4.
 METRICS: tuple[tuple[str, str], ...] = (("TIT", "TIT (s², ↓)"), ("M_CI", "M_CI (m²/s⁶, ↓)"),
@@ -102,16 +133,19 @@ def _cell(key: str, v: Any, improvement_row: bool, row: Mapping[str, Any] | None
         return v
     if v is None:
         if key == "m_fss" and not improvement_row:
-            return "0 (no certified gains executed)"
+            return format_m_fss(v)
         return "–"
     if improvement_row:
         return f"{v:+.2f}%"
     if isinstance(v, Mapping):
         text = f"{v['mean']:.3g} ± {v['std']:.2g}"
     elif key == "m_fss":
-        return f"{v:.4g}"
+        return format_m_fss(v)
     else:
         text = f"{v:.3f}" if key == "M_lss" else f"{v:.3g}"
+    caveat = metric_caveat(key, v["mean"] if isinstance(v, Mapping) else v)
+    if caveat:
+        text += f" {caveat}"
     if key == "M_lss" and row is not None and row.get("share_m_p_below_1") is not None:
         share = row["share_m_p_below_1"]
         share = float(share.get("mean", 0.0) if isinstance(share, Mapping) else share)

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Literal
 
 from ..errors import StringStabError
+from ..io.text_input import open_text
 from ..traffic.cycles import CYCLES, cycle
 from ..traffic.loaders import FollowingPair, load_csv, load_ngsim_pairs
 from ..traffic.split import train_test_split
@@ -143,15 +144,9 @@ def default_leaders(split: Split, *, seconds: float = 30.0, dt: float = 0.1) -> 
 
 
 def _is_ngsim(path: Path) -> bool:
-    from ..io.text_files import decoding
-
-    try:
-        with path.open(encoding="utf-8-sig") as fh, decoding(
-                path, label=f"leader file {str(path)!r}",
-                expected="a 't, v' CSV or an NGSIM trajectory file"):
-            head = fh.readline()
-    except OSError as e:
-        raise StringStabError(f"cannot read leader file {str(path)!r}: {e.strerror or e}") from e
+    with open_text(path, label=f"leader file {str(path)!r}",  # plain or gzip (.csv.gz)
+                   expected="a 't, v' CSV or an NGSIM trajectory file") as fh:
+        head = fh.readline()
     return "vehicle_id" in head.lower()
 
 

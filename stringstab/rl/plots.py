@@ -40,8 +40,10 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
     """Rolling episode return over training episodes (Fig. 3): mean of the last ``window``.
 
     The paper's window is 10; episodes on different leaders differ widely in return, so a
-    ``long_window`` mean is drawn too (None: only the paper's).
-
+    ``long_window`` mean is drawn too (None: only the paper's).  A rolling mean is drawn only
+    where its window is full (from episode ``window`` on): a "window 100" curve of a run with
+    96 episodes would be a cumulative mean under a wrong name, so it is left out and the figure
+    says so.
 
     Parameters
     ----------
@@ -59,35 +61,46 @@ def plot_rolling_reward(episodes: Sequence[Mapping[str, Any]], *, ax: Any = None
     Returns
     -------
     dict
-        ``ax``, ``line`` and (with ``long_window``) ``line_long``.
+        ``ax``, ``points`` (every episode's return), ``line`` (None when the run has fewer
+        than ``window`` episodes), ``line_long`` (None when not drawn) and ``note`` (what is
+        left out, or "").
 
     Examples
     --------
     >>> rows = [{"return": -float(i)} for i in range(30)]
     >>> d = plot_rolling_reward(rows)
-    >>> float(d["line"].get_ydata()[-1]), float(d["line_long"].get_ydata()[-1])
-    (-24.5, -14.5)
+    >>> float(d["line"].get_xdata()[0]), float(d["line"].get_ydata()[-1]), d["line_long"]
+    (10.0, -24.5, None)
+    >>> d["note"]
+    'window 100 not drawn: 30 episodes < 100'
     >>> import matplotlib.pyplot as plt; plt.close("all")
     """
     ax = _ax(ax)
     r = np.array([float(e["return"]) for e in episodes])
     c = np.cumsum(np.r_[0.0, r])
     n = np.arange(1, r.size + 1)
-
-    def rolling(w: int) -> npt.NDArray[np.float64]:
-        lo = np.maximum(n - w, 0)
-        return (c[n] - c[lo]) / (n - lo) if r.size else r
-
-    name = label or "rolling return"
-    (line,) = ax.plot(n, rolling(window), lw=0.8, alpha=0.7, label=f"{name} (window {window})")
-    out = {"ax": ax, "line": line}
-    if long_window:
-        (out["line_long"],) = ax.plot(n, rolling(long_window), lw=2.0,
-                                      label=f"{name} (window {long_window})")
+    name = label or "episode return"
+    points = ax.scatter(n, r, s=4, color="0.6", alpha=0.6, lw=0, label=f"{name}: each episode")
+    out: dict[str, Any] = {"ax": ax, "points": points, "line": None, "line_long": None}
+    missing = []
+    for key, w, style in (("line", window, {"lw": 1.0, "alpha": 0.85}),
+                          ("line_long", long_window, {"lw": 2.0})):
+        if not w:
+            continue
+        if r.size < w:
+            missing.append(f"window {w} not drawn: {r.size} episodes < {w}")
+            continue
+        full = n[w - 1:]
+        (out[key],) = ax.plot(full, (c[full] - c[full - w]) / w,
+                              label=f"{name}: mean of the last {w} episodes", **style)
+    out["note"] = "; ".join(missing)
+    if missing:
+        ax.text(0.99, 0.02, out["note"], transform=ax.transAxes, ha="right", va="bottom",
+                fontsize=8, color="0.3")
     ax.set_xlabel("training episode")
-    ax.set_ylabel("rolling episode return")
+    ax.set_ylabel("episode return")
     ax.grid(alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8, loc="best")
     return out
 
 
@@ -96,10 +109,15 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
                       bin_range: tuple[float, float] | None = None) -> dict[str, Any]:
     """Histogram of per-episode m_p with its CDF on a twin axis (Fig. 6); m_p = 1 marked.
 
+    Every finite value is drawn: a ``bin_range`` that does not hold them all is widened to
+    hold them (the CDF ends at 1 inside the axes).  Episodes whose m_p is undefined (NaN: a
+    predecessor that never accelerates) are counted on the figure, not dropped silently.  The
+    CDF is a line without a fill, so the histogram keeps its colour.
+
     Parameters
     ----------
     m_p : array_like
-        m_p per episode (IDL eq 29); non-finite values are left out.
+        m_p per episode (IDL eq 29).
     ax : matplotlib Axes, optional
         Where to draw (a new figure when None).
     bins : int
@@ -108,31 +126,45 @@ def plot_mp_histogram(m_p: npt.ArrayLike, *, ax: Any = None, bins: int = 30,
         The strategy, in the title.
     bin_range : (float, float), optional
         Range of the bins and of the x axis: give the same to panels drawn side by side so
-        they compare (default: the data's range).
+        they compare (default: the data's range, 1 included).
 
     Returns
     -------
     dict
-        ``ax``, ``ax_cdf``, ``patches``, ``cdf`` and ``share_below_1``.
+        ``ax``, ``ax_cdf``, ``patches``, ``cdf``, ``share_below_1``, ``range`` (the bins'
+        range drawn) and ``undefined`` (values left out as not finite).
     """
     ax = _ax(ax)
-    x = np.asarray(m_p, dtype=np.float64)
-    x = x[np.isfinite(x)]
-    _, _, patches = ax.hist(x, bins=bins, range=bin_range, color="tab:orange", alpha=0.8)
+    x_all = np.asarray(m_p, dtype=np.float64).ravel()
+    x = x_all[np.isfinite(x_all)]
+    undefined = int(x_all.size - x.size)
     if bin_range is not None:
-        ax.set_xlim(*bin_range)
+        lo, hi = bin_range
+    elif x.size:
+        lo, hi = min(1.0, float(x.min())) - 0.02, max(1.0, float(x.max())) + 0.02
+    else:
+        lo, hi = 0.0, 2.0
+    if x.size:
+        lo, hi = min(lo, float(x.min())), max(hi, float(x.max()))
+    _, _, patches = ax.hist(x, bins=bins, range=(lo, hi), color="tab:orange", alpha=0.85)
+    ax.set_xlim(lo, hi)
     ax2 = ax.twinx()
     xs = np.sort(x)
-    (cdf,) = ax2.plot(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue")
-    ax2.fill_between(xs, np.arange(1, xs.size + 1) / max(xs.size, 1), color="tab:blue", alpha=0.15)
+    (cdf,) = ax2.step(np.r_[lo, xs, hi], np.r_[0.0, np.arange(1, xs.size + 1), xs.size]
+                      / max(xs.size, 1), where="post", color="tab:blue", lw=1.5)
     ax2.set_ylim(0, 1.02)
-    ax2.set_ylabel("CDF")
+    ax2.set_ylabel("CDF (share of episodes ≤ m_p)")
     ax.axvline(1.0, color="k", ls="--", lw=1)
     share = float(np.mean(x < 1.0)) if x.size else float("nan")
-    ax.set_title(f"{label + ': ' if label else ''}m_p < 1 in {100 * share:.0f}% of episodes")
+    ax.set_title(f"{label + ': ' if label else ''}m_p < 1 in {100 * share:.0f}% of "
+                 f"{x.size} episodes", fontsize=10)
+    if undefined:
+        ax.text(0.02, 0.98, f"{undefined} episode(s) with undefined m_p left out",
+                transform=ax.transAxes, ha="left", va="top", fontsize=8, color="0.3")
     ax.set_xlabel("m_p (eq 29)")
     ax.set_ylabel("episodes")
-    return {"ax": ax, "ax_cdf": ax2, "patches": patches, "cdf": cdf, "share_below_1": share}
+    return {"ax": ax, "ax_cdf": ax2, "patches": patches, "cdf": cdf, "share_below_1": share,
+            "range": (lo, hi), "undefined": undefined}
 
 
 def plot_ttc_distribution(ttc: Mapping[str, npt.ArrayLike], *, ax: Any = None,
@@ -170,12 +202,15 @@ def plot_ttc_distribution(ttc: Mapping[str, npt.ArrayLike], *, ax: Any = None,
     edges = np.geomspace(min_ttc, max_ttc, bins + 1)
     for name, v in ttc.items():
         x = np.asarray(v, dtype=np.float64)
-        x = x[np.isfinite(x) & (x >= 0) & (x <= max_ttc)]
+        x = x[np.isfinite(x) & (x >= 0)]
         below[name] = float(np.mean(x < star)) if x.size else float("nan")
         h, _ = np.histogram(np.clip(x, min_ttc, None), bins=edges)
-        h = h / h.sum() if h.sum() else h.astype(np.float64)
+        h = h / x.size if x.size else h.astype(np.float64)  # shares of all closing moments
+        beyond = int(np.count_nonzero(x > max_ttc))
         (lines[name],) = ax.plot(np.sqrt(edges[1:] * edges[:-1]), h, marker=".",
-                                 label=f"{name} ({100 * below[name]:.1f} % below TTC*)")
+                                 label=f"{name} ({100 * below[name]:.1f} % below TTC*"
+                                       + (f"; {100 * beyond / x.size:.1f} % above {max_ttc:g} s, "
+                                          "off the axis" if beyond else "") + ")")
     ax.set_xscale("log")
     ax.axvspan(min_ttc, star, color="tab:red", alpha=0.12, label=f"TTC < TTC* = {star:g} s (TIT)")
     ax.set_xlim(min_ttc, max_ttc)
@@ -193,7 +228,9 @@ def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
 
     Linear bars of the percentage of each strategy's samples (from a zero baseline), each bar
     labelled with its count, so small ranges stay readable without a logarithmic axis (whose
-    baseline would be arbitrary).
+    baseline would be arbitrary).  Every finite sample is counted: those above the last range
+    (the paper stops at 60 m²/s⁶) get a bar of their own, so the shares are of all samples and
+    add up to 100 %; non-finite samples are counted in the legend.
 
     Parameters
     ----------
@@ -202,40 +239,59 @@ def plot_jerk_ranges(jerk_sq: Mapping[str, npt.ArrayLike], *, ax: Any = None,
     ax : matplotlib Axes, optional
         Where to draw (a new figure when None).
     ranges : sequence of (lo, hi)
-        The ranges (the last one closed).
+        The ranges (half-open [lo, hi), the last one closed); a bar "> hi" follows.
 
     Returns
     -------
     dict
-        ``ax``, ``bars`` and ``counts`` per strategy.
+        ``ax``, ``bars``, ``counts`` (one per range, then the count above the last) and
+        ``total`` (finite samples) per strategy.
+
+    Examples
+    --------
+    >>> d = plot_jerk_ranges({"a": [0.05, 0.5, 5.0, 30.0, 100.0, float("nan")]})
+    >>> d["counts"]["a"], d["total"]["a"]
+    ([1, 1, 1, 1, 1], 5)
+    >>> import matplotlib.pyplot as plt; plt.close("all")
     """
     ax = _ax(ax)
     names = list(jerk_sq)
+    nb = len(ranges) + 1
     width = 0.8 / max(len(names), 1)
     bars = {}
     counts = {}
+    totals = {}
+    top = ranges[-1][1]
     for j, name in enumerate(names):
-        c = np.asarray(jerk_sq[name], dtype=np.float64)
+        c_all = np.asarray(jerk_sq[name], dtype=np.float64).ravel()
+        c = c_all[np.isfinite(c_all)]
         counts[name] = [int(np.count_nonzero((c >= lo) & (c < hi) if k < len(ranges) - 1
                                              else (c >= lo) & (c <= hi)))
-                        for k, (lo, hi) in enumerate(ranges)]
-        total = max(sum(counts[name]), 1)
-        bars[name] = ax.bar(np.arange(len(ranges)) + j * width,
-                            [100.0 * k / total for k in counts[name]], width, label=name)
-        ax.bar_label(bars[name], labels=[f"{k:,}" for k in counts[name]], fontsize=7, padding=1)
-    ax.set_xticks(np.arange(len(ranges)) + 0.4 - width / 2,
-                  [f"[{lo:g}, {hi:g}]" for lo, hi in ranges])
+                        for k, (lo, hi) in enumerate(ranges)] + [int(np.count_nonzero(c > top))]
+        totals[name] = int(c.size)
+        total = max(c.size, 1)
+        bad = c_all.size - c.size
+        lab = f"{name} ({c.size:,} samples{f'; {bad:,} not finite, left out' if bad else ''})"
+        bars[name] = ax.bar(np.arange(nb) + j * width,
+                            [100.0 * k / total for k in counts[name]], width, label=lab)
+        ax.bar_label(bars[name], labels=[f"{k:,}" for k in counts[name]], fontsize=8, padding=1)
+    ax.set_xticks(np.arange(nb) + 0.4 - width / 2,
+                  [f"[{lo:g}, {hi:g}]" for lo, hi in ranges] + [f"> {top:g}"])
     ax.set_xlabel("squared jerk c (m²/s⁶)")
-    ax.set_ylabel("share of samples (%); count on each bar")
-    ax.set_ylim(0, 108)
-    ax.set_title("IDL Fig. 11: squared jerk by range (comfort; lower ranges are better)")
-    ax.legend()
-    return {"ax": ax, "bars": bars, "counts": counts}
+    ax.set_ylabel("share of all samples (%); count on each bar")
+    ax.set_ylim(0, 112)
+    ax.set_title("IDL Fig. 11: squared jerk by range (comfort; lower ranges are better)",
+                 fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
+    return {"ax": ax, "bars": bars, "counts": counts, "total": totals}
 
 
 def plot_headway_cdf(headway: Mapping[str, npt.ArrayLike], *, ax: Any = None,
                      max_h: float = 3.0, t_star: float | None = None) -> dict[str, Any]:
-    """CDF of the time headway in [0, max_h] s per strategy (Fig. 12), with T* marked.
+    """CDF of the time headway per strategy (Fig. 12), drawn over [0, max_h] s, with T* marked.
+
+    The CDF is of every finite sample; the shares below 0 s and above ``max_h`` (off the axis)
+    are given in the legend, so the curve ending below 1 at ``max_h`` is explained.
 
     Parameters
     ----------
@@ -257,8 +313,12 @@ def plot_headway_cdf(headway: Mapping[str, npt.ArrayLike], *, ax: Any = None,
     lines = {}
     for name, v in headway.items():
         x = np.sort(np.asarray(v, dtype=np.float64)[np.isfinite(np.asarray(v, dtype=np.float64))])
-        x = x[(x >= 0) & (x <= max_h)]
-        (lines[name],) = ax.plot(x, np.arange(1, x.size + 1) / max(x.size, 1), label=name)
+        y = np.arange(1, x.size + 1) / max(x.size, 1)  # the CDF of every finite sample
+        keep = (x >= 0) & (x <= max_h)
+        off = [f"{100 * np.mean(x < 0):.1f} % < 0 s"] if (x < 0).any() else []
+        off += [f"{100 * np.mean(x > max_h):.1f} % > {max_h:g} s"] if (x > max_h).any() else []
+        (lines[name],) = ax.plot(x[keep], y[keep],
+                                 label=f"{name}{' (off the axis: ' + ', '.join(off) + ')' if off else ''}")
     if t_star is not None:
         ax.axvline(t_star, color="k", ls="--", lw=0.8, label=f"T* = {t_star:g} s")
     ax.set_xlabel("time headway h (s, eq 22)")

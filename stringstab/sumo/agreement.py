@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..params import DEFAULT_DELTA, DEFAULT_TAU
-from ..traffic import PlatoonResult, Trajectory, simulate
+from ..traffic import Limits, PlatoonResult, Trajectory, simulate
 from ..traffic.controllers import Controller
 from .platoon import DEFAULT_LENGTH, ballistic_leader, cosimulate
 
@@ -58,14 +58,14 @@ def differences(a: PlatoonResult, b: PlatoonResult) -> dict[str, float]:
 
 def agreement(leader: Trajectory, controller: Controller, n_followers: int, *,
               tau: float = DEFAULT_TAU, delta: float = DEFAULT_DELTA, api: str = "libsumo",
-              length: float = DEFAULT_LENGTH, tolerance: float = TOLERANCE,
-              progress: bool = False) -> dict[str, Any]:
+              length: float = DEFAULT_LENGTH, limits: Limits | None = None,
+              tolerance: float = TOLERANCE, progress: bool = False) -> dict[str, Any]:
     """Run one case through :func:`~stringstab.traffic.simulate` and through SUMO; compare.
 
     Parameters
     ----------
-    leader, controller, n_followers, tau, delta, length
-        The case (as for :func:`~stringstab.traffic.simulate`).
+    leader, controller, n_followers, tau, delta, length, limits
+        The case (as for :func:`~stringstab.traffic.simulate`; ``limits`` default: IDL Table 2).
     api : {"libsumo", "traci"}
         How SUMO runs.
     tolerance : float
@@ -86,10 +86,11 @@ def agreement(leader: Trajectory, controller: Controller, n_followers: int, *,
     """
     leader, moved = ballistic_leader(leader)
     toolkit = simulate(leader, controller, n_followers, tau=tau, delta=delta, length=length,
-                       position_update="trapezoid")
-    exact = simulate(leader, controller, n_followers, tau=tau, delta=delta, length=length)
+                       limits=limits, position_update="trapezoid")
+    exact = simulate(leader, controller, n_followers, tau=tau, delta=delta, length=length,
+                     limits=limits)
     sumo = cosimulate(leader, controller, n_followers, tau=tau, delta=delta, api=api,
-                      length=length, progress=progress)
+                      limits=limits, length=length, progress=progress)
     d = differences(toolkit, sumo)
     finite = [v for v in d.values() if np.isfinite(v)]
     return {

@@ -19,6 +19,14 @@ leader that entered the simulation less than δ ago is assumed to have held its 
 acceleration before.  A controlled vehicle with no leader within 250 m is handed back to SUMO
 (speed mode restored, its own car-following model drives it) until a leader appears; its lag
 state restarts from SUMO's acceleration then.
+
+The controlled ids are checked against the scenario's route files before SUMO starts (an id no
+file defines, or one departing after the last of ``steps``, is refused), and each one when it
+is due: a vehicle neither driving nor waiting for insertion one step after its depart time
+stops the run there (:mod:`~stringstab.sumo.routes`).  The summary's m_p and collisions are
+the toolkit's metrics (:mod:`stringstab.traffic.metrics`, eq 29 and its collision count) over
+the steps each vehicle was driven; a vehicle that never had a leader is listed in
+``without_leader`` (nothing of the controller was exercised on it).
 """
 
 from __future__ import annotations
@@ -36,6 +44,8 @@ from ..params import DEFAULT_DELTA, DEFAULT_TAU
 from ..progress import Progress
 from ..traffic import Limits, Platoon
 from ..traffic.controllers import Controller, Observation
+from ..traffic.metrics import collision_count, damping_ratio
+from .routes import Schedule, scheduled_departures
 from .runtime import SumoSession, check_config
 
 __all__ = ["LOOKAHEAD", "ScenarioRun", "run_scenario"]
@@ -64,7 +74,8 @@ class ScenarioRun:
     summary : dict
         Per vehicle and overall: steps controlled, leader changes (the leaders in order),
         minimum gap, collisions (entries into gap ≤ 0), m_p over the controlled steps (eq 29:
-        its acceleration energy over its leaders'), and m_fss of the executed gains.
+        its acceleration energy over its leaders'), m_fss of the executed gains, and
+        ``without_leader``: the vehicles that never had a leader (never driven by the controller).
     """
 
     columns: dict[str, Any]
@@ -108,7 +119,9 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
         A SUMO configuration with ``step-length`` = ``dt`` and the ballistic update (refused
         otherwise, before SUMO starts).
     controlled : list of str
-        Vehicle ids; each must appear in the run (refused at the end otherwise, nothing kept).
+        Vehicle ids of the scenario's route files; each is refused before SUMO starts when no
+        route file defines it or it departs after the last of ``steps``, and stops the run
+        when it is due and SUMO neither drives it nor waits to insert it.
     controller : Controller
         Any toolkit controller (vectorised over the controlled vehicles present).
     dt, tau, delta : float
@@ -129,13 +142,16 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
     Raises
     ------
     StringStabError
-        A configuration with another step or the Euler update, an id that never appears, or
-        SUMO failing.
+        A configuration with another step or the Euler update, an id that is not in the
+        scenario or never appears when due, or SUMO failing.
     """
     check_config(sumocfg, dt)
     ids = list(dict.fromkeys(controlled))
     if not ids or any(not i.strip() for i in ids):
         raise StringStabError(f"--controlled: expected vehicle ids ID,ID,...; got {controlled!r}")
+    sched = scheduled_departures(sumocfg)
+    _check_ids(ids, sched, Path(sumocfg).name, None if steps is None else sched.begin + steps * dt)
+    due = {vid: d for vid in ids if (d := sched.depart(vid)) is not None}
     M = len(ids)
     lag = Platoon(M, 1, dt=dt, tau=tau, delta=delta, limits=limits)
     q = delta / dt
@@ -176,6 +192,11 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
                 present = np.array([i in res for i in ids])
                 gone |= seen & ~present
                 seen |= present
+                late = [v for j, v in enumerate(ids) if not seen[j] and v in due
+                        and t >= due[v] + dt * (1 + 1e-9)]
+                if late:
+                    _refuse_late(late, set(s.simulation.getPendingVehicles()), due, t,
+                                 Path(sumocfg).name, sched.begin)
                 idx = np.flatnonzero(present)
                 lead_info: list[Any] = []
                 for j in idx:
@@ -262,6 +283,41 @@ def run_scenario(sumocfg: str | Path, controlled: list[str], controller: Control
     return ScenarioRun(cols, ids, _summary(cols, ids, tau, delta, controller, dt))
 
 
+def _check_ids(ids: list[str], sched: Schedule, name: str, end: float | None) -> None:
+    """Refuse, before SUMO starts, ids no route file defines or departing after ``end`` (s)."""
+    if not sched.complete:
+        return  # a file not read here: the run checks the ids
+    unknown = [v for v in ids if not sched.defines(v)]
+    if unknown:
+        known = list(sched.vehicles)[:12] + [f"{f}.N" for f in list(sched.flows)[:4]]
+        raise StringStabError(
+            f"--controlled: no vehicle {', '.join(map(repr, unknown))} in the route files of "
+            f"{name} ({', '.join(p.name for p in sched.files) or 'none'}); expected ids of "
+            f"vehicles the scenario inserts, e.g. {', '.join(known)}")
+    if end is not None:
+        after = [(v, d) for v in ids if (d := sched.depart(v)) is not None and d > end + 1e-9]
+        if after:
+            v, d = after[0]
+            raise StringStabError(
+                f"--controlled: vehicle {v!r} departs at t = {d:g} s, after the run's end "
+                f"(--steps ends it at t = {end:g} s); expected more --steps or vehicles that "
+                "depart within the run")
+
+
+def _refuse_late(late: list[str], pending: set[str], due: dict[str, float], t: float,
+                 name: str, begin: float) -> None:
+    """Stop the run at a vehicle that is due but neither driving nor waiting for insertion."""
+    missing = [v for v in late if v not in pending]
+    if missing:
+        v = missing[0]
+        why = (f"it departs before the configuration's begin, t = {begin:g} s, and SUMO skips "
+               "it" if due[v] < begin else "SUMO dropped it, e.g. for a route it could not use")
+        raise StringStabError(
+            f"--controlled: vehicle {v!r} of {name} was due to depart at t = {due[v]:g} s and "
+            f"at t = {t:g} s SUMO neither drives it nor waits to insert it ({why}); expected a "
+            "vehicle the scenario inserts")
+
+
 def _summary(cols: dict[str, Any], ids: list[str], tau: float, delta: float,
              controller: Controller, dt: float) -> dict[str, Any]:
     per = []
@@ -273,10 +329,10 @@ def _summary(cols: dict[str, Any], ids: list[str], tau: float, delta: float,
             if not leaders or leaders[-1] != lid:
                 leaders.append(str(lid))
         gap = cols["gap"][m]
-        coll = int(np.sum(np.diff(np.r_[0, (gap <= 0).astype(int)]) == 1)) if gap.size else 0
+        coll = int(collision_count(gap)) if gap.size else 0
         a, ap = cols["accel"][m], cols["pred_accel"][m]
-        ea, ep = float(np.sum(a * a)), float(np.sum(ap * ap))
-        mp = math.sqrt(ea / ep) if ep > 0 else None
+        mp_value = float(damping_ratio(a, ap))  # eq 29 over the driven steps
+        mp = mp_value if math.isfinite(mp_value) else None
         K = np.column_stack([cols["k_x"][m], cols["k_v"][m], cols["k_a"][m]])
         if K.size and np.isfinite(K).all():
             K_all.append(K)
@@ -288,6 +344,8 @@ def _summary(cols: dict[str, Any], ids: list[str], tau: float, delta: float,
     out: dict[str, Any] = {"vehicles": per,
                            "leader_changes": sum(p["leader_changes"] for p in per),
                            "collisions": sum(p["collisions"] for p in per),
+                           "without_leader": [p["vehicle"] for p in per
+                                              if p["steps_controlled"] == 0],
                            "m_fss": None}
     if K_all and controller.headway is not None:
         from ..rl.evaluate import fss

@@ -10,14 +10,23 @@ others go on (a failed point is tried again by the next run); a worker that dies
 its task rescheduled on another worker by the scheduler, and ``retries`` more times after the
 scheduler gives up on it (``KilledWorker``).  At the end the table of all the spec's points
 and the study's report are written (:mod:`stringstab.sweep.report`).
+
+Interrupted (Ctrl-C, SIGTERM, an error), :func:`cancel_points` cancels the sweep's tasks on the
+scheduler (``Client.cancel(force=True)``: none not yet started will start) and stops the ones
+running in the workers (:func:`~stringstab.sweep.tasks.interrupt_points`): a cancelled Dask
+task is forgotten by the scheduler but its thread would compute on, which on an external
+scheduler (whose workers outlive this client) kept the workers busy for as long as the points
+take.
 """
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..errors import StringStabError
@@ -25,9 +34,12 @@ from ..io import atomic_write_text, check_output_dir, claim_folder, dumps_json, 
 from ..progress import Progress
 from .records import POINT_FORMAT, read_records, record_path
 from .spec import SweepSpec
-from .tasks import refuse_points_too_big, run_point
+from .tasks import interrupt_points, refuse_points_too_big, run_point
 
-__all__ = ["run_sweep"]
+__all__ = ["cancel_points", "run_sweep"]
+
+#: How long :func:`cancel_points` waits for the running points to stop, s.
+STOP_WAIT = 10.0
 
 class _Progress:
     """A tqdm bar on a terminal; otherwise a log line per finished point, with the time left.
@@ -76,6 +88,69 @@ def _lost_record(point: dict[str, Any], error: str) -> dict[str, Any]:
     return {"id": point["id"], "kind": point["kind"], "label": point["label"],
             "varied": point["varied"], "status": "failed", "metrics": {}, "artefacts": {},
             "error": error, "seconds": float("nan"), "worker": None, "pid": None}
+
+
+@contextlib.contextmanager
+def _quiet_scheduler() -> Iterator[None]:
+    """An in-process scheduler (a local cluster) does not log the workers a Ctrl-C already ended.
+
+    A terminal's Ctrl-C reaches the local cluster's workers too; the scheduler then logs an
+    ERROR for each worker ``Client.run`` cannot reach, which is expected here.
+    """
+    logger = logging.getLogger("distributed.scheduler")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+
+
+def cancel_points(client: Any, futures: list[Any], root: str, *,
+                  log: Callable[[str], None] = print, wait: float = STOP_WAIT) -> int:
+    """Cancel a sweep's tasks on the scheduler and stop those running; see the module.
+
+    Parameters
+    ----------
+    client : distributed.Client
+        The client that submitted them.
+    futures : list of distributed.Future
+        The sweep's futures (those already finished are left alone).
+    root : str
+        The sweep folder as given to :func:`~stringstab.sweep.tasks.run_point` (absolute).
+    log : callable
+        Receives one line if some point still runs after ``wait`` seconds.
+    wait : float
+        How long to wait for the running points to stop, s.
+
+    Returns
+    -------
+    int
+        How many points were still computing in a worker when this returned (0: the workers
+        are free of this sweep).
+    """
+    pending = [f for f in futures if not f.done()]
+    if not pending:
+        return 0
+    client.cancel(pending, force=True)
+    ids = sorted({str(f.key).removeprefix("stringstab-point-") for f in pending})
+    end = time.monotonic() + wait
+    running = 0
+    while True:
+        try:
+            with _quiet_scheduler():
+                counts = client.run(interrupt_points, root, ids, on_error="return")
+        except Exception as e:  # the scheduler is gone: nothing more to stop from here
+            log(f"sweep: could not reach the workers to stop the running points ({e})")
+            return 0
+        running = sum(c for c in counts.values() if isinstance(c, int))
+        if running == 0 or time.monotonic() > end:
+            break
+        time.sleep(0.1)
+    if running:
+        log(f"sweep: {running} point(s) still computing in the workers after {wait:g} s (a long "
+            "call into C); they stop at their next Python instruction")
+    return running
 
 
 def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retries: int = 2,
@@ -165,8 +240,7 @@ def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retr
             failed += rec["status"] != "done"
             bar.update(rec)
     except BaseException:
-        for fut in futures.values():
-            fut.cancel()
+        cancel_points(client, list(futures.values()), root_abs, log=log)
         raise
     finally:
         bar.close()

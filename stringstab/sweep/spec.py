@@ -461,7 +461,7 @@ def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
     StringStabError
         For a missing or unreadable file, or any error of :func:`parse_spec`.
     """
-    from ..io.text_files import read_text
+    from ..io.text_input import read_text
 
     p = Path(path)
     text = read_text(p, label=f"spec {str(p)!r}", expected="a TOML sweep spec")

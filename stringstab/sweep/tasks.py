@@ -9,15 +9,25 @@ the certificate summary, the artefact paths, the wall time, the worker and the p
 An ordinary exception of a point becomes a record with ``status = "failed"`` and the error (a
 retry would fail the same way); only the death of a worker is retried (by the scheduler, and by
 the runner's ``retries``).
+
+A running point can be stopped: Dask's cancel forgets a task but cannot stop the thread that
+computes it, so :func:`interrupt_points` (run in each worker by ``Client.run``, see
+:func:`stringstab.sweep.runner.cancel_points`) raises :class:`PointCancelled` in the threads
+computing the named points, at their next Python instruction.  A point's thread is registered
+only while :func:`run_point` computes it, and leaves the registry in a way that lets the
+exception land inside :func:`run_point` only, never in Dask's own code around it.
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
 import shutil
 import socket
+import threading
 import time
 import traceback
+from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
@@ -25,11 +35,60 @@ import numpy as np
 
 from ..errors import StringStabError, show
 
-__all__ = ["point_bytes", "refuse_points_too_big", "run_point"]
+__all__ = ["PointCancelled", "interrupt_points", "point_bytes", "refuse_points_too_big",
+           "run_point"]
 
 #: Metrics of a training point's evaluation copied into its record (IDL eqs 27-35).
 EVAL_METRICS = ("TIT", "M_CI", "M_effi", "M_lss", "m_fss", "m_fss_sampled", "collisions",
                 "collided_episodes", "share_m_p_below_1", "min_gap", "episodes")
+
+
+class PointCancelled(BaseException):
+    """Raised in a worker thread whose point was cancelled (:func:`interrupt_points`).
+
+    A :class:`BaseException`, as :class:`KeyboardInterrupt` is: no ``except Exception`` of the
+    library records it as a failed point; the cleanups (``finally``, atomic writes) still run.
+    """
+
+
+#: The threads computing a point in this process: thread id -> (sweep folder, point id).
+_RUNNING: dict[int, tuple[str, str]] = {}
+_RUNNING_LOCK = threading.Lock()
+
+
+def interrupt_points(root: str, ids: Collection[str]) -> int:
+    """Raise :class:`PointCancelled` in this process's threads computing points ``ids`` of ``root``.
+
+    Meant to run in every worker through ``distributed.Client.run``; the exception lands at the
+    thread's next Python instruction (a long call into C, a NumPy or torch kernel, finishes
+    first).  Calling it again for a thread still computing is harmless.
+
+    Parameters
+    ----------
+    root : str
+        The sweep folder as passed to :func:`run_point` (absolute).
+    ids : collection of str
+        The point ids to stop.
+
+    Returns
+    -------
+    int
+        How many threads of this process were computing one of those points (each was sent
+        the exception); 0 when none is.
+    """
+    wanted = set(ids)
+    n = 0
+    with _RUNNING_LOCK:
+        for ident, (r, pid) in _RUNNING.items():
+            if r == root and pid in wanted:
+                ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(ident),
+                                                           ctypes.py_object(PointCancelled))
+                n += 1
+    return n
+
+
+def _settle() -> None:
+    """A Python call: an exception sent to this thread earlier is raised at its start."""
 
 
 def _worker_name() -> str:
@@ -67,6 +126,29 @@ def run_point(point: dict[str, Any], root: str) -> dict[str, Any]:
         ``artefacts`` (paths relative to ``root``), ``seconds``, ``worker``, ``pid``, and
         ``error`` / ``traceback`` for a failed point.
     """
+    ident = threading.get_ident()
+    cancelled = False
+    try:
+        with _RUNNING_LOCK:  # inside the try: an interrupt can only land where it is caught
+            _RUNNING[ident] = (root, point["id"])
+        rec = _compute(point, root)
+    except PointCancelled:
+        cancelled = True
+    while True:  # leave the registry; an interrupt sent before that is raised (and caught) here
+        try:
+            with _RUNNING_LOCK:
+                _RUNNING.pop(ident, None)
+            _settle()
+            break
+        except PointCancelled:
+            cancelled = True
+    if cancelled:
+        raise PointCancelled(f"point {point['id']} was cancelled")
+    return rec
+
+
+def _compute(point: dict[str, Any], root: str) -> dict[str, Any]:
+    """:func:`run_point`'s record of one point (its thread is registered meanwhile)."""
     t0 = time.perf_counter()
     rec: dict[str, Any] = {"id": point["id"], "kind": point["kind"], "label": point["label"],
                            "varied": point["varied"], "worker": _worker_name(), "pid": os.getpid()}

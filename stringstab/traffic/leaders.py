@@ -98,7 +98,7 @@ def leader_by_name(spec: str, *, dt: float = DT, duration: float | None = None) 
         if params:
             raise StringStabError(f"leader {show(key)} takes no parameters; got {show(params)}")
         tr = cycle(key, dt=dt)
-    elif spec.lower().endswith(".csv") or Path(spec).is_file():
+    elif spec.lower().endswith((".csv", ".csv.gz")) or Path(spec).is_file():
         tr = load_csv(spec, dt=dt)
     else:
         raise StringStabError(

@@ -2,6 +2,8 @@
 
 :func:`load_csv` reads a generic speed profile in SI units; :func:`load_ngsim_pairs` cuts
 the US-101 / I-80 trajectory files (IDL paper §4.1.1) into leader–follower pairs in SI units.
+Both read plain or gzip-compressed files, strictly UTF-8, through the one reader
+(:mod:`stringstab.io.text_input`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy.typing as npt
 
 from ..constants import DT
 from ..errors import StringStabError, show
+from ..io.text_input import open_text, read_text
 from .trajectory import Trajectory, from_speed
 
 __all__ = ["FEET", "FollowingPair", "load_csv", "load_ngsim_pairs"]
@@ -52,10 +55,8 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
         ``t, v, a``, a value is not a finite number, times are not strictly increasing or a
         speed is negative.
     """
-    from ..io.text_files import read_text
-
     p = Path(path)
-    text = read_text(p, label=f"leader CSV {show(str(p))}",
+    text = read_text(p, label=f"leader CSV {show(str(p))}",  # plain or gzip (.csv.gz)
                      expected="a CSV file with columns 't, v' or 't, v, a'")
     rows = [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(c.strip() for c in r)]
     if not rows:
@@ -176,15 +177,9 @@ def load_ngsim_pairs(
     StringStabError
         If the file cannot be read, is not UTF-8 text or lacks a required column.
     """
-    from ..io.text_files import decoding
-
     p = Path(path)
-    try:
-        fh = p.open(newline="", encoding="utf-8-sig")
-    except OSError as e:
-        raise StringStabError(f"cannot read NGSIM file {show(str(p))}: {e.strerror or e}") from e
-    with fh, decoding(p, label=f"NGSIM file {show(str(p))}",
-                      expected="an NGSIM US-101/I-80 trajectory CSV file"):
+    with open_text(p, label=f"NGSIM file {show(str(p))}",  # plain or gzip (.csv.gz)
+                   expected="an NGSIM US-101/I-80 trajectory CSV file") as fh:
         reader = csv.reader(fh)
         header = [c.strip().lower() for c in next(reader, [])]
         missing = [c for c in _NGSIM_REQUIRED if c.lower() not in header]

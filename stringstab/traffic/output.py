@@ -186,7 +186,7 @@ def _write(result: PlatoonResult, out: OutputDir, metrics: dict[str, Any], fmt: 
         from ..plots.traffic import plot_damping_ratios, plot_platoon
 
         fig, _ = plot_platoon(result, title=title,
-                              fig=Figure(figsize=(12, 7.5), layout="constrained"))
+                              fig=Figure(figsize=(9, 6.5), layout="constrained"))
         fig.savefig(out.path("platoon.png"), dpi=110)
         fig = Figure(figsize=(6, 3.5), layout="constrained")
         ax = fig.subplots()

@@ -42,6 +42,7 @@ import numpy.typing as npt
 from ..certify import margin as _margin
 from ..certify.criteria import hurwitz_conditions
 from ..certify.grid import certified
+from ..errors import StringStabError
 from ..params import Box, Params
 
 __all__ = ["FORM_SIZE", "LoopConstraints", "Member", "Slot", "quadratic_form"]
@@ -162,6 +163,10 @@ class LoopConstraints:
         self.sample_time = sample_time
         self.heterogeneous = bool(heterogeneous)
         self.box = Box.of(params)
+        lo, hi = self.box.reaction_delay
+        if hi:  # issue 25 part 2: not here yet, and never silently dropped
+            raise StringStabError("the tuning certifies reaction_delay = 0 only so far; got "
+                                  f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else ""))
 
     @property
     def sampled(self) -> bool:

@@ -51,7 +51,9 @@ class TuneResult:
         a ``str``: ``"certified"``, ``"not_certified"`` or ``"inconclusive"``).
     status : str
         ``"unchanged"`` (the input was already certified), ``"repaired"`` (a new
-        output was found), ``"taylor_stable"`` (region growing only: the
+        output was found and the exact certificate certifies it), ``"moved_not_certified"``
+        (a new output was found, e.g. one the paper's Taylor test accepts, but the exact
+        certificate does not certify it), ``"taylor_stable"`` (region growing only: the
         paper's Taylor test calls the input stable, so the paper's method does
         not act), ``"no_solution"`` (the paper's "No optimized solution found")
         or ``"failed"`` (projection only; never observed, see ``docs/tuning.md``).
@@ -190,18 +192,19 @@ class TuneResults:
         Returns
         -------
         dict of str to dict
-            For each method: ``n`` (outputs), ``certified``, ``repaired``, ``unchanged``,
-            ``not_certified`` and ``median_distance_moved`` (0.0 when none was repaired).
+            For each method: ``n`` (outputs), ``certified``, ``repaired`` (moved and certified),
+            ``unchanged``, ``not_certified`` and ``median_distance_moved`` (over the outputs
+            that moved, certified or not; 0.0 when none moved).
         """
         out: dict[str, dict[str, Any]] = {}
         methods = self.methods or tuple(dict.fromkeys(r.method for r in self.results))
         for m in methods:
             rs = [r for r in self.results if r.method == m]
-            moved = [r.distance for r in rs if r.status == "repaired"]
+            moved = [r.distance for r in rs if r.status in ("repaired", "moved_not_certified")]
             out[m] = {
                 "n": len(rs),
                 "certified": sum(r.certified for r in rs),
-                "repaired": len(moved),
+                "repaired": sum(r.status == "repaired" for r in rs),
                 "unchanged": sum(r.status == "unchanged" for r in rs),
                 "not_certified": sum(not r.certified for r in rs),
                 "median_distance_moved": float(np.median(moved)) if moved else 0.0,
@@ -326,7 +329,9 @@ def make_result(method: str, K0: Array, K: Array, cert: Certificate | VerdictAnd
     cert : Certificate or VerdictAndGain
         The exact certificate of K (or the verdict and sup |Γ| taken from it).
     status : str
-        The method's exit status (recorded as is).
+        The method's exit status, recorded as is except ``"repaired"`` for an output the exact
+        certificate does not certify, which is recorded as ``"moved_not_certified"`` (a table
+        never says "repaired" beside "certified: no").
     w : ndarray, shape (3,)
         Weights of the reported distance ‖K − K0‖_W (:func:`wdist`).
     iterations : int
@@ -344,6 +349,8 @@ def make_result(method: str, K0: Array, K: Array, cert: Certificate | VerdictAnd
         ``certified`` and ``verdict`` come from ``cert``, never from ``status``.
     """
     v = cert if isinstance(cert, VerdictAndGain) else VerdictAndGain.of(cert)
+    if status == "repaired" and not v.certified:
+        status = "moved_not_certified"
     return TuneResult(
         method=method, k_in=triple(K0), k=triple(K), certified=v.certified,
         verdict=v.verdict, status=status, distance=float(wdist(K, K0, w)),
