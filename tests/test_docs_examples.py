@@ -62,6 +62,9 @@ PLACEHOLDERS: dict[str, str] = {
                 "(tests/test_sweep_spec.py)",
     "bad2.toml": "docs/sweeps.md's example of a spec with a bad value (tests/test_sweep_spec.py)",
     "bad3.toml": "docs/sweeps.md's example of an empty axis (tests/test_sweep_spec.py)",
+    "big.toml": "docs/sweeps.md's example of a spec whose certify point (n = 100000) no worker "
+                "can hold; the numbers in its error line depend on the machine's memory "
+                "(tests/test_cli_inputs.py refuses such a sweep before dispatch)",
 }
 
 #: Examples not run, by the start of the command (after `stringstab`), with the reason.
