@@ -19,6 +19,8 @@ T*             [0, 5] s          > 100 s       time headways are 0.3-3 s
 H              [1e-3, 1] s       < 1e-4 s,     control periods are 0.01-0.2 s; the sampled
                                  > 100 s       loop's order grows as δ/H (H = 1e-300 s
                                                divided by zero, 1e-8 s ran for ever)
+dt             [1e-3, 1] s       < 1e-4 s,     simulation steps are 0.01-0.1 s; the run's
+                                 > 100 s       samples grow as 1/dt (2e-308 s overflowed)
 duration       <= 1 day          > 1 year      a run, an episode, a cycle
 jerk limit J   <= 30 m/s³        > 1e6 m/s³    HCFS: 2 a_max / T = 30 m/s³ is what the
                                                ±3 m/s² bounds alone guarantee at T = 0.2 s
@@ -61,6 +63,7 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "headway": (5.0, 100.0, " s", "time headway T*"),
     "reaction_delay": (2.0, 100.0, " s", "reaction delay theta_r"),
     "sample_time": (1.0, 100.0, " s", "sample time H"),
+    "step": (1.0, 100.0, " s", "simulation step dt"),
     "duration": (86_400.0, 3.2e7, " s", "duration"),
     "jerk": (30.0, 1e6, " m/s³", "jerk limit J"),
     "length": (30.0, 1e4, " m", "length"),
@@ -72,6 +75,7 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
 #: name -> (sensible lower bound, refused below): the magnitudes that also have a floor.
 FLOORS: dict[str, tuple[float, float]] = {
     "sample_time": (1e-3, 1e-4),
+    "step": (1e-3, 1e-4),
 }
 
 #: name -> (sensible upper bound, largest accepted, what is counted, why the largest)

@@ -33,6 +33,9 @@ def _one_line(capsys, argv, code, starts, match=""):
      "--sample-time = 1e-300 s is far outside the physically meaningful range (sensible: 0.001 to "
      "1 s; refused below 0.0001 s)"),
     (["tune", "0.9,-0.5,1.1", "--sample-time", "5e-5"], "--sample-time = 5e-05 s is far outside"),
+    (["simulate", "--dt", "2.2250738585072014e-308", "--out", "unused"],  # fuzz: OverflowError
+     "--dt = 2.22507e-308 s is far outside the physically meaningful range (sensible: 0.001 to 1 "
+     "s; refused below 0.0001 s)"),
     (["certify", "1,1,1", "--delta", "1e5"], "communication delay delta = 100000 s"),
     (["tune", "7,1,1", "--method", "both"], "expected K0 within [-6, 6]"),
     (["tune", "0.9,-0.5,1.1", "--bounds", "-1e308,1e308"], "--bounds = -1e+308 is far outside"),

@@ -381,7 +381,7 @@ FLOATS = ["nan", "inf", "-1", "1e300"]
 INTS = ["nan", "inf", "-1", HUGE_INT]
 GAINS = ["nan,0.5,0.6", "inf,0.5,0.6", "1e300,0.5,0.6"]  # a negative gain is valid
 A_MIN = ["nan", "-inf", "1", "-1e300"]  # a braking limit is negative
-SAMPLE = [*FLOATS, "1e-300"]  # a sample time also has a floor (1e-300 divided by zero)
+SAMPLE = [*FLOATS, "1e-300"]  # a sample time or step also has a floor (1e-300 divided by zero)
 #: Every numeric flag of every command (sumo's own are listed in SUMO_NUMERIC) and its bad values.
 NUMERIC = {
     "derive": {"--delay-order": INTS, "--sample-time": SAMPLE, "--reaction-delay": FLOATS,
@@ -397,7 +397,7 @@ NUMERIC = {
              "--max-iter": INTS, "--hurwitz-margin": FLOATS, "--eps": FLOATS},
     "simulate": {"--followers": INTS, "--gains": GAINS, "--vehicle": INTS, "--tau": FLOATS,
                  "--delta": FLOATS, "--headway": FLOATS, "--standstill": FLOATS,
-                 "--length": FLOATS, "--dt": FLOATS, "--duration": FLOATS, "--hold": FLOATS,
+                 "--length": FLOATS, "--dt": SAMPLE, "--duration": FLOATS, "--hold": FLOATS,
                  "--ttc-star": FLOATS, "--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS},
     "train": {"--steps": INTS, "--seed": INTS, "--num-envs": INTS, "--stop-episodes": INTS},
     "evaluate": {"--platoon": [f"{v},10" for v in INTS], "--v-max": FLOATS, "--a-min": A_MIN,

@@ -230,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
             )
     sizes = [(kind, getattr(args, name), f"--{name.replace('_', '-')}")
              for name, kind in (("standstill", "length"), ("length", "length"), ("ttc_star", "ttc"))]
-    for kind, v, option in sizes:
+    for kind, v, option in [("step", args.dt, "--dt"), *sizes]:
         check_magnitude(kind, v, name=option)
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
@@ -256,7 +256,8 @@ def run(args: argparse.Namespace) -> int:
 
     settling = settling_time(controller, tau if args.model == "lag" else 0.0)
     warnings = checked_leaders(args, [leader], limits, settling=settling)
-    warn_beyond_sensible(args, [("followers", args.followers, "--followers"), *sizes])
+    warn_beyond_sensible(args, [("followers", args.followers, "--followers"),
+                                ("step", args.dt, "--dt"), *sizes])
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length, limits=limits)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
