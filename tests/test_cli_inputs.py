@@ -122,6 +122,33 @@ def test_gains_from_binary_standard_input_are_refused(capsys, monkeypatch):
              "byte offset 16)")
 
 
+def test_standard_input_goes_through_the_one_reader(capsys, monkeypatch):
+    """gzip on standard input is decompressed; a stream that cannot be read is one line (the
+    2000-example fuzz found ``certify --file -`` a traceback when reading stdin raised OSError)."""
+    import gzip
+    import io
+    import json
+    import sys
+
+    class Broken(io.RawIOBase):
+        def readable(self):
+            return True
+
+        def readinto(self, b):
+            raise OSError(5, "Input/output error")
+
+    text = b"k_x,k_v,k_a\n1.2,0.5,0.6\n"
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(gzip.compress(text))))
+    assert main(["certify", "--file", "-", "--format", "json"]) == 0
+    packed = json.loads(capsys.readouterr().out)["results"]
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(text)))
+    assert main(["certify", "--file", "-", "--format", "json"]) == 0
+    assert json.loads(capsys.readouterr().out)["results"] == packed
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BufferedReader(Broken())))
+    _refused(capsys, ["certify", "--file", "-"], "<stdin>: cannot read it (Input/output error); "
+             "expected a CSV or JSON gain file")
+
+
 # --------------------------------------------------------------------------- the leader check
 def test_settling_time_is_the_decay_rate_of_the_simulated_follower():
     """ln 50 / σ, σ from the roots of τs³ + s² + (k_v + k_x T*)s + k_x; σ checked against the

@@ -45,7 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
-from .text_input import read_text, undecodable
+from .text_input import read_stream, read_text
 
 __all__ = [
     "GAIN_COLUMNS",
@@ -612,23 +612,8 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
 
 
 def _read_stream(stream: IO[str], name: str) -> str:
-    """All of a text stream (standard input: its bytes decoded as UTF-8), or a one-line refusal."""
-    raw = getattr(stream, "buffer", None)
-    if raw is not None:  # sys.stdin: decode the bytes here (its own decoder may be strict)
-        data = raw.read()
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as e:
-            raise undecodable(name, "a CSV or JSON gain file", data[:4], e.start) from e
-    else:
-        try:
-            text = stream.read()
-        except UnicodeDecodeError as e:
-            raise undecodable(name, "a CSV or JSON gain file", b"", None) from e
-    if "\0" in text:
-        raise StringStabError(f"{name}: expected a CSV or JSON gain file (UTF-8 text); got binary "
-                              "data, not UTF-8 text (a NUL byte, which no text holds)")
-    return text
+    """All of a text stream (standard input: gzip by content, strict UTF-8), or a one-line refusal."""
+    return read_stream(stream, label=name, expected="a CSV or JSON gain file")
 
 
 def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = None) -> GainTable:

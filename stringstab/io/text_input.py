@@ -29,7 +29,7 @@ from typing import IO, Any, TypeVar
 
 from ..errors import StringStabError
 
-__all__ = ["GZIP_MAGIC", "is_gzip", "open_text", "read_text", "undecodable"]
+__all__ = ["GZIP_MAGIC", "is_gzip", "open_text", "read_stream", "read_text", "undecodable"]
 
 #: The first two bytes of every gzip member (RFC 1952, ID1 ID2).
 GZIP_MAGIC = b"\x1f\x8b"
@@ -101,6 +101,13 @@ def undecodable(label: str, expected: str, head: bytes, offset: int | None, *,
         where = f" (first at byte offset {offset}{of})" if offset is not None else ""
         what = f"a binary file or text in another encoding, not UTF-8 text{where}"
     return StringStabError(f"{label}: expected {expected} (UTF-8 text); got {what}; save it as UTF-8")
+
+
+def _nul(label: str, expected: str, offset: int | None) -> StringStabError:
+    """The one-line refusal of text holding a NUL byte (at ``offset``, when known)."""
+    where = f"a NUL byte at offset {offset}" if offset is not None else "a NUL byte"
+    return StringStabError(f"{label}: expected {expected} (UTF-8 text); got a binary file, not "
+                           f"UTF-8 text ({where}, which no text file holds)")
 
 
 def _binary(path: Path) -> IO[bytes]:
@@ -182,11 +189,7 @@ class _Text:
 
     def _no_nul(self, text: str) -> str:
         if "\0" in text:
-            at = _first_nul(self._path)
-            where = f"a NUL byte at offset {at}" if at is not None else "a NUL byte"
-            raise StringStabError(
-                f"{self._label}: expected {self._expected} (UTF-8 text); got a binary file, not "
-                f"UTF-8 text ({where}, which no text file holds)")
+            raise _nul(self._label, self._expected, _first_nul(self._path))
         return text
 
     def __iter__(self) -> Iterator[str]:
@@ -291,4 +294,67 @@ def read_text(path: str | os.PathLike[str], *, label: str, expected: str) -> str
     """
     with open_text(path, label=label, expected=expected) as fh:
         text: str = fh.read()
+    return text
+
+
+def read_stream(stream: IO[str], *, label: str, expected: str) -> str:
+    r"""All of an open text stream (standard input), read as :func:`read_text` reads a file.
+
+    A stream with a byte buffer (``sys.stdin``) is read as bytes: gzip data is recognised by
+    its first two bytes and decompressed, then the bytes are decoded as strict UTF-8 here
+    (the stream's own decoder may be another encoding's or lenient).  A plain text stream
+    (``io.StringIO``) is read as text.
+
+    Parameters
+    ----------
+    stream : text stream
+        The stream, read to its end.
+    label : str
+        How the messages name it, e.g. ``"<stdin>"``.
+    expected : str
+        What it should hold, e.g. ``"a CSV or JSON gain file"``.
+
+    Returns
+    -------
+    str
+        The text (a leading byte-order mark dropped).
+
+    Raises
+    ------
+    StringStabError
+        When the stream cannot be read, holds damaged gzip data, text that is not UTF-8 or a
+        NUL byte.
+
+    Examples
+    --------
+    >>> import io
+    >>> raw = io.TextIOWrapper(io.BytesIO(b"k_x,k_v,k_a\n1,1,\xe9\n"))
+    >>> read_stream(raw, label="<stdin>", expected="a CSV gain file")
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: <stdin>: expected a CSV gain file (UTF-8 text); got a binary file or text in another encoding, not UTF-8 text (first at byte offset 16); save it as UTF-8
+    """
+    raw = getattr(stream, "buffer", None)
+    try:
+        if raw is None:
+            text = stream.read()
+            text = text[1:] if text.startswith("\ufeff") else text
+        else:
+            data = raw.read()
+            compressed = data[:2] == GZIP_MAGIC
+            if compressed:
+                data = gzip.decompress(data)
+            try:
+                text = data.decode("utf-8-sig")
+            except UnicodeDecodeError as e:
+                raise undecodable(label, expected, data[:4], e.start, compressed=compressed) from e
+    except UnicodeDecodeError as e:  # a text stream's own decoder
+        raise undecodable(label, expected, b"", None) from e
+    except (OSError, *_DAMAGED) as e:
+        reason = (f"damaged gzip data: {e}" if isinstance(e, _DAMAGED)
+                  else getattr(e, "strerror", None) or str(e))
+        raise StringStabError(f"{label}: cannot read it ({reason}); expected {expected}") from e
+    at = text.find("\0")
+    if at >= 0:
+        raise _nul(label, expected, len(text[:at].encode("utf-8")))
     return text
