@@ -263,6 +263,26 @@ def test_hcfs_verify_notes_a_jerk_limit_that_never_binds(tmp_path, capsys):
              "--jerk-limit J = 1e+09 m/s³ is far outside", tmp_path / "h2")
 
 
+def test_a_count_beyond_its_sensible_bound_warns_and_runs_beyond_its_largest_is_refused(tmp_path,
+                                                                                        capsys):
+    """ranges.COUNTS: 1,001 followers is a note (the run is computed); 1,001 retries a refusal.
+
+    (A platoon's size is bounded by the memory estimate, not by a count: a million followers of
+    12 s fit in 20 GiB and run, with the note.)
+    """
+    argv = ["simulate", "--leader", "sinusoid:omega=0.5", "--duration", "12", "--no-figures"]
+    out = tmp_path / "many"
+    assert main([*argv, "--followers", "1001", "--out", str(out)]) in (0, 1)
+    err = capsys.readouterr().err
+    assert ("stringstab simulate: warning: --followers 1001 is more than the sensible 1000 "
+            "followers; the run is computed but will take long") in err
+    assert np.load(out / "trajectories.npz")["speed"].shape[0] == 1002  # leader + 1001 followers
+    spec = _spec(tmp_path / "s.toml", "certify", n=3)
+    _refused(capsys, ["sweep", str(spec), "--retries", "1001", "--out", str(tmp_path / "too")],
+             "--retries must be at most 1000 retries (a task that fails this often will not "
+             "succeed); got 1001", tmp_path / "too")
+
+
 # --------------------------------------------------------------------------- sweep memory
 def _spec(path: Path, kind: str, **base) -> Path:
     lines = [f'[sweep]\nname = "t"\nkind = "{kind}"\n[base]']
