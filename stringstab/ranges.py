@@ -28,6 +28,9 @@ length         <= 30 m           > 10 km       vehicles are 3-25 m long; l0 is 1
 TTC*           <= 10 s           > 1 hour      TTC thresholds are 1.5-5 s
 weight         <= 1000           > 1e6         distance weights are ratios near 1
 margin         <= 1              > 1e6         the repair's margins: 1e-3 and 1e-4 by default
+burst          <= 100 messages   > 1e6         Gilbert-Elliott bursts of a few messages
+speed noise σ  <= 5 m/s          > 70 m/s      speed sensors err by cm/s; 70 m/s is no road
+                                               vehicle's speed
 =============  ================  ============  ==========================================
 
 Counts (:data:`COUNTS`: a seed, steps, workers, refits, orders) have an upper bound of the same
@@ -70,6 +73,8 @@ RANGES: dict[str, tuple[float, float, str, str]] = {
     "ttc": (10.0, 3600.0, " s", "TTC* threshold"),
     "weight": (1000.0, 1e6, "", "weight"),
     "margin": (1.0, 1e6, "", "margin"),
+    "burst": (100.0, 1e6, " messages", "mean burst of lost messages"),
+    "speed_noise": (5.0, 70.0, " m/s", "speed noise sigma"),
 }
 
 #: name -> (sensible lower bound, refused below): the magnitudes that also have a floor.

@@ -382,6 +382,15 @@ INTS = ["nan", "inf", "-1", HUGE_INT]
 GAINS = ["nan,0.5,0.6", "inf,0.5,0.6", "1e300,0.5,0.6"]  # a negative gain is valid
 A_MIN = ["nan", "-inf", "1", "-1e300"]  # a braking limit is negative
 SAMPLE = [*FLOATS, "1e-300"]  # a sample time or step also has a floor (1e-300 divided by zero)
+#: The loop's flags (cli/_loop.py: θ_r, the radio, the sensors) of simulate (and sumo run).
+LOOP = {"--reaction-delay": FLOATS, "--message-period": FLOATS, "--message-phase": INTS,
+        "--loss": FLOATS, "--burst": FLOATS, "--stale-after": FLOATS,
+        "--fallback-gains": ["nan,0.5", "inf,0.5", "1e300,0.5"], "--noise-gap": FLOATS,
+        "--noise-gap-rate": FLOATS, "--noise-speed": FLOATS, "--noise-correlation": FLOATS,
+        "--noise-filter": FLOATS, "--radio-seed": INTS}
+#: What a flag needs beside it (its value is checked only then).
+NEEDS = {"--burst": ["--loss", "0.1"], "--message-phase": ["--message-period", "0.2"],
+         "--fallback-gains": ["--stale-after", "0.5"], "--radio-seed": ["--loss", "0.1"]}
 #: Every numeric flag of every command (sumo's own are listed in SUMO_NUMERIC) and its bad values.
 NUMERIC = {
     "derive": {"--delay-order": INTS, "--sample-time": SAMPLE, "--reaction-delay": FLOATS,
@@ -398,7 +407,8 @@ NUMERIC = {
     "simulate": {"--followers": INTS, "--gains": GAINS, "--vehicle": INTS, "--tau": FLOATS,
                  "--delta": FLOATS, "--headway": FLOATS, "--standstill": FLOATS,
                  "--length": FLOATS, "--dt": SAMPLE, "--duration": FLOATS, "--hold": FLOATS,
-                 "--ttc-star": FLOATS, "--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS},
+                 "--ttc-star": FLOATS, "--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS,
+                 **LOOP},
     "train": {"--steps": INTS, "--seed": INTS, "--num-envs": INTS, "--stop-episodes": INTS},
     "evaluate": {"--platoon": [f"{v},10" for v in INTS], "--v-max": FLOATS, "--a-min": A_MIN,
                  "--a-max": FLOATS},
@@ -419,7 +429,7 @@ SUMO_NUMERIC = {"sumo check": {"--followers", "--gains", "--tau", "--delta", "--
                                "--v-max", "--a-min", "--a-max"},
                 "sumo run": {"--followers", "--gains", "--tau", "--delta", "--headway", "--standstill",
                              "--length", "--dt", "--duration", "--hold", "--steps", "--v-max",
-                             "--a-min", "--a-max"},
+                             "--a-min", "--a-max", *LOOP},
                 "sumo cacc": {"--followers", "--duration", "--dt"}}
 #: The other value-taking options: file arguments (FILE_ARGUMENTS), names and text.
 NOT_NUMERIC = {"--out", "--file", "--from", "--overlay", "--report", "--leader", "--leaders",
@@ -471,6 +481,6 @@ def test_every_numeric_flag_refuses_nan_inf_negative_and_huge(command, flag, val
     elif flag in argv:
         argv[argv.index(flag) + 1] = value
     else:
-        argv += [flag, value]
+        argv += [flag, value, *NEEDS.get(flag, [])]
     line = _refused(argv, capsys, tmp_path, out)
     assert "expect" in line or "must" in line or "far outside" in line, line  # what was expected

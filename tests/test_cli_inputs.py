@@ -283,6 +283,21 @@ def test_a_count_beyond_its_sensible_bound_warns_and_runs_beyond_its_largest_is_
              "succeed); got 1001", tmp_path / "too")
 
 
+def test_the_radio_and_sensor_flags_have_their_ranges(tmp_path, capsys):
+    """--message-period 1e300 was simulated (one message, 'radio: messages every 1e+300 s')."""
+    argv = ["simulate", "--leader", "sinusoid:omega=0.5", "--duration", "20", "--followers", "2",
+            "--no-figures"]
+    _refused(capsys, [*argv, "--message-period", "1e300", "--out", str(tmp_path / "a")],
+             "--message-period = 1e+300 s is far outside the physically meaningful range",
+             tmp_path / "a")
+    _refused(capsys, [*argv, "--stale-after", "0.5", "--fallback-gains", "nan,0.5", "--out",
+                      str(tmp_path / "b")], "--fallback-gains must be two finite numbers",
+             tmp_path / "b")
+    assert main([*argv, "--noise-speed", "6", "--out", str(tmp_path / "c")]) in (0, 1)
+    assert ("stringstab simulate: warning: --noise-speed = 6 m/s is outside the sensible range "
+            "(up to 5 m/s)") in capsys.readouterr().err
+
+
 # --------------------------------------------------------------------------- sweep memory
 def _spec(path: Path, kind: str, **base) -> Path:
     lines = [f'[sweep]\nname = "t"\nkind = "{kind}"\n[base]']

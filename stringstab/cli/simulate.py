@@ -29,9 +29,10 @@ from ._common import (
     limits_from_args,
     warn_beyond_sensible,
 )
+from ._loop import add_loop_arguments, radio_from_args, reaction_from_args
 from ._outcome import collision_status
 
-__all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "run"]
+__all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "radio_line", "run"]
 
 #: A certified triple at the default τ, δ, T* (internally stable, sup_ω |Γ(jω)| = 1 at ω = 0).
 DEFAULT_GAINS = "1.2,0.5,0.6"
@@ -80,8 +81,9 @@ def add_parser(sub: Any) -> None:
                         "t,k_x,k_v,k_a held between rows; with a vehicle column, one series per "
                         "follower 1..N")
     p.add_argument("--from", dest="from_identify", metavar="IDENTIFY_JSON",
-                   help="take k_x, k_v, k_a, tau, delta, headway and standstill of a vehicle fitted by "
-                        "'stringstab identify' (with --vehicle POS) for every follower")
+                   help="take k_x, k_v, k_a, tau, delta, headway, standstill (and the reaction delay, "
+                        "if fitted) of a vehicle fitted by 'stringstab identify' (with --vehicle POS) "
+                        "for every follower")
     p.add_argument("--vehicle", type=int, default=None, metavar="POS",
                    help="with --from: the platoon position of the fitted vehicle (default: the only one)")
     add_vehicle_arguments(p)
@@ -100,6 +102,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, metavar="DIR",
                    help="output directory (an earlier run's files in it are replaced)")
     add_limit_arguments(p)
+    add_loop_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -189,6 +192,12 @@ def _from_identified(args: argparse.Namespace) -> None:
     r = rows[0]
     args.gains = f"{r['k_x']!r},{r['k_v']!r},{r['k_a']!r}"
     args.tau, args.delta, args.headway, args.standstill = r["tau"], r["delta"], r["headway"], r["standstill"]
+    theta = r.get("reaction_delay", 0.0)  # absent in a file written before θ_r was fitted
+    if getattr(args, "reaction_delay", None) is not None:
+        raise StringStabError(f"--from {args.from_identify} takes the reaction delay of the fit "
+                              f"({theta!r} s); expected no --reaction-delay with it, got "
+                              f"--reaction-delay {args.reaction_delay}")
+    args.reaction_delay = theta if theta else None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -235,6 +244,8 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
     _check_step(args.dt, tau, delta)
+    theta = reaction_from_args(args)
+    radio, sensors = radio_from_args(args, args.dt)
 
     for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
         if v is not None and math.isfinite(v):
@@ -259,7 +270,8 @@ def run(args: argparse.Namespace) -> int:
     warn_beyond_sensible(args, [("followers", args.followers, "--followers"),
                                 ("step", args.dt, "--dt"), *sizes])
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
-                      length=args.length, limits=limits)
+                      length=args.length, limits=limits, reaction_delay=theta, radio=radio,
+                      sensors=sensors)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
                        ttc_star=args.ttc_star, warnings=warnings)
     metrics = doc
@@ -275,7 +287,10 @@ def run(args: argparse.Namespace) -> int:
                         started=t0).write(out)
     mp = metrics["m_p"]
     print(f"simulated {leader.name} ({leader.duration:g} s, dt = {args.dt:g} s), "
-          f"{args.followers} followers, {args.controller} controller, model = {args.model}")
+          f"{args.followers} followers, {args.controller} controller, model = {args.model}"
+          + (f", reaction delay θ_r = {theta:g} s" if theta else ""))
+    if "radio" in doc:
+        print(radio_line(doc["radio"], radio))
     shown = ", ".join(_fmt(v, ".3f") for v in mp[:20]) + (", ..." if len(mp) > 20 else "")
     print(f"m_p per follower (eq 29, follower/predecessor acceleration energy): {shown}")
     print(f"max m_p = {_fmt(metrics['max_m_p'], '.3f')}, M_lss = {_fmt(metrics['M_lss'], '.3f')}, "
@@ -289,6 +304,34 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {', '.join(files.values())} to {out.root}/")
     return collision_status(args, metrics["collisions"], first_collision(result),
                             metrics["m_fss"])
+
+
+def radio_line(summary: dict[str, Any], radio: Any) -> str:
+    """One line on what the radio did (the ``radio`` entry of ``metrics.json``).
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`stringstab.traffic.output.radio_summary` of the run.
+    radio : Radio
+        The radio simulated.
+
+    Returns
+    -------
+    str
+        Messages received and lost, the share lost and the time in fallback.
+    """
+    rec = int(np.sum(summary["messages_received"]))
+    lost = int(np.sum(summary["messages_lost"]))
+    period = "every step" if radio.message_period is None else f"every {radio.message_period:g} s"
+    share = summary["loss_share"]
+    out = (f"radio: messages {period}: {rec} received, {lost} lost"
+           + (f" ({100 * share:.2f} %)" if share is not None else ""))
+    if radio.stale_after is not None:
+        fb = float(np.sum(summary["fallback_time"]))
+        out += (f"; time in fallback (ACC) {fb:.4g} s in all "
+                f"({100 * (summary['fallback_share'] or 0.0):.2f} % of follower time)")
+    return out
 
 
 def first_collision(result: Any) -> str:

@@ -100,6 +100,9 @@ def add_parser(sub: Any) -> None:
                     "a vehicle collided or a controlled vehicle never had a leader (outputs "
                     "written, a warning says which); 2 on bad input.")
     _case_arguments(r, policy=True)
+    from ._loop import add_loop_arguments
+
+    add_loop_arguments(r)  # θ_r, the radio and the sensors: on the toolkit's side, like τ
     r.add_argument("--sumocfg", metavar="FILE",
                    help="an existing scenario (its step-length must be --dt and it must use "
                         "step-method.ballistic); needs --controlled")
@@ -318,16 +321,26 @@ def run_platoon(args: argparse.Namespace) -> int:
     if (args.sumocfg is None) != (args.controlled is None):
         raise StringStabError("--sumocfg and --controlled go together; expected both or neither, "
                               f"got {'--sumocfg' if args.sumocfg else '--controlled'} alone")
+    from ._loop import RADIO_FLAGS, radio_from_args, reaction_from_args
+
     if args.sumocfg:
+        given = [f"--{n.replace('_', '-')}" for n in ("reaction_delay", *RADIO_FLAGS)
+                 if getattr(args, n, None) is not None]
+        if given:
+            raise StringStabError(f"{', '.join(given)}: simulated for a platoon behind a leader; "
+                                  "expected none of them with --sumocfg")
         return _run_scenario(args)
     t0 = time.perf_counter()
     out = OutputDir(args.out, command="sumo run", owns=RUN_FILES, what="--out")
     case = _case(args)
+    theta = reaction_from_args(args)
+    radio, sensors = radio_from_args(args, case["dt"])
     from ..sumo.platoon import cosimulate
 
     leader, controller = case["leader"], case["controller"]
     result = cosimulate(leader, controller, args.followers, tau=case["tau"], delta=case["delta"],
-                        api=args.api, limits=case["limits"], length=args.length, progress=True)
+                        api=args.api, limits=case["limits"], length=args.length, progress=True,
+                        reaction_delay=theta, radio=radio, sensors=sensors)
     warnings = list(case["warnings"])
     over = float(result.params["sumo_speed_override"])
     if over > 1e-9:
@@ -336,7 +349,9 @@ def run_platoon(args: argparse.Namespace) -> int:
         print(f"stringstab sumo run: warning: {warnings[-1]}", file=sys.stderr)
     doc = run_document(result, leader=leader, controller=controller, spec=args.leader,
                        warnings=warnings)
-    if result.gains is not None and result.gains.shape[-2] == result.t.size:
+    if result.gains is not None and result.gains.shape[-2] == result.t.size and not theta:
+        # (with θ_r > 0 the executed gains' m_fss is metrics.json's: the sampled certificate
+        # has no θ_r yet)
         from ..rl.evaluate import fss
 
         f = fss(result.gains, tau=case["tau"], delta=case["delta"], headway=case["headway"],
@@ -361,6 +376,10 @@ def run_platoon(args: argparse.Namespace) -> int:
         e = doc["executed_gains"]
         print(f"executed gains: m_fss = {e['m_fss']:.4g} certified (exact), "
               f"{e['m_fss_sampled']:.4g} (sampled-data at dt = {case['dt']:g} s) of {e['n']}")
+    if "radio" in doc:
+        from .simulate import radio_line
+
+        print(radio_line(doc["radio"], radio))
     print(f"wrote {', '.join(files.values())} to {out.root}/")
     return collision_status(args, doc["collisions"], first_collision(result), doc["m_fss"])
 

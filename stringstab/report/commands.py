@@ -114,15 +114,20 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
     """
     run = dict(doc.get("run", {}))
     params = {k: run[k] for k in ("leader_name", "followers", "duration_s", "dt", "tau", "delta",
-                                  "headway", "controller", "model") if k in run}
+                                  "headway", "controller", "model", "reaction_delay") if k in run}
+    for part in ("radio", "sensors"):  # the loop as it runs (issue 26): its settings in one row
+        if run.get(part) is not None:
+            params[part] = ", ".join(f"{k} = {v}" for k, v in run[part].items() if v is not None)
     rep = Report(f"Platoon simulation{': ' + title if title else ''}", command=command,
                  params=params, started=started)
     sec = rep.section("Verdicts")
     cert = doc.get("certificate")
     if cert:
+        theta = f", reaction delay θ_r = {cert['reaction_delay']:g} s" if cert.get("reaction_delay") else ""
         sec.verdict(f"K = ({cert['k_x']:g}, {cert['k_v']:g}, {cert['k_a']:g}) certified string "
-                    "stable (exact delay)", cert["verdict"] == "certified",
-                    f"{cert['verdict']}; sup|Γ| = {cert['sup_gain']:.4g}")
+                    f"stable (exact delay{theta})", cert["verdict"] == "certified",
+                    f"{cert['verdict']}; sup|Γ| = {cert['sup_gain']:.4g}"
+                    + (f"; scope: {cert['scope']}" if cert.get("scope") else ""))
     else:
         sec.verdict("gains certified", None, "no fixed eq-4 gains to certify (time-varying gains, "
                                              "CACC or IDM)")
@@ -130,6 +135,15 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
     sec.verdict("every follower damps the leader's disturbance (m_p < 1)",
                 None if mp is None else mp < 1, "max m_p = n/a" if mp is None else f"max m_p = {mp:.3f}")
     sec.verdict("no collision", doc.get("collisions") == 0, f"{doc.get('collisions')} collided")
+    radio = doc.get("radio")
+    if radio is not None:
+        share = radio.get("loss_share")
+        import numpy as np
+
+        sec.verdict("the radio", None,
+                    f"{int(np.sum(radio['messages_received']))} messages received"
+                    + ("" if share is None else f", {100 * share:.2f} % lost")
+                    + f"; time in fallback {100 * (radio.get('fallback_share') or 0.0):.2f} % of follower time")
     for w in doc.get("warnings", []):
         sec.verdict("leader", None, f"warning: {w}")
     m = rep.section("Metrics")

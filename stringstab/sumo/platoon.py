@@ -10,7 +10,9 @@ CACC, IDM, any :class:`~stringstab.traffic.FunctionController` — runs unchange
     them into a toolkit :class:`~stringstab.traffic.Platoon` that keeps what SUMO has no
     model of — each follower's first-order actuator lag state a_i (IDL eq 7) and the
     communication delay buffer of a_{i−1}(t − δ) (eq 4) — and returns that platoon's
-    :class:`~stringstab.traffic.Observation` (gaps and speeds are SUMO's);
+    :class:`~stringstab.traffic.Observation` (gaps and speeds are SUMO's); the reaction
+    delay θ_r (the command reaching the lag θ_r late) is that platoon's too, and the radio and
+    the sensors (:class:`~stringstab.traffic.Onboard`) sit between it and the controller;
 ``advance``
     integrates the lag exactly over the step with the command held (the toolkit's zero-order
     hold, limits included), sends SUMO each follower's resulting speed v_{k+1} with
@@ -36,7 +38,7 @@ import numpy.typing as npt
 from ..errors import StringStabError, show
 from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from ..progress import Progress
-from ..traffic import Limits, Platoon, PlatoonResult, Trajectory
+from ..traffic import Limits, Onboard, Platoon, PlatoonResult, Radio, SensorNoise, Trajectory
 from ..traffic.controllers import Controller, Observation
 from .runtime import SumoSession
 from .scenario import LEADER_ID, follower_ids, straight_road
@@ -142,6 +144,9 @@ class SumoPlatoon:
     speed_mode : int
         SUMO speed mode of every vehicle; 0 (default) makes SUMO execute the commanded speed
         exactly.  Another value lets SUMO's safety rules override the controller (for tests).
+    reaction_delay : float or array
+        Reaction delay θ_r, s (kept on the toolkit's side like τ: the command reaches the lag
+        θ_r late, :class:`~stringstab.traffic.Platoon`).
 
     Attributes
     ----------
@@ -155,7 +160,7 @@ class SumoPlatoon:
                  leader_id: str = LEADER_ID, tau: npt.ArrayLike = DEFAULT_TAU,
                  delta: float = DEFAULT_DELTA, limits: Limits | None = None,
                  length: float = DEFAULT_LENGTH, fractional_delay: Any = "linear",
-                 speed_mode: int = 0) -> None:
+                 speed_mode: int = 0, reaction_delay: npt.ArrayLike = 0.0) -> None:
         self.session, self.leader, self.leader_id = session, leader, leader_id
         self.ids = [leader_id, *followers]
         self.N = len(followers)
@@ -166,7 +171,7 @@ class SumoPlatoon:
                 "expected one step")
         self.inner = Platoon(1, self.N, dt=self.dt, tau=tau, delta=delta, model="lag",
                              limits=limits, length=length, fractional_delay=fractional_delay,
-                             position_update="trapezoid")
+                             position_update="trapezoid", reaction_delay=reaction_delay)
         self.speed_override = 0.0
         self._vcmd: Array | None = None
         present = set(session.vehicle.getIDList())
@@ -263,7 +268,8 @@ def cosimulate(leader: Trajectory, controller: Controller, n_followers: int, *,
                initial_gap: npt.ArrayLike | None = None,
                initial_speed: npt.ArrayLike | None = None,
                fractional_delay: Any = "linear", speed_mode: int = 0,
-               progress: bool = False, on_step: Any = None) -> PlatoonResult:
+               progress: bool = False, on_step: Any = None, reaction_delay: float = 0.0,
+               radio: Radio | None = None, sensors: SensorNoise | None = None) -> PlatoonResult:
     """Run ``n_followers`` behind ``leader`` in Eclipse SUMO on a straight generated road.
 
     The same inputs and result as :func:`stringstab.traffic.simulate` (one leader), so
@@ -290,12 +296,19 @@ def cosimulate(leader: Trajectory, controller: Controller, n_followers: int, *,
         Show progress (a bar on a terminal, lines otherwise).
     on_step : callable, optional
         Called as ``on_step(k, session)`` after each step (tests use it to break SUMO).
+    reaction_delay : float
+        Reaction delay θ_r, s, kept on the toolkit's side like τ (the command reaches the lag
+        θ_r late; SUMO gets the resulting speeds).
+    radio, sensors : Radio, SensorNoise, optional
+        The followers' V2V radio and sensors, on the toolkit's side
+        (:class:`~stringstab.traffic.Onboard`); as for :func:`~stringstab.traffic.simulate`.
 
     Returns
     -------
     PlatoonResult
         With ``params["simulator"] = "sumo"``, the API, SUMO's version and the largest speed
-        override (``sumo_speed_override``, m/s).
+        override (``sumo_speed_override``, m/s); θ_r, the radio and the sensors in ``params``
+        when given, what the radio did in ``radio``.
 
     Raises
     ------
@@ -315,6 +328,9 @@ def cosimulate(leader: Trajectory, controller: Controller, n_followers: int, *,
     gap0 = np.broadcast_to(np.asarray(gap0, dtype=np.float64), (1, N)).ravel()
     if not (np.isfinite(gap0).all() and np.isfinite(v0a).all()):
         raise StringStabError(f"initial gaps and speeds must be finite; got {show(gap0)}, {show(v0a)}")
+    onboard = None
+    if radio is not None or sensors is not None:
+        onboard = Onboard(controller, (1, N), dt, radio=radio, sensors=sensors)
     distance = float(leader.position[-1] - leader.position[0])
     with tempfile.TemporaryDirectory(prefix="stringstab-sumo-") as tmp:
         road = straight_road(tmp, distance=distance, gaps=gap0, speeds=v0a,
@@ -323,11 +339,11 @@ def cosimulate(leader: Trajectory, controller: Controller, n_followers: int, *,
             session.step()  # insertion: SUMO time dt is toolkit step 0
             plat = SumoPlatoon(session, leader, follower_ids(N), tau=tau, delta=delta,
                                limits=limits, length=length, fractional_delay=fractional_delay,
-                               speed_mode=speed_mode)
+                               speed_mode=speed_mode, reaction_delay=reaction_delay)
             plat.reset(accel=0.0)
             version = _version(session)
-            result = run_loop(plat, controller, T, progress=progress, on_step=on_step,
-                              desc=f"sumo {N} followers")
+            result = run_loop(plat, controller if onboard is None else onboard, T,
+                              progress=progress, on_step=on_step, desc=f"sumo {N} followers")
     result.params.update({
         "tau": np.asarray(tau).tolist(), "delta": float(delta), "model": "lag",
         "limits": vars(plat.limits).copy(), "length": float(length),
@@ -338,6 +354,15 @@ def cosimulate(leader: Trajectory, controller: Controller, n_followers: int, *,
     })
     if fractional_delay != "linear":
         result.params["fractional_delay"] = fractional_delay
+    if plat.inner.reaction_delay.any():
+        result.params["reaction_delay"] = plat.inner.reaction_delay.tolist()
+    if radio is not None:
+        result.params["radio"] = radio.describe()
+    if sensors is not None:
+        result.params["sensors"] = sensors.describe()
+    rec = None if onboard is None else onboard.summary()
+    if rec is not None:
+        result.radio = {k: v[0] for k, v in rec.items()}
     return result
 
 

@@ -11,6 +11,10 @@
   :mod:`~stringstab.traffic.result` (its :class:`PlatoonResult`);
 * :mod:`~stringstab.traffic.controllers` — the eq-4 linear law, time-varying gains, CACC, IDM
   (a subpackage, one module per controller);
+* the loop as it runs (issue 26): :mod:`~stringstab.traffic.radio` (V2V messages every N
+  steps, held, lost, stale, the fallback to ACC), :mod:`~stringstab.traffic.loss` (Bernoulli
+  and Gilbert–Elliott message loss), :mod:`~stringstab.traffic.sensors` (noise and a filter on
+  gap, gap rate and speed) and :mod:`~stringstab.traffic.onboard` (a controller behind both);
 * :mod:`~stringstab.traffic.metrics` — the IDL evaluation metrics;
 * :mod:`~stringstab.traffic.reward` — the IDL reward (eqs 18-24);
 * environments: :mod:`~stringstab.traffic.state` (the eq-16 state and its extensions),
@@ -41,10 +45,13 @@ from .env import BatchedCarFollowingEnv, CarFollowingEnv
 from .leaders import leader_by_name
 from .limits import Limits, check_leader
 from .loaders import FollowingPair, load_csv, load_ngsim_pairs
+from .onboard import Onboard
 from .output import RUN_FILES, run_document, save_trajectories, write_run
 from .platoon import simulate
+from .radio import Radio
 from .result import PlatoonResult
 from .reward import comfort_reward, efficiency_reward, headway_density, reward, safety_reward
+from .sensors import SensorNoise
 from .split import train_test_split
 from .state import SCALES, state_vector
 from .synthetic import SYNTHETIC, hard_acceleration, hard_braking, paper_mix, sinusoid, stop_and_go
@@ -66,8 +73,11 @@ __all__ = [
     "LinearController",
     "MixedController",
     "Observation",
+    "Onboard",
     "Platoon",
     "PlatoonResult",
+    "Radio",
+    "SensorNoise",
     "TimeVaryingLinearController",
     "Trajectory",
     "check_leader",

@@ -45,6 +45,20 @@ Communication delay δ
     The paper's simpler update (eqs 1-2): no lag, a_k = u_k (limited), v_{k+1} = v_k + a_k Δt,
     and positions by the trapezoid rule, which is exactly the spacing update of eq 2.
 
+Reaction delay θ_r (``reaction_delay``, issue 25)
+    The command is applied θ_r late: τ ȧ_i = u_i(t − θ_r) − a_i, u_i the held (ZOH) command
+    signal.  With θ_r = q Δt + f (q integer, 0 ≤ f < Δt) the command applied over step k is
+    u_{k−q−1} for the first f seconds and u_{k−q} for the remaining Δt − f: the lag is
+    integrated exactly over both constant pieces (the closed form above, once with h = f and
+    once with h = Δt − f, from the state the first piece ends in), the speed and position
+    integrals too; with ``model="kinematic"`` the acceleration is the applied command itself and
+    speed and position are the exact integrals of the two pieces.  θ_r may differ per vehicle
+    (an array broadcasting to ``(P, N)``).  The commands before t = 0 are the initial
+    acceleration (0 in an equilibrium start: the equilibrium command), a constant history as
+    for the delay δ.  With θ_r = 0 for every vehicle the step is the one above, bit for bit.
+    With ``fractional_delay="exact"`` the predecessor's acceleration inside the step is
+    evaluated on the same two pieces.
+
 Limits
     u is limited to [acc_min, acc_max] = [−7.6, 3] m/s² before the lag (so a stays within it
     too), and v to [0, 33.3] m/s (IDL paper Table 2).  When a speed bound is reached inside a
@@ -66,11 +80,11 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
-from ..params import DEFAULT_DELTA, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_TAU, check_reaction_delay
 from .controllers.base import Observation
 from .limits import DEFAULT_LENGTH, Limits
 
-__all__ = ["FractionalDelay", "Model", "Platoon", "PositionUpdate"]
+__all__ = ["FractionalDelay", "Model", "Platoon", "PositionUpdate", "lag_pieces"]
 
 Array = npt.NDArray[np.float64]
 
@@ -96,6 +110,52 @@ def _check_lag_delay(tau: npt.ArrayLike, delta: float) -> tuple[Array, float]:
     if not (math.isfinite(d) and d >= 0):
         raise StringStabError(f"delta (communication delay) must be a finite number >= 0 s; got {show(delta)}")
     return t, d
+
+
+def _check_reaction(reaction_delay: npt.ArrayLike, shape: tuple[int, int]) -> Array:
+    """θ_r per follower, (P, N): each finite, ≥ 0 and ≤ 100 s (:func:`check_reaction_delay`)."""
+    try:
+        r = np.asarray(reaction_delay, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise StringStabError(f"reaction_delay (reaction delay θ_r) must be a number >= 0 s; "
+                              f"got {show(reaction_delay)}") from e
+    for v in np.unique(r.ravel()):
+        check_reaction_delay(v)
+    try:
+        return np.broadcast_to(r, shape)
+    except ValueError as e:
+        raise StringStabError(f"reaction_delay must broadcast to (n_platoons, n_followers)={shape}; "
+                              f"got shape {r.shape}") from e
+
+
+def lag_pieces(h: Array, tau: Array) -> tuple[Array, Array, Array]:
+    """The exact ZOH constants of the lag over a piece of h seconds: e, τ(1 − e), τ(h − τ(1 − e)).
+
+    Over h seconds of a constant command u, τ ȧ = u − a (IDL eq 7) gives, with ā = a_0 − u,
+    a(h) = u + ā e, v(h) = v_0 + u h + ā τ(1 − e), x(h) = x_0 + v_0 h + u h²/2 + ā τ(h − τ(1 − e)),
+    e = exp(−h/τ).
+
+    Parameters
+    ----------
+    h : array
+        Piece durations, s (≥ 0; 0 gives e = 1 and zero integrals).
+    tau : array
+        Actuator lags τ, s (> 0), broadcasting with ``h``.
+
+    Returns
+    -------
+    (e, c1, c2) : arrays
+        exp(−h/τ), τ(1 − e) and τ(h − τ(1 − e)).
+
+    Examples
+    --------
+    >>> e, c1, c2 = lag_pieces(np.array([0.0, 0.1]), np.array([0.1, 0.1]))
+    >>> e.round(6).tolist(), c1.round(6).tolist(), c2.round(6).tolist()
+    ([1.0, 0.367879], [0.0, 0.063212], [0.0, 0.003679])
+    """
+    e = np.exp(-h / tau)
+    c1 = tau * (1.0 - e)
+    return e, c1, tau * (h - c1)
 
 
 class Platoon:
@@ -128,6 +188,9 @@ class Platoon:
     position_update : {"exact", "trapezoid"}
         With ``model="lag"``: the exact integral of the speed over the step (default) or the
         trapezoid rule, SUMO's ballistic update (the module docstring).
+    reaction_delay : float or array
+        Reaction delay θ_r, s (≥ 0): the command is applied θ_r late (the module docstring);
+        an array broadcasts against ``(P, N)``.  0 (default) is the step without it, bit for bit.
 
     Attributes
     ----------
@@ -146,7 +209,8 @@ class Platoon:
     def __init__(self, n_platoons: int, n_followers: int, *, dt: float, tau: npt.ArrayLike = DEFAULT_TAU,
                  delta: float = DEFAULT_DELTA, model: Model = "lag", limits: Limits | None = None,
                  length: float = DEFAULT_LENGTH, fractional_delay: FractionalDelay = "linear",
-                 position_update: PositionUpdate = "exact") -> None:
+                 position_update: PositionUpdate = "exact",
+                 reaction_delay: npt.ArrayLike = 0.0) -> None:
         if int(n_platoons) < 1 or int(n_followers) < 1:
             raise StringStabError(
                 f"n_platoons and n_followers must be >= 1; got {show(n_platoons)} and {show(n_followers)}"
@@ -205,6 +269,38 @@ class Platoon:
         self.first_collision_step = np.full((P, N), -1, dtype=np.int64)
         self._in_collision = np.zeros((P, N), dtype=bool)
         self._any_in_collision = False
+        self.state_arrays = self.STATE_ARRAYS
+        self._setup_reaction(reaction_delay, tau_b)
+
+    def _setup_reaction(self, reaction_delay: npt.ArrayLike, tau_b: Array) -> None:
+        """θ_r = q Δt + f per follower: the command history and the constants of both pieces."""
+        P, N, dt = self.P, self.N, self.dt
+        theta = _check_reaction(reaction_delay, (P, N))
+        self.reaction_delay = np.asarray(reaction_delay, dtype=np.float64)
+        self._react = bool((theta > 0).any())
+        if not self._react:
+            return
+        q = np.floor(theta / dt + 1e-9)
+        f = theta - q * dt
+        f = np.where(f < 1e-9 * dt, 0.0, f)
+        qi = q.astype(np.int64)
+        self._cring = int(qi.max()) + 2
+        self._cbuf = np.zeros((self._cring, P, N))  # the commands computed, newest at k % ring
+        self._rq: int | npt.NDArray[np.int64] = int(qi[0, 0]) if (qi == qi[0, 0]).all() else qi
+        self._one_piece = not (f > 0).any() and not self._exact_frac
+        self._h1 = f  # the first piece (the older command u_{k−q−1}), then Δt − f of u_{k−q}
+        self._p1 = lag_pieces(f, tau_b)
+        self._p2 = lag_pieces(dt - f, tau_b)
+        extra: tuple[str, ...] = ("_cbuf",)
+        if self._exact_frac:
+            # the exact fractional delay reads each vehicle's acceleration at (1 − f_δ)Δt into
+            # its step, evaluated on the two pieces in advance() and kept here per step
+            s = (1.0 - self._frac) * dt
+            self._mid_first = s <= f
+            self._mid_e = np.exp(-np.where(self._mid_first, s, s - f) / tau_b)
+            self._mbuf = np.zeros((self._ring, P, N + 1))
+            extra += ("_mbuf",)
+        self.state_arrays = self.STATE_ARRAYS + extra
 
     def reset(self, leader_position: npt.ArrayLike, leader_speed: npt.ArrayLike,
               leader_accel: npt.ArrayLike, *, gap: npt.ArrayLike, speed: npt.ArrayLike,
@@ -241,6 +337,10 @@ class Platoon:
         self.accel[r] = A
         self._buf[:, r] = A
         self._ubuf[:, r] = A  # a constant history: a = u
+        if self._react:  # the commands before t = 0: the initial acceleration (a = u)
+            self._cbuf[:, r] = A[:, 1:]
+            if self._exact_frac:
+                self._mbuf[:, r] = A
         self.collided[r] = False
         self.collision_events[r] = 0
         self.first_collision_step[r] = -1
@@ -284,7 +384,10 @@ class Platoon:
         if self._frac:
             older = self._buf[(k - self._n_delay - 1) % self._ring][:, :-1]
             lead = (1.0 - self._frac) * ad[:, 0] + self._frac * older[:, 0]
-            if self._exact_frac:
+            if self._exact_frac and self._react:
+                ad = self._mbuf[(k - self._n_delay - 1) % self._ring][:, :-1].copy()
+                ad[:, 0] = lead  # the leader's acceleration between samples is not modelled
+            elif self._exact_frac:
                 u_old = self._ubuf[(k - self._n_delay - 1) % self._ring][:, :-1]
                 ad = u_old + (older - u_old) * self._frac_c
                 ad[:, 0] = lead  # the leader's acceleration between samples is not modelled
@@ -317,10 +420,11 @@ class Platoon:
             ``step`` and ``any_in_collision`` (JSON-ready).
         arrays : dict of str to ndarray
             Copies of the arrays named in :attr:`STATE_ARRAYS` (positions, speeds,
-            accelerations, the delay buffers and the collision records).
+            accelerations, the delay buffers and the collision records), and with a reaction
+            delay θ_r > 0 its command history (``state_arrays`` names them all).
         """
         meta = {"step": int(self.step), "any_in_collision": bool(self._any_in_collision)}
-        return meta, {a: np.array(getattr(self, a), copy=True) for a in self.STATE_ARRAYS}
+        return meta, {a: np.array(getattr(self, a), copy=True) for a in self.state_arrays}
 
     def load_state(self, meta: dict[str, Any], arrays: dict[str, Any]) -> None:
         """Restore :meth:`state` output into this platoon (same shape; checked).
@@ -338,11 +442,11 @@ class Platoon:
             If a key or an array is missing, or an array has another shape.
         """
         missing = [k for k in ("step", "any_in_collision") if k not in meta]
-        missing += [a for a in self.STATE_ARRAYS if a not in arrays]
+        missing += [a for a in self.state_arrays if a not in arrays]
         if missing:
             raise StringStabError(f"platoon state: expected {', '.join(missing)}; found "
                                   f"{sorted(meta)} and arrays {sorted(arrays)}")
-        for a in self.STATE_ARRAYS:
+        for a in self.state_arrays:
             dst, src = getattr(self, a), np.asarray(arrays[a])
             if src.shape != dst.shape:
                 raise StringStabError(f"platoon state {a}: expected shape {dst.shape}; "
@@ -374,6 +478,31 @@ class Platoon:
             u = np.ascontiguousarray(np.broadcast_to(u, (self.P, self.N)))
         dt = self.dt
         xo, vo, ao = self.position[:, 1:], self.speed[:, 1:], self.accel[:, 1:]
+        if self._react:
+            xn, vn, an = self._advance_delayed(u, xo, vo, ao)
+        else:
+            xn, vn, an = self._held_step(u, xo, vo, ao)
+        if vn.min() < lim.speed_min or vn.max() > lim.speed_max:
+            lo = vn < lim.speed_min
+            hi = vn > lim.speed_max
+            vc = np.clip(vn, lim.speed_min, lim.speed_max)
+            xn = np.where(lo | hi, xo + 0.5 * dt * (vo + vc), xn)
+            if self.model == "lag":
+                an = np.where(lo, np.maximum(an, 0.0), np.where(hi, np.minimum(an, 0.0), an))
+            else:
+                an = (vc - vo) / dt
+            vn = vc
+        xo[...] = xn
+        vo[...] = vn
+        ao[...] = an
+        if self._exact_frac:
+            self._ubuf[self.step % self._ring][:, 1:] = u
+        self.step += 1
+        return u
+
+    def _held_step(self, u: Array, xo: Array, vo: Array, ao: Array) -> tuple[Array, Array, Array]:
+        """One step with u held over all of it: the exact ZOH of the lag, or eqs 1-2."""
+        dt = self.dt
         if self.model == "lag":
             du = ao - u
             xn = vo * dt
@@ -396,20 +525,41 @@ class Platoon:
             xn = vo + vn
             xn *= 0.5 * dt
             xn += xo
-        if vn.min() < lim.speed_min or vn.max() > lim.speed_max:
-            lo = vn < lim.speed_min
-            hi = vn > lim.speed_max
-            vc = np.clip(vn, lim.speed_min, lim.speed_max)
-            xn = np.where(lo | hi, xo + 0.5 * dt * (vo + vc), xn)
-            if self.model == "lag":
-                an = np.where(lo, np.maximum(an, 0.0), np.where(hi, np.minimum(an, 0.0), an))
-            else:
-                an = (vc - vo) / dt
-            vn = vc
-        xo[...] = xn
-        vo[...] = vn
-        ao[...] = an
-        if self._exact_frac:
-            self._ubuf[self.step % self._ring][:, 1:] = u
-        self.step += 1
-        return u
+        return xn, vn, an
+
+    def _advance_delayed(self, u: Array, xo: Array, vo: Array, ao: Array) -> tuple[Array, Array, Array]:
+        """One step with the command applied θ_r late: two constant pieces (module docstring)."""
+        k, R, q = self.step, self._cring, self._rq
+        self._cbuf[k % R] = u
+        if isinstance(q, int):
+            u2, u1 = self._cbuf[(k - q) % R], self._cbuf[(k - q - 1) % R]
+        else:
+            u2 = np.take_along_axis(self._cbuf, ((k - q) % R)[None], axis=0)[0]
+            u1 = np.take_along_axis(self._cbuf, ((k - q - 1) % R)[None], axis=0)[0]
+        if self._one_piece:  # θ_r a whole number of steps: the command of step k − q, held
+            return self._held_step(np.array(u2, copy=True), xo, vo, ao)
+        h1 = self._h1
+        h2 = self.dt - h1
+        if self.model == "lag":
+            (e1, c11, c21), (e2, c12, c22) = self._p1, self._p2
+            d1 = ao - u1
+            a1 = u1 + d1 * e1
+            v1 = vo + u1 * h1 + d1 * c11
+            x1 = xo + vo * h1 + u1 * (0.5 * h1 * h1) + d1 * c21
+            d2 = a1 - u2
+            an = u2 + d2 * e2
+            vn = v1 + u2 * h2 + d2 * c12
+            xn = x1 + v1 * h2 + u2 * (0.5 * h2 * h2) + d2 * c22
+            if self.position_update == "trapezoid":
+                xn = xo + 0.5 * self.dt * (vo + vn)
+            mid = (np.where(self._mid_first, u1 + d1 * self._mid_e, u2 + d2 * self._mid_e)
+                   if self._exact_frac else None)
+        else:
+            an = np.array(u2, copy=True)
+            v1 = vo + u1 * h1
+            vn = v1 + u2 * h2
+            xn = xo + vo * h1 + u1 * (0.5 * h1 * h1) + v1 * h2 + u2 * (0.5 * h2 * h2)
+            mid = np.where(self._mid_first, u1, u2) if self._exact_frac else None
+        if mid is not None:
+            self._mbuf[k % self._ring][:, 1:] = mid
+        return xn, vn, an

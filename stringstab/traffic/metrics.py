@@ -367,7 +367,7 @@ def lss_index(m_p: ArrayLike) -> Array:
 
 
 def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, delta: float,
-              headway: float) -> float:
+              headway: float, reaction_delay: float = 0.0) -> float:
     """m_fss, the share of (vehicle, moment) gains that are string stable (IDL eqs 27-28).
 
     m_fss = 1 where the gains in force are *certified* by the exact delay-aware certificate
@@ -382,6 +382,9 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
         Gains at every (vehicle, moment), any common shape.
     tau, delta, headway : float
         τ, δ and T*, s.
+    reaction_delay : float
+        θ_r, s (issue 25): the triples are certified for the loop with the command applied θ_r
+        late; 0 (default) is the loop without it.
 
     Returns
     -------
@@ -406,7 +409,8 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     if K.shape[0] == 0:
         raise StringStabError("fss_ratio needs at least one gain triple")
     uniq, inverse = np.unique(K, axis=0, return_inverse=True)
-    cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway)
+    cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway,
+                         reaction_delay=reaction_delay)
     ok = np.asarray(cert.verdict == "certified")[np.ravel(inverse)]
     return float(ok.mean())
 
@@ -459,8 +463,8 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
     ttc_star : float
         TTC threshold TTC* of TIT (IDL eqs 31-32), s.
     certificate : bool
-        Compute M_fss (certifies every distinct gain triple in force; skipped also when
-        the actuator lag τ differs between vehicles).
+        Compute M_fss (certifies every distinct gain triple in force, with the run's reaction
+        delay θ_r; skipped also when the actuator lag τ or θ_r differs between vehicles).
 
     Returns
     -------
@@ -499,11 +503,13 @@ def platoon_metrics(result: Any, *, ttc_star: float = TTC_STAR,
     out["m_fss"] = None
     if certificate and result.gains is not None and result.params.get("headway") is not None:
         taus = np.unique(np.asarray(result.params["tau"], dtype=np.float64))
-        if taus.size == 1:
+        thetas = np.unique(np.asarray(result.params.get("reaction_delay", 0.0), dtype=np.float64))
+        if taus.size == 1 and thetas.size == 1:
             G = result.gains
             out["m_fss"] = fss_ratio(G[..., 0], G[..., 1], G[..., 2], tau=float(taus[0]),
                                      delta=result.params["delta"],
-                                     headway=result.params["headway"])
+                                     headway=result.params["headway"],
+                                     reaction_delay=float(thetas[0]))
     for key in ("min_ttc", "min_headway", "M_effi"):
         if key in out and not math.isfinite(out[key]):
             out[key] = None

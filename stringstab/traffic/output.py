@@ -20,7 +20,7 @@ from ..errors import StringStabError, show
 from ..io import OutputDir, atomic_path, dumps_json, to_plain, write_results
 from .result import PlatoonResult
 
-__all__ = ["RUN_FILES", "UNITS", "run_document", "save_trajectories", "write_run"]
+__all__ = ["RUN_FILES", "UNITS", "radio_summary", "run_document", "save_trajectories", "write_run"]
 
 Format = Literal["npz", "csv", "parquet"]
 
@@ -65,7 +65,7 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
         The JSON-serialisable document written as ``metrics.json``.
     """
     metrics = result.metrics(ttc_star=ttc_star)
-    return {
+    doc = {
         "run": {"leader": spec if spec is not None else leader.name, "leader_name": leader.name,
                 "followers": result.n_followers, "duration_s": leader.duration, **result.params},
         **metrics,
@@ -73,19 +73,59 @@ def run_document(result: PlatoonResult, *, leader: Any, controller: Any, spec: s
         "certificate": _certificate(controller, result.params),
         "warnings": list(warnings),
     }
+    if result.radio is not None:
+        doc["radio"] = radio_summary(result)
+    return doc
+
+
+def radio_summary(result: PlatoonResult) -> dict[str, Any]:
+    """What the radio did in a run (:mod:`stringstab.traffic.radio`), JSON-ready.
+
+    Parameters
+    ----------
+    result : PlatoonResult
+        A run with a radio (``result.radio`` not None).
+
+    Returns
+    -------
+    dict
+        Per follower (nested per platoon for a batch): ``messages_received``,
+        ``messages_lost``, ``fallback_time`` (s); and pooled: ``loss_share`` (lost / due
+        messages) and ``fallback_share`` (time in fallback / (followers × run time)).
+    """
+    r = result.radio
+    assert r is not None
+    rec, lost = np.asarray(r["messages_received"]), np.asarray(r["messages_lost"])
+    fb = np.asarray(r["fallback_time"], dtype=np.float64)
+    due = int(rec.sum() + lost.sum())
+    span = result.t.size * result.dt * rec.size
+    return {"messages_received": rec.tolist(), "messages_lost": lost.tolist(),
+            "fallback_time": fb.round(6).tolist(),
+            "loss_share": float(lost.sum() / due) if due else None,
+            "fallback_share": float(fb.sum() / span) if span else None}
 
 
 def _certificate(controller: Any, params: dict[str, Any]) -> dict[str, Any] | None:
     K = controller.gains(None) if not controller.time_varying else None
     taus = np.unique(np.asarray(params.get("tau"), dtype=np.float64))
-    if K is None or controller.headway is None or np.ndim(K) != 1 or taus.size != 1:
+    thetas = np.unique(np.asarray(params.get("reaction_delay", 0.0), dtype=np.float64))
+    if K is None or controller.headway is None or np.ndim(K) != 1 or taus.size != 1 or thetas.size != 1:
         return None
     from ..certify.api import certify
 
+    theta = float(thetas[0])
     c = certify(float(K[0]), float(K[1]), float(K[2]), tau=float(taus[0]),
-                delta=params["delta"], headway=controller.headway)
-    return {"k_x": float(K[0]), "k_v": float(K[1]), "k_a": float(K[2]), "verdict": c.verdict,
-            "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
+                delta=params["delta"], headway=controller.headway, reaction_delay=theta)
+    out = {"k_x": float(K[0]), "k_v": float(K[1]), "k_a": float(K[2]), "verdict": c.verdict,
+           "sup_gain": c.sup_gain, "peak_omega": c.peak_omega}
+    if theta:
+        out["reaction_delay"] = theta
+    if params.get("radio") is not None or params.get("sensors") is not None:
+        out["scope"] = ("the continuous-time loop, with the acceleration received continuously and "
+                        "exact measurements; messages every period P are the multi-rate certificate's "
+                        "(issue 26); message loss, switching to the fallback and sensor noise are "
+                        "covered by no certificate")
+    return out
 
 
 def _trajectory_columns(result: PlatoonResult, digits: int | None = 6) -> dict[str, np.ndarray]:

@@ -20,7 +20,10 @@ from ..params import DEFAULT_DELTA, DEFAULT_TAU, count
 from .controllers.base import Controller
 from .dynamics import FractionalDelay, Model, Platoon, PositionUpdate
 from .limits import DEFAULT_LENGTH, Limits
+from .onboard import Onboard
+from .radio import Radio
 from .result import PlatoonResult
+from .sensors import SensorNoise
 from .trajectory import Trajectory
 
 __all__ = ["simulate"]
@@ -68,6 +71,9 @@ def simulate(
     progress: bool | None = None,
     fractional_delay: FractionalDelay = "linear",
     position_update: PositionUpdate = "exact",
+    reaction_delay: npt.ArrayLike = 0.0,
+    radio: Radio | None = None,
+    sensors: SensorNoise | None = None,
 ) -> PlatoonResult:
     """Simulate platoons of ``n_followers`` behind prescribed leaders.
 
@@ -106,6 +112,22 @@ def simulate(
     position_update : {"exact", "trapezoid"}
         Positions by the exact integral of the lag model (default) or by the trapezoid rule,
         Eclipse SUMO's ballistic update (module docstring; recorded in ``params`` then).
+    reaction_delay : float or array
+        Reaction delay θ_r, s (≥ 0, issue 25): every follower applies its command θ_r late,
+        τ ȧ = u(t − θ_r) − a, integrated exactly for any θ_r (:mod:`stringstab.traffic.dynamics`);
+        an array of shape (N,) or (P, N) gives each vehicle its own.  The commands before
+        t = 0 are the equilibrium command.  ``command`` records u as computed (applied θ_r
+        later).  Recorded in ``params`` when > 0; 0 (default) changes nothing, bit for bit.
+    radio : Radio, optional
+        The V2V link of every follower (:mod:`stringstab.traffic.radio`, issue 26): messages
+        every N steps, held, lost at random, a fallback to ACC when stale.  None (default): the
+        acceleration arrives every step, as without radio.  Recorded in ``params["radio"]``;
+        what it did per follower in the result's ``radio``.  With a ``stale_after`` the gains
+        in force are recorded at every step (the fallback's where stale).
+    sensors : SensorNoise, optional
+        Noise and a filter on the measured gap, gap rate and own speed
+        (:mod:`stringstab.traffic.sensors`); the trajectories, collisions and minimum gaps stay
+        the true ones.  Recorded in ``params["sensors"]``.
 
     Returns
     -------
@@ -132,13 +154,18 @@ def simulate(
     N = count("n_followers", n_followers)
     P, T, dt = len(leaders), leaders[0].n_steps, leaders[0].dt
     plat = Platoon(P, N, dt=dt, tau=tau, delta=delta, model=model, limits=limits, length=length,
-                   fractional_delay=fractional_delay, position_update=position_update)
+                   fractional_delay=fractional_delay, position_update=position_update,
+                   reaction_delay=reaction_delay)
     LX = np.ascontiguousarray(np.stack([tr.position for tr in leaders], axis=1))  # (T, P)
     LV = np.ascontiguousarray(np.stack([tr.speed for tr in leaders], axis=1))
     LA = np.ascontiguousarray(np.stack([tr.accel for tr in leaders], axis=1))
     v0 = LV[0][:, None] if initial_speed is None else np.asarray(initial_speed, dtype=np.float64)
     gap0 = controller.equilibrium_gap(v0 * np.ones((1, N))) if initial_gap is None else initial_gap
     plat.reset(LX[0], LV[0], LA[0], gap=gap0, speed=np.broadcast_to(v0, (P, N)), accel=0.0)
+    onboard = None
+    if radio is not None or sensors is not None:
+        onboard = Onboard(controller, (P, N), dt, radio=radio, sensors=sensors)
+        controller = onboard
 
     if record:
         pos = np.empty((T, P, N + 1))
@@ -208,6 +235,13 @@ def simulate(
         params["fractional_delay"] = fractional_delay
     if position_update != "exact":
         params["position_update"] = position_update
+    if plat.reaction_delay.any():
+        params["reaction_delay"] = plat.reaction_delay.tolist()
+    if radio is not None:
+        params["radio"] = radio.describe()
+    if sensors is not None:
+        params["sensors"] = sensors.describe()
+    radio_rec = None if onboard is None else onboard.summary()
     sq = (lambda a: a) if batched else (lambda a: a[0])
     return PlatoonResult(
         dt=dt,
@@ -224,4 +258,5 @@ def simulate(
         sum_sq_accel=sq(sumsq),
         params=params,
         length=plat.length,
+        radio=None if radio_rec is None else {k: sq(v) for k, v in radio_rec.items()},
     )

@@ -53,7 +53,13 @@ class PlatoonResult:
     sum_sq_accel : array (P, N + 1)
         Σ_t a_i(t)² (for m_p, eq 29).
     params : dict
-        τ, δ, T*, model, limits, length, controller.
+        τ, δ, T*, model, limits, length, controller (and θ_r, the radio and the sensors when
+        given).
+    length : float
+        Vehicle length, m.
+    radio : dict or None
+        What the radio did (:mod:`stringstab.traffic.radio`), per follower (P, N):
+        ``messages_received``, ``messages_lost`` and ``fallback_time`` (s); None without radio.
     """
 
     dt: float
@@ -70,6 +76,7 @@ class PlatoonResult:
     sum_sq_accel: Array
     params: dict[str, Any] = field(default_factory=dict)
     length: float = DEFAULT_LENGTH
+    radio: dict[str, Array] | None = None
 
     @property
     def n_followers(self) -> int:
