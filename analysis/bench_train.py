@@ -12,6 +12,11 @@ Also the repair's per-triple latency against :func:`stringstab.tuning.project` o
 uncertified proposals, and how much farther from the proposal the lookup lands than the exact
 projection.  Ratios are what count: the 2 cores are shared.
 
+Since issue 31 the point coefficients compute the parameters' quantities once per parameter set
+(``zoh.point_coefficients``), so the "before" arms above (which re-route ``zoh.primitives``)
+no longer reproduce the state before the point-path fix; ``analysis/bench_speed.py`` measures
+the repair against the base commit itself.
+
     python analysis/bench_train.py --steps 20000
 """
 

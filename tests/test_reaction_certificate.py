@@ -202,12 +202,17 @@ def test_derive_shows_the_theta_forms():
     assert rc == 2 and "reaction delay" in err
 
 
-def test_the_tuning_refuses_theta_instead_of_dropping_it():
+def test_the_tuning_keeps_theta_on_the_point_and_refuses_it_elsewhere():
+    # issue 25 part 2: the continuous point loop is tuned with θ_r (tests/test_reaction_tune.py);
+    # the sampled loop and boxes refuse it with the certificate's line, never drop it
     from stringstab.tuning.constraints import LoopConstraints
 
-    with pytest.raises(StringStabError, match=r"tuning certifies reaction_delay = 0 only so far; "
-                                              r"got reaction_delay=0\.2"):
-        LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), None)
+    assert LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), None).reaction_delay == 0.2
+    with pytest.raises(StringStabError, match=r"continuous time only so far; got "
+                                              r"reaction_delay=0\.2 with sample_time=0\.1"):
+        LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), 0.1)
+    with pytest.raises(StringStabError, match=r"continuous time only so far"):
+        LoopConstraints(ss.Box((0.1, 0.2), (0.2, 0.2), (1.1, 1.1), (0.2, 0.2)), None)
     assert LoopConstraints(ss.Params(0.1, 0.2, 1.1), None).box.reaction_delay == (0.0, 0.0)
 
 

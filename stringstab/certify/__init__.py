@@ -7,7 +7,9 @@ only, for inner loops) — checks the arguments once and chooses the certificate
 (:mod:`~stringstab.certify.continuous`), the sampled-data loop when a sample time is given
 (:mod:`~stringstab.certify.sampled`), or a box of parameters when τ, δ or T* is an interval
 (:mod:`~stringstab.certify.robust`, with :mod:`~stringstab.certify.robust_continuous` and
-:mod:`~stringstab.certify.robust_sampled`).  The sampled-data loop is built from the ZOH
+:mod:`~stringstab.certify.robust_sampled`, whose split form and search are
+:mod:`~stringstab.certify.sampled_split`, :mod:`~stringstab.certify.sampled_split_cells` and
+:mod:`~stringstab.certify.robust_split`).  The sampled-data loop is built from the ZOH
 discretisation (:mod:`~stringstab.certify.zoh`), the Schur test
 (:mod:`~stringstab.certify.schur`), H(e^{jθ}) and its margin
 (:mod:`~stringstab.certify.sampled_frequency`, :mod:`~stringstab.certify.sampled_excess`), on
@@ -27,9 +29,10 @@ Also here: the Padé cross-check (:mod:`~stringstab.certify.pade`, never a verdi
 branch and bound (:mod:`~stringstab.certify.branch_bound`), the margin g(ω) and its tail
 bound (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
 (:mod:`~stringstab.certify.criteria`), |Γ(jω)| (:mod:`~stringstab.certify.frequency`) and
-sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screen
-(:mod:`~stringstab.certify.screen`) and the certified points of a grid of gains
-(:mod:`~stringstab.certify.grid`).
+sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screens
+(:mod:`~stringstab.certify.screen`), the certified points of a grid of gains
+(:mod:`~stringstab.certify.grid`) and the certificates over cells of gains
+(:mod:`~stringstab.certify.gain_cells`, the repair's proven cells).
 
 The function :func:`certify` and this subpackage share a name: ``stringstab.certify`` is the
 function (the façade binds it); import the modules with ``from stringstab.certify import

@@ -17,9 +17,11 @@ box of parameters — and :func:`certified_lattice` applies it to the lattice of
   decides.  That step is sound only as far as the point certificate is never inconclusive
   where the robust one (with its looser bounds) certifies: not proven, never observed
   (``tests/test_certify_grid.py`` compares with the robust certificate on every row);
-* the sampled-data loop: its certificate decides every row (the continuous screen says
-  nothing about it), after the continuous certificate when both are asked for
-  (``also_continuous``: the gains a sampled controller executes in the repair's training loop).
+* the sampled-data loop: its own sound screen (:class:`stringstab.certify.screen.SampledScreen`:
+  g_H below its threshold at a fixed frequency, |H| > 1 there) drops rows, then its certificate
+  decides the rest (the continuous screen says nothing about it), after the continuous
+  certificate when both are asked for (``also_continuous``: the gains a sampled controller
+  executes in the repair's training loop).
 
 The region map (:func:`stringstab.regions.region_map`) reports every point's verdict,
 sup |Γ| and margin rather than the certified points, so it runs the full certificate;
@@ -35,7 +37,7 @@ from ..errors import StringStabError
 from ..params import Box, Params
 from ..params import sample_time as checked_sample_time
 from .criteria import hurwitz_conditions
-from .screen import surely_uncertifiable
+from .screen import sampled_screen, surely_uncertifiable
 from .verdicts import Verdict
 
 __all__ = ["certified", "certified_lattice", "lattice"]
@@ -130,7 +132,14 @@ def certified(K: npt.ArrayLike, params: Params | Box, *, sample_time: float | No
                             heterogeneous=heterogeneous)
         return ok
     point = params if isinstance(params, Params) else params.centre()
-    cand = ~surely_uncertifiable(K, point) if sample_time is None else np.ones(len(K), bool)
+    if point.reaction_delay:
+        # the screens are of the loop without reaction delay: with θ_r > 0 (issue 25) every row goes on
+        cand = np.ones(len(K), bool)
+    elif sample_time is None:
+        cand = ~surely_uncertifiable(K, point)
+    else:  # the sampled loop's own screen (at the centre of a box: a member)
+        H = checked_sample_time(sample_time)
+        cand = ~sampled_screen(point.tau, point.delta, point.headway, H).surely_uncertifiable(K)
     idx = np.flatnonzero(cand)
     if not isinstance(params, Params) and idx.size:
         idx = idx[_check_certified(K[idx], point, sample_time, heterogeneous)]

@@ -15,9 +15,11 @@ gain triple, or one parameter cell, per row):
 * polynomials with interval coefficients (ascending lists): :func:`poly_add`,
   :func:`poly_scale`.
 
-Only +, − and × are defined (the coefficients of the loop need nothing else); the end points
-are not rounded outward: every comparison made with them carries a slack proportional to
-``mag`` instead (:data:`stringstab.certify.verdicts.ROUNDOFF_SLACK`).
+Only +, −, × and the reciprocal of a positive quantity are defined (the coefficients of the
+loop need nothing else; the reciprocal is for the split form of
+:mod:`stringstab.certify.sampled_split`); the end points are not rounded outward: every
+comparison made with them carries a slack proportional to ``mag`` instead
+(:data:`stringstab.certify.verdicts.ROUNDOFF_SLACK`).
 
 References
 ----------
@@ -42,8 +44,9 @@ Array = npt.NDArray[np.float64]
 class Interval:
     """[lo, hi] with ``mag`` ≥ the magnitude of every intermediate (round-off bound).
 
-    A point has ``hi is lo``.  Only +, −, × are defined: the computed end points are
-    within 10⁻¹³ × ``mag`` of the exact interval operations (γ_n for depth n ≤ 400).
+    A point has ``hi is lo``.  Only +, −, × and :meth:`reciprocal` are defined: the computed
+    end points are within 10⁻¹³ × ``mag`` of the exact interval operations (γ_n for depth
+    n ≤ 400).
 
     Parameters
     ----------
@@ -62,6 +65,13 @@ class Interval:
         self.hi = self.lo if hi is None else np.asarray(hi, dtype=float)
         self.mag = np.maximum(np.abs(self.lo), np.abs(self.hi)) if mag is None else mag
 
+    @classmethod
+    def _new(cls, lo: Any, hi: Any, mag: Any) -> Interval:
+        """The result of an operation (arrays already): no conversion, ``hi is lo`` for points."""
+        out = object.__new__(cls)
+        out.lo, out.hi, out.mag = lo, hi, mag
+        return out
+
     @property
     def point(self) -> bool:
         """True for a point (``hi is lo``): the fast path, one array for both ends."""
@@ -73,17 +83,20 @@ class Interval:
         return v if isinstance(v, Interval) else Interval(np.asarray(v, dtype=float))
 
     def __add__(self, o: Any) -> Interval:
-        o = Interval.of(o)
-        if self.point and o.point:
-            return Interval(self.lo + o.lo, None, self.mag + o.mag)
-        return Interval(self.lo + o.lo, self.hi + o.hi, self.mag + o.mag)
+        if not isinstance(o, Interval):
+            o = Interval(np.asarray(o, dtype=float))
+        if self.hi is self.lo and o.hi is o.lo:
+            lo = self.lo + o.lo
+            return Interval._new(lo, lo, self.mag + o.mag)
+        return Interval._new(self.lo + o.lo, self.hi + o.hi, self.mag + o.mag)
 
     __radd__ = __add__
 
     def __neg__(self) -> Interval:
-        if self.point:
-            return Interval(-self.lo, None, self.mag)
-        return Interval(-self.hi, -self.lo, self.mag)
+        if self.hi is self.lo:
+            lo = -self.lo
+            return Interval._new(lo, lo, self.mag)
+        return Interval._new(-self.hi, -self.lo, self.mag)
 
     def __sub__(self, o: Any) -> Interval:
         return self + (-Interval.of(o))
@@ -92,17 +105,45 @@ class Interval:
         return Interval.of(o) + (-self)
 
     def __mul__(self, o: Any) -> Interval:
-        o = Interval.of(o)
-        if self.point and o.point:
-            return Interval(self.lo * o.lo, None, self.mag * o.mag)
-        p = (self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi)
-        return Interval(np.minimum.reduce(p), np.maximum.reduce(p), self.mag * o.mag)
+        if type(o) is float:  # a constant: the products with the one number, no conversion
+            if self.hi is self.lo:
+                lo = self.lo * o
+                return Interval._new(lo, lo, self.mag * abs(o))
+            a, c = self.lo * o, self.hi * o
+            return Interval._new(np.minimum(a, c), np.maximum(a, c), self.mag * abs(o))
+        if not isinstance(o, Interval):
+            o = Interval(np.asarray(o, dtype=float))
+        if self.hi is self.lo and o.hi is o.lo:
+            lo = self.lo * o.lo
+            return Interval._new(lo, lo, self.mag * o.mag)
+        a, b, c, d = self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi
+        # pairwise min/max: the same end points as a reduction over the four, without
+        # stacking them into one array first
+        return Interval._new(np.minimum(np.minimum(a, b), np.minimum(c, d)),
+                             np.maximum(np.maximum(a, b), np.maximum(c, d)), self.mag * o.mag)
 
     __rmul__ = __mul__
 
     def const(self, v: Any) -> Interval:
         """A point constant of this item's shape."""
         return Interval(np.zeros_like(self.lo) + v)
+
+    def reciprocal(self) -> Interval:
+        """1/x over an interval of positive numbers (lo > 0: the caller's guarantee).
+
+        1/x decreases, so the ends are 1/hi and 1/lo.  The magnitude companion is
+        ``mag``/lo²: an error e ≤ γ·``mag`` of x moves 1/x by about e/x², and the division's
+        own rounding (one ulp of 1/x ≤ 1/lo ≤ ``mag``/lo²) is within the same bound.
+
+        Returns
+        -------
+        Interval
+            [1/hi, 1/lo] (a point stays a point).
+        """
+        mag = self.mag / (self.lo * self.lo)
+        if self.point:
+            return Interval(1.0 / self.lo, None, mag)
+        return Interval(1.0 / self.hi, 1.0 / self.lo, mag)
 
     def take(self, idx: npt.NDArray[np.intp]) -> Interval:
         """The rows ``idx`` (a point stays a point)."""
@@ -129,10 +170,12 @@ class IntervalAD:
         Enclosures of the partial derivatives over the cell, one per parameter.
     """
 
-    __slots__ = ("c", "g", "r")
+    __slots__ = ("c", "g", "k", "r")
 
-    def __init__(self, c: Interval, r: Interval, g: tuple[Interval, ...]) -> None:
-        self.c, self.r, self.g = c, r, g
+    def __init__(self, c: Interval, r: Interval, g: tuple[Interval, ...],
+                 k: bool = False) -> None:
+        # k: a constant (every derivative zero), so sums and products skip its derivatives
+        self.c, self.r, self.g, self.k = c, r, g, k
 
     @staticmethod
     def variable(lo: Array, hi: Array, i: int, d: int) -> IntervalAD:
@@ -146,7 +189,7 @@ class IntervalAD:
         """A constant of this item's shape (zero derivatives)."""
         k = self.c.const(v)
         z = self.c.const(0.0)
-        return IntervalAD(k, k, tuple(z for _ in self.g))
+        return IntervalAD(k, k, tuple(z for _ in self.g), True)
 
     @staticmethod
     def of(v: Any, like: IntervalAD) -> IntervalAD:
@@ -155,12 +198,15 @@ class IntervalAD:
 
     def __add__(self, o: Any) -> IntervalAD:
         o = IntervalAD.of(o, self)
+        if o.k or self.k:  # a constant's derivatives are zero: the other's are the sum's
+            return IntervalAD(self.c + o.c, self.r + o.r, self.g if o.k else o.g,
+                              self.k and o.k)
         return IntervalAD(self.c + o.c, self.r + o.r, tuple(a + b for a, b in zip(self.g, o.g)))
 
     __radd__ = __add__
 
     def __neg__(self) -> IntervalAD:
-        return IntervalAD(-self.c, -self.r, tuple(-a for a in self.g))
+        return IntervalAD(-self.c, -self.r, tuple(-a for a in self.g), self.k)
 
     def __sub__(self, o: Any) -> IntervalAD:
         return self + (-IntervalAD.of(o, self))
@@ -171,15 +217,36 @@ class IntervalAD:
     def __mul__(self, o: Any) -> IntervalAD:
         if not isinstance(o, IntervalAD):
             k = Interval.of(o)
-            return IntervalAD(self.c * k, self.r * k, tuple(a * k for a in self.g))
+            return IntervalAD(self.c * k, self.r * k, tuple(a * k for a in self.g), self.k)
+        if self.k and o.k:
+            return IntervalAD(self.c * o.c, self.r * o.r, self.g, True)
+        if o.k:  # (a·b)' = a'·b when b is constant
+            return IntervalAD(self.c * o.c, self.r * o.r, tuple(a * o.r for a in self.g))
+        if self.k:
+            return IntervalAD(self.c * o.c, self.r * o.r, tuple(self.r * b for b in o.g))
         return IntervalAD(self.c * o.c, self.r * o.r,
                           tuple(a * o.r + self.r * b for a, b in zip(self.g, o.g)))
 
     __rmul__ = __mul__
 
+    def reciprocal(self) -> IntervalAD:
+        """1/x of a positive quantity: derivative −x'/x², enclosed by −g·(1/x)² over the cell.
+
+        Returns
+        -------
+        IntervalAD
+            The value at the centre, the enclosure [1/hi, 1/lo] and the derivatives.
+        """
+        r = self.r.reciprocal()
+        if self.k:
+            return IntervalAD(self.c.reciprocal(), r, self.g, True)
+        r2 = r * r
+        return IntervalAD(self.c.reciprocal(), r, tuple(-(g * r2) for g in self.g))
+
     def take(self, idx: npt.NDArray[np.intp]) -> IntervalAD:
         """The rows ``idx`` of the value, the enclosure and every derivative."""
-        return IntervalAD(self.c.take(idx), self.r.take(idx), tuple(g.take(idx) for g in self.g))
+        return IntervalAD(self.c.take(idx), self.r.take(idx), tuple(g.take(idx) for g in self.g),
+                          self.k)
 
 
 def interval(lo: Array, hi: Array) -> Interval:

@@ -37,13 +37,14 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..params import Box, as_gains, check_box
+from ..params import Box, Params, as_gains, check_box
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
+from .continuous import check_kernel
 from .criteria import hurwitz_bands_kernel
 from .excess import EXCESS_SEARCH, searched_excess, violation_peak
 from .frequency import gain_squared, margin_g_coefficients
 from .margin import curvature_bound, separable, tail_bound
-from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
+from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK, Verdict
 
 __all__ = ["box_margin", "certify_box_continuous", "robust_margin"]
 
@@ -51,8 +52,8 @@ Array = npt.NDArray[np.float64]
 
 
 def box_margin(
-    w: Array, kx: Array, kv: Array, ka: Array, box: Box,
-) -> tuple[Array, Array, Array, Array, Array]:
+    w: Array, kx: Array, kv: Array, ka: Array, box: Box, *, minimiser: bool = True,
+) -> tuple[Any, ...]:
     """(min_box g(ω), τ*, δ*, T*, magnitude) at ω ≥ 0; gains broadcast against ω.
 
     g = (τω² − c)² + h2 ω² + h0 + cx cos δω − cv ω sin δω
@@ -68,12 +69,15 @@ def box_margin(
         The gains, broadcast against ``w``.
     box : Box
         τ, δ, T* intervals (validated).
+    minimiser : bool
+        Also return the minimiser (default); False returns (min g, magnitude) alone, the
+        same numbers without the work of the minimiser (the branch and bound's evaluations).
 
     Returns
     -------
     (ndarray, ndarray, ndarray, ndarray, ndarray)
         min over the box of g(ω); the minimiser τ*, δ*, T*; the magnitude of the terms
-        (for the round-off slack).
+        (for the round-off slack).  Without ``minimiser``: (min g, magnitude).
     """
     (t_lo, t_hi), (d_lo, d_hi), (h_lo, h_hi) = box.tau, box.delta, box.headway
     (c_a, h2, h0, cx, cv), (s_ca, s_h2, s_h0, s_cx, s_cv) = separable(kx, kv, ka, headway=h_lo)
@@ -85,31 +89,40 @@ def box_margin(
     e_lo = t_lo * w2 - c_max  # at (τ_lo, argmax c)
     e_hi = t_hi * w2 - c_min  # at (τ_hi, argmin c)
     S = np.where(e_lo > 0, e_lo * e_lo, np.where(e_hi < 0, e_hi * e_hi, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.clip(np.where(e_hi > e_lo, e_lo / (e_lo - e_hi), 0.0), 0.0, 1.0)
-    s = np.where(e_lo > 0, 0.0, np.where(e_hi < 0, 1.0, s))
-    tau_w = np.clip(t_lo + s * (t_hi - t_lo), t_lo, t_hi)
-    h_w = np.clip(h_at_max + s * (h_at_min - h_at_max), h_lo, h_hi)
     r0 = h2 * w2 + h0
 
     def trig(d: float) -> Array:
         return np.asarray(cx * np.cos(d * w) - cv * w * np.sin(d * w))
 
     t_a, t_b = trig(d_lo), trig(d_hi)
-    R = np.hypot(cx, cv * w)
-    phi = np.arctan2(cv * w, cx)
-    a = d_lo * w + phi
-    b = d_hi * w + phi
-    k = np.ceil((a - np.pi) / (2.0 * np.pi))
-    crit = np.pi + 2.0 * np.pi * k
-    inside = (crit <= b + 1e-12 * (1.0 + np.abs(b))) & (d_hi > d_lo) & (w > 0)
-    T = np.where(inside, -R, np.minimum(t_a, t_b))
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        d_in = np.clip((crit - phi) / w, d_lo, d_hi)
-    d_w = np.where(inside, d_in, np.where(t_a <= t_b, d_lo, d_hi))
+    if d_hi > d_lo:
+        R = np.hypot(cx, cv * w)
+        phi = np.arctan2(cv * w, cx)
+        a = d_lo * w + phi
+        b = d_hi * w + phi
+        k = np.ceil((a - np.pi) / (2.0 * np.pi))
+        crit = np.pi + 2.0 * np.pi * k
+        inside = (crit <= b + 1e-12 * (1.0 + np.abs(b))) & (w > 0)
+        T = np.where(inside, -R, np.minimum(t_a, t_b))
+    else:  # a point δ: the trigonometric terms at that δ
+        inside = np.zeros(np.shape(t_a), dtype=bool)
+        T = np.minimum(t_a, t_b)
     G = S + r0 + T
     e_mag = t_hi * w2 + np.maximum(s_ca, s_cb)
     mag = e_mag * e_mag + s_h2 * w2 + s_h0 + s_cx + s_cv * w
+    if not minimiser:
+        return G, mag
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.clip(np.where(e_hi > e_lo, e_lo / (e_lo - e_hi), 0.0), 0.0, 1.0)
+    s = np.where(e_lo > 0, 0.0, np.where(e_hi < 0, 1.0, s))
+    tau_w = np.clip(t_lo + s * (t_hi - t_lo), t_lo, t_hi)
+    h_w = np.clip(h_at_max + s * (h_at_min - h_at_max), h_lo, h_hi)
+    if d_hi > d_lo:
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            d_in = np.clip((crit - phi) / w, d_lo, d_hi)
+    else:
+        d_in = np.full(np.shape(t_a), d_lo)
+    d_w = np.where(inside, d_in, np.where(t_a <= t_b, d_lo, d_hi))
     return G, tau_w, d_w, h_w, mag
 
 
@@ -194,7 +207,13 @@ def certify_box_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid:
         return v[idx][:, None]
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
-        G, _, _, _, mag = box_margin(X, col(kx, idx), col(kv, idx), col(ka, idx), box)
+        # in blocks of rows that stay in cache (the same numbers as all at once)
+        G, mag = np.empty(X.shape), np.empty(X.shape)
+        step = max(1, 32_768 // X.shape[1])
+        for s in range(0, X.shape[0], step):
+            q, i = slice(s, s + step), idx[s:s + step]
+            G[q], mag[q] = box_margin(X[q], col(kx, i), col(kv, i), col(ka, i), box,
+                                      minimiser=False)
         # M ≥ |g''| of every member: the bound of stringstab.certify.margin with its largest
         # coefficients (t2 at τ_hi, |a| over the box; b does not enter) and δ_hi
         M = curvature_bound(X[:, 1:], (t_hi * t_hi, col(a_absmax, idx), 0.0, col(cx, idx),
@@ -214,10 +233,22 @@ def certify_box_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid:
     }
     unstable = fail & ~sure
     out["tau"] = np.where(unstable, t_hi, tw)
-    out["tau_prev"] = out["tau"].copy()
     out["headway"] = np.where(unstable, h_lo, hw)
     out["delta"] = np.where(unstable, d_lo, dw)
     out["omega"] = np.where(unstable, np.nan, w)
+    # a box its own members prove not string stable is not certified (issue 29, item 7)
+    rows = np.flatnonzero(v == INCONCLUSIVE)
+    if rows.size:
+        ev = _own_evidence(kx[rows], kv[rows], ka[rows], box,
+                           (out["tau"][rows], out["delta"][rows], out["headway"][rows]))
+        r, e = rows[ev["bad"]], ev["bad"]
+        v[r] = NOT_CERTIFIED
+        for key in ("tau", "delta", "headway", "omega", "margin"):
+            out[key][r] = ev[key][e]
+        unstable[r] = ev["unstable"][e]
+        w = w.copy()
+        w[r] = np.where(ev["unstable"][e], w[r], ev["omega"][e])
+    out["tau_prev"] = out["tau"].copy()
     sup = np.where(v == CERTIFIED, 1.0, np.where(unstable, np.inf, np.nan))
     need = np.flatnonzero(np.isnan(sup))
     if need.size:
@@ -240,6 +271,44 @@ def certify_box_continuous(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid:
     return out
 
 
+def _own_evidence(kx: Array, kv: Array, ka: Array, box: Box,
+                  witness: tuple[Array, Array, Array]) -> dict[str, Array]:
+    """The point certificate (:func:`stringstab.certify.continuous.check_kernel`) at members.
+
+    The members: the 8 corners of the box and each row's witness (τ, δ, T*).  Returns, per
+    row, whether some member is not certified and that member (the one with the smallest
+    margin when there are several): τ, δ, T*, its witness ω (NaN when Γ is not internally
+    stable there), its margin and whether it is unstable.
+    """
+    n = kx.size
+    corners = [(t, d, h) for t in sorted(set(box.tau)) for d in sorted(set(box.delta))
+               for h in sorted(set(box.headway))]
+    k = len(corners) + 1
+    M = np.empty((n, k, 3))
+    M[:, :-1] = np.array(corners)
+    M[:, -1] = np.stack(witness, axis=1)
+    verdict = np.empty((n, k), dtype=object)
+    margin, omega, stable = np.full((n, k), np.inf), np.full((n, k), np.nan), np.ones((n, k), bool)
+
+    def run(i: npt.NDArray[np.intp], j: int, p: Params) -> None:
+        c = check_kernel(kx[i], kv[i], ka[i], p)
+        verdict[i, j], margin[i, j], omega[i, j], stable[i, j] = (c.verdict, c.margin,
+                                                                  c.witness_omega, c.hurwitz)
+
+    for col_, (t, d, h) in enumerate(corners):
+        run(np.arange(n), col_, Params(t, d, h))
+    for row in range(n):
+        if np.all(np.isfinite(M[row, -1])):
+            run(np.array([row]), k - 1, Params(*M[row, -1]))
+    bad = verdict == Verdict.NOT_CERTIFIED.value
+    j = np.where(bad, margin, np.inf).argmin(axis=1)
+    i = np.arange(n)
+    unstable = ~stable[i, j]
+    return {"bad": bad.any(axis=1), "tau": M[i, j, 0], "delta": M[i, j, 1],
+            "headway": M[i, j, 2], "omega": np.where(unstable, np.nan, omega[i, j]),
+            "margin": margin[i, j], "unstable": unstable}
+
+
 def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array, h: Array,
                             w0: Array) -> tuple[Array, Array]:
     """sup_ω |Γ(jω)| of each witness member (its own parameters) and where (reporting)."""
@@ -252,7 +321,14 @@ def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array,
                          delta=d[:, None], headway=h[:, None])
         return np.where(np.isnan(v), np.inf, v)
 
-    A = g2(W)
+    # the grid in blocks of rows that stay in cache (the same numbers as all at once)
+    A = np.empty(W.shape)
+    step = max(1, 32_768 // W.shape[1])
+    for s in range(0, kx.size, step):
+        q = slice(s, s + step)
+        v = gain_squared(W[q], kx[q, None], kv[q, None], ka[q, None], tau=t[q, None],
+                         delta=d[q, None], headway=h[q, None])
+        A[q] = np.where(np.isnan(v), np.inf, v)
     j = np.argmax(A, axis=1)
     rows = np.arange(kx.size)
     best, bw = zoom_max(g2, W[rows, j], A[rows, j], Om / 512.0, rounds=10)

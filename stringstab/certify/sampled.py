@@ -73,7 +73,7 @@ from .verdicts import (
     names,
     one_triple,
 )
-from .zoh import Coefficients, loop_parameters, point_coefficients
+from .zoh import Coefficients, coefficients, loop_parameters, point_coefficients, split_delay
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -84,6 +84,7 @@ __all__ = [
     "certify_sampled",
     "certify_sampled_batch",
     "check_kernel",
+    "check_members",
     "check_sampled",
 ]
 
@@ -232,6 +233,51 @@ def check_kernel(
     v[~sure] = np.where(fail[~sure], NOT_CERTIFIED, INCONCLUSIVE)
     return SampledCheck(names(v), sure, bb.minimum, bb.argmin / H, sample_time=H,
                         witness_theta=bb.argmin)
+
+
+def check_members(kx: Array, kv: Array, ka: Array, *, tau: Array, tau_prev: Array, delta: Array,
+                  headway: Array, H: float) -> tuple[npt.NDArray[np.int8], Array, Array]:
+    """The point certificate of :func:`check_kernel` at one member (τ, τ_p, δ, T*) per row.
+
+    Row i is decided exactly as ``check_sampled(kx[i], kv[i], ka[i], tau=tau[i],
+    delta=delta[i], headway=headway[i], sample_time=H, tau_prev=tau_prev[i])`` decides it
+    (the same coefficients, Schur test and branch and bound, grouped by m = ⌊δ/H⌋): what a
+    box's members say of themselves (:mod:`stringstab.certify.robust_sampled`).
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray, shape (n,)
+        The gains (checked).
+    tau, tau_prev, delta, headway : ndarray, shape (n,)
+        Each row's member: τ > 0, τ_p > 0, δ ≥ 0, T* ≥ 0, s.
+    H : float
+        Sample time, s.
+
+    Returns
+    -------
+    (ndarray of int8, ndarray, ndarray)
+        Verdict codes, the smallest g_H found and where (θ, rad/sample; NaN when Δ is not
+        Schur there).
+    """
+    n = kx.size
+    v = np.full(n, INCONCLUSIVE, dtype=np.int8)
+    g, th = np.full(n, np.nan), np.full(n, np.nan)
+    split = [split_delay(float(d), H) for d in delta]
+    m_all = np.array([s[0] for s in split], dtype=np.intp)
+    e_all = np.array([s[1] for s in split], dtype=float)
+    for m in np.unique(m_all):
+        idx = np.flatnonzero(m_all == m)
+        c = kv[idx] + headway[idx] * kx[idx]
+        t, tp, e = tau[idx], tau_prev[idx], e_all[idx]
+        co = coefficients(kx[idx], kv[idx], ka[idx], H=H, tau=(t, t), tau_p=(tp, tp),
+                          eps=(e, e), c=(c, c))
+        sure, fail = schur_bands(co.delta)
+        bb = _bnb_points(co, int(m), n_grid=_default_grid(int(m)), max_rounds=30,
+                         max_intervals=1024, refine=~fail)
+        vi = verdict_codes(bb.status)
+        vi[~sure] = np.where(fail[~sure], NOT_CERTIFIED, INCONCLUSIVE)
+        v[idx], g[idx], th[idx] = vi, bb.minimum, np.where(fail, np.nan, bb.argmin)
+    return v, g, th
 
 
 # ---------------------------------------------------------------------------

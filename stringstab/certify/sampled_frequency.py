@@ -41,6 +41,7 @@ from .verdicts import ROUNDOFF_SLACK
 from .zoh import Coefficients, loop_parameters, point_coefficients
 
 __all__ = [
+    "curvature_bound",
     "margin_bound",
     "margin_curvature",
     "margin_over_cells",
@@ -300,9 +301,8 @@ def margin_spread(theta: Array, co: Coefficients, m: Array, hw: Array) -> Array:
 # ---------------------------------------------------------------------------
 # The curvature bound of the branch and bound
 # ---------------------------------------------------------------------------
-def _bounds_poly(c: list[Interval], rho_r: Array) -> tuple[Array, Array, Array]:
-    """(max|Q|, max|Q_ρ|, max|Q_ρρ|) over ρ ∈ [0, ρ_r] for Q with coefficients c (≤ 2)."""
-    a = [np.maximum(np.abs(q.lo), np.abs(q.hi)) + ROUNDOFF_SLACK * q.mag for q in c]
+def _bounds_poly(a: list[Array], rho_r: Array) -> tuple[Array, Array, Array]:
+    """(max|Q|, max|Q_ρ|, max|Q_ρρ|) over ρ ∈ [0, ρ_r] for Q whose |coefficients| are ≤ a."""
     A0 = np.zeros_like(rho_r)
     A1 = np.zeros_like(rho_r)
     A2 = np.zeros_like(rho_r)
@@ -314,6 +314,11 @@ def _bounds_poly(c: list[Interval], rho_r: Array) -> tuple[Array, Array, Array]:
         if j >= 2:
             A2 = A2 + j * (j - 1) * aj * rho_r ** (j - 2)
     return A0, A1, A2
+
+
+def _magnitudes(c: list[Interval]) -> list[Array]:
+    """max(|lo|, |hi|) + the round-off slack of each coefficient: bounds on |coefficient|."""
+    return [np.maximum(np.abs(q.lo), np.abs(q.hi)) + ROUNDOFF_SLACK * q.mag for q in c]
 
 
 def margin_curvature(co: Coefficients, m: Array, L: Array, R: Array) -> Array:
@@ -332,19 +337,47 @@ def margin_curvature(co: Coefficients, m: Array, L: Array, R: Array) -> Array:
     Returns
     -------
     ndarray, shape (n, k)
+        The bound on each interval (:func:`curvature_bound` of the coefficients' magnitudes).
+    """
+    return curvature_bound(_magnitudes(co.P), _magnitudes(co.Yr), _magnitudes(co.Yi), m, L, R)
+
+
+def curvature_bound(aP: list[Array], aYr: list[Array], aYi: list[Array], m: Array, L: Array,
+                    R: Array) -> Array:
+    """M ≥ |f''(θ)| on [L, R] for f = P(ρ) + cos(mθ)Y_r(ρ) + sin(mθ) sin θ Y_i(ρ).
+
+    For every P, Y_r, Y_i whose coefficients (in ρ = 4 sin²(θ/2), constant term first) are
+    bounded in absolute value by ``aP``, ``aYr``, ``aYi``: g_H of one triple or of every
+    member of a cell (:func:`margin_curvature`), or the split form's F and G
+    (:mod:`stringstab.certify.sampled_split`, with Y_r = Y_i = 0 for F).  Derivation in
+    docs/sampled.md: bounds on P, Y_r, Y_i and their ρ-derivatives at ρ(R), |sin θ| on
+    [L, R] and the factors m, m² of the oscillating terms.
+
+    Parameters
+    ----------
+    aP, aYr, aYi : list of ndarray, shape (n,)
+        Bounds on the absolute values of the coefficients (empty lists for none).
+    m : ndarray, shape (n,)
+        Whole samples of delay.
+    L, R : ndarray, shape (n, k)
+        The intervals' ends, 0 ≤ L ≤ R ≤ π.
+
+    Returns
+    -------
+    ndarray, shape (n, k)
         The bound on each interval.
     """
     rho_r = 4.0 * np.sin(0.5 * R) ** 2
     S1 = np.where(R <= 0.5 * np.pi, np.sin(R), np.where(L >= 0.5 * np.pi, np.sin(L), 1.0))
     mm = m[:, None] if (np.ndim(m) and R.ndim == 2) else m
 
-    def d2(c: list[Interval]) -> tuple[Array, Array, Array]:
-        A0, A1, A2 = _bounds_poly(c, rho_r)
+    def d2(a: list[Array]) -> tuple[Array, Array, Array]:
+        A0, A1, A2 = _bounds_poly(a, rho_r)
         return A0, 2.0 * S1 * A1, 4.0 * S1 * S1 * A2 + 2.0 * A1
 
-    _, _, p2 = d2(co.P)
-    r0, r1, r2 = d2(co.Yr)
-    i0, i1, i2 = d2(co.Yi)
+    _, _, p2 = d2(aP)
+    r0, r1, r2 = d2(aYr)
+    i0, i1, i2 = d2(aYi)
     f0 = S1
     f1 = mm * S1 + 1.0
     f2 = (mm * mm + 1.0) * S1 + 2.0 * mm

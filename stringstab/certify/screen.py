@@ -20,6 +20,8 @@ frequencies then seed a repair).  The screen only saves certificate calls; it ne
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 import numpy.typing as npt
 
@@ -28,8 +30,11 @@ from . import margin as _margin
 from .criteria import hurwitz
 
 __all__ = [
+    "SAMPLED_SCREEN_RTOL",
     "SCREEN_OMEGA",
     "SCREEN_RTOL",
+    "SampledScreen",
+    "sampled_screen",
     "surely_uncertifiable",
     "violating_dips",
     "violation_threshold",
@@ -134,3 +139,109 @@ def violating_dips(K: npt.ArrayLike, p: Params) -> list[float]:
     _, dips = _margin.local_minima(K, tau=p.tau, delta=p.delta, headway=p.headway,
                                    threshold=threshold)
     return dips
+
+
+#: The frequencies of the sampled screen, rad/sample: the continuous screen's ω at H, then a
+#: uniform grid up to π.
+def _sampled_thetas(H: float) -> Array:
+    th = np.concatenate([SCREEN_OMEGA * H, np.linspace(0.0, np.pi, 49)[1:]])
+    return np.unique(th[(th > 0) & (th <= np.pi)])
+
+
+#: Monomials of K̃ = (1, k_x, k_v, k_a) of degree ≤ 2, as index pairs.
+_MONOMIALS = [(a, b) for a in range(4) for b in range(a, 4)]
+
+
+def _monomials(K: Array) -> Array:
+    """The 10 monomials of degree ≤ 2 of each row of K, shape (n, 10)."""
+    Kt = np.concatenate([np.ones((K.shape[0], 1)), K], axis=1)
+    return np.stack([Kt[:, a] * Kt[:, b] for a, b in _MONOMIALS], axis=1)
+
+
+class SampledScreen:
+    """The "surely not certifiable" screen of the sampled-data loop at one τ, δ, T*, H, τ_p.
+
+    g_H(θ) of :func:`stringstab.certify.sampled_frequency.sampled_margin` is a polynomial of
+    degree 2 in the gains at fixed parameters (every coefficient of
+    :func:`stringstab.certify.zoh.build` is), so at each of the screen's frequencies it is a
+    quadratic form in (1, k_x, k_v, k_a), fitted here once from g_H itself at 30 gain triples
+    (and refused — the screen then flags nothing — unless it reproduces g_H at 30 others to
+    10⁻¹⁰ of its terms' magnitude).  A row whose form is below −:data:`SAMPLED_SCREEN_RTOL`
+    times that magnitude at some frequency has |H(e^{jθ})| > 1 there, far beyond any error of
+    the fit: the sampled certificate cannot certify it.  Sound, like :func:`surely_uncertifiable`;
+    it only saves certificate calls.
+
+    Parameters
+    ----------
+    p : Params
+        τ, δ, T* (s).
+    H : float
+        Sample time, s.
+    tau_prev : float, optional
+        The predecessor's lag (default τ).
+
+    Examples
+    --------
+    >>> s = SampledScreen(Params(0.1, 0.2, 1.1), 0.1)
+    >>> s.surely_uncertifiable([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]]).tolist()
+    [False, True]
+    """
+
+    def __init__(self, p: Params, H: float, tau_prev: float | None = None) -> None:
+        from .sampled_frequency import sampled_margin  # the sampled loop only when asked
+
+        self.theta = _sampled_thetas(H)
+        rng = np.random.default_rng(0)
+        K = rng.uniform(-2.0, 2.0, (60, 3))
+        g = np.stack([sampled_margin(self.theta, *k, tau=p.tau, delta=p.delta, headway=p.headway,
+                                     sample_time=H, tau_prev=tau_prev) for k in K])
+        Mf, Mv = _monomials(K[:30]), _monomials(K[30:])
+        self.Q = np.linalg.lstsq(Mf, g[:30], rcond=None)[0]  # (10, nθ)
+        err = np.abs(Mv @ self.Q - g[30:])
+        self.ok = bool(np.all(err <= 1e-10 * (1.0 + np.abs(Mv) @ np.abs(self.Q))))
+
+    def surely_uncertifiable(self, K: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Which rows of K the sampled certificate surely cannot certify (class docstring).
+
+        Parameters
+        ----------
+        K : array_like, shape (n, 3)
+            Gain triples (k_x, k_v, k_a).
+
+        Returns
+        -------
+        ndarray of bool, shape (n,)
+            True where g_H is below its threshold at a screen frequency.
+        """
+        K = np.asarray(K, dtype=float).reshape(-1, 3)
+        if not self.ok or not K.shape[0]:
+            return np.zeros(K.shape[0], dtype=bool)
+        M = _monomials(K)
+        g = M @ self.Q
+        scale = 1.0 + np.abs(M) @ np.abs(self.Q)
+        return np.asarray(np.any(g < -SAMPLED_SCREEN_RTOL * scale, axis=1))
+
+
+#: Relative tolerance of the sampled screen (of the magnitude of the quadratic form's terms).
+SAMPLED_SCREEN_RTOL = 1e-7
+
+
+@lru_cache(maxsize=16)
+def sampled_screen(tau: float, delta: float, headway: float, sample_time: float,
+                   tau_prev: float | None = None) -> SampledScreen:
+    """The :class:`SampledScreen` of one loop, built once per process (16 cached).
+
+    Parameters
+    ----------
+    tau, delta, headway : float
+        τ, δ, T* (s).
+    sample_time : float
+        H (s).
+    tau_prev : float, optional
+        The predecessor's lag (default τ).
+
+    Returns
+    -------
+    SampledScreen
+    """
+    return SampledScreen(Params(tau, delta, headway), sample_time, tau_prev)

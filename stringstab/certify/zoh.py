@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -52,14 +53,19 @@ from .interval import Interval, IntervalAD, interval, poly_add, poly_scale
 __all__ = [
     "WHOLE_SAMPLE_RTOL",
     "Coefficients",
+    "abs2_over_rho",
     "build",
     "cell_coefficients",
     "coefficients",
+    "cross_terms",
+    "exp_neg_ad",
     "loop_parameters",
     "phi",
+    "phi_ad",
     "phi_interval",
     "point_coefficients",
     "primitives",
+    "ratio_ad",
     "split_delay",
 ]
 
@@ -95,12 +101,16 @@ def phi(x: npt.ArrayLike) -> tuple[Array, Array, Array]:
     """
     x = np.asarray(x, dtype=float)
     xs = np.minimum(x, 1.0)
+    neg = -xs
     acc = np.zeros_like(xs)
-    for k in range(26, 2, -1):  # Horner on x³ Σ (−x)^{k−3}/k!
-        acc = acc * (-xs) + _INV_FACT[k]
+    for k in range(26, 2, -1):  # Horner on x³ Σ (−x)^{k−3}/k! (in place: the same numbers)
+        acc *= neg
+        acc += _INV_FACT[k]
     p3s = acc * xs * xs * xs
     p2s = 0.5 * xs * xs - p3s
     p1s = xs - p2s
+    if acc.ndim and bool(np.all(x <= 1.0)):  # every x on the series (H ≤ τ): no direct forms
+        return p1s, p2s, p3s
     p1l = -np.expm1(-x)
     p2l = x - p1l
     p3l = 0.5 * x * x - p2l
@@ -169,47 +179,70 @@ _R = {0: [1.0], 1: [0.0, -0.5], 2: [0.0, -1.0, 0.5], 3: [0.0, 0.0, 1.5, -0.5]}
 _T = {0: [0.0], 1: [1.0], 2: [0.0, -1.0], 3: [0.0, -1.0, 1.0]}
 
 
-def _const_poly(c: list[float], like: Any) -> list[Any]:
-    """Constant coefficients as points shaped as ``like``."""
-    return [like.const(v) for v in c]
+def _scaled(c: Any, coefs: list[float]) -> list[Any]:
+    """c times each constant of ``coefs`` (None for a zero: adding it would change nothing)."""
+    return [None if v == 0.0 else c * v for v in coefs]
 
 
-def _abs2_over_rho(p: list[Interval]) -> list[Interval]:
+def _filled(p: list[Any], like: Any) -> list[Any]:
+    """``p`` with every missing (None) coefficient a zero constant shaped as ``like``."""
+    return [like.const(0.0) if v is None else v for v in p]
+
+
+def abs2_over_rho(p: list[Any]) -> list[Any]:
     """(|Σ p_k w^k|² − p_0²)/ρ on the unit circle, as a polynomial in ρ.
 
     |Σp_k w^k|² = Σ_k p_k² ρ^k + 2 Σ_{k<l} p_k p_l ρ^k R_{l−k}(ρ); every term but p_0²
     carries a factor ρ (R_j(0) = 0 for j ≥ 1), divided out exactly.
+
+    Parameters
+    ----------
+    p : list of Interval or IntervalAD
+        The coefficients p_0, p_1, ... of a polynomial in w = z − 1 (at least two).
+
+    Returns
+    -------
+    list
+        The coefficients in ρ = |w|² = 4 sin²(θ/2), constant term first, in the arithmetic
+        of ``p``.
     """
-    out: list[Interval] = []
-    like = p[0]
+    out: list[Any] = []
     for k in range(1, len(p)):
-        out = poly_add(out, [like.const(0.0)] * (k - 1) + [p[k] * p[k]])
+        out = poly_add(out, [None] * (k - 1) + [p[k] * p[k]])
     for k in range(len(p)):
         for l_ in range(k + 1, len(p)):
             r = _R[l_ - k]
             # ρ^k R_j / ρ = ρ^{k-1} R_j  (k ≥ 1) or R_j/ρ (k = 0: drop R_j's zero constant)
             rr = ([0.0] * (k - 1) + r) if k >= 1 else r[1:]
-            term = poly_scale(2.0 * (p[k] * p[l_]), _const_poly(rr, like))
-            out = poly_add(out, term)
-    return out
+            out = poly_add(out, _scaled(2.0 * (p[k] * p[l_]), rr))
+    return _filled(out, p[0])
 
 
-def _cross(ell: list[Interval], nu: list[Interval]) -> tuple[list[Interval], list[Interval]]:
-    """Y = ℓ(w)·conj(n(w)) = Y_r(ρ) + j sin θ · Y_i(ρ)."""
-    like = ell[0]
-    yr: list[Interval] = []
-    yi: list[Interval] = []
+def cross_terms(ell: list[Any], nu: list[Any]) -> tuple[list[Any], list[Any]]:
+    """Y = ℓ(w)·conj(n(w)) = Y_r(ρ) + j sin θ · Y_i(ρ) on the unit circle.
+
+    Parameters
+    ----------
+    ell, nu : list of Interval or IntervalAD
+        The coefficients of ℓ(w) and n(w) in w = z − 1, constant term first.
+
+    Returns
+    -------
+    (list, list)
+        The coefficients of Y_r and Y_i in ρ = 4 sin²(θ/2), constant term first.
+    """
+    yr: list[Any] = []
+    yi: list[Any] = []
     for a, la in enumerate(ell):
         for b, nb in enumerate(nu):
             c = la * nb
             lo_, d = min(a, b), abs(a - b)
             shift = [0.0] * lo_
-            yr = poly_add(yr, poly_scale(c, _const_poly(shift + _R[d], like)))
+            yr = poly_add(yr, _scaled(c, shift + _R[d]))
             if d:
                 sgn = 1.0 if a > b else -1.0
-                yi = poly_add(yi, poly_scale(c, _const_poly(shift + [sgn * t for t in _T[d]],
-                                                             like)))
-    return yr, yi
+                yi = poly_add(yi, _scaled(c, shift + [sgn * t for t in _T[d]]))
+    return _filled(yr, ell[0]), _filled(yi, ell[0])
 
 
 def primitives(
@@ -290,13 +323,13 @@ def build(q: dict[str, Any], H: float) -> Coefficients:
     A = kap * f1p
     B = kap * f1
     A2, B2 = A * A, B * B
-    Ad = _abs2_over_rho([d0, d1, d2, d0.const(1.0)])
-    An = _abs2_over_rho(nu)
+    Ad = abs2_over_rho([d0, d1, d2, d0.const(1.0)])
+    An = abs2_over_rho(nu)
     # |ℓ|² = ℓ0² − ℓ1 (ℓ0 − ℓ1) ρ, with ℓ0 − ℓ1 = C − E_p = C (1 − e^{−εH/τ_p}) ≥ 0
     L = [f1p * f1p, -(ell1 * cm)]
     kaL = poly_scale(B2 * K_a * K_a, [d0.const(0.0), *L])
     P = poly_add(poly_add(poly_scale(A2, Ad), poly_scale(B2, An), -1.0), kaL, -1.0)
-    yr, yi = _cross(ell, nu)
+    yr, yi = cross_terms(ell, nu)
     k2 = 2.0 * (B2 * K_a)
     return Coefficients([d0, d1, d2], nu, ell, f1, f1p, P, poly_scale(k2, yr), poly_scale(k2, yi))
 
@@ -329,15 +362,39 @@ def coefficients(
 # ---------------------------------------------------------------------------
 # Parameter cells: the mean-value form
 # ---------------------------------------------------------------------------
-def _recip_ad(t: IntervalAD, H: float) -> IntervalAD:
-    """H/t for t > 0: decreasing, derivative −H/t² ∈ [−H/t_lo², −H/t_hi²]."""
+def ratio_ad(t: IntervalAD, H: float) -> IntervalAD:
+    """x = H/t for t > 0 (a lag): decreasing, derivative −H/t² ∈ [−H/t_lo², −H/t_hi²].
+
+    Parameters
+    ----------
+    t : IntervalAD
+        A lag over the cells (τ or τ_p), s, > 0.
+    H : float
+        Sample time, s.
+
+    Returns
+    -------
+    IntervalAD
+        H/t with its derivative enclosures.
+    """
     lo, hi = t.r.lo, t.r.hi
     dr = Interval(-H / (lo * lo), -H / (hi * hi))
     return IntervalAD(Interval(H / t.c.lo), Interval(H / hi, H / lo), tuple(dr * gi for gi in t.g))
 
 
-def _phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
-    """φ1, ψ2, ψ3 of x ≥ 0: increasing, with φ1' = 1 − φ1, ψ2' = φ1, ψ3' = ψ2."""
+def phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
+    """φ1, ψ2, ψ3 of x ≥ 0 (:func:`phi`): increasing, with φ1' = 1 − φ1, ψ2' = φ1, ψ3' = ψ2.
+
+    Parameters
+    ----------
+    x : IntervalAD
+        x ≥ 0 over the cells (e.g. H/τ of :func:`ratio_ad`).
+
+    Returns
+    -------
+    (IntervalAD, IntervalAD, IntervalAD)
+        φ1, ψ2 and ψ3 with their derivative enclosures.
+    """
     c = tuple(Interval(v) for v in phi(x.c.lo))
     r = phi_interval(x.r.lo, x.r.hi)
     ders = (1.0 - r[0], r[0], r[1])
@@ -345,8 +402,19 @@ def _phi_ad(x: IntervalAD) -> tuple[IntervalAD, IntervalAD, IntervalAD]:
                  for ci, ri, dk in zip(c, r, ders))
 
 
-def _exp_neg_ad(y: IntervalAD) -> IntervalAD:
-    """e^{−y}: decreasing, derivative −e^{−y}."""
+def exp_neg_ad(y: IntervalAD) -> IntervalAD:
+    """e^{−y}: decreasing, derivative −e^{−y}.
+
+    Parameters
+    ----------
+    y : IntervalAD
+        The exponent over the cells.
+
+    Returns
+    -------
+    IntervalAD
+        e^{−y} with its derivative enclosures.
+    """
     r = Interval(np.exp(-y.r.hi), np.exp(-y.r.lo))
     return IntervalAD(Interval(np.exp(-y.c.lo)), r, tuple(-(r * gi) for gi in y.g))
 
@@ -380,16 +448,15 @@ def cell_coefficients(
     E = IntervalAD.variable(eps[:, 0], eps[:, 1], d - 2, d)
     Th = IntervalAD.variable(headway[:, 0], headway[:, 1], d - 1, d)
     K_x, K_v, K_a = T.const(kx), T.const(kv), T.const(ka)
-    f1, p2, p3 = _phi_ad(_recip_ad(T, H))
-    xp = _recip_ad(Tp, H)
-    f1p, p2p, p3p = _phi_ad(xp)
+    f1, p2, p3 = phi_ad(ratio_ad(T, H))
+    xp = ratio_ad(Tp, H)
+    f1p, p2p, p3p = phi_ad(xp)
     y = (1.0 - E) * xp
-    cm = _exp_neg_ad(y) * _phi_ad(E * xp)[0]
+    cm = exp_neg_ad(y) * phi_ad(E * xp)[0]
     q = {"K_x": K_x, "K_v": K_v, "K_a": K_a, "T": T, "Tp": Tp, "Cc": K_v + Th * K_x,
          "f1": f1, "p2": p2, "p3": p3, "f1p": f1p, "p2p": p2p, "p3p": p3p,
-         "ell1": _phi_ad(y)[0], "cm": cm}
+         "ell1": phi_ad(y)[0], "cm": cm}
     return build(q, H)
-
 
 
 # ---------------------------------------------------------------------------
@@ -489,8 +556,20 @@ def point_coefficients(kx: Array, kv: Array, ka: Array, p: Params, H: float,
     """
     m, eps = split_delay(p.delta, H)
     n = kx.size
-    t = np.full(n, p.tau)
-    t_p = np.full(n, tp)
-    e = np.full(n, eps)
+    # the parameters' quantities once per parameter set, on one element: each row's numbers
+    # are those of the full arrays (the same operations on the same values, broadcast)
+    q = dict(_parameter_primitives(float(p.tau), float(tp), float(eps), float(H)))
     c = kv + p.headway * kx
-    return coefficients(kx, kv, ka, H=H, tau=(t, t), tau_p=(t_p, t_p), eps=(e, e), c=(c, c)), m
+    q.update(K_x=Interval(kx), K_v=Interval(kv), K_a=Interval(ka), Cc=Interval(c))
+    co = build(q, H)
+    one = np.ones(n)
+    return co.map(lambda v: v if v.lo.shape == (n,) else
+                  Interval(v.lo * one, None, np.asarray(v.mag) * one)), m
+
+
+@lru_cache(maxsize=64)
+def _parameter_primitives(tau: float, tau_p: float, eps: float, H: float) -> dict[str, Interval]:
+    """The parameter-only primitives of :func:`primitives` at one point (one element)."""
+    t, t_p, e, one = np.array([tau]), np.array([tau_p]), np.array([eps]), np.ones(1)
+    q = primitives(one, one, one, H=H, tau=(t, t), tau_p=(t_p, t_p), eps=(e, e), c=(one, one))
+    return {k: v for k, v in q.items() if k not in ("K_x", "K_v", "K_a", "Cc")}

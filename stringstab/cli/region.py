@@ -20,7 +20,7 @@ import numpy as np
 
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
-from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU
+from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
 from ..regions import CONTINUOUS, GAIN_NAMES
 from ._common import add_model_arguments, loop_params
 
@@ -39,6 +39,8 @@ examples:
   stringstab region --fix k_a=0.5 --sample-time 0.1 --compare continuous --out maps_dt01/
   stringstab region --fix k_a=0.5 --tau 0.1:0.3 --delta 0.1:0.3 --n 101 --out maps_box/
   stringstab region --3d --n 81 --method exact --scheduler tcp://head:8786 --out maps3d/
+  stringstab region --fix k_a=0.5 --reaction-delay 0.2 --out maps_r02/
+  stringstab region --fix k_a=0.5 --reaction-delay 0:0.3:4 --n 101 --out maps_r/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
 in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
@@ -49,6 +51,9 @@ taylor, printed = not internally stable / type III / type IV / type I / type II.
 with --sample-time or a LO:HI interval, exact is the sampled or robust certificate (the
 only method; the Taylor criteria are of the continuous loop at one tau, delta, headway);
 --compare continuous adds the continuous certificate and the band where they differ.
+with --reaction-delay S > 0, exact is the certificate with the reaction delay (the only
+method); a list A,B,... or a range LO:HI:N maps each θ_r (files <prefix>_theta_r_<θ_r>.*)
+and writes the certified share vs θ_r: <prefix>_share_vs_theta_r.csv and its figure.
 defaults: range {DEFAULT_RANGE[0]:g},{DEFAULT_RANGE[1]:g}, n {DEFAULT_N_2D} (2-D) or {DEFAULT_N_3D} (3-D),
 tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/regions.md.
 """
@@ -86,6 +91,12 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--n", metavar="N[,N2[,N3]]",
                    help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
     add_model_arguments(p)
+    # -- the reaction delay θ_r (issue 25 part 2): one value, or a list/range as a map axis
+    p.add_argument("--reaction-delay", metavar="S|A,B,...|LO:HI:N",
+                   help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
+                        "(τ a' = u(t − θ_r) − a), continuous time only so far (default: 0); a "
+                        "list A,B,... or a range LO:HI:N maps each θ_r and the certified share "
+                        "vs θ_r")
     p.add_argument("--method", metavar="M[,M...]",
                    help="methods among exact, taylor, printed (default: all three; exact alone "
                         "with --sample-time or an interval)")
@@ -269,7 +280,14 @@ def run(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     axes, fixed = _grid(args)
+    # -- θ_r as a map axis (issue 25 part 2): a list or range; one value goes to loop_params
+    from ..regions.reaction_sweep import parse_reaction_delays
+
+    thetas = None if args.reaction_delay is None else parse_reaction_delays(args.reaction_delay)
+    if thetas is not None:
+        args.reaction_delay = None  # the axis: loop_params checks τ, δ, T* alone
     model, H = loop_params(args)
+    with_theta = thetas is not None or Box.of(model).reaction_delay != (0.0, 0.0)
     methods = args.method
     if args.compare is not None:
         if H is None:
@@ -290,6 +308,10 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--prefix must be a plain file name stem; got {args.prefix!r}")
     gains = None
     if args.overlay is not None:
+        if with_theta:
+            raise StringStabError("--overlay draws on the map without a reaction delay so far; "
+                                  f"expected no --overlay with --reaction-delay, got --overlay "
+                                  f"{args.overlay}")
         if args.three_d:
             raise StringStabError("--overlay draws on a 2-D map; got --3d")
         from ..io.gains import read_gains
@@ -309,12 +331,25 @@ def run(args: argparse.Namespace) -> int:
     try:
         # region_map validates the methods before computing anything
         with _executor(args.scheduler, workers) as (executor, n_dask):
-            rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
-                              headway=model.headway, sample_time=H, methods=methods,
-                              workers=n_dask or workers, executor=executor,
-                              progress=False if args.no_progress else None)
+            if thetas is not None:  # -- one map per θ_r (issue 25 part 2)
+                from ..regions.reaction_sweep import reaction_sweep
+
+                sweep = reaction_sweep(axes, fixed or None, reaction_delays=thetas,
+                                       tau=model.tau, delta=model.delta, headway=model.headway,
+                                       sample_time=H, methods=methods,
+                                       workers=n_dask or workers, executor=executor,
+                                       progress=False if args.no_progress else None)
+                rmap = sweep.maps[0]
+            else:
+                rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
+                                  headway=model.headway, sample_time=H, methods=methods,
+                                  workers=n_dask or workers, executor=executor,
+                                  progress=False if args.no_progress else None,
+                                  reaction_delay=model.reaction_delay)
     finally:
         warm.join()
+    if thetas is not None:
+        return _write_sweep(sweep, out, args, formats, dpi, t0)
     verdicts = None
     if gains is not None:  # compute, then draw: the overlay's own exact verdicts
         from ..plots import trajectory_verdicts
@@ -331,5 +366,21 @@ def run(args: argparse.Namespace) -> int:
 
         region_report(rmap, written, command=command_line(args), started=t0).write(out)
     print(rmap.report())
+    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
+    return 0
+
+
+def _write_sweep(sweep: Any, out: Any, args: argparse.Namespace, formats: list[str], dpi: int,
+                 t0: float) -> int:
+    """The files of a map per θ_r (issue 25 part 2): each map's, the share table and figure."""
+    from ..plots.reaction_sweep import save_reaction_sweep_outputs
+    from ..report import command_line
+    from ..report.reaction_sweep import reaction_sweep_report
+
+    with out:
+        written = save_reaction_sweep_outputs(sweep, out, prefix=args.prefix, formats=formats,
+                                              dpi=dpi)
+        reaction_sweep_report(sweep, written, command=command_line(args), started=t0).write(out)
+    print(sweep.report())
     print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
     return 0

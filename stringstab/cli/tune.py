@@ -41,13 +41,15 @@ examples:
   stringstab tune 0.2,0.7,0 --method region-growing --r0 0.05 --criterion printed
   stringstab tune 0.9,-0.5,1.1 --sample-time 0.1      # certified for the loop sampled at 10 Hz
   stringstab tune 0.9,-0.5,1.1 --tau 0.1:0.2 --delta 0.15:0.25   # for every τ, δ in the box
+  stringstab tune 1.2,0.5,0.6 --reaction-delay 0.2    # certified with the command 0.2 s late
 
 input files: as for `stringstab certify` (CSV with a header k_x,k_v,k_a and
 optional t, vehicle; JSON; NPZ).
 
 with --sample-time or a LO:HI interval the projection repairs to gains certified for
 that loop (sampled, or every member of the box); region growing (a continuous-time
-Taylor test at one tau, delta, headway) takes neither.
+Taylor test at one tau, delta, headway) takes neither. With --reaction-delay S > 0 the
+projection repairs to gains certified with the reaction delay (continuous time only so far).
 
 output: per input and method, the input gains (k_x_in, ...), the output gains,
 whether the output is certified by the exact certificate, the status
@@ -87,6 +89,11 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--method", "-m", choices=_METHODS, default="projection",
                    help="repair method (default: projection)")
     add_model_arguments(p)
+    # -- the reaction delay θ_r (issue 25 part 2)
+    p.add_argument("--reaction-delay", metavar="SECONDS",
+                   help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
+                        "(τ a' = u(t − θ_r) − a): the projection repairs to gains certified with "
+                        "it; continuous time only so far (default: 0)")
     p.add_argument("--bounds", default="-2,2", metavar="LO,HI",
                    help="bounds on every gain (default: -2,2, IDL Table 2)")
     p.add_argument("--weights", default="1,1,1", metavar="WX,WV,WA",
@@ -165,6 +172,14 @@ def run(args: argparse.Namespace) -> int:
     """
     model, H = loop_params(args)
     general = H is not None or isinstance(model, Box)
+    # -- θ_r > 0 (issue 25 part 2): the projection only; beyond the continuous point loop the
+    # certificate's refusal (raised by the Projector below, before any output)
+    theta = Box.of(model).reaction_delay[1]
+    if theta and args.method != "projection":
+        raise StringStabError(
+            "region growing tests candidates with the Taylor Proposition 1 of the loop without "
+            f"reaction delay; expected --method projection with --reaction-delay, got --method "
+            f"{args.method}")
     if general and args.method != "projection":
         raise StringStabError(
             "region growing tests candidates with the Taylor Proposition 1 of the continuous loop "
@@ -226,7 +241,8 @@ def run(args: argparse.Namespace) -> int:
     if "projection" in methods:
         projector = Projector(tau=model.tau, delta=model.delta, headway=model.headway,
                               sample_time=H, weights=weights, bounds=(lo, hi),
-                              hurwitz_margin=margin, eps=eps, cache_size=0)
+                              hurwitz_margin=margin, eps=eps, cache_size=0,
+                              reaction_delay=model.reaction_delay)
     results = []
     rows = []
     K = table.K
@@ -258,7 +274,8 @@ def run(args: argparse.Namespace) -> int:
         params.update(hurwitz_margin=margin, eps=eps)
     summary = repaired.summary()
     if args.format == "table":  # for people: units on the numbers
-        shown = {k: _seconds(v) if k in ("tau", "delta", "headway", "sample_time") else v
+        shown = {k: _seconds(v) if k in ("tau", "delta", "headway", "sample_time",
+                                         "reaction_delay") else v
                  for k, v in params.items()}
         text = format_results(repaired.columns(), "table", params=shown, table=TABLE_COLUMNS,
                               summary={m: _with_units(s) for m, s in summary.items()})
@@ -268,7 +285,7 @@ def run(args: argparse.Namespace) -> int:
         text = format_results(repaired.columns(), "json", params=params, summary=summary)
     write_text(text, out if out is not None else sys.stdout, what="--out")
     if report_dir is not None:
-        _write_report(report_dir, results, params, general, t0, args)
+        _write_report(report_dir, results, params, general or bool(theta), t0, args)
     n_cert = int(repaired.certified.sum())
     if out is not None:
         print(f"stringstab tune: {n_cert} of {len(repaired)} outputs certified; "

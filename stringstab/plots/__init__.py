@@ -17,6 +17,7 @@ module / function              shows
 :func:`plot_region_3d`         the boundary of the certified region in 3-D
 :func:`plot_facets`            one class map per τ (or δ): how the region shrinks
 :func:`plot_boundaries`        the certified boundaries of several maps on one axes
+:func:`plot_certified_share`   certified share vs θ_r (files: save_reaction_sweep_outputs)
 **gain trajectories**          (:mod:`stringstab.plots.trajectory`)
 :func:`trajectory_verdicts`    the exact verdict of each triple for a map's loop (compute)
 :func:`plot_trajectory`        a policy's gain trajectory over a map, by verdict
@@ -40,6 +41,7 @@ from __future__ import annotations
 from ..io.figures import FIGURE_FORMATS
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
 from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
+from .reaction_sweep import plot_certified_share, save_reaction_sweep_outputs
 from .region_sets import plot_boundaries, plot_facets
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
@@ -58,6 +60,7 @@ __all__ = [
     "moves_projection",
     "moves_region",
     "plot_boundaries",
+    "plot_certified_share",
     "plot_class_map",
     "plot_comparison",
     "plot_damping_ratios",
@@ -70,6 +73,7 @@ __all__ = [
     "plot_trajectory",
     "plot_vehicles",
     "save_figures",
+    "save_reaction_sweep_outputs",
     "save_region_outputs",
     "trajectory_verdicts",
     "warm_up",

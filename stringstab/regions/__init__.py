@@ -51,7 +51,9 @@ point with Λ ≤ 0.  The class map shows the types; the verdicts are in
 Modules: :mod:`~stringstab.regions.grid` (the grid, its blocks, :func:`region_map`),
 :mod:`~stringstab.regions.pool` (worker processes), :mod:`~stringstab.regions.result`
 (:class:`RegionMap`: classes, shares, columns, summary), :mod:`~stringstab.regions.files`
-(NPZ and CSV) and :mod:`~stringstab.regions.report` (the text report).
+(NPZ and CSV), :mod:`~stringstab.regions.report` (the text report) and
+:mod:`~stringstab.regions.reaction_sweep` (:func:`reaction_sweep`: a map per reaction delay
+θ_r and the certified share vs θ_r, issue 25).
 
 Evaluation is chunked in blocks of grid points (memory bounded by the block
 size, not the grid) and spread over worker processes.  The Taylor quantities
@@ -70,6 +72,7 @@ IDL paper, Proposition 1 (eqs 12-15), §3.3 (types I-IV), Definition 1 (eq 10).
 from __future__ import annotations
 
 from .grid import EXACT_BLOCK, TAYLOR_BLOCK, region_map
+from .reaction_sweep import ReactionSweep, reaction_sweep
 from .result import (
     CONTINUOUS,
     EXACT_CLASSES,
@@ -91,8 +94,10 @@ __all__ = [
     "TAYLOR_BLOCK",
     "TYPE_CLASSES",
     "VERDICT_LABELS",
+    "ReactionSweep",
     "RegionMap",
     "describe_params",
     "load_npz",
+    "reaction_sweep",
     "region_map",
 ]

@@ -622,8 +622,8 @@ def describe_params(p: Params | Box) -> str:
     Parameters
     ----------
     p : Params or Box
-        Actuator lag τ (IDL eq 7), communication delay δ (eq 4) and time headway T* (eq 3), in
-        s, each a value or an interval.
+        Actuator lag τ (IDL eq 7), communication delay δ (eq 4), time headway T* (eq 3) and,
+        when not 0, the reaction delay θ_r (issue 25), in s, each a value or an interval.
 
     Returns
     -------
@@ -634,9 +634,11 @@ def describe_params(p: Params | Box) -> str:
     --------
     >>> describe_params(Box((0.1, 0.3), (0.2, 0.2), (1.1, 1.1)))
     'τ ∈ [0.1, 0.3] s, δ = 0.2 s, T* = 1.1 s'
+    >>> describe_params(Params(0.1, 0.2, 1.1, reaction_delay=0.2))  # θ_r only when > 0
+    'τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, θ_r = 0.2 s'
     """
     parts = []
-    for sym, (lo, hi) in zip(("τ", "δ", "T*"), Box.of(p).as_dict().values()):
+    for sym, (lo, hi) in zip(("τ", "δ", "T*", "θ_r"), Box.of(p).as_dict().values()):
         parts.append(f"{sym} = {lo:g} s" if lo == hi else f"{sym} ∈ [{lo:g}, {hi:g}] s")
     return ", ".join(parts)
 

@@ -25,6 +25,9 @@ CAPTIONS: list[tuple[str, str]] = [
     ("*_class_printed.*", "What the IDL paper's printed Proposition 1 says on the same slice "
      "(its printed Ψ formulas, errata included): compare with the exact map to see where a reader "
      "of the paper would be misled."),
+    ("*_share_vs_theta_r.*", "The share of the gain grid the exact certificate certifies at "
+     "each reaction delay θ_r (the whole command applied θ_r late), the slices at each θ_r "
+     "beside it; a dashed line gives the inconclusive share when there is one."),
     ("*_class_continuous.*", "The continuous-time certificate on the same slice, to compare with "
      "the sampled-data map: the gains it certifies that sampling loses are the difference."),
     ("*_compare.*", "Where the three verdicts (exact, Taylor, printed) agree and where they "

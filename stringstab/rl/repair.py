@@ -10,18 +10,22 @@ so calling them per environment step would dominate training.  The default metho
 *certified lookup*:
 
 ``"projection"`` (default)
-    1. a cheap screen drops triples that surely fail
+    1. a proposal inside a *proven cell* of the lattice below — a cell on which both
+       certificates hold for every gain (:mod:`stringstab.certify.gain_cells`, proven by blocks
+       the first time a proposal comes near: :func:`certified_cells`) — is executed unchanged,
+       without a certificate call;
+    2. for the others, cheap screens drop triples that surely fail
        (:func:`stringstab.certify.screen.surely_uncertifiable`: not internally stable, or g(ω)
        below its round-off threshold at one of 48 fixed frequencies, where g is the margin of
-       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there);
-    2. the rest are checked by the exact certificate in one vectorised call; certified triples
-       are executed unchanged;
+       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there; with a sample time, the sampled
+       loop's :class:`~stringstab.certify.screen.SampledScreen`), and the rest are checked by
+       the exact certificates in one vectorised call each; certified triples are executed
+       unchanged;
     3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
-       points of a grid of spacing ``resolution`` over the gain box that the exact certificate
-       certifies (built once per process and parameter set, one vectorised call, about 10 s for
-       the default 81³ grid);
+       points of a grid of spacing ``resolution`` over the gain box that the exact certificates
+       certify (built once per process and parameter set, one vectorised call);
     4. ``refine`` bisection steps along the segment from that point towards the proposed K keep
-       the farthest point the exact certificate certifies (one vectorised call per step).
+       the farthest point in a proven cell (no certificate call).
 
     The result is within about one lattice spacing of the true projection (the nearest certified
     triple); ``analysis/bench_train.py`` measures the difference against
@@ -36,11 +40,12 @@ so calling them per environment step would dominate training.  The default metho
 ``"off"``
     no repair: the ablation (executed gains may be uncertified).
 
-Whatever the method, a triple is executed only if :func:`~stringstab.certify.api.check` returned
-``"certified"`` for exactly that triple (``"off"`` excepted) — and, with ``sample_time`` H, also
-:func:`stringstab.certify.sampled.check_sampled` at H: the loop the simulator runs holds u over each
-control step, and gains on the continuous certificate's boundary need not be string stable in
-that sampled loop.
+Whatever the method, a triple is executed only if it is certified (``"off"`` excepted): by
+:func:`~stringstab.certify.api.check` for exactly that triple, or by the proof of a proven cell
+that contains it — and, with ``sample_time`` H, also by the sampled-data certificate
+(:func:`stringstab.certify.sampled.check_sampled` at H, or the cell's proof): the loop the
+simulator runs holds u over each control step, and gains on the continuous certificate's
+boundary need not be string stable in that sampled loop.
 """
 
 from __future__ import annotations
@@ -54,13 +59,14 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify import grid
+from ..certify.gain_cells import CertifiedCells
 from ..certify.screen import surely_uncertifiable
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Params, positive
 from .config import REPAIRS, TD3Config
 
-__all__ = ["REPAIR_KEYS", "GainRepair", "certified_lattice", "repair_for"]
+__all__ = ["REPAIR_KEYS", "GainRepair", "certified_cells", "certified_lattice", "repair_for"]
 
 Array = npt.NDArray[np.float64]
 
@@ -117,6 +123,47 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
             f"no certified gains on the {n}^3 lattice over [{lo}, {hi}]^3 at tau={tau}, "
             f"delta={delta}, headway={headway}; expected parameters with a certified region")
     return pts
+
+
+@lru_cache(maxsize=8)
+def certified_cells(tau: float, delta: float, headway: float, lo: float, hi: float,
+                    resolution: float, sample_time: float | None = None) -> CertifiedCells:
+    """The cells of the repair's lattice, proven on demand (:class:`~stringstab.certify.gain_cells.CertifiedCells`).
+
+    The candidates are the cells whose 8 corners are points of :func:`certified_lattice`
+    (both certificates, with ``sample_time``); a cell is proven for every gain in it the first
+    time a gain falls in it or next to it.  Cached (8 entries, one object per parameter set,
+    shared by the repairs of a process).
+
+    Parameters
+    ----------
+    tau, delta, headway : float
+        τ, δ, T* (s).
+    lo, hi : float
+        The gain box of every gain.
+    resolution : float
+        Lattice spacing (as for :func:`certified_lattice`).
+    sample_time : float, optional
+        Also the sampled-data certificate at this period H, s.
+
+    Returns
+    -------
+    CertifiedCells
+    """
+    n = round((hi - lo) / resolution) + 1
+    pts = certified_lattice(tau, delta, headway, lo, hi, resolution, sample_time)
+    g = np.linspace(lo, hi, n)
+    ijk = np.clip(np.searchsorted(g, pts, side="left"), 0, n - 1)
+    on = np.zeros((n, n, n), dtype=bool)
+    on[ijk[:, 0], ijk[:, 1], ijk[:, 2]] = np.all(g[ijk] == pts, axis=1)
+    m = n - 1
+    cand = np.ones((m, m, m), dtype=bool)
+    for dx in (0, 1):
+        for dy in (0, 1):
+            for dz in (0, 1):
+                cand &= on[dx:m + dx, dy:m + dy, dz:m + dz]
+    return CertifiedCells(lo, hi, n, Params(tau, delta, headway), sample_time=sample_time,
+                          candidates=cand)
 
 
 class GainRepair:
@@ -190,6 +237,12 @@ class GainRepair:
         return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
                                  self.sample_time)
 
+    def cells(self) -> CertifiedCells:
+        """The proven cells of this repair's lattice (:func:`certified_cells`, shared)."""
+        p = self.params
+        return certified_cells(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                               self.sample_time)
+
     def _kdtree(self) -> Any:
         if self._tree is None:
             from scipy.spatial import cKDTree
@@ -197,29 +250,29 @@ class GainRepair:
             self._tree = cKDTree(self.lattice())
         return self._tree
 
-    def _nearest(self, K0: Array) -> tuple[Array, npt.NDArray[np.bool_]]:
-        """The lattice points nearest K0, refined by bisection under the continuous certificate.
+    def _nearest(self, K0: Array) -> Array:
+        """The lattice points nearest K0, moved towards K0 by bisection within proven cells.
 
-        Also returns which rows moved off the lattice (those still need the sampled-data check,
-        if any).
+        Each step keeps the farther point of the segment from the lattice point to K0 that
+        lies in a proven cell of :meth:`cells`: every point returned is a certified lattice
+        point or in a proven cell, so certified by both certificates.
         """
         _, idx = self._kdtree().query(K0)
         P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
-        moved = np.zeros(K0.shape[0], dtype=bool)
         if self.refine:
+            cells = self.cells()
             lo = np.zeros(K0.shape[0])
             hi = np.ones(K0.shape[0])
             best = P.copy()
-            for _ in range(self.refine):  # bisection under the continuous certificate
+            for _ in range(self.refine):  # bisection within the proven cells
                 mid = 0.5 * (lo + hi)
                 C = P + mid[:, None] * (K0 - P)
-                ok = grid.certified(C, self.params)
+                ok = cells.contains(C)
                 best[ok] = C[ok]
-                moved |= ok
                 lo = np.where(ok, mid, lo)
                 hi = np.where(ok, hi, mid)
             P = best
-        return P, moved
+        return P
 
     def _exact(self, K0: Array) -> Array:
         from ..tuning import Projector, region_growing
@@ -241,7 +294,7 @@ class GainRepair:
             if r.certified and grid.certified(kr[None], p)[0]:
                 out[i] = kr
             else:
-                out[i] = self._nearest(k[None])[0][0]
+                out[i] = self._nearest(k[None])[0]
                 self.stats["fallbacks"] += 1
         return out
 
@@ -285,24 +338,31 @@ class GainRepair:
         out = K0.copy()
         if self.method != "off":
             p = self.params
-            ok = grid.certified(K0, p)  # continuous-time certificate (``check``)
+            cells = self.cells()
+            # a gain in a proven cell is certified by both certificates (the cell's proof);
+            # the others go to the continuous-time certificate (``check``)
+            in_cell = cells.contains(K0)
+            ok = in_cell.copy()
+            rest = np.flatnonzero(~in_cell)
+            if rest.size:
+                ok[rest] = grid.certified(K0[rest], p)
             bad = np.flatnonzero(~ok)
-            pending = ok.copy()  # rows whose executed gains still need the sampled check
+            pending = ok & ~in_cell  # rows whose executed gains still need the sampled check
             if bad.size:
                 if self.method == "projection":
-                    out[bad], moved = self._nearest(K0[bad])
-                    pending[bad] = moved  # unmoved rows are lattice points: certified both ways
+                    # lattice points and points in proven cells: certified both ways
+                    out[bad] = self._nearest(K0[bad])
+                    pending[bad] = False
                 else:
                     out[bad] = self._exact(K0[bad])
-                    pending[bad] = True
+                    pending[bad] = ~cells.contains(out[bad])
             if self.sample_time is not None and pending.any():
                 # one sampled-data call per step; where it fails, the nearest lattice point
                 j = np.flatnonzero(pending)
                 keep = grid.certified(out[j], p, sample_time=self.sample_time)
                 if (~keep).any():
                     jj = j[~keep]
-                    _, idx = self._kdtree().query(K0[jj])
-                    out[jj] = self.lattice()[np.asarray(idx)]
+                    out[jj] = self._nearest(K0[jj])
                     bad = np.union1d(bad, jj)
                     self.stats["fallbacks"] += int(jj.size)
             self.stats["unchanged"] += int(K0.shape[0] - bad.size)

@@ -244,16 +244,17 @@ class Episodes:
         self.k += 1
         o = self.observe()
         gap, spd, pspd = o.gap[:, 0], o.speed[:, 0], o.pred_speed[:, 0]
+        ttc, hw = time_to_collision(gap, spd, pspd), time_headway(gap, spd)
         r, r_f, r_j, r_e = reward(gap, spd, pspd, o.accel[:, 0], prev_accel, weights=self.weights,
-                                  ttc_star=self.ttc_star)
+                                  ttc_star=self.ttc_star, ttc=ttc, headway=hw)
         collision = gap <= 0
         terminated = collision & self.terminate_on_collision
         truncated = (self.k >= self.lengths[self.which] - 1) & ~terminated
         self.ret += r
         info: dict[str, Any] = {
             "gap": gap.copy(), "speed": spd.copy(), "accel": o.accel[:, 0].copy(),
-            "command": u_lim[:, 0].copy(), "ttc": time_to_collision(gap, spd, pspd),
-            "headway": time_headway(gap, spd), "r_f": r_f, "r_j": r_j, "r_e": r_e,
+            "command": u_lim[:, 0].copy(), "ttc": ttc,
+            "headway": hw, "r_f": r_f, "r_j": r_j, "r_e": r_e,
             "collision": collision, "leader_index": self.which.copy(), "t": self.k * self.dt,
         }
         if K is not None:

@@ -16,6 +16,7 @@ Notes on the printed equations
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -123,6 +124,12 @@ def headway_density(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
     return np.asarray(np.where(pos, f, 0.0))
 
 
+@functools.lru_cache(maxsize=16)
+def _density_peak(mu: float, sigma: float) -> float:
+    """F(h*) of eq 23 at its mode h* = e^{μ − σ²} (computed once per (μ, σ))."""
+    return float(headway_density(math.exp(mu - sigma**2), mu=mu, sigma=sigma))
+
+
 def efficiency_reward(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
                       sigma: float = HEADWAY_SIGMA) -> Array:
     """r_e (IDL eq 24) = F(h)/F(h*) − 1 for h ∈ (0, ∞), −1 otherwise (NaN h counts as −1).
@@ -146,7 +153,7 @@ def efficiency_reward(h: npt.ArrayLike, *, mu: float = HEADWAY_MU,
     >>> efficiency_reward([1.2612, 0.0]).round(4).tolist()
     [0.0, -1.0]
     """
-    peak = float(headway_density(math.exp(mu - sigma**2), mu=mu, sigma=sigma))
+    peak = _density_peak(mu, sigma)
     x = np.asarray(h, dtype=np.float64)
     ok = np.isfinite(x) & (x > 0)
     return np.asarray(np.where(ok, headway_density(x, mu=mu, sigma=sigma) / peak - 1.0, -1.0))
@@ -161,6 +168,8 @@ def reward(
     *,
     weights: tuple[float, float, float] = (1 / 3, 1 / 3, 1 / 3),
     ttc_star: float = TTC_STAR,
+    ttc: npt.ArrayLike | None = None,
+    headway: npt.ArrayLike | None = None,
 ) -> tuple[Array, Array, Array, Array]:
     """The composite IDL reward r = ω₁ r_f + ω₂ r_j + ω₃ r_e (eq 18) and its three terms.
 
@@ -174,6 +183,9 @@ def reward(
         ω₁, ω₂, ω₃ (Table 2: 1/3 each).
     ttc_star : float
         TTC*, s.
+    ttc, headway : array_like, optional
+        The TTC (eq 19) and the time headway (eq 22) of these gaps and speeds when the caller
+        has them already (computed here from ``gap`` and the speeds when omitted).
 
     Returns
     -------
@@ -185,9 +197,12 @@ def reward(
     >>> float(rf), float(rj), round(float(re), 3)
     (0.0, -0.0, -0.012)
     """
-    ttc = time_to_collision(gap, speed, pred_speed)
+    if ttc is None:
+        ttc = time_to_collision(gap, speed, pred_speed)
+    if headway is None:
+        headway = time_headway(gap, speed)
     r_f = safety_reward(ttc, ttc_star=ttc_star, gap=gap)
     r_j = comfort_reward(accel, prev_accel)
-    r_e = efficiency_reward(time_headway(gap, speed))
+    r_e = efficiency_reward(headway)
     w1, w2, w3 = weights
     return w1 * r_f + w2 * r_j + w3 * r_e, r_f, r_j, r_e

@@ -40,6 +40,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify import margin as _margin
+from ..certify import margin_reaction as _margin_reaction
 from ..certify.criteria import hurwitz_conditions
 from ..certify.grid import certified
 from ..errors import StringStabError
@@ -164,9 +165,15 @@ class LoopConstraints:
         self.heterogeneous = bool(heterogeneous)
         self.box = Box.of(params)
         lo, hi = self.box.reaction_delay
-        if hi:  # issue 25 part 2: not here yet, and never silently dropped
-            raise StringStabError("the tuning certifies reaction_delay = 0 only so far; got "
-                                  f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else ""))
+        if hi and (not isinstance(params, Params) or sample_time is not None):
+            # θ_r > 0 beyond the continuous point loop: the certificate's own refusal line
+            from ..certify.api import Loop
+
+            Loop(params, sample_time)
+            raise StringStabError(  # pragma: no cover - Loop refuses first
+                f"reaction_delay={lo:g}:{hi:g} is not tuned for this loop")
+        #: The reaction delay θ_r (s) of the continuous point loop (issue 25); 0 otherwise.
+        self.reaction_delay = float(lo)
 
     @property
     def sampled(self) -> bool:
@@ -248,6 +255,9 @@ class LoopConstraints:
             g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (≥ 0 iff |Γ(jω)| ≤ 1), or the normalised sampled
             margin g_H(θ), at each frequency.
         """
+        if self.reaction_delay:  # θ_r > 0: g_θ of its one home (issue 25)
+            return _margin_reaction.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
+                                      headway=member.headway, reaction_delay=self.reaction_delay)
         if not self.sampled:
             return _margin.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                              headway=member.headway)
@@ -272,7 +282,10 @@ class LoopConstraints:
         Slot
             Kind ``"margin"``, with the form (c, b, A) of g (:func:`quadratic_form`).
         """
-        if not self.sampled:
+        if self.reaction_delay:  # g_θ(ω; K) is quadratic in K too (margin_reaction's basis)
+            form = quadratic_form(lambda x, v, a: self.margin(member, np.asarray(freq),
+                                                              np.array([x, v, a])))
+        elif not self.sampled:
             form = quadratic_form(lambda x, v, a: _margin.g(
                 freq, x, v, a, tau=member.tau, delta=member.delta, headway=member.headway))
         else:
@@ -287,6 +300,10 @@ class LoopConstraints:
         """Internal stability at ``member``, as constraints that are quadratic forms in K.
 
         The Hurwitz conditions (continuous) or the normalised Schur conditions (sampled).
+        With a reaction delay θ_r > 0 the one condition is k_x ≥ margin: the characteristic
+        function D(s) = τs³ + s² + e^{−θ_r s}((k_v + T*k_x)s + k_x) is real on the real axis,
+        D(0) = k_x and D(σ) → +∞, so k_x ≤ 0 puts a root on [0, ∞) (necessary, not
+        sufficient: internal stability is the certificate's, which decides every output).
 
         Parameters
         ----------
@@ -298,8 +315,11 @@ class LoopConstraints:
         list of Slot
             Kind ``"stability"``: two Hurwitz conditions
             (:func:`stringstab.certify.criteria.hurwitz_conditions`) or five Schur conditions
-            (:func:`stringstab.certify.schur.schur_margins`), ``index`` 0, 1, ….
+            (:func:`stringstab.certify.schur.schur_margins`), ``index`` 0, 1, …; with θ_r > 0,
+            k_x alone (index 0).
         """
+        if self.reaction_delay:
+            return [Slot("stability", member, math.nan, 0, quadratic_form(lambda x, v, a: x))]
         def conditions(x: Array, v: Array, a: Array) -> Array:
             if not self.sampled:
                 return np.asarray(hurwitz_conditions(x, v, a, tau=member.tau,
@@ -348,7 +368,8 @@ class LoopConstraints:
         threshold : float
             Only minima with a margin below it are returned.
         n : int
-            Grid points of the sampled scan on [0, π] (the continuous scan is
+            Grid points of the scan on [0, π] (sampled) or on [0, Ω] (θ_r > 0, Ω the proven
+            tail bound of g_θ; the continuous scan without θ_r is
             :func:`stringstab.certify.margin.local_minima`'s).
 
         Returns
@@ -356,10 +377,16 @@ class LoopConstraints:
         list of float
             The minimisers: ω (rad/s) or θ (rad/sample), at most 12.
         """
-        if not self.sampled:
+        top = math.pi
+        if self.reaction_delay:  # θ_r > 0: the scan below on [0, Ω], g_θ > 0 beyond Ω (proven)
+            Q = _margin_reaction.coefficient_table(
+                np.array([K[0]]), np.array([K[1]]), np.array([K[2]]), member.tau, member.delta,
+                member.headway, self.reaction_delay)
+            top = float(_margin_reaction.tail_bound(Q)[0])
+        elif not self.sampled:
             return _margin.local_minima(K, tau=member.tau, delta=member.delta,
                                         headway=member.headway, threshold=threshold)[1]
-        grid = np.linspace(0.0, math.pi, n)
+        grid = np.linspace(0.0, top, n)
         g = self.margin(member, grid, K)
         left = np.concatenate([[np.inf], g[:-1]])
         right = np.concatenate([g[1:], [np.inf]])
@@ -371,7 +398,7 @@ class LoopConstraints:
                 z = np.linspace(lo, hi, 9)
                 j = int(np.argmin(self.margin(member, z, K)))
                 h = (hi - lo) / 8.0
-                lo, hi = max(z[j] - h, 0.0), min(z[j] + h, math.pi)
+                lo, hi = max(z[j] - h, 0.0), min(z[j] + h, top)
             out.append(float(0.5 * (lo + hi)))
         return out
 
@@ -402,7 +429,8 @@ class LoopConstraints:
 
         b = self.box
         c = check(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
-                  sample_time=self.sample_time, heterogeneous=self.heterogeneous)
+                  sample_time=self.sample_time, heterogeneous=self.heterogeneous,
+                  reaction_delay=self.reaction_delay)
         verdict, stable = str(c.verdict[0]), bool(c.hurwitz[0])
         freq = c.witness_theta if c.witness_theta is not None else c.witness_omega
         f = float(np.asarray(freq)[0])
@@ -436,7 +464,8 @@ class LoopConstraints:
 
         b = self.box
         return certify(K[0], K[1], K[2], tau=b.tau, delta=b.delta, headway=b.headway,
-                       sample_time=self.sample_time, heterogeneous=self.heterogeneous)
+                       sample_time=self.sample_time, heterogeneous=self.heterogeneous,
+                       reaction_delay=self.reaction_delay)
 
     def certified_points(self, K: Array) -> npt.NDArray[np.bool_]:
         """Which rows of K (n, 3) this loop's certificate certifies.

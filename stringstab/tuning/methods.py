@@ -28,6 +28,7 @@ def tune(
     delta: Any,
     headway: Any,
     sample_time: float | None = None,
+    reaction_delay: Any = 0.0,
     **options: Any,
 ) -> TuneResult:
     """Repair K0 with ``method`` (``"region-growing"`` or ``"projection"``).
@@ -52,6 +53,8 @@ def tune(
     sample_time : float, optional
         Sampling period H of the sampled-data loop, in s (projection only); None for the
         continuous loop.
+    reaction_delay : float
+        Reaction delay θ_r ≥ 0 on the whole command, in s (projection only; issue 25).
     **options
         Passed on to the method (for instance ``weights``, ``bounds``; ``r0``, ``grid`` for
         region growing; ``eps``, ``hurwitz_margin`` for the projection).
@@ -76,9 +79,13 @@ def tune(
             raise StringStabError(
                 "region growing tests candidates with the Taylor Proposition 1 of the continuous "
                 "loop at one τ, δ, T*; for a sample time or an interval use the projection")
+        if Box.of(parameter_model(tau, delta, headway, reaction_delay)).reaction_delay[1]:
+            raise StringStabError(
+                "region growing tests candidates with the Taylor Proposition 1 of the loop "
+                f"without reaction delay; for reaction_delay={reaction_delay!r} use the projection")
         return region_growing(K0, tau=tau, delta=delta, headway=headway, **options)
     if method == "projection":
         return project(K0, tau=tau, delta=delta, headway=headway, sample_time=sample_time,
-                       **options)
+                       reaction_delay=reaction_delay, **options)
     raise StringStabError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
 

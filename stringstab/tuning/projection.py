@@ -55,7 +55,8 @@ def _default_projector(params: Params | Box, weights: tuple[float, ...],
     return Projector(tau=params.tau, delta=params.delta, headway=params.headway,
                      sample_time=sample_time, heterogeneous=heterogeneous, weights=weights,
                      bounds=bounds, hurwitz_margin=hurwitz_margin, eps=eps,
-                     max_exchange=max_exchange, cache_size=0, predictor=predictor)
+                     max_exchange=max_exchange, cache_size=0, predictor=predictor,
+                     reaction_delay=params.reaction_delay)
 
 
 def project(
@@ -73,6 +74,7 @@ def project(
     warm_start: Sequence[float] | None = None,
     max_exchange: int = 25,
     predictor: bool = True,
+    reaction_delay: Any = 0.0,
 ) -> TuneResult:
     r"""The certified gains nearest to K0: min ‖K − K0‖_W subject to string stability.
 
@@ -157,6 +159,11 @@ def project(
         Maximum number of solves.
     predictor : bool
         Try the Newton predictor before IPOPT (default); False: IPOPT only.
+    reaction_delay : float
+        θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25; continuous loop at
+        one τ, δ, T* only so far): the margin is g_θ (:mod:`stringstab.certify.margin_reaction`),
+        taken as quadratic forms in K as for the sampled loop, with k_x ≥ ``hurwitz_margin``;
+        the certificate with θ_r (:mod:`stringstab.certify.reaction`) decides every output.
 
     Returns
     -------
@@ -184,7 +191,7 @@ def project(
     ('repaired', True)
     """
     proj = _default_projector(
-        parameter_model(tau, delta, headway), tuple(float(v) for v in as_weights(weights)),
+        parameter_model(tau, delta, headway, reaction_delay), tuple(float(v) for v in as_weights(weights)),
         as_bounds(bounds), positive("hurwitz_margin", hurwitz_margin, allow_zero=True),
         positive("eps", eps), max_exchange, bool(predictor),
         None if sample_time is None else _sample_time(sample_time), bool(heterogeneous),

@@ -85,7 +85,8 @@ def _loop_map(box: Box, sample_time: float | None, heterogeneous: bool, lo: floa
     Only points whose stability conditions (at the box's corners) are ≥ ``margin`` are kept;
     they serve as starting points and fallbacks.
     """
-    loop = LoopConstraints(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0]),
+    loop = LoopConstraints(box if not box.is_point else Params(box.tau[0], box.delta[0], box.headway[0],
+                                                               box.reaction_delay[0]),
                 sample_time, heterogeneous)
     g = np.linspace(lo, hi, n)
     K = np.stack([a.ravel() for a in np.meshgrid(g, g, g, indexing="ij")], axis=1)
@@ -144,6 +145,12 @@ class Projector:
         Decimals of the cache key.
     predictor : bool
         Try the Newton predictor before IPOPT (see :func:`project`).
+    reaction_delay : float
+        θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25): with θ_r > 0 the
+        gains are certified by :mod:`stringstab.certify.reaction` (continuous point loop only
+        so far; otherwise that certificate's refusal is raised).  The exchange then runs on
+        the quadratic forms of g_θ(ω_j; K) (:mod:`stringstab.tuning.constraints`) under
+        k_x ≥ ``hurwitz_margin``, without the predictor.
     warm_from_previous : bool
         Start IPOPT from the previous output when it is nearer to K0 than the
         nearest map point.  Off by default: on a 2,000-step random walk it made
@@ -169,11 +176,13 @@ class Projector:
         cache_decimals: int = 6,
         predictor: bool = True,
         warm_from_previous: bool = False,
+        reaction_delay: Any = 0.0,
     ) -> None:
-        self.params: Params | Box = parameter_model(tau, delta, headway)
+        self.params: Params | Box = parameter_model(tau, delta, headway, reaction_delay)
         self.sample_time = None if sample_time is None else _sample_time(sample_time)
-        #: The sampled or robust loop (None: the continuous loop at one τ, δ, T*).
+        #: The sampled, robust or reaction-delay loop (None: the continuous loop at one τ, δ, T*).
         self.loop = (None if self.sample_time is None and isinstance(self.params, Params)
+                     and not self.params.reaction_delay
                      else LoopConstraints(self.params, self.sample_time, heterogeneous))
         self.weights = as_weights(weights)
         self.bounds = as_bounds(bounds)
@@ -466,6 +475,8 @@ class Projector:
     def _loop_name(self) -> str:
         H = self.sample_time
         what = "continuous" if H is None else f"sampled (Δt = {H:g} s)"
+        if self.loop is not None and self.loop.reaction_delay:
+            what += f" (θ_r = {self.loop.reaction_delay:g} s)"
         return f"{what}, robust over the box," if isinstance(self.params, Box) else what
 
     def _remember(self, key: tuple[float, ...], k: Array, use_state: bool) -> None:
