@@ -7,9 +7,12 @@ platoon of 5 followers), measured in the same run:
   :func:`stringstab.traffic.simulate` with the measured predecessor as leader (a
   :class:`~stringstab.traffic.Trajectory` built from its speed), the follower at its fitted law;
 * **one simulation** by the identifier's linear-filter recursion
-  (:func:`stringstab.identify.simulate_follower`) on the same data;
+  (:func:`stringstab.identify.simulate_follower`) on the same data, and the same with a reaction
+  delay θ_r = 0.55 s on the whole law (a filter of order q + 4 = 9);
 * **point fit** — :func:`stringstab.identify.fit_follower` with ``--starts`` starting points;
-* **bootstrap refit** — one moving-block bootstrap refit (from the point estimate);
+* **bootstrap refit** — one moving-block bootstrap refit (from the point estimate and from a
+  random start, the lower optimum kept, as :func:`stringstab.identify.identify` does);
+* **point fit with θ_r** — the same with the reaction delay fitted (``--fit-delay``);
 * **identify** — the whole :func:`stringstab.identify.identify` with ``--bootstrap`` refits
   (fits, certificates, T* profile, empirical transfer; no figures).
 
@@ -37,7 +40,8 @@ from stringstab.identify import (
     simulate_follower,
 )
 from stringstab.identify.closed_loop import FollowerModel
-from stringstab.identify.core import block_counts
+from stringstab.identify.estimate import block_counts
+from stringstab.identify.fit import start_points
 from stringstab.identify.logs import example_log
 from stringstab.traffic import LinearController, from_speed, simulate
 
@@ -78,7 +82,7 @@ def main() -> None:
     load0 = os.getloadavg()
     log, what = _log(args.log)
     print(f"log: {what}; followers {log.followers()}; load before {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}")
-    tot = {"baseline": 0.0, "filter": 0.0, "fit": 0.0, "boot": 0.0}
+    tot = {"baseline": 0.0, "filter": 0.0, "filter_delay": 0.0, "fit": 0.0, "fit_delay": 0.0, "boot": 0.0}
     hours = 0.0
     for p in log.followers():
         segs = tuple(clean_segments(log, p))
@@ -90,10 +94,12 @@ def main() -> None:
         hours += h
         fit = fit_follower(data, "acc", n_starts=args.starts)
         tot["fit"] += _best(1, fit_follower, data, "acc", n_starts=args.starts)
+        tot["fit_delay"] += _best(1, fit_follower, data, "acc", n_starts=args.starts, fit_delay=True)
         q = fit.params
         m = FollowerModel(q["k_x"], q["k_v"], 0.0, q["tau"], 0.0, q["headway"], q["standstill"])
+        md = FollowerModel(q["k_x"], q["k_v"], 0.0, q["tau"], 0.0, q["headway"], q["standstill"], 0.55)
         ctrl = LinearController(q["k_x"], q["k_v"], 0.0, headway=q["headway"], standstill=q["standstill"])
-        base = filt = 0.0
+        base = filt = filt_d = 0.0
         for s in segs:
             n = len(s)
             tr = from_speed(np.arange(n) * log.dt, np.maximum(vp[s.start:s.stop], 0.0), dt=log.dt)
@@ -101,11 +107,15 @@ def main() -> None:
                           initial_gap=float(g[s.start]), initial_speed=float(v[s.start]), progress=False)
             filt += _best(args.repeat, simulate_follower, m, vp[s.start:s.stop], log.dt,
                           s0=float(g[s.start]), v0=float(v[s.start]))
+            filt_d += _best(args.repeat, simulate_follower, md, vp[s.start:s.stop], log.dt,
+                            s0=float(g[s.start]), v0=float(v[s.start]))
         tot["baseline"] += base
         tot["filter"] += filt
+        tot["filter_delay"] += filt_d
         rng = np.random.default_rng(0)
         counts = block_counts(list(segs), v.size, 200, rng)
-        tot["boot"] += _best(1, fit_follower, data, "acc", x0=fit.theta, counts=counts,
+        x_rand = start_points(data, "acc", 2, seed=1)[1]
+        tot["boot"] += _best(1, fit_follower, data, "acc", x0=[fit.theta, x_rand], counts=counts,
                              identifiability=False)
     t0 = time.perf_counter()
     identify(log, bootstrap=args.bootstrap, n_starts=args.starts, progress=False)
@@ -116,8 +126,10 @@ def main() -> None:
     rows = [
         ("baseline: one closed-loop simulation (traffic.simulate)", b),
         ("one simulation (identify's linear-filter recursion)", tot["filter"]),
+        ("one simulation with θ_r = 0.55 s (order-9 filter)", tot["filter_delay"]),
         (f"point fit ({args.starts} starts)", tot["fit"]),
-        ("one bootstrap refit", tot["boot"]),
+        (f"point fit with θ_r ({args.starts} starts)", tot["fit_delay"]),
+        ("one bootstrap refit (two starts)", tot["boot"]),
         (f"identify, {args.bootstrap} bootstrap refits, certificates, profile", t_all),
     ]
     print(f"{'what':<66} {'s per vehicle-hour':>19} {'x baseline':>11}")

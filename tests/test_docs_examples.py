@@ -91,6 +91,14 @@ NOT_RUN: dict[str, str] = {
     "sweep analysis/sweeps/certificate": "minutes of certificates on a local cluster; "
         "tests/test_sweep_run.py runs tiny sweeps on one",
     "demo ": "the whole pipeline, a few minutes; tests/test_demo*.py run its steps",
+    "platoon simulate ": "designs a CAV and replays ~550 s of the recorded leader twice and a "
+        "probe (~30 s of CPU, minutes under load); tests/test_platoon_cli.py runs the design and "
+        "the probe on small strings",
+    "platoon design --from runs/acc/identify.json --cav-at auto": "designs every position and "
+        "pair of the string (minutes); tests/test_platoon_cli.py runs single designs",
+    "platoon design --from runs/acc/identify.json --cav-at 1": "a full design search (bisection "
+        "of NLPs, ~20 s of CPU, a minute under load); the quick `--cav-at 5` example runs, and "
+        "tests/test_platoon_cli.py runs certified designs on small strings",
 }
 
 
@@ -123,6 +131,12 @@ SHRINK: list[tuple[str, Callable[[list[str]], list[str]], str]] = [
     ("sumo run --sumocfg", lambda a: _set(a, "--steps", "300"), "the first 300 steps (30 s)"),
     ("hcfs verify ", lambda a: _set(_set(a, "--duration", "20"), "--no-figures", None),
      "20 s of each leader, no figures (tests/test_hcfs_closed_loop.py writes them)"),
+    ("radio ", lambda a: _set(_set(_set(_set(_set(_set(a, "--seeds", "2"), "--loss", "0,0.1"),
+                                             "--burst", "1"), "--duration", "5"), "--hold", "0"),
+                              "--followers", "3"),
+     "2 seeds, loss 0 and 0.1 (independent), 5 s of the leader, 3 followers: the same command "
+     "on a grid of 2 points instead of 14 x 20 runs of 10 followers (minutes; "
+     "tests/test_radio_study.py runs the study and checks its numbers)"),
     ("simulate ", lambda a: _set(_set(a, "--no-figures", None), "--duration", "200"),
      "the first 200 s of the leader, no figures (tests/test_cli_simulate.py and "
      "tests/test_figures.py draw them)"),

@@ -265,7 +265,7 @@ def test_identify_figures(tmp_path, captured, capsys):
 
     out = tmp_path / "run"
     assert main(["identify", str(_platoon_csv(tmp_path / "log.csv")), "--bootstrap", "2",
-                 "--starts", "1", "--no-progress", "--out", str(out)]) == 0
+                 "--starts", "1", "--no-fit-delay", "--no-progress", "--out", str(out)]) == 0
     _check(captured, ["fit_1", "fit_2", "transfer_1", "transfer_2", "sup_gain"])
     figs = {n.rsplit("/", 1)[-1]: f for n, f, *_ in captured}
     rows = {r["position"]: r for r in json.loads((out / "identify.json").read_text())["vehicles"]}

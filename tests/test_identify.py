@@ -164,11 +164,33 @@ def test_statement_wording() -> None:
 def test_identify_refuses_a_log_without_usable_segment() -> None:
     log = _log(noise=False)
     speed = log.speed.copy()
-    speed[1, ::100] = np.nan  # a dropout every 10 s: no clean segment of 30 s
+    speed[1, ::100] = np.nan  # a two-sample dropout every 10 s: no clean segment of 30 s
+    speed[1, 1::100] = np.nan
     speed[2, ::100] = np.nan
+    speed[2, 1::100] = np.nan
     bad = PlatoonLog(log.t, log.positions, log.names, speed, log.gap, None, "<x>", "csv", {})
     with pytest.raises(ss.StringStabError, match="no follower has a usable segment"):
         identify(bad, bootstrap=0, progress=False)
+
+
+def test_single_missing_samples_are_bridged() -> None:
+    """One missing sample every 10 s (in the speeds and the gap) is bridged, stated, and the
+    fit is the clean log's: the car is identified, not dropped (issue 28, robustness)."""
+    log = _log(noise=False)
+    speed, gap2 = log.speed.copy(), log.gap[2].copy()
+    speed[1, 50::100] = np.nan
+    gap2[70::100] = np.nan
+    holed = PlatoonLog(log.t, log.positions, log.names, speed, {1: log.gap[1], 2: gap2}, None, "<x>",
+                       "csv", {})
+    res = identify(holed, bootstrap=0, n_starts=1, progress=False)
+    assert [v.position for v in res.vehicles] == [1, 2]
+    unstable = res.vehicles[1]
+    assert [(x.start, x.stop) for x in unstable.segments] == [(0, log.t.size)]
+    assert any("single missing samples bridged" in n for n in unstable.notes)
+    ref = fit_follower(FollowerData(*log.pair(2)[:3], None, tuple(clean_segments(log, 2)), log.dt), "acc",
+                       n_starts=1)
+    for k in ("k_x", "k_v", "tau", "headway"):
+        assert unstable.fit.params[k] == pytest.approx(ref.params[k], rel=0.02)
 
 
 def test_cacc_recovers_k_a_and_delta() -> None:

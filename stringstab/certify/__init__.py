@@ -32,7 +32,11 @@ bound (:mod:`~stringstab.certify.margin`), the Taylor and Hurwitz criteria
 sup |Γ| − 1 (:mod:`~stringstab.certify.excess`), the "surely not certifiable" screens
 (:mod:`~stringstab.certify.screen`), the certified points of a grid of gains
 (:mod:`~stringstab.certify.grid`) and the certificates over cells of gains
-(:mod:`~stringstab.certify.gain_cells`, the repair's proven cells).
+(:mod:`~stringstab.certify.gain_cells`, the repair's proven cells).  Strings of different
+vehicles are certified head to tail (:func:`~stringstab.certify.api.certify_string`:
+:mod:`~stringstab.certify.head_to_tail`, :mod:`~stringstab.certify.head_to_tail_sampled`,
+:mod:`~stringstab.certify.string_decision`, :mod:`~stringstab.certify.string_certificate`, on the
+interval jets of :mod:`~stringstab.certify.interval_jets`).
 
 The function :func:`certify` and this subpackage share a name: ``stringstab.certify`` is the
 function (the façade binds it); import the modules with ``from stringstab.certify import

@@ -9,7 +9,10 @@ the sample time H or None) and decides which certificate answers, :attr:`Loop.ki
 * ``"continuous"`` — point parameters, no sample time
   (:mod:`stringstab.certify.continuous`);
 * ``"sampled"`` — point parameters and a sample time (:mod:`stringstab.certify.sampled`);
-* ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`).
+* ``"robust"`` — any interval, with or without a sample time (:mod:`stringstab.certify.robust`);
+* ``"multirate"`` — point parameters, a sample time H and a V2V message period N·H with
+  N ≥ 2 (:mod:`stringstab.certify.multirate`); N = 1 is the sampled loop, answered by the
+  sampled certificate (the same loop: messages every control step).
 
 The gains are broadcast, checked finite and within range, and flattened once
 (:func:`gains`).  The kernels of the three certificates (``certify_kernel`` and
@@ -37,14 +40,18 @@ from .continuous import Certificate, CertificateBatch
 from .verdicts import Check, one_triple
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from .multirate import MultirateCertificate, MultirateCertificateBatch
     from .robust import RobustCertificate, RobustCertificateBatch
     from .sampled import SampledCertificate, SampledCertificateBatch
+    from .string_certificate import StringCertificate
 
-__all__ = ["Loop", "LoopKind", "certify", "certify_batch", "check", "gains"]
+__all__ = ["Loop", "LoopKind", "certify", "certify_batch", "certify_string", "check", "gains"]
 
 Array = npt.NDArray[np.float64]
 #: Which certificate answers: the continuous-time loop, the sampled-data loop, or a box.
-LoopKind = Literal["continuous", "sampled", "robust"]
+LoopKind = Literal["continuous", "sampled", "robust", "multirate"]
 #: The methods of :func:`certify_batch`: the exact certificate, or it plus the Padé cross-check.
 METHODS = ("exact", "pade")
 
@@ -98,6 +105,9 @@ class Loop:
         Sampled box only: the predecessor's lag ranges over the τ box independently.
     method : {"exact", "pade"}
         ``"pade"`` adds python-control's cross-check (continuous point loop only).
+    message_steps, message_phase, fallback : int or None, int, (float, float) or None
+        The multi-rate loop (N ≥ 2; None or 1: the sampled loop): V2V messages every N steps
+        at phase φ, and the fallback (ACC) gains, default each triple's own (docs/sampled.md §9).
     """
 
     model: Params | Box
@@ -105,6 +115,9 @@ class Loop:
     tau_prev: float | None = None
     heterogeneous: bool = True
     method: str = "exact"
+    message_steps: int | None = None
+    message_phase: int = 0
+    fallback: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         box, H = isinstance(self.model, Box), self.sample_time
@@ -129,16 +142,22 @@ class Loop:
         if theta and H is not None:
             raise StringStabError(
                 "reaction_delay > 0 is certified in continuous time only so far; got "
-                f"reaction_delay={theta:g} with sample_time={H!r}")
+                f"reaction_delay={theta:g} with sample_time={H!r}"
+                + (f" and a message every {self.message_steps} steps" if self.message_steps else ""))
         if theta and self.method == "pade":
             raise StringStabError(
                 "method='pade' (python-control's cross-check) has no reaction delay; expected "
                 f"reaction_delay=0 with it; got reaction_delay={theta:g}")
+        if self.message_steps is not None or self.fallback is not None:  # issue 26
+            from .message import check_message_loop
+
+            check_message_loop(self.message_steps, H, box, self.tau_prev, self.fallback)
 
     @classmethod
     def of(cls, tau: Any, delta: Any, headway: Any, sample_time: Any = None,
            tau_prev: Any = None, heterogeneous: bool = True, method: str = "exact",
-           reaction_delay: Any = 0.0) -> Loop:
+           reaction_delay: Any = 0.0, message_period: Any = None, message_phase: Any = None,
+           fallback_gains: Any = None) -> Loop:
         """The loop a caller asks for, every value checked (the one place they are).
 
         Parameters
@@ -157,6 +176,8 @@ class Loop:
         reaction_delay : float
             θ_r ≥ 0 (s), the delay on the whole command (issue 25); > 0 is certified in
             continuous time only so far (a sampled or box loop refuses it).
+        message_period, message_phase, fallback_gains : optional
+            The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 
         Returns
         -------
@@ -174,10 +195,17 @@ class Loop:
         'sampled'
         >>> Loop.of("0.1:0.3", 0.2, 1.1).kind
         'robust'
+        >>> Loop.of(0.1, 0.2, 1.1, sample_time=0.01, message_period=0.1).kind
+        'multirate'
         """
         model = parameter_model(tau, delta, headway, reaction_delay)
         H = None if sample_time is None else checked_sample_time(sample_time)
-        loop = cls(model, H, tau_prev, heterogeneous, method)
+        N, phase, fb = None, 0, None
+        if message_period is not None or message_phase is not None or fallback_gains is not None:
+            from .message import message_schedule
+
+            N, phase, fb = message_schedule(H, message_period, message_phase, fallback_gains)
+        loop = cls(model, H, tau_prev, heterogeneous, method, N, phase, fb)
         if tau_prev is None:
             return loop
         tp = positive("tau_prev (predecessor's actuator lag)", tau_prev, unit=" s")
@@ -192,16 +220,19 @@ class Loop:
 
     @property
     def kind(self) -> LoopKind:
-        """Which certificate answers: ``"continuous"``, ``"sampled"`` or ``"robust"``."""
+        """Which certificate answers: ``"continuous"``, ``"sampled"``, ``"robust"`` or ``"multirate"``."""
         if isinstance(self.model, Box):
             return "robust"
+        if self.message_steps is not None and self.message_steps >= 2:
+            return "multirate"
         return "continuous" if self.sample_time is None else "sampled"
 
     def certify_batch(
         self, k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *, pade_order: int = 5,
         progress: bool = False, chunk: int = 4096, n_grid: int | None = None,
         max_rounds: int = 30, max_intervals: int = 1024,
-    ) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    ) -> (CertificateBatch | SampledCertificateBatch | RobustCertificateBatch
+          | MultirateCertificateBatch):
         """Certify many gain triples on this loop (:func:`certify_batch` with a checked loop).
 
         Parameters
@@ -213,7 +244,7 @@ class Loop:
 
         Returns
         -------
-        CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
+        CertificateBatch, SampledCertificateBatch, RobustCertificateBatch or MultirateCertificateBatch
             By :attr:`kind`.
         """
         return _certify(self, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
@@ -248,6 +279,11 @@ class Loop:
 def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
            max_rounds: int, max_intervals: int) -> Check:
     model, H = loop.model, loop.sample_time
+    if loop.kind == "multirate":
+        from . import multirate
+
+        return multirate.check_kernel(kx, kv, ka, model, H, loop.message_steps,  # type: ignore[arg-type]
+                                      n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
     if isinstance(model, Box):
         from . import robust
 
@@ -271,8 +307,15 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
 def _certify(
     loop: Loop, kx: Array, kv: Array, ka: Array, *, pade_order: int, progress: bool, chunk: int,
     n_grid: int | None, max_rounds: int, max_intervals: int,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch | MultirateCertificateBatch:
     model, H = loop.model, loop.sample_time
+    if loop.kind == "multirate":
+        from . import multirate
+
+        return multirate.certify_kernel(
+            kx, kv, ka, model, H, loop.message_steps, phase=loop.message_phase,  # type: ignore[arg-type]
+            fallback=loop.fallback, progress=progress, n_grid=n_grid, max_rounds=max_rounds,
+            max_intervals=max_intervals)
     if isinstance(model, Box):
         from . import robust
 
@@ -311,6 +354,7 @@ def check(
     tau_prev: float | None = None, heterogeneous: bool = True,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     reaction_delay: Any = 0.0,
+    message_period: float | None = None, message_phase: int | None = None,
 ) -> Check:
     """The certificate's verdicts alone, for inner loops (e.g. gain repair).
 
@@ -342,6 +386,8 @@ def check(
         far (with a sample time or a box: refused).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
+    message_period, message_phase
+        As for :func:`certify_batch`.
 
     Returns
     -------
@@ -360,7 +406,8 @@ def check(
     (['certified', 'not_certified'], 0.1)
     """
     loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous,
-                   reaction_delay=reaction_delay)
+                   reaction_delay=reaction_delay, message_period=message_period,
+                   message_phase=message_phase)
     return _check(loop, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                   max_intervals=max_intervals)
 
@@ -382,7 +429,10 @@ def certify_batch(
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch: ...
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> (CertificateBatch | SampledCertificateBatch | RobustCertificateBatch
+      | MultirateCertificateBatch): ...
 
 
 def certify_batch(
@@ -391,7 +441,9 @@ def certify_batch(
     method: str = "exact", pade_order: int = 5, progress: bool = False, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
-) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch:
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> CertificateBatch | SampledCertificateBatch | RobustCertificateBatch | MultirateCertificateBatch:
     """Certify many gain triples at once (exact delay, sound; see :mod:`stringstab.certify.continuous`).
 
     With point parameters and no sample time this is the continuous-time certificate of
@@ -436,12 +488,15 @@ def certify_batch(
         rounds, and the cap on undecided intervals *per triple* beyond which that triple is
         declared inconclusive (per triple, so a verdict never depends on the rest of the
         batch).
+    message_period, message_phase, fallback_gains : optional
+        With ``sample_time``: V2V messages every P = N·H s, used at step φ and held, and the
+        fallback (ACC) gains: the multi-rate certificate (:mod:`stringstab.certify.multirate`).
 
     Returns
     -------
-    CertificateBatch, SampledCertificateBatch or RobustCertificateBatch
-        The last two carry ``sample_time`` and the parameter box in their columns, rows and
-        summary.
+    CertificateBatch, SampledCertificateBatch, RobustCertificateBatch or MultirateCertificateBatch
+        The last three carry ``sample_time`` and the parameter box in their columns, rows and
+        summary (the multi-rate batch also the message schedule and the fallback columns).
 
     Raises
     ------
@@ -462,7 +517,7 @@ def certify_batch(
     (['certified', 'not_certified'], [0.1, 0.3])
     """
     loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
-                   reaction_delay)
+                   reaction_delay, message_period, message_phase, fallback_gains)
     return _certify(loop, *gains(k_x, k_v, k_a), pade_order=pade_order, progress=progress,
                     chunk=chunk, n_grid=n_grid, max_rounds=max_rounds,
                     max_intervals=max_intervals)
@@ -481,14 +536,18 @@ def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
     tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
-) -> Certificate | SampledCertificate | RobustCertificate: ...
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> Certificate | SampledCertificate | RobustCertificate | MultirateCertificate: ...
 
 
 def certify(
     k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
     sample_time: float | None = None, method: str = "exact", pade_order: int = 5,
     tau_prev: float | None = None, heterogeneous: bool = True, reaction_delay: Any = 0.0,
-) -> Certificate | SampledCertificate | RobustCertificate:
+    message_period: float | None = None, message_phase: int | None = None,
+    fallback_gains: tuple[float, float] | None = None,
+) -> Certificate | SampledCertificate | RobustCertificate | MultirateCertificate:
     """Certify one gain triple K = [k_x, k_v, k_a] (exact delay, sound).
 
     Parameters
@@ -513,13 +572,13 @@ def certify(
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
         far (with a sample time or a box: refused).
-    method, pade_order
+    method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 
     Returns
     -------
-    Certificate, SampledCertificate or RobustCertificate
-        The continuous, sampled-data or robust certificate of the triple.
+    Certificate, SampledCertificate, RobustCertificate or MultirateCertificate
+        The continuous, sampled-data, robust or multi-rate certificate of the triple.
 
     Examples
     --------
@@ -532,9 +591,67 @@ def certify(
     >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)
     ('not_certified', 1.0911, 1.379, 0.1379)
+    >>> m = certify(1.2, 0.5, 0.6, tau=0.1, delta=0.2, headway=1.1, sample_time=0.01,
+    ...             message_period=0.1)
+    >>> m.verdict, m.message_steps, m.fallback_verdict
+    ('certified', 10, 'certified')
     """
     one_triple("certify", "certify_batch", k_x=k_x, k_v=k_v, k_a=k_a)
     loop = Loop.of(tau, delta, headway, sample_time, tau_prev, heterogeneous, method,
-                   reaction_delay)
+                   reaction_delay, message_period, message_phase, fallback_gains)
     return _certify(loop, *gains([k_x], [k_v], [k_a]), pade_order=pade_order, progress=False,
                     chunk=4096, n_grid=None, max_rounds=30, max_intervals=1024)[0]
+
+
+def certify_string(
+    vehicles: Sequence[Any], *, sample_time: float | None = None, leader_tau: float | None = None,
+    substrings: bool = True, n_grid: int | None = None, max_rounds: int = 30,
+    max_intervals: int = 4096,
+) -> StringCertificate:
+    """Certify a heterogeneous string head to tail: every vehicle stable and sup ∏|Γ_i| ≤ 1.
+
+    The sound certificate of :mod:`stringstab.certify.head_to_tail` (the telescoping margin,
+    the one branch and bound, exact delays), each vehicle's own certificate, and the worst
+    sub-string (:mod:`stringstab.certify.string_certificate`).
+
+    Parameters
+    ----------
+    vehicles : sequence of Vehicle or mapping
+        The followers in order from the head (the leader is position 0, not listed), each
+        with its own k_x, k_v, k_a, tau, delta, headway (optional reaction_delay θ_r, name).
+    sample_time : float, optional
+        H > 0 (s): the sampled-data loop (every vehicle sampling with period H).
+    leader_tau : float, optional
+        Sampled loop only: the leader's lag (the first follower's predecessor), default the
+        first follower's.
+    substrings : bool
+        Also certify every run of consecutive vehicles (the worst sub-string).
+    n_grid, max_rounds, max_intervals : int
+        The branch and bound's initial intervals (default 64 + 8N), rounds and cap on
+        undecided intervals per string.
+
+    Returns
+    -------
+    StringCertificate
+
+    Raises
+    ------
+    StringStabError
+        On fewer than 2 vehicles, a missing, non-finite or out-of-range parameter (the message
+        names the vehicle), or a bad sample time.
+
+    Examples
+    --------
+    >>> acc = {"k_x": 0.1, "k_v": 0.3, "k_a": 0.0, "tau": 0.5, "delta": 0.0, "headway": 1.5}
+    >>> cav = {"k_x": 0.5, "k_v": 1.0, "k_a": 0.6, "tau": 0.2, "delta": 0.2, "headway": 2.0}
+    >>> c = certify_string([acc, cav])
+    >>> c.verdict, c.certificates[0].verdict, round(c.certificates[0].sup_gain, 4)
+    ('certified', 'not_certified', 1.1243)
+    >>> c.worst_substring.first, c.worst_substring.last, c.worst_substring.verdict
+    (1, 1, 'not_certified')
+    """
+    from .string_certificate import certify_string_kernel, check_vehicles
+
+    vs, H, lt = check_vehicles(vehicles, sample_time=sample_time, leader_tau=leader_tau)
+    return certify_string_kernel(vs, sample_time=H, leader_tau=lt, substrings=substrings,
+                                 n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)

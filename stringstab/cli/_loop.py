@@ -23,7 +23,8 @@ RADIO_FLAGS = ("message_period", "message_phase", "loss", "burst", "stale_after"
                "radio_seed")
 
 
-def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True) -> None:
+def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True,
+                       loss: bool = True, message_period_note: str = "") -> None:
     """``--reaction-delay`` and the radio and sensor options (values checked later).
 
     Parameters
@@ -32,6 +33,11 @@ def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True) -> 
         The command's parser.
     reaction : bool
         Also add ``--reaction-delay`` (False where the command defines it already).
+    loss : bool
+        Also add ``--loss`` and ``--burst`` (False where the command defines them, e.g. as the
+        lists ``stringstab radio`` sweeps; :func:`radio_from_args` checks each value).
+    message_period_note : str
+        Appended to ``--message-period``'s help (a command's own default, said in words).
     """
     if reaction:
         p.add_argument("--reaction-delay", metavar="SECONDS", default=None,
@@ -40,13 +46,15 @@ def add_loop_arguments(p: argparse.ArgumentParser, *, reaction: bool = True) -> 
     g = p.add_argument_group(
         "radio and sensors (default: the predecessor's acceleration every step, exact sensors)")
     g.add_argument("--message-period", metavar="SECONDS",
-                   help="V2V messages every P s (a whole multiple of the step), the last one held")
+                   help="V2V messages every P s (a whole multiple of the step), the last one held"
+                        + (f" {message_period_note}" if message_period_note else ""))
     g.add_argument("--message-phase", metavar="STEPS",
                    help="the step (0..P/dt - 1) at which messages are used (default 0)")
-    g.add_argument("--loss", metavar="RATE", help="share of messages lost at random, in [0, 1]")
-    g.add_argument("--burst", metavar="MESSAGES",
-                   help="mean number of messages lost in a row (Gilbert-Elliott; default: "
-                        "independent losses)")
+    if loss:
+        g.add_argument("--loss", metavar="RATE", help="share of messages lost at random, in [0, 1]")
+        g.add_argument("--burst", metavar="MESSAGES",
+                       help="mean number of messages lost in a row (Gilbert-Elliott; default: "
+                            "independent losses)")
     g.add_argument("--stale-after", metavar="SECONDS",
                    help="fall back to ACC (k_a = 0) when the last message is older than this, "
                         "until the next one (>= the message period)")

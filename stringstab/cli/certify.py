@@ -2,12 +2,15 @@
 
 Reads triples from the command line or a file (:func:`stringstab.io.read_gains`),
 certifies them on the :class:`~stringstab.certify.api.Loop` they ask for — the continuous-time loop,
-the sampled-data loop (``--sample-time``) or every member of a box of parameters (``--tau``,
-``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
+the sampled-data loop (``--sample-time``), the multi-rate loop whose V2V messages arrive every
+``--message-period`` (with ``--sample-time``), or every member of a box of parameters
+(``--tau``, ``--delta``, ``--headway`` as ``LO:HI``) — and writes the batch's columns
 (``columns()``; the table's, ``table_columns()``) as a table, JSON, CSV, Parquet or
-NPZ (:func:`stringstab.io.write_results`).  Exit code 0
-when every triple is certified, 1 when any is not (``not_certified`` or
-``inconclusive``), 2 on bad input (nothing printed, no file written).
+NPZ (:func:`stringstab.io.write_results`).  ``--max-message-period [CAP]`` writes instead the
+largest message period certified with every shorter one
+(:func:`stringstab.certify.message_period.largest_message_period`).  Exit code 0
+when every triple is certified (with ``--max-message-period``: up to the cap), 1 when any is
+not (``not_certified`` or ``inconclusive``), 2 on bad input (nothing printed, no file written).
 """
 
 from __future__ import annotations
@@ -29,8 +32,13 @@ from ._common import (
     loop_params,
     shown_params,
 )
+from ._message import add_message_arguments, message_from_args
 
-__all__ = ["PROGRESS_ROWS", "add_parser", "run"]
+__all__ = ["DEFAULT_CAP", "PROGRESS_ROWS", "add_parser", "run"]
+
+#: The default cap of ``--max-message-period`` (s); the library's
+#: :data:`stringstab.certify.message_period.DEFAULT_CAP` (not imported: the CLI starts light).
+DEFAULT_CAP = 0.5
 
 #: Show a progress bar when there are more rows than this (or stderr is a terminal).
 PROGRESS_ROWS = 10_000
@@ -54,6 +62,8 @@ examples:
   stringstab certify 0.9,-0.5,1.1 --method pade         # also python-control's Padé numbers
   stringstab certify 1.2,0.5,0.6 --sample-time 0.1       # the loop sampled every 0.1 s (ZOH)
   stringstab certify 1.2,0.5,0.6 --tau 0.1:0.5 --delta 0.1:0.3   # every τ, δ in the box
+  stringstab certify 1.2,0.5,0.6 --sample-time 0.01 --message-period 0.1   # 10 Hz V2V, held
+  stringstab certify 1.2,0.5,0.6 --sample-time 0.01 --max-message-period 0.5
   stringstab certify 1.2,0.5,0.6 --reaction-delay 0.2   # the command applied 0.2 s late
 
 input files: CSV with a header k_x,k_v,k_a (a gain time series adds t and
@@ -64,6 +74,10 @@ Parquet (columns k_x, k_v, k_a [, t, vehicle]).
 output: table (for people: sup|Γ| and margin rounded, ω_peak in rad/s; sampled:
 also θ_peak in rad/sample; a box: the witness member), or every column in json, csv,
 parquet or npz (the last two need --out); sample_time and the box are in every format.
+multi-rate (--message-period): sup σ(G) is the l2-induced gain of the link u_(i-1) -> u_i
+(lifted over one message period; θ_peak in rad per message period), and the fallback (ACC,
+k_a = 0) loop is certified beside it; switching between the two modes and random message
+loss are not covered by either certificate.
 
 exit status: 0 every triple certified; 1 some triple not_certified or
 inconclusive; 2 bad input (no verdicts printed, no file written).
@@ -97,6 +111,13 @@ def add_parser(sub: Any) -> None:
     )
     add_gain_arguments(p)
     add_model_arguments(p)
+    add_message_arguments(p)
+    p.add_argument("--fallback-gains", metavar="K_X,K_V",
+                   help="with --message-period: the fallback (ACC, k_a = 0) gains certified beside "
+                        "the multi-rate loop (default: each triple's own k_x, k_v)")
+    p.add_argument("--max-message-period", nargs="?", const=str(DEFAULT_CAP), metavar="CAP",
+                   help="with --sample-time: report the largest message period N*H <= CAP s "
+                        f"(default {DEFAULT_CAP:g}) such that every N'*H, N' <= N, is certified")
     p.add_argument("--reaction-delay", metavar="SECONDS",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
                         "(τ a' = u(t − θ_r) − a); continuous time only so far (default: 0)")
@@ -165,13 +186,26 @@ def run(args: argparse.Namespace) -> int:
     """
     model, H = loop_params(args)
     order = _pade_order(args.pade_order)
+    N, phase = message_from_args(args, H)
+    fallback = _fallback_gains(args, N)
     from ..certify.api import Loop
 
     # the values are checked (with the flags' names); the library decides the loop's kind and
     # refuses what no certificate answers (--method pade beyond the continuous point loop)
-    loop = Loop(model, H, method=args.method)
+    loop = Loop(model, H, method=args.method, message_steps=N, message_phase=phase,
+                fallback=fallback)
     out = check_output(args)
+    if args.max_message_period is not None:
+        if N is not None:
+            raise StringStabError("--max-message-period searches the message period; expected "
+                                  f"no --message-period with it, got --message-period {args.message_period}")
+        if H is None:
+            raise StringStabError("--max-message-period needs the control period: expected "
+                                  "--sample-time H with it, got none")
     if getattr(args, "from_identify", None):
+        if N is not None or args.max_message_period is not None:
+            raise StringStabError("--from certifies each identified vehicle on its own loop; "
+                                  "expected no --message-period or --max-message-period with it")
         return _run_identified(args, out, H, Box.of(model).reaction_delay[0])
     table = gains_from_args(args)
     check_horizon(H, table)
@@ -186,6 +220,8 @@ def run(args: argparse.Namespace) -> int:
     from ..io import write_results
 
     n = len(table)
+    if args.max_message_period is not None:
+        return _run_max_period(args, loop, table, out)
     progress = not args.no_progress and (sys.stderr.isatty() or n > PROGRESS_ROWS)
     with warnings.catch_warnings():
         # Padé disagreements are reported once, below, instead of per row.
@@ -200,6 +236,8 @@ def run(args: argparse.Namespace) -> int:
                       "method": args.method}
     else:
         params = {**shown_params(model, H), "method": args.method}
+    if loop.kind == "multirate":
+        params.update(message_period=batch.summary()["message_period"], message_phase=phase)
     if args.method == "pade":
         params["pade_order"] = order
     summary = batch.summary()
@@ -214,6 +252,50 @@ def run(args: argparse.Namespace) -> int:
             f"wrote {args.format} to {out}",
             file=sys.stderr,
         )
+    return 0 if summary["certified"] == summary["n"] else 1
+
+
+def _fallback_gains(args: argparse.Namespace, N: int | None) -> tuple[float, float] | None:
+    """``--fallback-gains K_X,K_V``, checked (multi-rate loop only)."""
+    text = getattr(args, "fallback_gains", None)
+    if text is None:
+        return None
+    if N is None or N < 2:
+        raise StringStabError("--fallback-gains is for the multi-rate loop; expected --message-period "
+                              f"of at least two sample times with it, got --fallback-gains {text}")
+    parts = str(text).split(",")
+    try:
+        fx, fv = (float(v) for v in parts)
+    except ValueError as e:
+        raise StringStabError(f"--fallback-gains must be K_X,K_V (two numbers); got {text!r}") from e
+    from ..params import as_gains
+
+    gx, gv, _ = as_gains(fx, fv, 0.0)
+    return float(gx), float(gv)
+
+
+def _run_max_period(args: argparse.Namespace, loop: Any, table: Any, out: Any) -> int:
+    """``certify --max-message-period [CAP]``: the largest certified message period per triple."""
+    from ..certify.message_period import largest_message_period
+    from ..io import write_results
+
+    try:
+        cap = float(args.max_message_period)
+    except ValueError as e:
+        raise StringStabError("--max-message-period must be a number of seconds >= --sample-time; "
+                              f"got {args.max_message_period!r}") from e
+    if not cap >= loop.sample_time or cap != cap or cap == float("inf"):
+        raise StringStabError(f"--max-message-period must be a finite number of seconds >= "
+                              f"--sample-time {loop.sample_time:g}; got {args.max_message_period}")
+    b = largest_message_period(loop, table.k_x, table.k_v, table.k_a, cap=cap)
+    params = {**shown_params(loop.model, loop.sample_time), "max_message_period_cap": b.cap}
+    summary = b.summary()
+    write_results({**table.meta_columns(), **b.columns()}, out, args.format,
+                  params=_for_table(params) if args.format == "table" else params,
+                  summary=summary, table=b.table_columns(), what="--out")
+    if out is not None:
+        print(f"stringstab certify: {summary['certified']} of {summary['n']} certified up to "
+              f"{b.cap:g} s; wrote {args.format} to {out}", file=sys.stderr)
     return 0 if summary["certified"] == summary["n"] else 1
 
 
@@ -237,12 +319,16 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
         from ..params import parameter_model
 
         tau, delta, headway = (given.get(k, r[k]) for k in ("tau", "delta", "headway"))
-        loop = Loop(parameter_model(tau, delta, headway, theta), H)
+        # each vehicle at its own fitted θ_r (identify --fit-delay) unless --reaction-delay is given
+        theta_r = theta if getattr(args, "reaction_delay", None) is not None else r["reaction_delay"]
+        loop = Loop(parameter_model(tau, delta, headway, theta_r), H)
         b = loop.certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]])
         c: dict[str, Any] = b.records()[0]
         rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
         for k in ("tau", "delta", "headway"):
             rec[k] = given.get(k, f"{r[k]:.6g}")
+        if theta_r:
+            rec["reaction_delay"] = f"{theta_r:.6g}"
         for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega"):
             if k in c:
                 rec[k] = c[k]
@@ -252,6 +338,10 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
              TableColumn("τ[s]", "tau", "%s"), TableColumn("δ[s]", "delta", "%s"),
              TableColumn("T*[s]", "headway", "%s"), TableColumn("sup|Γ|", "sup_gain"),
              TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"), TableColumn("verdict", "verdict", "%s")]
+    if any("reaction_delay" in r for r in records):  # a θ_r = 0 file writes what it always did
+        table.insert(8, TableColumn("θ_r[s]", "reaction_delay", "%s"))
+        for r in records:
+            r.setdefault("reaction_delay", "0")
     n_ok = sum(r["verdict"] == "certified" for r in records)
     write_results(columns_from_records(records), out, args.format,
                   params={"from": args.from_identify, "sample_time": H},

@@ -23,6 +23,7 @@ from ..errors import StringStabError
 from ..params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box
 from ..regions import CONTINUOUS, GAIN_NAMES
 from ._common import add_model_arguments, loop_params
+from ._message import add_message_arguments, message_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -38,6 +39,7 @@ examples:
   stringstab region --fix k_a=0.3 --range k_x=0,1.5 --range k_v=-1,1 --overlay rollout.csv
   stringstab region --fix k_a=0.5 --sample-time 0.1 --compare continuous --out maps_dt01/
   stringstab region --fix k_a=0.5 --tau 0.1:0.3 --delta 0.1:0.3 --n 101 --out maps_box/
+  stringstab region --fix k_a=0.5 --sample-time 0.01 --message-period 0.2 --compare continuous
   stringstab region --3d --n 81 --method exact --scheduler tcp://head:8786 --out maps3d/
   stringstab region --fix k_a=0.5 --reaction-delay 0.2 --out maps_r02/
   stringstab region --fix k_a=0.5 --reaction-delay 0:0.3:4 --n 101 --out maps_r/
@@ -91,6 +93,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--n", metavar="N[,N2[,N3]]",
                    help=f"grid points per axis, >= 2 (default {DEFAULT_N_2D}; {DEFAULT_N_3D} with --3d)")
     add_model_arguments(p)
+    add_message_arguments(p)
     # -- the reaction delay θ_r (issue 25 part 2): one value, or a list/range as a map axis
     p.add_argument("--reaction-delay", metavar="S|A,B,...|LO:HI:N",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
@@ -287,6 +290,7 @@ def run(args: argparse.Namespace) -> int:
     if thetas is not None:
         args.reaction_delay = None  # the axis: loop_params checks τ, δ, T* alone
     model, H = loop_params(args)
+    N, _ = message_from_args(args, H)  # the multi-rate map (issue 26): exact is its certificate
     with_theta = thetas is not None or Box.of(model).reaction_delay != (0.0, 0.0)
     methods = args.method
     if args.compare is not None:
@@ -345,7 +349,8 @@ def run(args: argparse.Namespace) -> int:
                                   headway=model.headway, sample_time=H, methods=methods,
                                   workers=n_dask or workers, executor=executor,
                                   progress=False if args.no_progress else None,
-                                  reaction_delay=model.reaction_delay)
+                                  reaction_delay=model.reaction_delay,
+                                  message_period=None if N is None else args.message_period)
     finally:
         warm.join()
     if thetas is not None:

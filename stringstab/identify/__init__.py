@@ -5,7 +5,12 @@
 * :mod:`~stringstab.identify.fit` — closed-loop simulation-error fit, multi-start, bounds,
   identifiability notes;
 * :mod:`~stringstab.identify.empirical` — the data's own transfer and amplifications;
-* :mod:`~stringstab.identify.core` — :func:`identify`: fits, certificates, block bootstrap;
+* :mod:`~stringstab.identify.record` — a follower's record: single samples bridged, the
+  stretches where it does not follow its predecessor excluded, clean segments;
+* :mod:`~stringstab.identify.spacing` — the spacing policy (T*, l_0) from the quasi-steady parts;
+* :mod:`~stringstab.identify.estimate` — one record's fit, certificate, bootstrap and profiles;
+* :mod:`~stringstab.identify.wording` — verdicts and notes no more confident than the evidence;
+* :mod:`~stringstab.identify.core` — :func:`identify`: every follower of one or more logs;
 * :mod:`~stringstab.identify.report` — the table, ``identify.json``, CSV/Parquet and figures.
 
 Readers of the logs: :func:`read_logs` (:func:`stringstab.io.platoon_logs.read_platoon_logs`
@@ -17,10 +22,11 @@ from __future__ import annotations
 
 from ..io.platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
 from .closed_loop import FollowerModel, simulate_follower
-from .core import IdentifyResult, VehicleResult, identify, statement
+from .core import IdentifyResult, VehicleResult, identify
 from .empirical import Empirical, empirical_transfer
 from .fit import BOUNDS, PARAMETERS, FitResult, FollowerData, fit_follower
 from .logs import EXAMPLES, example_log, read_logs
+from .wording import statement
 
 __all__ = [
     "BOUNDS",

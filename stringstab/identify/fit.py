@@ -40,7 +40,8 @@ from ..io.platoon_logs import Segment
 from .blas import single_threaded_blas
 from .closed_loop import FollowerModel, simulate_follower
 
-__all__ = ["BOUNDS", "PARAMETERS", "FitResult", "FollowerData", "fit_follower", "model_of"]
+__all__ = ["BOUNDS", "PARAMETERS", "FitResult", "FollowerData", "fit_follower", "model_of",
+           "parameter_names"]
 
 Array = npt.NDArray[np.float64]
 
@@ -51,7 +52,8 @@ PARAMETERS: dict[str, tuple[str, ...]] = {
 }
 
 #: Search box of each parameter (units of docs/conventions.md; standstill in m).  Wide enough
-#: for commercial ACC (k_x ~ 0.01-0.3 s⁻², k_v ~ 0.1-1 s⁻¹, lags up to ~1 s, headways 0.6-3 s).
+#: for commercial ACC (k_x ~ 0.01-0.3 s⁻², k_v ~ 0.1-1 s⁻¹, lags up to ~1 s, headways 0.6-3 s)
+#: and for people (reaction delays θ_r of 0.5-2 s).
 BOUNDS: dict[str, tuple[float, float]] = {
     "k_x": (1e-3, 3.0),
     "k_v": (-0.5, 4.0),
@@ -60,6 +62,7 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "standstill": (0.0, 40.0),
     "k_a": (-1.0, 2.0),
     "delta": (0.0, 1.5),
+    "reaction_delay": (0.0, 2.5),
 }
 
 #: |correlation| of two estimates beyond which they are reported as not separately identified.
@@ -93,8 +96,31 @@ class FollowerData:
         return max(float(v.std()), 0.1), max(float(g.std()), 0.5)
 
 
+def parameter_names(model: str, fit_delay: bool = False) -> tuple[str, ...]:
+    """The parameters a fit estimates, in the order of its parameter vector.
+
+    Parameters
+    ----------
+    model : {"acc", "cacc"}
+        :data:`PARAMETERS`.
+    fit_delay : bool
+        Also the reaction delay θ_r (``reaction_delay``, issue 25), last.
+
+    Returns
+    -------
+    tuple of str
+        The names.
+
+    Examples
+    --------
+    >>> parameter_names("acc", fit_delay=True)
+    ('k_x', 'k_v', 'tau', 'headway', 'standstill', 'reaction_delay')
+    """
+    return PARAMETERS[model] + (("reaction_delay",) if fit_delay else ())
+
+
 def model_of(theta: Array, names: tuple[str, ...]) -> FollowerModel:
-    """The :class:`FollowerModel` of a parameter vector (k_a = δ = 0 when not estimated).
+    """The :class:`FollowerModel` of a parameter vector (k_a = δ = θ_r = 0 when not estimated).
 
     Parameters
     ----------
@@ -102,7 +128,8 @@ def model_of(theta: Array, names: tuple[str, ...]) -> FollowerModel:
         Parameter values, in the order of ``names``.
     names : tuple of str
         Their names, among ``k_x``, ``k_v``, ``k_a``, ``tau``, ``delta``, ``headway``,
-        ``standstill`` (all but ``k_a`` and ``delta`` required).
+        ``standstill``, ``reaction_delay`` (all but ``k_a``, ``delta`` and ``reaction_delay``
+        required).
 
     Returns
     -------
@@ -111,7 +138,7 @@ def model_of(theta: Array, names: tuple[str, ...]) -> FollowerModel:
     """
     p = dict(zip(names, (float(x) for x in theta)))
     return FollowerModel(p["k_x"], p["k_v"], p.get("k_a", 0.0), p["tau"], p.get("delta", 0.0),
-                         p["headway"], p["standstill"])
+                         p["headway"], p["standstill"], p.get("reaction_delay", 0.0))
 
 
 #: Samples of the straight line fitted to the start of a segment for its initial state.
@@ -250,7 +277,7 @@ class FitResult:
     Attributes
     ----------
     params : dict
-        Estimated parameters by name (plus k_a = δ = 0 for ``acc``).
+        Estimated parameters by name (plus k_a = δ = 0 for ``acc``, θ_r = 0 unless fitted).
     rmse_speed, rmse_gap : float
         Root-mean-square simulation error in speed (m/s) and gap (m).
     cost : float
@@ -262,12 +289,18 @@ class FitResult:
     correlation : dict
         Correlations of the estimates above :data:`CORRELATION_LIMIT` in absolute value.
     starts : int
-        Starting points tried; ``nfev`` evaluations in all.
+        Starting points tried; ``nfev`` evaluations in all; ``best_start`` the index of the
+        one whose optimum was kept (0: the first; a later one only when better by more than
+        10⁻⁶ of the cost), ``start_costs`` the optimum's cost from each.
     theta, names : array, tuple of str
         The whole solution vector (the parameters ``names``, then the initial states) and
         the parameter names.
     initial : array (n_segments, 3)
         Fitted initial gap, speed and acceleration of each segment.
+    rmse_speed_measured_start, rmse_gap_measured_start : float
+        The same fit's errors simulated from the *measured* initial state of each segment
+        (:func:`measured_initial`) instead of the fitted one: a free restart per segment
+        flatters the error, this does not.
     """
 
     params: dict[str, float]
@@ -282,6 +315,10 @@ class FitResult:
     theta: Array | None = None
     names: tuple[str, ...] = ()
     initial: Array | None = None
+    best_start: int = 0
+    start_costs: list[float] = field(default_factory=list)
+    rmse_speed_measured_start: float = math.nan
+    rmse_gap_measured_start: float = math.nan
 
 
 def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.Generator,
@@ -292,9 +329,12 @@ def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.G
     """
     vbar = float(np.mean([data.v[s.start:s.stop].mean() for s in data.segments]))
     gbar = float(np.mean([data.gap[s.start:s.stop].mean() for s in data.segments]))
-    typical = {"k_x": 0.1, "k_v": 0.4, "tau": 0.5, "headway": 1.2, "k_a": 0.3, "delta": 0.2}
-    lo = {"k_x": 0.02, "k_v": 0.1, "tau": 0.1, "headway": 0.5, "k_a": 0.0, "delta": 0.05}
-    hi = {"k_x": 0.6, "k_v": 1.5, "tau": 1.2, "headway": 2.5, "k_a": 0.8, "delta": 0.5}
+    typical = {"k_x": 0.1, "k_v": 0.4, "tau": 0.5, "headway": 1.2, "k_a": 0.3, "delta": 0.2,
+               "reaction_delay": 0.3}
+    lo = {"k_x": 0.02, "k_v": 0.1, "tau": 0.1, "headway": 0.5, "k_a": 0.0, "delta": 0.05,
+          "reaction_delay": 0.0}
+    hi = {"k_x": 0.6, "k_v": 1.5, "tau": 1.2, "headway": 2.5, "k_a": 0.8, "delta": 0.5,
+          "reaction_delay": 1.0}
     out = []
     for i in range(n):
         p = dict(typical) if i == 0 else {k: float(rng.uniform(lo[k], hi[k])) for k in lo}
@@ -306,9 +346,43 @@ def _starts(names: tuple[str, ...], data: FollowerData, n: int, rng: np.random.G
     return out
 
 
+def start_points(data: FollowerData, model: str = "acc", n: int = 1, *, seed: int = 0,
+                 fit_delay: bool = False, fixed: dict[str, float] | None = None) -> list[Array]:
+    """Whole starting vectors of :func:`fit_follower` (parameters, then measured initial states).
+
+    The first is a typical ACC, the others random draws from plausible ranges (l_0 from the
+    data's mean gap at the drawn T*).
+
+    Parameters
+    ----------
+    data : FollowerData
+        The record.
+    model : {"acc", "cacc"}
+        The law.
+    n : int
+        How many.
+    seed : int
+        Seed of the draws.
+    fit_delay : bool
+        Include θ_r.
+    fixed : dict, optional
+        Parameters held at a value.
+
+    Returns
+    -------
+    list of ndarray
+        ``n`` starting vectors.
+    """
+    names = parameter_names(model, fit_delay)
+    init0 = measured_initial(data).ravel()
+    return [np.r_[x, init0] for x in _starts(names, data, max(n, 1), np.random.default_rng(seed), fixed)]
+
+
 def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, seed: int = 0,
-                 x0: Array | None = None, counts: Array | None = None,
-                 identifiability: bool = True, fixed: dict[str, float] | None = None) -> FitResult:
+                 x0: Array | list[Array] | None = None, counts: Array | None = None,
+                 identifiability: bool = True, fixed: dict[str, float] | None = None,
+                 fit_delay: bool = False,
+                 bounds: dict[str, tuple[float, float]] | None = None) -> FitResult:
     """Fit the eq-4 law and the lag to one follower by closed-loop simulation error.
 
     Parameters
@@ -322,29 +396,36 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
         Starting points (the best optimum is kept); ignored when ``x0`` is given.
     seed : int
         Seed of the random starting points.
-    x0 : array, optional
-        A single starting point (the bootstrap starts from the point estimate).
+    x0 : array or list of arrays, optional
+        Whole starting vectors (parameters, then initial states) instead of ``n_starts``
+        generated ones (the bootstrap starts from the point estimate and a random draw).
     counts : array (T,), optional
         Per-sample multiplicities (the block bootstrap); default 1.
     identifiability : bool
         Compute the correlation and speed-range notes.
     fixed : dict, optional
         Parameters held at a value (e.g. ``{"headway": 1.0}`` for a profile).
+    fit_delay : bool
+        Also estimate the reaction delay θ_r on the whole law (issue 25).
+    bounds : dict, optional
+        Narrower search intervals for some parameters (e.g. T* within the spacing policy's
+        interval), replacing :data:`BOUNDS` for them.
 
     Returns
     -------
     FitResult
+        The best optimum over the starting points.
     """
     from scipy.optimize import least_squares
 
     if model not in PARAMETERS:
         raise StringStabError(f"model must be 'acc' or 'cacc'; got {model!r}")
-    names = PARAMETERS[model]
+    names = parameter_names(model, fit_delay)
     if model == "cacc" and data.a_pred is None:
         raise StringStabError("--model cacc needs the predecessor's acceleration; this log has none")
     sv, sg = data.scales()
     w = None if counts is None else residual_weights(data, counts)
-    box = dict(BOUNDS)
+    box = {**BOUNDS, **(bounds or {})}
     for k, val in (fixed or {}).items():
         box[k] = (float(val), float(val) + 1e-9)
     init0 = measured_initial(data)
@@ -353,20 +434,23 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     lb = np.r_[[box[k][0] for k in names], init0.ravel() - slack]
     ub = np.r_[[box[k][1] for k in names], init0.ravel() + slack]
     if x0 is not None:
-        xs = [np.asarray(x0, dtype=float)]
+        xs = [np.asarray(x, dtype=float) for x in (x0 if isinstance(x0, list) else [x0])]
     else:
         xs = [np.r_[x, init0.ravel()]
               for x in _starts(names, data, max(n_starts, 1), np.random.default_rng(seed), fixed)]
     best: Any = None
+    best_start = 0
+    costs: list[float] = []
     nfev = 0
     with single_threaded_blas():
-        for x in xs:
+        for i, x in enumerate(xs):
             xc = np.clip(x, lb + 1e-9 * (ub - lb), ub - 1e-9 * (ub - lb))
             res = least_squares(_residuals, xc, bounds=(lb, ub), args=(names, data, sv, sg, w),
                                 x_scale="jac", max_nfev=400, xtol=1e-8, ftol=1e-8, tr_solver="lsmr")
             nfev += int(res.nfev)
-            if best is None or res.cost < best.cost:
-                best = res
+            costs.append(float(res.cost))
+            if best is None or res.cost < best.cost * (1 - 1e-6):
+                best, best_start = res, i
     theta = best.x
     m = model_of(theta[:p], names)
     init = theta[p:].reshape(-1, 3)
@@ -377,17 +461,22 @@ def fit_follower(data: FollowerData, model: str = "acc", *, n_starts: int = 4, s
     at_bound = [k for k, x, lo_, hi_, wd in zip(names, theta, lb, ub, width)
                 if k not in (fixed or {}) and (x - lo_ < 1e-3 * wd or hi_ - x < 1e-3 * wd)]
     params = {"k_x": m.k_x, "k_v": m.k_v, "k_a": m.k_a, "tau": m.tau, "delta": m.delta,
-              "headway": m.headway, "standstill": m.standstill}
+              "headway": m.headway, "standstill": m.standstill, "reaction_delay": m.reaction_delay}
+    gm, sm = simulate_segments(m, data)  # from the measured initial states
+    evm = np.concatenate([v - data.v[s.start:s.stop] for s, v in zip(data.segments, sm)])
+    egm = np.concatenate([g - data.gap[s.start:s.stop] for s, g in zip(data.segments, gm)])
     out = FitResult(params, float(np.sqrt(np.mean(ev ** 2))), float(np.sqrt(np.mean(eg ** 2))),
                     float(best.cost), at_bound, starts=len(xs), nfev=nfev, theta=theta, names=names,
-                    initial=init)
+                    initial=init, best_start=best_start, start_costs=costs,
+                    rmse_speed_measured_start=float(np.sqrt(np.mean(evm ** 2))),
+                    rmse_gap_measured_start=float(np.sqrt(np.mean(egm ** 2))))
     if identifiability:
-        out.notes, out.correlation = _identifiability(best.jac, names, data, at_bound)
+        out.notes, out.correlation = _identifiability(best.jac, names, data, at_bound, box)
     return out
 
 
-def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
-                     at_bound: list[str]) -> tuple[list[str], dict[str, float]]:
+def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData, at_bound: list[str],
+                     box: dict[str, tuple[float, float]]) -> tuple[list[str], dict[str, float]]:
     notes: list[str] = []
     corr: dict[str, float] = {}
     J = np.asarray(J, dtype=float)
@@ -421,8 +510,9 @@ def _identifiability(J: Array, names: tuple[str, ...], data: FollowerData,
         notes.append(f"the speed stays within {lo:.3g}-{hi:.3g} m/s (5-95 %): T* v + l_0 is "
                      "nearly constant, so T* and the standstill distance are weakly separated")
     for k in at_bound:
-        lo_b, hi_b = BOUNDS[k]
-        notes.append(f"{k} stopped at the bound of its search box [{lo_b:g}, {hi_b:g}]: the "
+        lo_b, hi_b = box[k]
+        where = "search box" if box[k] == BOUNDS[k] else "constraint"
+        notes.append(f"{k} stopped at the bound of its {where} [{lo_b:.3g}, {hi_b:.3g}]: the "
                      "fit would go further; treat it and the verdict with care")
     return notes, corr
 
@@ -444,7 +534,7 @@ def rms(x: Array) -> float:
 
 
 def profile_headway(data: FollowerData, model: str, grid: Array, *, n_starts: int = 2,
-                    seed: int = 0) -> list[FitResult]:
+                    seed: int = 0, fit_delay: bool = False, name: str = "headway") -> list[FitResult]:
     """Refit with T* held at each value of ``grid`` (a profile over the time headway).
 
     When T* and l_0 are weakly separated (the speed varies little), the best fit may pick any T*
@@ -453,15 +543,17 @@ def profile_headway(data: FollowerData, model: str, grid: Array, *, n_starts: in
 
     Parameters
     ----------
-    data, model, n_starts, seed
+    data, model, n_starts, seed, fit_delay
         As for :func:`fit_follower`.
     grid : array
-        Values of T*, s.
+        Values of the profiled parameter (T* by default), s.
+    name : str
+        The parameter held: ``"headway"`` (T*) or ``"reaction_delay"`` (θ_r).
 
     Returns
     -------
     list of FitResult
-        One per grid value (T* at the grid value, the other parameters refitted).
+        One per grid value (the parameter at the grid value, the others refitted).
     """
     return [fit_follower(data, model, n_starts=n_starts, seed=seed, identifiability=False,
-                         fixed={"headway": float(T)}) for T in grid]
+                         fixed={name: float(T)}, fit_delay=fit_delay) for T in grid]

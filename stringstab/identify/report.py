@@ -10,6 +10,11 @@ Files (all written through one :class:`stringstab.io.OutputDir`, all-or-nothing)
 * ``transfer_<position>.png`` — the model's |Γ(jω)| beside the empirical |Ĝ(jω)| and coherence;
 * ``sup_gain.png`` — sup|Γ| with its bootstrap interval and the empirical amplification along
   the platoon.
+
+With ``--by car`` (:func:`stringstab.identify.cars.identify_cars`): ``cars.json`` (the ``cars``
+list), ``cars.csv`` and ``cars.parquet`` (intervals as ``_lo``/``_hi`` columns), per car
+``fit_<car>_<setting>.png`` and ``transfer_<car>_<setting>.png``, and ``cars.png`` (sup|Γ| per
+car with its interval beside the data's own amplification): :func:`write_cars_outputs`.
 """
 
 from __future__ import annotations
@@ -22,9 +27,10 @@ import numpy as np
 
 from ..certify.verdicts import Verdict
 from ..io import OutputDir, TableColumn, columns_from_records, format_results, write_results
-from .core import IdentifyResult, VehicleResult, simulated
+from .core import IdentifyResult
+from .estimate import simulated
 
-__all__ = ["TABLE", "render", "write_outputs"]
+__all__ = ["CARS_TABLE", "TABLE", "car_tag", "render", "render_cars", "write_cars_outputs", "write_outputs"]
 
 #: The human table.
 TABLE = [
@@ -36,12 +42,14 @@ TABLE = [
     TableColumn("τ[s]", "tau", "%.3g"),
     TableColumn("T*[s]", "headway", "%.3g"),
     TableColumn("l0[m]", "standstill", "%.3g"),
+    TableColumn("θ_r[s]", "reaction_delay", "%.3g"),
     TableColumn("rmse_v[m/s]", "rmse_speed", "%.3g"),
     TableColumn("rmse_gap[m]", "rmse_gap", "%.3g"),
     TableColumn("sup|Γ|", "sup_gain", "%.4g"),
     TableColumn("sup|Γ| 5-95%", "sup_interval", "%s"),
     TableColumn("ω_peak[rad/s]", "peak_omega", "%.3g"),
     TableColumn("verdict", "verdict", "%s"),
+    TableColumn("bootstrap", "supported_verdict", "%s"),
     TableColumn(Verdict.CERTIFIED.value, "certified_share", "%.2f"),
     TableColumn("box", "box_verdict", "%s"),
     TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),
@@ -50,8 +58,45 @@ TABLE = [
     TableColumn("energy", "energy_gain", "%.3g"),
 ]
 
+#: The car-level table (``--by car``).
+CARS_TABLE = [
+    TableColumn("car", "car", "%s"),
+    TableColumn("setting", "setting", "%s"),
+    TableColumn("logs", "n_logs", "%d"),
+    TableColumn("k_x[1/s²]", "k_x", "%.3g"),
+    TableColumn("k_v[1/s]", "k_v", "%.3g"),
+    TableColumn("τ[s]", "tau", "%.3g"),
+    TableColumn("θ_r[s]", "reaction_delay", "%.3g"),
+    TableColumn("T*[s]", "headway", "%.3g"),
+    TableColumn("T* 5-95%", "headway_text", "%s"),
+    TableColumn("l0[m]", "standstill", "%.3g"),
+    TableColumn("sup|Γ|", "sup_gain", "%.4g"),
+    TableColumn("sup|Γ| 5-95%", "sup_text", "%s"),
+    TableColumn("verdict", "verdict", "%s"),
+    TableColumn(Verdict.CERTIFIED.value, "certified_share", "%.2f"),
+    TableColumn("|Ĝ|max", "empirical_gain", "%.3g"),
+    TableColumn("data>1", "data_amplifies", "%s"),
+]
+
+#: Baseline columns, added to a table when the baselines were fitted.
+BASELINE_COLUMNS = [
+    TableColumn("IDM rmse_v", "idm_rmse_speed", "%.3g"),
+    TableColumn("IDM", "idm_verdict", "%s"),
+    TableColumn("OVRV rmse_v", "ovrv_rmse_speed", "%.3g"),
+    TableColumn("OVRV", "ovrv_verdict", "%s"),
+    TableColumn("law rmse_v (measured start)", "rmse_speed_measured_start", "%.3g"),
+]
+
 #: Every file name the command may write (figures are added per follower).
 FILES = ("identify.json", "identify.csv", "identify.parquet", "sup_gain.png")
+
+
+def _interval(lo: float, hi: float) -> str:
+    """``lo-hi`` to 3 digits, solver noise within 1e-6 of 0 shown as 0; ``-`` when unknown."""
+    def f(x: float) -> str:
+        return "0" if abs(x) < 1e-6 else f"{x:.3g}"
+
+    return f"{f(lo)}-{f(hi)}" if math.isfinite(lo) and math.isfinite(hi) else "-"
 
 
 def _table_rows(res: IdentifyResult) -> list[dict[str, Any]]:
@@ -80,7 +125,8 @@ def render(res: IdentifyResult) -> str:
     rows = _table_rows(res)
     params = {"model": res.model, "sample_time": res.sample_time or "continuous",
               "bootstrap": res.settings["bootstrap"], "block_s": res.settings["block"]}
-    text = format_results(columns_from_records(rows), "table", params=params, table=TABLE)
+    table = TABLE + (BASELINE_COLUMNS if res.settings.get("baselines") else [])
+    text = format_results(columns_from_records(rows), "table", params=params, table=table)
     lines = [text.rstrip("\n")]
     for v in res.vehicles:
         lines.append(f"# {v.position} {v.name}: {v.statement()}")
@@ -144,7 +190,14 @@ def _small(x: float, unit: str) -> str:
     return f"< 0.01 {unit}" if x < 0.01 else f"{x:.2g} {unit}"
 
 
-def _fig_fit(v: VehicleResult) -> Any:
+def _who(v: Any) -> str:
+    """A follower ("follower 2 (BMW_I3)") or a car ("BMW_I3, short setting, 3 logs")."""
+    if hasattr(v, "car"):
+        return f"{v.car}, {v.setting} setting, {len(v.logs)} log{'s' if len(v.logs) != 1 else ''}"
+    return f"follower {v.position} ({v.name})"
+
+
+def _fig_fit(v: Any) -> Any:
     fig = _figure(9, 5.5)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     gaps, speeds = simulated(v)
@@ -159,22 +212,26 @@ def _fig_fit(v: VehicleResult) -> Any:
         ax2.plot(t, g, color="#D55E00", lw=1.0, ls="--", label=lab("simulated"))
     ax1.set_ylabel("speed (m/s)")
     ax2.set_ylabel("gap (m)")
-    ax2.set_xlabel("time from the log's start (s)")
+    ax2.set_xlabel("time from the log's start (s)" if not hasattr(v, "car")
+                   else "time along the pooled record (the logs end to end, s)")
     ax1.legend(fontsize=8)
     ax2.legend(fontsize=8)
     p = v.fit.params
     b = list(v.fit.at_bound)
-    ax1.set_title(f"follower {v.position} ({v.name}), fitted: k_x = {_num(p['k_x'], 'k_x', b, '1/s²')}, "
-                  f"k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, τ = {_num(p['tau'], 'tau', b, 's')}, "
-                  f"T* = {_num(p['headway'], 'headway', b, 's')}, "
-                  f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}\n"
-                  f"fit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
-                  f"{_small(v.fit.rmse_gap, 'm')}",
-                  fontsize=9)
+    theta = (f", θ_r = {_num(p['reaction_delay'], 'reaction_delay', b, 's')}"
+             if "reaction_delay" in v.fit.names else "")
+    params = (f"k_x = {_num(p['k_x'], 'k_x', b, '1/s²')}, k_v = {_num(p['k_v'], 'k_v', b, '1/s')}, "
+              f"τ = {_num(p['tau'], 'tau', b, 's')}{theta}, T* = {_num(p['headway'], 'headway', b, 's')}, "
+              f"l0 = {_num(p['standstill'], 'standstill', b, 'm')}")
+    head = f"{_who(v)}, fitted: {params}"
+    if len(head) > 110:  # the parameters on a line of their own (θ_r and bounds lengthen it)
+        head = f"{_who(v)}, fitted:\n{params}"
+    ax1.set_title(f"{head}\nfit error (RMSE): speed {_small(v.fit.rmse_speed, 'm/s')}, gap "
+                  f"{_small(v.fit.rmse_gap, 'm')}", fontsize=9)
     return fig
 
 
-def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
+def _fig_transfer(v: Any, H: float | None) -> Any:
     from ..certify.frequency import gain
 
     fig = _figure(7, 5.8)
@@ -187,8 +244,14 @@ def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
     # from a decade below the model's peak (or the data) up: the model's whole shape is shown
     w_lo = min(w_data, peak_w / 10 if math.isfinite(peak_w) and peak_w > 0 else w_data, 0.01)
     w = np.geomspace(w_lo, 10.0, 600)
-    ax1.loglog(w, gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
-                       headway=p["headway"]), color="#D55E00", label="model |Γ(jω)| (continuous)")
+    if p.get("reaction_delay", 0.0) > 0:
+        from ..certify.reaction import gain_squared
+
+        model = np.sqrt(gain_squared(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"],
+                                     headway=p["headway"], reaction_delay=p["reaction_delay"]))
+    else:
+        model = gain(w, p["k_x"], p["k_v"], p["k_a"], tau=p["tau"], delta=p["delta"], headway=p["headway"])
+    ax1.loglog(w, model, color="#D55E00", label="model |Γ(jω)| (continuous)")
     if math.isfinite(sup) and math.isfinite(peak_w) and peak_w > 0:
         ax1.plot([peak_w], [sup], "D", color="#D55E00", ms=6,
                  label=f"model peak: sup|Γ| = {sup:.3g} at {peak_w:.2g} rad/s")
@@ -217,7 +280,7 @@ def _fig_transfer(v: VehicleResult, H: float | None) -> Any:
                  transform=ax1.get_xaxis_transform(), fontsize=8, color="0.35")
     ax1.set_ylabel("|follower speed / predecessor speed|")
     ax1.legend(fontsize=8, loc="lower center")
-    ax1.set_title(f"follower {v.position} ({v.name}): {v.certificate.verdict}"
+    ax1.set_title(f"{_who(v)}: {v.certificate.verdict}"
                   + ("" if H is None else f", certified sampled at H = {H:g} s"), fontsize=9)
     ax2.semilogx(e.omega[m], e.coherence[m], color="k", lw=0.8)
     ax2.axhline(0.5, color="0.3", lw=0.6, ls=":")
@@ -254,6 +317,121 @@ def _fig_platoon(res: IdentifyResult) -> Any:
     return fig
 
 
+def car_tag(car: Any) -> str:
+    """The file-name tag of a car: ``<car>_<setting>``.
+
+    Characters other than letters, digits, ``-`` and ``_`` are replaced by ``_``.
+
+    Parameters
+    ----------
+    car : CarResult
+        A car of :func:`stringstab.identify.cars.identify_cars`.
+
+    Returns
+    -------
+    str
+        E.g. ``MERCEDES_GLE450_short``.
+    """
+    import re
+
+    return re.sub(r"[^A-Za-z0-9_-]", "_", f"{car.car}_{car.setting}")
+
+
+def _cars_rows(res: Any) -> list[dict[str, Any]]:
+    rows = []
+    for c in res.cars:
+        r = c.flat_row()
+        r["n_logs"] = len(c.logs)
+        r["headway_text"] = _interval(r["headway_interval_lo"], r["headway_interval_hi"])
+        r["sup_text"] = _interval(r["sup_gain_interval_lo"], r["sup_gain_interval_hi"])
+        rows.append(r)
+    return rows
+
+
+def render_cars(res: Any) -> str:
+    """The car-level table, its settings line, and per car its statement and notes.
+
+    Parameters
+    ----------
+    res : CarsResult
+        :func:`stringstab.identify.cars.identify_cars`.
+
+    Returns
+    -------
+    str
+        The text report (newline-terminated).
+    """
+    params = {"model": res.model, "sample_time": res.sample_time or "continuous",
+              "bootstrap": res.settings["bootstrap"], "block_s": res.settings["block"], "by": "car"}
+    table = CARS_TABLE + (BASELINE_COLUMNS if res.settings.get("baselines") else [])
+    text = format_results(columns_from_records(_cars_rows(res)), "table", params=params, table=table)
+    lines = [text.rstrip("\n")]
+    for c in res.cars:
+        lines.append(f"# {c.car} ({c.setting}): {c.statement()}")
+        for n in c.fit.notes + c.notes:
+            lines.append(f"#   note: {n}")
+    for sk in res.skipped:
+        lines.append(f"# skipped: {sk}")
+    return "\n".join(lines) + "\n"
+
+
+def write_cars_outputs(res: Any, out: OutputDir, *, figures: bool = True) -> list[str]:
+    """Write ``cars.json``, ``cars.csv``, ``cars.parquet`` (and figures) into a staged folder.
+
+    Parameters
+    ----------
+    res : CarsResult
+        The car-level identification.
+    out : OutputDir
+        The staged output folder (the caller commits it).
+    figures : bool, default True
+        Also write per car the fit and transfer figures and ``cars.png``.
+
+    Returns
+    -------
+    list of str
+        The names written into ``out`` so far (``out.written``).
+    """
+    out.write_json("cars.json", res.document())
+    cols = columns_from_records(res.rows())
+    params = {"model": res.model, "sample_time": res.sample_time, "by": "car"}
+    write_results(cols, out.path("cars.csv"), "csv", params=params)
+    write_results(cols, out.path("cars.parquet"), "parquet", params=params)
+    if figures:
+        for c in res.cars:
+            _fig_fit(c).savefig(out.path(f"fit_{car_tag(c)}.png"), dpi=110)
+            _fig_transfer(c, res.sample_time).savefig(out.path(f"transfer_{car_tag(c)}.png"), dpi=110)
+        _fig_cars(res).savefig(out.path("cars.png"), dpi=110)
+    return out.written
+
+
+def _fig_cars(res: Any) -> Any:
+    import textwrap
+
+    n = len(res.cars)
+    fig = _figure(max(7.0, 0.85 * n), 4.6)
+    ax = fig.add_subplot()
+    x = np.arange(n)
+    sup = np.array([float(c.certificate.sup_gain) for c in res.cars])
+    iv = np.array([c.interval("sup_gain") for c in res.cars]).reshape(-1, 2)
+    lo = np.where(np.isfinite(iv[:, 0]), sup - iv[:, 0], 0.0)
+    hi = np.where(np.isfinite(iv[:, 1]), iv[:, 1] - sup, 0.0)
+    ax.errorbar(x - 0.08, sup, yerr=np.clip(np.vstack([lo, hi]), 0, None), fmt="o", color="#D55E00",
+                capsize=3, label="model sup|Γ| (5-95 % bootstrap)")
+    g = np.array([c.empirical.gain for c in res.cars], dtype=float)
+    ge = np.array([c.empirical.gain_error for c in res.cars], dtype=float)
+    ax.errorbar(x + 0.08, g, yerr=np.where(np.isfinite(ge), 2 * ge * g, 0.0), fmt="s", color="k",
+                capsize=3, label="data's max |Ĝ| ± 2ε (pooled)")
+    ax.axhline(1.0, color="0.3", lw=0.6, ls=":")
+    ax.set_xticks(x, [textwrap.fill(c.car.replace("_", " "), 9) + f"\n({c.setting}, {len(c.logs)})"
+                      for c in res.cars], fontsize=7)
+    ax.set_xlabel("car (setting, logs pooled)", fontsize=8)
+    ax.set_ylabel("amplification (follower over predecessor)")
+    ax.set_title("one row per car and setting: above the dotted line at 1 a car amplifies", fontsize=9)
+    ax.legend(fontsize=8)
+    return fig
+
+
 def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, Any]]:
     """The fitted vehicles of an ``identify.json`` (for ``certify --from`` and ``simulate --from``).
 
@@ -267,7 +445,8 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
     Returns
     -------
     list of dict
-        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill.
+        Rows with at least position, name, k_x, k_v, k_a, tau, delta, headway, standstill and
+        reaction_delay (0 in a file written before θ_r was fitted).
 
     Raises
     ------
@@ -296,6 +475,11 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
         bad = [k for k in need if k not in r or (k != "name" and not isinstance(r[k], (int, float)))]
         if bad:
             raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} lacks numeric {bad}")
+    for r in rows:
+        theta = r.setdefault("reaction_delay", 0.0)
+        if not isinstance(theta, (int, float)) or not theta >= 0:
+            raise StringStabError(f"--from {path!r}: vehicle {r.get('name', '?')!r} has reaction_delay "
+                                  f"{theta!r}; expected a number of seconds >= 0")
     if vehicle is not None:
         rows = [r for r in rows if r["position"] == vehicle]
         if not rows:

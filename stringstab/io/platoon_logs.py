@@ -212,6 +212,27 @@ def _refuse_units(what: str, ratio: float, path: Path) -> None:
             "1 (speeds in m/s, distances in m)")
 
 
+def _check_last_line(path: Path, n_rows: int) -> None:
+    """Refuse a file whose last line has no line break: it may be cut mid-row.
+
+    A number cut short is still a number (a spacing of 17.17 cut to "1" reads as 1 m), so a
+    truncated last row cannot be told from a complete one by its cells; every row a CSV writer
+    writes ends with a line break, so a missing one is taken as the sign of a cut.
+    """
+    try:
+        with open_text(path) as fh:
+            last = ""
+            while chunk := fh.read(1 << 20):
+                last = chunk[-1]
+    except (OSError, UnicodeDecodeError):
+        return  # the reader has already read it; its own errors are reported there
+    if last not in ("\n", "\r"):
+        raise StringStabError(
+            f"{_where(path)}: the last line (line {n_rows}) does not end with a line break: the file "
+            "looks cut mid-row (a number cut short would be read as another number); expected "
+            "every row to end with a line break")
+
+
 # --------------------------------------------------------------------------- OpenACC
 
 
@@ -234,6 +255,11 @@ def _numeric(rows: list[list[str]], ncol: int, path: Path, first_line: int) -> A
         if len(r) > ncol and any(c.strip() for c in r[ncol:]):
             raise StringStabError(
                 f"{_where(path)} line {first_line + i}: expected {ncol} values; found {len(r)}")
+        if len(r) < ncol:  # a row cut short: its last cell may be a number cut short too
+            raise StringStabError(
+                f"{_where(path)} line {first_line + i}: expected {ncol} values (empty cells "
+                f"separated by commas where not measured); found {len(r)}: the row is cut short "
+                "(a file cut mid-row?)")
         try:
             vals = [_cell(c) for c in r[:ncol]]
         except ValueError as e:
@@ -259,6 +285,14 @@ def _read_openacc(path: Path, rows: list[list[str]]) -> PlatoonLog:
         raise StringStabError(f"{_where(path)}: OpenACC header without Speedk columns; found {header[:8]}")
     ivs_cols = {int(m.group(1)): j for j, c in enumerate(header)
                 if (m := re.fullmatch(r"ivs(\d+)", c, re.IGNORECASE))}
+    if len(speed_cols) == 1:
+        (n,) = speed_cols
+        order = meta.get("Vehicle_order", [])
+        who = f"vehicle {n}" + (f" ({order[n - 1]})" if 0 < n <= len(order) else "")
+        raise StringStabError(
+            f"{_where(path)}: expected at least two recorded vehicles (a predecessor and its "
+            f"follower, with their spacing IVSk); found one vehicle, {who}: a one-vehicle log has "
+            "no car following to identify")
     if not ivs_cols:
         raise StringStabError(
             f"{_where(path)}: no spacing columns IVSk; expected the inter-vehicle spacing of each pair")
@@ -387,7 +421,11 @@ def _read_long(path: Path, rows: list[list[str]], base: list[str],
     iv = base.index("vehicle")
     order: list[str] = []
     per: dict[str, list[list[str]]] = {}
-    for r in rows[1:]:
+    for i, r in enumerate(rows[1:]):
+        if len(r) < len(base):
+            raise StringStabError(
+                f"{_where(path)} line {i + 2}: expected {len(base)} values; found {len(r)}: the row "
+                "is cut short (a file cut mid-row?)")
         name = r[iv].strip() if iv < len(r) else ""
         if not name:
             raise StringStabError(f"{_where(path)}: a row without a vehicle name: {r}")
@@ -460,7 +498,9 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
     StringStabError
         One line: a missing or unreadable file, an unknown header, a bad number, time not
         increasing or irregular, an empty or all-NaN speed or gap, negative or absurd speeds,
-        speeds whose unit disagrees with the positions or the spacing, fewer than two vehicles.
+        speeds whose unit disagrees with the positions or the spacing, fewer than two vehicles,
+        a row with fewer cells than the header or a last line without a line break (a file cut
+        mid-row: a number cut short is still a number).
     """
     p = Path(path)
     if not p.is_file():
@@ -470,8 +510,8 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
         raise StringStabError(f"{_where(p)}: expected a header and data rows; found {len(rows)} line(s)")
     header_low = [c.strip().lower() for c in rows[0]]
     if any(r and r[0].strip().lower() == "time"
-           and any(re.fullmatch(r"speed\d+", c.strip(), re.IGNORECASE) for c in r)
-           and any(re.fullmatch(r"ivs\d+", c.strip(), re.IGNORECASE) for c in r) for r in rows[:30]):
+           and any(re.fullmatch(r"speed\d+", c.strip(), re.IGNORECASE) for c in r) for r in rows[:30]):
+        _check_last_line(p, len(rows))
         logs = [_read_openacc(p, rows)]
     elif "vehicle_id" in header_low and "frame_id" in header_low:
         if ngsim is None:
@@ -479,6 +519,7 @@ def read_platoon_logs(path: str | Path, *, min_duration: float = 30.0,
                                   "stringstab.identify.read_logs (or stringstab identify)")
         logs = ngsim(p, min_duration)
     else:
+        _check_last_line(p, len(rows))
         logs = [_read_plain(p, rows)]
     for log in logs:
         if len(log.positions) < 2 or not log.followers():

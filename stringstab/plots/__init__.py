@@ -31,6 +31,10 @@ module / function              shows
 :func:`plot_vehicles`          one line per vehicle, coloured by position
 :func:`plot_platoon`           speed, acceleration, spacing, headway (IDL Figs 7-8)
 :func:`plot_damping_ratios`    m_p of each follower (IDL eq 29)
+**mixed strings**              (:mod:`stringstab.plots.mixed`)
+:func:`plot_head_to_tail`      ∏|Γ_i(jω)| of strings, with the data's first-to-last |Ĝ|
+:func:`plot_replay_speeds`     the leader's and the last car's speed in each replay
+:func:`plot_replay_energy`     the acceleration-energy ratio to the leader along the string
 =============================  ===============================================================
 
 matplotlib is imported on first use.
@@ -40,6 +44,7 @@ from __future__ import annotations
 
 from ..io.figures import FIGURE_FORMATS
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
+from .mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
 from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
 from .reaction_sweep import plot_certified_share, save_reaction_sweep_outputs
 from .region_sets import plot_boundaries, plot_facets
@@ -65,9 +70,12 @@ __all__ = [
     "plot_comparison",
     "plot_damping_ratios",
     "plot_facets",
+    "plot_head_to_tail",
     "plot_moves",
     "plot_platoon",
     "plot_region_3d",
+    "plot_replay_energy",
+    "plot_replay_speeds",
     "plot_slices",
     "plot_sup_gain",
     "plot_trajectory",

@@ -86,6 +86,7 @@ class _Spec:
     methods: tuple[str, ...]
     sample_time: float | None = None
     heterogeneous: bool = True
+    message_period: float | None = None  # the multi-rate loop (issue 26)
 
     @property
     def continuous_point(self) -> bool:
@@ -107,7 +108,8 @@ def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, in
     out: dict[str, Any] = {}
     b = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway,
                       sample_time=spec.sample_time, heterogeneous=spec.heterogeneous,
-                      reaction_delay=_reaction(p))
+                      reaction_delay=_reaction(p),
+                      message_period=spec.message_period)
     out["hurwitz"] = np.asarray(b.stable).reshape(shape)
     out["verdict_exact"] = codes(b.verdict).reshape(shape)
     out["sup_gain"] = b.sup_gain.reshape(shape)
@@ -190,7 +192,8 @@ def _warm(spec: _Spec) -> None:
 
         p = spec.params
         certify_batch([1.0], [0.5], [0.2], tau=p.tau, delta=p.delta, headway=p.headway,
-                      sample_time=spec.sample_time, reaction_delay=_reaction(p))
+                      sample_time=spec.sample_time, reaction_delay=_reaction(p),
+                      message_period=spec.message_period)
 
 
 # --------------------------------------------------------------------------- validation
@@ -287,6 +290,7 @@ def region_map(
     progress: bool | None = None,
     heterogeneous: bool = True,
     executor: Any = None,
+    message_period: float | None = None,
     reaction_delay: Any = 0.0,
 ) -> RegionMap:
     """Evaluate every method on a grid of gains (see the module docstring).
@@ -325,6 +329,10 @@ def region_map(
         Evaluate the blocks there instead of the local pool, ``2 × workers`` in flight (e.g.
         a Dask client's ``get_executor()``: the blocks as tasks of a cluster).  The map is the
         same bit for bit: every block is evaluated by the same function and put in its place.
+    message_period : float, optional
+        With ``sample_time``: ``exact`` is the multi-rate certificate of V2V messages every
+        ``message_period`` s (:mod:`stringstab.certify.multirate`); equal to the sample time,
+        the sampled one.
     reaction_delay : float
         θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25): with θ_r > 0,
         ``exact`` is the continuous certificate of :mod:`stringstab.certify.reaction` (the one
@@ -362,6 +370,7 @@ def region_map(
     p = parameter_model(tau, delta, headway, reaction_delay)
     H = None if sample_time is None else _sample_time(sample_time)
     box = isinstance(p, Box)
+    P = _message_period(message_period, H, box)
     theta = Box.of(p).reaction_delay != (0.0, 0.0)
     if theta:  # θ_r > 0 (issue 25): refused beyond the continuous point loop, before any work
         from ..certify.api import Loop
@@ -378,7 +387,8 @@ def region_map(
     if target < 1:
         raise StringStabError(f"block must be >= 1 grid points; got {block!r}")
     blocks = grid_blocks(n0, n1, n2, target)
-    cost = (_COST[H is not None, box] + (CONTINUOUS in ms)) * (_REACTION_COST if theta else 1.0)
+    cost = (_COST[H is not None, box] * (30.0 if P is not None else 1.0) + (CONTINUOUS in ms)) * (
+        _REACTION_COST if theta else 1.0)
     seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:
         workers = 1 if seconds < _PARALLEL_SECONDS and executor is None else cpu_count()
@@ -389,7 +399,7 @@ def region_map(
         workers = 1
     if progress is None:
         progress = seconds / workers > 5.0
-    spec = _Spec(names, internal, p, ms, H, bool(heterogeneous))  # type: ignore[arg-type]
+    spec = _Spec(names, internal, p, ms, H, bool(heterogeneous), P)  # type: ignore[arg-type]
 
     shape3 = (n0, n1, n2)
     res: dict[str, np.ndarray] = {"hurwitz": np.empty(shape3, dtype=bool)}
@@ -435,6 +445,23 @@ def region_map(
         prop1={m: get(f"prop1_{m}") for m in ms if m in ("taylor", "printed")},
         type_printed=get("type_printed"), sup_gain=get("sup_gain"), margin=get("margin"),
         version=__version__, sample_time=H, heterogeneous=bool(heterogeneous),
-        hurwitz_continuous=get("hurwitz_continuous"),
+        hurwitz_continuous=get("hurwitz_continuous"), message_period=P,
     )
 
+
+def _message_period(message_period: Any, H: float | None, box: bool) -> float | None:
+    """The multi-rate map's message period N·H, checked; None for N = 1 (the sampled map)."""
+    if message_period is None:
+        return None
+    if H is None:
+        raise StringStabError("message_period (the V2V message period) needs the control "
+                              "period: expected sample_time with it, got none")
+    from ..certify.message import message_steps
+
+    N = message_steps(message_period, H)
+    if N < 2:
+        return None
+    if box:
+        raise StringStabError("the multi-rate certificate is for one τ, δ, T*; got a parameter "
+                              "box with message_period (not supported)")
+    return round(N * H, 12)

@@ -78,6 +78,11 @@ class ReportedMap(Protocol):
         """
         ...
 
+    @property
+    def message_period(self) -> float | None:
+        """The V2V message period (s) of a multi-rate map, else None (issue 26)."""
+        ...
+
     def stable(self, method: str) -> np.ndarray:
         """Where ``method`` says string stable.
 
@@ -153,7 +158,9 @@ def render_report(rmap: ReportedMap) -> str:
     if "continuous" in rmap.methods:
         band = int((rmap.stable("continuous") & ~rmap.stable("exact")).sum())
         back = int((rmap.stable("exact") & ~rmap.stable("continuous")).sum())
-        lines.append(f"certified in continuous time but not when sampled: {band:,} points "
-                     f"({percent(band / rmap.size)}); certified when sampled but not in "
+        how = ("when sampled" if rmap.message_period is None  # a multi-rate map (issue 26)
+               else f"with messages every {rmap.message_period:g} s")
+        lines.append(f"certified in continuous time but not {how}: {band:,} points "
+                     f"({percent(band / rmap.size)}); certified {how} but not in "
                      f"continuous time: {back:,}")
     return "\n".join(lines)

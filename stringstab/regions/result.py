@@ -127,6 +127,9 @@ class RegionMap:
         Sampled box only: the predecessor's lag ranged over the τ box independently.
     hurwitz_continuous : ndarray of bool or None
         Internal stability of the continuous loop, when :data:`CONTINUOUS` is evaluated.
+    message_period : float or None
+        The V2V message period N·H (s) of a multi-rate map (``exact`` is then the multi-rate
+        certificate); None otherwise.
     """
 
     axes: dict[str, Array]
@@ -144,6 +147,7 @@ class RegionMap:
     sample_time: float | None = None
     heterogeneous: bool = True
     hurwitz_continuous: npt.NDArray[np.bool_] | None = None
+    message_period: float | None = None
 
     @property
     def is_box(self) -> bool:
@@ -154,6 +158,8 @@ class RegionMap:
     def loop(self) -> str:
         """Which loop ``exact`` certifies, in words (``continuous``, ``sampled Δt = 0.1 s``, ...)."""
         what = "continuous" if self.sample_time is None else f"sampled Δt = {self.sample_time:g} s"
+        if self.message_period is not None:
+            what += f", V2V messages every {self.message_period:g} s"
         return f"{what}, robust over the box" if self.is_box else what
 
     # ---------------------------------------------------------------- shape and points
@@ -345,6 +351,8 @@ class RegionMap:
         parts.append(describe_params(self.params))
         if self.sample_time is not None:
             parts.append(f"sampled Δt = {self.sample_time:g} s")
+        if self.message_period is not None:
+            parts.append(f"messages every {self.message_period:g} s")
         return "; ".join(parts)
 
     # ---------------------------------------------------------------- slicing
@@ -387,6 +395,7 @@ class RegionMap:
             type_printed=take(self.type_printed), sup_gain=take(self.sup_gain),
             margin=take(self.margin), version=self.version, sample_time=self.sample_time,
             heterogeneous=self.heterogeneous, hurwitz_continuous=take(self.hurwitz_continuous),
+            message_period=self.message_period,
         )
 
     # ---------------------------------------------------------------- files
@@ -397,6 +406,7 @@ class RegionMap:
             "stringstab_version": self.version,
             "params": self.params.as_dict(),
             **({} if self.sample_time is None else {"sample_time": self.sample_time}),
+            **({} if self.message_period is None else {"message_period": self.message_period}),
             **({"heterogeneous": self.heterogeneous}
                if self.sample_time is not None and self.is_box else {}),
             "axes": {n: {"min": float(a[0]), "max": float(a[-1]), "n": int(a.size)}
@@ -613,6 +623,7 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
         margin=data.get("margin"), version=meta["stringstab_version"],
         sample_time=meta.get("sample_time"), heterogeneous=bool(meta.get("heterogeneous", True)),
         hurwitz_continuous=data.get("hurwitz_continuous"),
+        message_period=meta.get("message_period"),
     )
 
 

@@ -65,6 +65,9 @@ CAPTIONS: list[tuple[str, str]] = [
     ("sup_gain.png", "Along the identified platoon: the model's sup|Γ| per follower with its 5-95 % "
      "bootstrap interval, and the data's own amplification (max |Ĝ| ± two standard errors, and "
      "the energy ratio); points above the dotted line at 1 amplify disturbances."),
+    ("cars.png", "One row per car and distance setting (every log of it pooled): the model's "
+     "sup|Γ| with its 5-95 % bootstrap interval and the data's own max |Ĝ| ± two standard errors, "
+     "pooled over the car's logs; points above the dotted line at 1 amplify disturbances."),
     # tune
     ("tune_moves.png", "Each uncertified triple (numbered dot) and where each repair moved it "
      "(square: certified, cross: not), over the certified region projected over the repaired "

@@ -16,7 +16,7 @@ from typing import Any
 from ..ranges import metric_caveat
 from .render import Report
 
-__all__ = ["compare_report", "evaluate_report", "identify_report", "region_report",
+__all__ = ["cars_report", "compare_report", "evaluate_report", "identify_report", "region_report",
            "scenario_report", "simulate_report", "sweep_report", "tune_report"]
 
 #: Metrics of a run with their meaning and unit, in the order a report lists them.
@@ -302,24 +302,28 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     sec = rep.section("Verdicts")
     for v in res.vehicles:
         r = v.row()
+        sv = r["supported_verdict"]  # yes/no only where every bootstrap fit agrees (issue 28)
         sec.verdict(f"{v.position} {v.name}: fitted gains certified string stable (exact delay)",
-                    r["verdict"] == "certified",
-                    f"{r['verdict']}; sup|Γ| = {r['sup_gain']:.4g}; {v.statement()}")
+                    None if sv == "inconclusive" else sv == "certified",
+                    f"{v.statement()}; the point fit: {r['verdict']}, sup|Γ| = {r['sup_gain']:.4g}")
     rows = []
     for v in res.vehicles:
         r = v.row()
         rows.append({"pos": r["position"], "name": r["name"], "k_x": _denoise(r["k_x"]),
                      "k_v": _denoise(r["k_v"]), "k_a": _denoise(r["k_a"]), "τ": _denoise(r["tau"]),
                      "T*": _denoise(r["headway"]), "l0": _denoise(r["standstill"]),
+                     "θ_r": _denoise(r["reaction_delay"]),
                      "RMSE v": r["rmse_speed"], "RMSE gap": r["rmse_gap"], "sup|Γ|": r["sup_gain"],
                      "sup|Γ| 5 %": r["sup_gain_lo"], "sup|Γ| 95 %": r["sup_gain_hi"],
-                     "verdict": r["verdict"], "certified share (%)": 100 * r["certified_share"],
+                     "verdict": r["verdict"], "bootstrap verdict": r["supported_verdict"],
+                     "certified share (%)": 100 * r["certified_share"],
                      "not certified share (%)": 100 * r["not_certified_share"]})
     rep.section("Fitted followers").table(
         rows, caption="Per follower: the fitted parameters, the fit's error, sup|Γ| with its "
-        "5-95 % bootstrap interval, the certificate's verdict and the shares of bootstrap fits "
-        "certified / not certified.",
-        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "T*": "s", "l0": "m", "RMSE v": "m/s",
+        "5-95 % bootstrap interval, the certificate's verdict on the point fit, the verdict the "
+        "bootstrap supports (certified or not certified only when every refit agrees, else "
+        "inconclusive) and the shares of bootstrap fits certified / not certified.",
+        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "T*": "s", "l0": "m", "θ_r": "s", "RMSE v": "m/s",
                "RMSE gap": "m"})
     amp = [{"pos": v.position, "name": v.name, "max |Ĝ|": v.empirical.gain,
             "at ω": v.empirical.gain_omega, "± (2ε)": 2 * v.empirical.gain_error * v.empirical.gain,
@@ -340,6 +344,91 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
         for f in figs:
             sec.figure(f, _identify_caption(res, f))
     return rep
+
+
+def cars_report(res: Any, files: Sequence[Any], *, command: str, started: float | None = None) -> Report:
+    """The report of ``stringstab identify --by car``: one row per car and setting.
+
+    Parameters
+    ----------
+    res : CarsResult
+        :func:`stringstab.identify.cars.identify_cars`.
+    files : sequence of path-like
+        The files written (only their names are used; images become figures).
+    command : str
+        The command line.
+    started : float, optional
+        ``time.perf_counter()`` at the start of the command.
+
+    Returns
+    -------
+    Report
+        The report.
+    """
+    st = res.settings
+    rep = Report("Identified cars (every log of a car and setting pooled)", command=command,
+                 params={"logs": ", ".join(res.sources), "model": res.model,
+                         "sample time H": res.sample_time or "continuous",
+                         **{k: st[k] for k in ("bootstrap", "block", "starts", "seed", "min_duration")
+                            if k in st}},
+                 intro="Each car's controller is fitted jointly to every log of it at one distance "
+                       "setting (one law, the initial state of every segment free), certified with "
+                       "the exact delay, and bootstrapped over all its logs; a verdict is certified "
+                       "or not certified only when every bootstrap refit agrees, inconclusive "
+                       "otherwise, with the share certified.",
+                 started=started)
+    sec = rep.section("Verdicts")
+    for c in res.cars:
+        r = c.row()
+        sec.verdict(f"{c.car} ({c.setting}, {len(c.logs)} log{'s' if len(c.logs) != 1 else ''}): string "
+                    "stable (exact delay)", None if r["verdict"] == "inconclusive" else r["verdict"] == "certified",
+                    f"{c.statement()}; sup|Γ| = {r['sup_gain']:.4g}"
+                    + ("" if not all(math.isfinite(x) for x in r["sup_gain_interval"])
+                       else f" ({r['sup_gain_interval'][0]:.3g}-{r['sup_gain_interval'][1]:.3g})"))
+    rows = []
+    for c in res.cars:
+        r = c.row()
+        lo, hi = r["headway_interval"]
+        rows.append({"car": r["car"], "setting": r["setting"], "logs": len(r["logs"]),
+                     "k_x": _denoise(r["k_x"]), "k_v": _denoise(r["k_v"]), "τ": _denoise(r["tau"]),
+                     "θ_r": _denoise(r["reaction_delay"]), "T*": _denoise(r["headway"]),
+                     "T* 5 %": lo, "T* 95 %": hi, "T* from": r["headway_source"],
+                     "median time gap": r["median_time_gap"], "l0": _denoise(r["standstill"]),
+                     "sup|Γ|": r["sup_gain"], "sup|Γ| 5 %": r["sup_gain_interval"][0],
+                     "sup|Γ| 95 %": r["sup_gain_interval"][1], "verdict": r["verdict"],
+                     "certified share (%)": 100 * r["certified_share"], "max |Ĝ|": r["empirical_gain"]})
+    rep.section("Cars").table(
+        rows, caption="Per car and setting: the jointly fitted parameters, T* with its interval and "
+        "where it comes from (the spacing policy of the quasi-steady parts, or the dynamic fit), "
+        "the logs' median time gap (T* + l_0/v), sup|Γ| with its 5-95 % bootstrap interval, the "
+        "verdict the bootstrap supports with its share certified, and the data's own pooled max |Ĝ|.",
+        units={"k_x": "1/s²", "k_v": "1/s", "τ": "s", "θ_r": "s", "T*": "s", "T* 5 %": "s", "T* 95 %": "s",
+               "median time gap": "s", "l0": "m"})
+    notes = [f"{c.car} ({c.setting}): {n}" for c in res.cars for n in c.fit.notes + c.notes]
+    notes += [f"skipped: {sk}" for sk in res.skipped]
+    if notes:
+        rep.section("Notes").text("\n".join(f"- {n}".replace("*", "\\*") for n in notes))
+    figs = _pngs(Path(str(f)).name for f in files)
+    if figs:
+        sec = rep.section("Figures")
+        for f in figs:
+            sec.figure(f, _cars_caption(res, f))
+    return rep
+
+
+def _cars_caption(res: Any, name: str) -> str:
+    """The caption of one ``--by car`` figure: whose it is and its numbers, then what to see."""
+    import re
+
+    from .captions import caption_for
+
+    for c in res.cars:
+        tag = re.sub(r"[^A-Za-z0-9_-]", "_", f"{c.car}_{c.setting}")
+        if name in (f"fit_{tag}.png", f"transfer_{tag}.png"):
+            head = (f"{c.car} ({c.setting} setting, {len(c.logs)} log{'s' if len(c.logs) != 1 else ''} pooled): "
+                    f"the model's sup|Γ| = {float(c.certificate.sup_gain):.3g}, {c.statement()}. ")
+            return head + caption_for(name)
+    return caption_for(name)
 
 
 def _denoise(x: Any) -> Any:
