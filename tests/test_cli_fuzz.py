@@ -16,6 +16,7 @@ no traceback, nothing on stdout, no output.
 """
 
 import gzip
+import json
 import os
 import signal
 import string
@@ -267,7 +268,24 @@ def inputs(tmp_path_factory):
     spec.write_text('[sweep]\nname = "tiny"\nkind = "certify"\n[base]\nn = 3\n')
     hcfs = root / "hcfs"
     shutil.copytree(bundled_policy_dir(), hcfs)
-    return {"run": run, "log": log, "leader": leader, "spec": spec, "hcfs": hcfs}
+    # platoon: a CSV list of two followers, and an identify.json naming a log of two followers
+    string = root / "string.csv"
+    string.write_text("name,k_x,k_v,k_a,tau,delta,headway\nacc,0.2,0.7,0,0.3,0,1.5\n"
+                      "cav,0.5,1.0,0.6,0.2,0.2,2.0\n")
+    r2 = simulate(lead, LinearController([0.2] * 2, [0.7] * 2, [0.0] * 2, headway=1.5, standstill=4.0),
+                  2, tau=0.3, delta=0.0)
+    log2 = root / "log2.csv"
+    log2.write_text("t,v0,v1,v2,gap1,gap2\n" + "".join(
+        f"{t[k]:.1f},{r2.speed[0][k]:.6f},{r2.speed[1][k]:.6f},{r2.speed[2][k]:.6f},"
+        f"{r2.gap[0][k]:.6f},{r2.gap[1][k]:.6f}\n" for k in range(t.size)))
+    ident = root / "identify.json"
+    ident.write_text(json.dumps({"command": "identify", "skipped": [], "sources": [str(log2)],
+                                 "vehicles": [{"platoon": 0, "position": p, "name": f"car{p}",
+                                               "predecessor": f"car{p - 1}", "k_x": 0.2, "k_v": 0.7,
+                                               "k_a": 0.0, "tau": 0.3, "delta": 0.0, "headway": 1.5,
+                                               "standstill": 4.0} for p in (1, 2)]}))
+    return {"run": run, "log": log, "leader": leader, "spec": spec, "hcfs": hcfs, "string": string,
+            "log2": log2, "identify": ident}
 
 
 def _sumo() -> bool:
@@ -306,6 +324,15 @@ FILE_ARGUMENTS = [
     ["sumo", "run", "--gains-file", "{F}.csv", "--out", "{O}"],
     ["sumo", "run", "--sumocfg", "{F}.sumocfg", "--controlled", "a", "--out", "{O}"],
     ["sumo", "cacc", "--vtype", "{F}.rou.xml:cacc"],
+    ["platoon", "certify", "{F}.csv"],
+    ["platoon", "certify", "{F}.json"],
+    ["platoon", "certify", "{F}"],
+    ["platoon", "design", "--from", "{F}.csv", "--cav-at", "1"],
+    ["platoon", "design", "--from", "{F}.json", "--cav-at", "1"],
+    ["platoon", "simulate", "--from", "{F}.json", "--cav-at", "1", "--cav-gains", "0.5,1,0.6",
+     "--no-figures", "--out", "{O}"],
+    ["radio", "--leader", "{F}.csv", "--followers", "2", "--seeds", "2", "--no-figures",
+     "--no-progress", "--out", "{O}"],
 ]
 #: Files read inside a folder argument: (argv with {D}, the folder's source, the file replaced).
 FOLDER_FILES = [
@@ -355,6 +382,24 @@ def test_every_file_read_in_a_folder_argument_refuses_undecodable_bytes(argv, so
     assert Path(name).name in line and "expected" in line, line
 
 
+#: The recorded log an identify.json names (read by platoon simulate's replay).
+LOG_NAMED = [["platoon", "simulate", "--from", "{J}", "--cav-at", "1", "--cav-gains", "0.5,1,0.6",
+              "--no-figures", "--out", "{O}"]]
+
+
+@pytest.mark.parametrize("payload", sorted(PAYLOADS))
+@pytest.mark.parametrize("argv", LOG_NAMED, ids=lambda a: " ".join(a[:2]))
+def test_every_log_named_in_an_identify_json_refuses_undecodable_bytes(argv, payload, inputs,
+                                                                        tmp_path, capsys):
+    bad, out, j = tmp_path / "log.csv", tmp_path / "out", tmp_path / "identify.json"
+    bad.write_bytes(PAYLOADS[payload])
+    doc = json.loads(inputs["identify"].read_text())
+    doc["sources"] = [str(bad)]
+    j.write_text(json.dumps(doc))
+    line = _refused(_subst(argv, J=j, O=out), capsys, tmp_path, out)
+    assert bad.name in line and "expected" in line, line
+
+
 #: A valid, quick command line of each command (sub-command); {O} an output path, {RUN} etc.
 NUMERIC_BASES = {
     "derive": ["derive"],
@@ -376,6 +421,13 @@ NUMERIC_BASES = {
                  "--no-progress", "--out", "{O}"],
     "sweep": ["sweep", "{SPEC}", "--workers", "1", "--no-progress", "--out", "{O}"],
     "demo": ["demo", "--only", "certify", "--out", "{O}"],
+    "radio": ["radio", "--gains", "1.2,0.5,0.6", "--leader", "sinusoid:omega=0.5", "--duration", "20",
+              "--hold", "0", "--followers", "2", "--seeds", "2", "--loss", "0,0.1", "--burst", "1",
+              "--no-figures", "--no-progress", "--out", "{O}"],
+    "platoon certify": ["platoon", "certify", "{IDENT}", "--no-empirical"],
+    "platoon design": ["platoon", "design", "--from", "{IDENT}", "--cav-at", "2"],
+    "platoon simulate": ["platoon", "simulate", "--from", "{IDENT}", "--cav-at", "2", "--cav-gains",
+                         "0.5,1,0.6", "--no-figures", "--out", "{O}"],
 }
 FLOATS = ["nan", "inf", "-1", "1e300"]
 INTS = ["nan", "inf", "-1", HUGE_INT]
@@ -388,9 +440,23 @@ LOOP = {"--reaction-delay": FLOATS, "--message-period": FLOATS, "--message-phase
         "--fallback-gains": ["nan,0.5", "inf,0.5", "1e300,0.5"], "--noise-gap": FLOATS,
         "--noise-gap-rate": FLOATS, "--noise-speed": FLOATS, "--noise-correlation": FLOATS,
         "--noise-filter": FLOATS, "--radio-seed": INTS}
-#: What a flag needs beside it (its value is checked only then).
+#: What a flag needs beside it (its value is checked only then); (command, flag) before flag.
 NEEDS = {"--burst": ["--loss", "0.1"], "--message-phase": ["--message-period", "0.2"],
-         "--fallback-gains": ["--stale-after", "0.5"], "--radio-seed": ["--loss", "0.1"]}
+         "--fallback-gains": ["--stale-after", "0.5"], "--radio-seed": ["--loss", "0.1"],
+         ("certify", "--message-period"): ["--sample-time", "0.01"],
+         ("certify", "--max-message-period"): ["--sample-time", "0.01"],
+         ("certify", "--message-phase"): ["--sample-time", "0.01", "--message-period", "0.1"],
+         ("certify", "--fallback-gains"): ["--sample-time", "0.01", "--message-period", "0.1"],
+         ("region", "--message-period"): ["--sample-time", "0.01"],
+         ("region", "--message-phase"): ["--sample-time", "0.01", "--message-period", "0.1"],
+         ("platoon certify", "--leader-tau"): ["--sample-time", "0.1"]}
+#: The multi-rate loop's flags of certify and region (cli/_message.py, issue 26).
+MESSAGE = {"--message-period": FLOATS, "--message-phase": INTS}
+#: platoon: the string's own flags, and the CAV's (cli/platoon.py, issue 27).
+STRING = {"--platoon": INTS, "--positions": [*INTS, "1:nan", f"1:{HUGE_INT}"]}
+CAV = {"--cav-at": INTS, "--cav-tau": FLOATS, "--cav-delta": FLOATS, "--cav-headway": FLOATS,
+       "--cav-reaction-delay": FLOATS, "--gain-bounds": ["nan:2", "-inf:2", "-1e300:2", "-2:1e300"],
+       "--min-kx": FLOATS, "--max-cavs": INTS}
 #: Every numeric flag of every command (sumo's own are listed in SUMO_NUMERIC) and its bad values.
 NUMERIC = {
     "derive": {"--delay-order": INTS, "--sample-time": SAMPLE, "--reaction-delay": FLOATS,
@@ -423,7 +489,19 @@ NUMERIC = {
                  "--seed": INTS, "--min-segment": FLOATS},
     "sweep": {"--workers": INTS, "--retries": INTS},
     "demo": {"--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS},
+    "radio": {"--gains": GAINS, "--followers": INTS, "--tau": FLOATS, "--delta": FLOATS,
+              "--headway": FLOATS, "--standstill": FLOATS, "--length": FLOATS, "--dt": SAMPLE,
+              "--duration": FLOATS, "--hold": FLOATS, "--loss": [*FLOATS, "0,nan", "0,1e300"],
+              "--burst": [*FLOATS, "1,nan", "1,1e300"], "--seeds": INTS, "--v-max": FLOATS,
+              "--a-min": A_MIN, "--a-max": FLOATS,
+              **{k: v for k, v in LOOP.items() if k not in ("--loss", "--burst")}},
+    "platoon certify": {**STRING, "--sample-time": SAMPLE, "--leader-tau": FLOATS},
+    "platoon design": {**STRING, **CAV},
+    "platoon simulate": {**STRING, **CAV, "--cav-gains": GAINS},
 }
+NUMERIC["certify"].update(MESSAGE, **{"--fallback-gains": ["nan,0.5", "inf,0.5", "1e300,0.5"],
+                                      "--max-message-period": FLOATS})
+NUMERIC["region"].update(MESSAGE)
 #: sumo's numeric flags: cli/sumo.py is another engineer's (issue 29 item 4); not fuzzed here.
 SUMO_NUMERIC = {"sumo check": {"--followers", "--gains", "--tau", "--delta", "--headway", "--standstill",
                                "--length", "--dt", "--duration", "--hold", "--tolerance",
@@ -436,7 +514,7 @@ SUMO_NUMERIC = {"sumo check": {"--followers", "--gains", "--tau", "--delta", "--
 NOT_NUMERIC = {"--out", "--file", "--from", "--overlay", "--report", "--leader", "--leaders",
                "--gains-file", "--policy", "--json", "--sumocfg", "--vtype", "--scheduler",
                "--algo", "--baselines", "--reference", "--controlled", "--x", "--y", "--method",
-               "--prefix", "--format", "--only", "RUN", "LOG", "SPEC"}
+               "--prefix", "--format", "--only", "RUN", "LOG", "SPEC", "FILE"}
 
 
 def _value_options() -> dict[str, set[str]]:
@@ -476,12 +554,12 @@ def test_every_numeric_flag_refuses_nan_inf_negative_and_huge(command, flag, val
                                                                tmp_path, capsys):
     out = tmp_path / "out"
     argv = _subst(NUMERIC_BASES[command], O=out, RUN=inputs["run"], LEADER=inputs["leader"],
-                  LOG=inputs["log"], SPEC=inputs["spec"])
+                  LOG=inputs["log"], SPEC=inputs["spec"], IDENT=inputs["identify"])
     if flag == "K_X,K_V,K_A":
         argv[len(command.split())] = value
     elif flag in argv:
         argv[argv.index(flag) + 1] = value
     else:
-        argv += [flag, value, *NEEDS.get(flag, [])]
+        argv += [flag, value, *NEEDS.get((command, flag), NEEDS.get(flag, []))]
     line = _refused(argv, capsys, tmp_path, out)
     assert "expect" in line or "must" in line or "far outside" in line, line  # what was expected

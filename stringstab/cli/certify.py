@@ -287,6 +287,10 @@ def _run_max_period(args: argparse.Namespace, loop: Any, table: Any, out: Any) -
     if not cap >= loop.sample_time or cap != cap or cap == float("inf"):
         raise StringStabError(f"--max-message-period must be a finite number of seconds >= "
                               f"--sample-time {loop.sample_time:g}; got {args.max_message_period}")
+    from ..ranges import check_count
+
+    check_count("message_steps", int(cap / loop.sample_time + 1e-9),
+                name=f"--max-message-period {args.max_message_period} / --sample-time {loop.sample_time:g}")
     b = largest_message_period(loop, table.k_x, table.k_v, table.k_a, cap=cap)
     params = {**shown_params(loop.model, loop.sample_time), "max_message_period_cap": b.cap}
     summary = b.summary()

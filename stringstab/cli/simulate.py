@@ -32,7 +32,8 @@ from ._common import (
 from ._loop import add_loop_arguments, radio_from_args, reaction_from_args
 from ._outcome import collision_status
 
-__all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "radio_line", "run"]
+__all__ = ["DEFAULT_GAINS", "add_parser", "check_step", "first_collision", "parse_gains", "radio_line",
+           "run"]
 
 #: A certified triple at the default τ, δ, T* (internally stable, sup_ω |Γ(jω)| = 1 at ω = 0).
 DEFAULT_GAINS = "1.2,0.5,0.6"
@@ -158,8 +159,22 @@ def _controller(args: argparse.Namespace, headway: float) -> Any:
                             standstill=args.standstill)
 
 
-def _check_step(dt: float, tau: float, delta: float) -> None:
-    """Refuse a step longer than the actuator lag or the delay (see the module docstring)."""
+def check_step(dt: float, tau: float, delta: float) -> None:
+    """Refuse a step ``--dt`` longer than the actuator lag τ or the delay δ (module docstring).
+
+    Parameters
+    ----------
+    dt : float
+        The simulation step, s (checked finite and > 0).
+    tau, delta : float
+        The actuator lag τ and the communication delay δ, s (checked).
+
+    Raises
+    ------
+    StringStabError
+        When dt > τ, or dt > δ > 0: the exact-ZOH step would hold the command over more than
+        one lag, or interpolate the delayed acceleration across a whole step.
+    """
     limit = min(tau, delta) if delta > 0 else tau
     if dt > limit * (1 + 1e-12):
         longer = [f"the actuator lag tau = {tau:g} s"] if dt > tau * (1 + 1e-12) else []
@@ -243,7 +258,7 @@ def run(args: argparse.Namespace) -> int:
         check_magnitude(kind, v, name=option)
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
-    _check_step(args.dt, tau, delta)
+    check_step(args.dt, tau, delta)
     theta = reaction_from_args(args)
     radio, sensors = radio_from_args(args, args.dt)
 

@@ -220,11 +220,12 @@ def _check_last_line(path: Path, n_rows: int) -> None:
     writes ends with a line break, so a missing one is taken as the sign of a cut.
     """
     try:
-        with open_text(path) as fh:
+        with open_text(path, label=_where(path),
+                       expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)") as fh:
             last = ""
             while chunk := fh.read(1 << 20):
                 last = chunk[-1]
-    except (OSError, UnicodeDecodeError):
+    except (OSError, StringStabError):
         return  # the reader has already read it; its own errors are reported there
     if last not in ("\n", "\r"):
         raise StringStabError(
