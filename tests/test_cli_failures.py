@@ -232,6 +232,90 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     assert "trained ddpg: 64 steps" in capsys.readouterr().out
 
 
+def _ctrl_c_twice_at(env, at_call):
+    """``env.step`` presses Ctrl-C twice on its call ``at_call``: recorded, then raised at once."""
+    step, calls = env.step, {"n": 0}
+
+    def stepped(actions):
+        calls["n"] += 1
+        if calls["n"] == at_call:
+            signal.raise_signal(signal.SIGINT)  # the first: recorded (stop at the next step)
+            signal.raise_signal(signal.SIGINT)  # the second: KeyboardInterrupt here, mid-step
+        return step(actions)
+
+    env.step = stepped
+    return env
+
+
+def _tiny(**kw):
+    from stringstab.rl import config_for
+
+    return config_for("ddpg", total_steps=64, learning_starts=16, batch_size=8, num_envs=4, seed=0,
+                      **kw)
+
+
+def test_a_second_ctrl_c_before_the_first_checkpoint_leaves_no_folder(capsys, tmp_path, monkeypatch):
+    """The window of the flaky fuzz case: the folder used to exist from before the loop."""
+    pytest.importorskip("torch")
+    import importlib
+
+    rl_envs = importlib.import_module("stringstab.rl.envs")
+    real = rl_envs.make_env
+    monkeypatch.setattr(rl_envs, "make_env", lambda c, leaders=None: _ctrl_c_twice_at(real(c, leaders), 1))
+    handler = signal.getsignal(signal.SIGINT)
+    out = tmp_path / "run"
+    rc = main(["train", "--algo", "ddpg", "--steps", "64", "--num-envs", "4", "--out", str(out),
+               "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 130 and "interrupted; nothing partial was written" in err, err
+    assert not out.exists(), sorted(p.name for p in out.iterdir())  # (was run.json, config.json)
+    assert signal.getsignal(signal.SIGINT) is handler
+
+
+def test_a_second_ctrl_c_after_a_checkpoint_leaves_a_resumable_folder(tmp_path):
+    pytest.importorskip("torch")
+    import json
+
+    from stringstab.rl import train
+    from stringstab.rl.envs import make_env
+
+    config = _tiny(checkpoint_every=16)
+    out = tmp_path / "run"
+    with pytest.raises(KeyboardInterrupt):  # on the 7th vector step (24 steps; checkpoint at 16)
+        train(config, envs=_ctrl_c_twice_at(make_env(config), 7), out=out, progress=False)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["steps"] == 16 and summary["stopped_by"] == "checkpoint", summary
+    assert (out / "train_log.csv").is_file() and (out / "policy.json").is_file()
+    assert not (out / "rolling_reward.png").exists()  # the figure is the end's
+    res = train(config, out=out, resume=True, progress=False)  # it resumes, to the end
+    assert res.steps == 64 and res.stopped_by == "steps"
+    assert json.loads((out / "summary.json").read_text())["stopped_by"] == "steps"
+    uninterrupted = train(config, out=tmp_path / "whole", progress=False)
+    assert [e["return"] for e in res.episodes] == [e["return"] for e in uninterrupted.episodes]
+
+
+def test_ctrl_c_twice_while_a_checkpoint_is_written_is_held(tmp_path, monkeypatch):
+    pytest.importorskip("torch")
+    import json
+
+    from stringstab.rl import checkpoint as ckpt
+    from stringstab.rl import train
+
+    real = ckpt.write_checkpoint
+
+    def pressed(*a, **kw):
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)  # held: the checkpoint's files are written whole
+        return real(*a, **kw)
+
+    monkeypatch.setattr(ckpt, "write_checkpoint", pressed)
+    out = tmp_path / "run"
+    res = train(_tiny(checkpoint_every=16), out=out, progress=False)
+    assert res.stopped_by == "interrupted" and res.steps == 16  # stopped at the next step boundary
+    assert json.loads((out / "summary.json").read_text())["stopped_by"] == "interrupted"
+    assert (out / "rolling_reward.png").is_file()
+
+
 def test_a_batch_file_too_big_for_memory_is_refused(capsys, tmp_path, monkeypatch):
     """The estimate (4.5 kB per row) against the memory available, before certifying."""
     import numpy as np
