@@ -10,12 +10,17 @@ once after a warm-up (SymPy lambdify caches built):
 
 Targets on 2 cores: Taylor 201³ < 1 s, exact 801² < 10 s, exact 101³ < 60 s.
 
-``--only cli`` (issue 9): the same 801² exact slice through the command line,
-``stringstab region --method exact --format png`` in a fresh process (NPZ, CSV and the
-PNG figures included), against :func:`region_map` alone in this process on the same
-grid, ``--reps`` times, alternating, with the median ratio (target ≤ 1.5) and the
-load beside each pair; then where the command's time goes (phases timed in
-process: the map, the NPZ and CSV in this process, the figures in the forked one).
+``--only cli`` (issues 9 and 31): the 801² slice through the command line with its
+**default outputs** (every method, the NPZ, the CSV, the figures in the default formats, the
+report): ``stringstab region --fix k_a=0.5 --n 801 --workers 2``, a fresh process, against
+:func:`region_map` alone on the same grid with the same methods and workers (timed in a fresh
+process too, after a warm-up), ``--reps`` times, every variant alternated within a rep, with
+the load beside each: wall and CPU time (all processes), and the median ratios CLI / map
+(target ≤ 1.5 with the default outputs, issue 31).  The variants: *before* is the code of
+``--base`` (default f6db69e, exported with ``git archive`` into a temporary folder, run on this
+interpreter), *after* this checkout; *after, forkserver* this checkout with
+``STRINGSTAB_START_METHOD=forkserver`` (the other start method of the policy, measured for the
+choice); *after, png,pdf* this checkout with the figure formats of the base.
 For the exact maps it also times :func:`stringstab.certify.api.certify_batch`
 alone, in this process, on a 20 000-point sample of the same grid: the
 certificate's own cost per point, which bounds what the map can reach.
@@ -25,6 +30,7 @@ Prints its figures; asserts nothing.  Example::
 
     python analysis/bench_regions.py            # all three
     python analysis/bench_regions.py --only taylor --workers 1
+    python analysis/bench_regions.py --only cli --reps 5 --base f6db69e
 """
 
 from __future__ import annotations
@@ -92,74 +98,130 @@ def _cpu() -> float:
     return a.ru_utime + a.ru_stime + b.ru_utime + b.ru_stime
 
 
-def _region_cli(n: int, reps: int, workers: int | None) -> None:
-    """The 801² CLI target: the command (fresh process) against region_map alone, alternating."""
-    g = np.linspace(-2, 2, n)
-    kw = {} if workers is None else {"workers": workers}
-    cmd = [sys.executable, "-m", "stringstab", "region", "--x", "k_x", "--y", "k_v", "--fix", "k_a=0.5",
-           "--range", "-2,2", "--n", str(n), "--method", "exact", "--format", "png", "--no-progress"]
-    if workers is not None:
-        cmd += ["--workers", str(workers)]
-    print(f"region CLI target: {n}x{n} exact slice, {' '.join(cmd[3:])}")
-    ratios = []
-    cpu_ratios = []
-    for r in range(reps):
-        c0 = _cpu()
-        t0 = time.perf_counter()
-        region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, **P, methods="exact", progress=False, **kw)
-        alone = time.perf_counter() - t0
-        cpu_alone = _cpu() - c0
-        load_alone = _load()
-        work = Path(tempfile.mkdtemp(prefix="bench_regions_cli_"))
+#: Times region_map alone in a fresh process: a warm-up, then the map, wall and CPU
+#: (this process and its reaped workers) printed as one line "<wall> <cpu>".
+_MAP_ALONE = """
+import resource, sys, time
+import numpy as np
+from stringstab.regions import region_map
+def cpu():
+    a, b = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return a.ru_utime + a.ru_stime + b.ru_utime + b.ru_stime
+n, workers = int(sys.argv[1]), int(sys.argv[2])
+P = dict(tau=0.1, delta=0.2, headway=1.1)
+g = np.linspace(-2, 2, 9)
+region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, **P, workers=1, progress=False)
+g = np.linspace(-2, 2, n)
+c0, t0 = cpu(), time.perf_counter()
+region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, **P, workers=workers, progress=False)
+print(time.perf_counter() - t0, cpu() - c0)
+"""
+
+
+def _children_cpu() -> float:
+    """CPU seconds of the finished children, and of their descendants that were reaped."""
+    import resource
+
+    b = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return b.ru_utime + b.ru_stime
+
+
+def _adopt_orphans() -> None:
+    """Become a subreaper (Linux): a command's orphans (a forkserver and the workers it forked,
+    which outlive the command by a moment) are then reaped here and their CPU counted."""
+    import ctypes
+
+    PR_SET_CHILD_SUBREAPER = 36
+    ctypes.CDLL(None).prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+
+
+def _reap_orphans(timeout: float = 10.0) -> None:
+    """Wait for the adopted orphans to end (and count their CPU)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
         try:
-            c0 = _cpu()
-            t0 = time.perf_counter()
-            res = subprocess.run([*cmd, "--out", str(work / "maps")], capture_output=True, text=True)
-            cli = time.perf_counter() - t0
-            cpu_cli = _cpu() - c0
-            if res.returncode != 0:
-                raise SystemExit(f"stringstab region failed: {res.stderr.strip()}")
-            files = sorted(p.name for p in (work / "maps").iterdir() if not p.name.startswith("."))
-        finally:
-            shutil.rmtree(work, ignore_errors=True)
-        ratios.append(cli / alone)
-        cpu_ratios.append(cpu_cli / cpu_alone)
-        print(f"  rep {r + 1}: region_map alone {alone:6.2f} s wall, {cpu_alone:5.2f} s CPU "
-              f"({load_alone}); CLI {cli:6.2f} s wall, {cpu_cli:5.2f} s CPU ({_load()}); "
-              f"ratio {cli / alone:.2f} wall, {cpu_cli / cpu_alone:.2f} CPU")
-    print(f"  files written: {', '.join(files)}")
-    print(f"  median ratio CLI / region_map alone: {np.median(ratios):.2f} wall "
-          f"(target <= 1.5; min {min(ratios):.2f}, max {max(ratios):.2f}), "
-          f"{np.median(cpu_ratios):.2f} CPU time (all processes)")
-    _region_cli_phases(n, workers)
+            pid, _ = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:  # no children left
+            return
+        if pid == 0:
+            time.sleep(0.02)
 
 
-def _region_cli_phases(n: int, workers: int | None) -> None:
-    """Where the command's time goes: its phases, timed in this process."""
-    from stringstab.io import OutputDir
-    from stringstab.plots import save_region_outputs
+def _checkout(commit: str) -> Path:
+    """The package at ``commit``, exported into a temporary folder (no worktree, no checkout)."""
+    root = Path(__file__).resolve().parents[1]
+    dest = Path(tempfile.mkdtemp(prefix=f"bench_regions_{commit[:7]}_"))
+    archive = subprocess.run(["git", "-C", str(root), "archive", commit, "stringstab"],
+                             capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    return dest
 
-    g = np.linspace(-2, 2, n)
-    kw = {} if workers is None else {"workers": workers}
-    work = Path(tempfile.mkdtemp(prefix="bench_regions_phases_"))
+
+def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
+    """CLI (default outputs) over region_map alone, before (``base``) and after, alternated."""
+    w = str(workers or 2)
+    cli = [sys.executable, "-m", "stringstab", "region", "--fix", "k_a=0.5", "--n", str(n),
+           "--workers", w, "--no-progress"]
+    base_dir = _checkout(base)
+    # run every command from a neutral folder: from the repository root, Python would import
+    # this checkout's package (the current directory comes before PYTHONPATH)
+    outside = tempfile.mkdtemp(prefix="bench_regions_cwd_")
+    _adopt_orphans()
+    here = dict(os.environ)
+    here.pop("STRINGSTAB_START_METHOD", None)
+    old = {**here, "PYTHONPATH": str(base_dir)}
+    variants = {  # name: (environment, extra arguments, ratio against the map of ...)
+        "before": (old, [], "before"),
+        "after": (here, [], "after"),
+        "after, forkserver": ({**here, "STRINGSTAB_START_METHOD": "forkserver"}, [], "after"),
+        "after, png,pdf": (here, ["--format", "png,pdf"], "after"),
+    }
+    print(f"region CLI target (issue 31): {n}x{n} slice, default outputs: stringstab region "
+          f"{' '.join(cli[4:])} --out DIR; before = {base} ({base_dir}), after = this checkout")
+    rows: dict[str, list[tuple[float, float]]] = {k: [] for k in ("map before", "map after", *variants)}
+    files: dict[str, list[str]] = {}
     try:
-        t0 = time.perf_counter()
-        m = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, **P, methods="exact", progress=False, **kw)
-        t_map = time.perf_counter() - t0
-        times = {}
-        for processes in (2, 1):
-            t1 = time.perf_counter()
-            with OutputDir(work / f"maps{processes}", command="region") as out:
-                save_region_outputs(m, out, formats=("png",), processes=processes)
-            times[processes] = time.perf_counter() - t1
-        t1 = time.perf_counter()
-        m.save_csv(work / "alone.csv")
-        t_csv = time.perf_counter() - t1
+        for r in range(reps):
+            for label, env in (("map before", old), ("map after", here)):
+                res = subprocess.run([sys.executable, "-c", _MAP_ALONE, str(n), w], env=env,
+                                     capture_output=True, text=True, check=True, cwd=outside)
+                wall, cpu = (float(x) for x in res.stdout.split())
+                rows[label].append((wall, cpu))
+                print(f"  rep {r + 1}: {label:<18} {wall:6.2f} s wall {cpu:6.2f} s CPU ({_load()})",
+                      flush=True)
+            for name, (env, extra, _) in variants.items():
+                work = Path(tempfile.mkdtemp(prefix="bench_regions_cli_"))
+                try:
+                    c0, t0 = _children_cpu(), time.perf_counter()
+                    res = subprocess.run([*cli, *extra, "--out", str(work / "maps")], env=env,
+                                         capture_output=True, text=True, cwd=outside)
+                    wall = time.perf_counter() - t0
+                    _reap_orphans()
+                    cpu = _children_cpu() - c0
+                    if res.returncode != 0:
+                        raise SystemExit(f"{name}: stringstab region failed: {res.stderr.strip()}")
+                    files[name] = sorted(p.name for p in (work / "maps").iterdir()
+                                         if not p.name.startswith("."))
+                finally:
+                    shutil.rmtree(work, ignore_errors=True)
+                rows[name].append((wall, cpu))
+                print(f"  rep {r + 1}: CLI {name:<14} {wall:6.2f} s wall {cpu:6.2f} s CPU "
+                      f"({_load()})", flush=True)
     finally:
-        shutil.rmtree(work, ignore_errors=True)
-    print(f"  phases (in process, {_load()}): map {t_map:.2f} s; outputs (NPZ, CSV, PNGs) "
-          f"{times[2]:.2f} s shared by two processes, {times[1]:.2f} s in one "
-          f"(of which the CSV alone {t_csv:.2f} s)")
+        shutil.rmtree(base_dir, ignore_errors=True)
+        shutil.rmtree(outside, ignore_errors=True)
+    for name, fs in files.items():
+        print(f"  files, {name}: {len(fs)}: {', '.join(fs)}")
+    print(f"  medians over {reps} reps ({_load()}):")
+    for label in ("map before", "map after"):
+        wall, cpu = (float(np.median([x[k] for x in rows[label]])) for k in (0, 1))
+        print(f"    region_map alone, {label[4:]:<17} {wall:6.2f} s wall {cpu:6.2f} s CPU")
+    for name, (_, _, against) in variants.items():
+        ratio = [a[0] / b[0] for a, b in zip(rows[name], rows[f"map {against}"])]
+        cpu_ratio = [a[1] / b[1] for a, b in zip(rows[name], rows[f"map {against}"])]
+        print(f"    CLI / region_map, {name:<17} {np.median(ratio):5.2f} wall "
+              f"(min {min(ratio):.2f}, max {max(ratio):.2f}), {np.median(cpu_ratio):5.2f} CPU"
+              f"{'   (target <= 1.5)' if name == 'after' else ''}")
 
 
 def main() -> None:
@@ -168,7 +230,9 @@ def main() -> None:
                     help="run only these benchmarks (repeatable; 'cli' only when named)")
     ap.add_argument("--reps", type=int, default=5, help="repetitions of the cli target (default 5)")
     ap.add_argument("--workers", type=int, default=None,
-                    help="worker processes (default: region_map's choice, all cores)")
+                    help="worker processes (default: region_map's choice, all cores; 2 for cli)")
+    ap.add_argument("--base", default="f6db69e",
+                    help="the commit measured as 'before' by --only cli (default f6db69e)")
     args = ap.parse_args()
     which = args.only or ["taylor", "slice", "volume"]
     print(f"cores available: {len(os.sched_getaffinity(0))}; workers: {args.workers or 'auto'}")
@@ -192,7 +256,7 @@ def main() -> None:
         _time_map("exact 101^3 volume", axes, None, ("exact",), args.workers, 60.0)
         _time_certificate(axes, None)
     if "cli" in which:
-        _region_cli(801, args.reps, args.workers)
+        _region_cli(801, args.reps, args.workers, args.base)
 
 
 if __name__ == "__main__":

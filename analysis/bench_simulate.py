@@ -23,10 +23,10 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from stringstab.parallel import process_pool
 from stringstab.traffic import BatchedCarFollowingEnv, LinearController, cycle, simulate
 
 K = (1.2, 0.5, 0.6)
@@ -50,7 +50,7 @@ def best(repeat: int, *args: object) -> tuple[float, int]:
 def parallel(processes: int, n_platoons: int, n_followers: int) -> tuple[float, int]:
     shares = [len(c) for c in np.array_split(np.arange(n_platoons), processes)]
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(processes) as ex:
+    with process_pool(processes) as ex:  # the package's start-method policy
         done = list(ex.map(_run, shares, [n_followers] * processes, [None] * processes,
                            [False] * processes))
     return time.perf_counter() - t0, sum(n for _, n in done)

@@ -88,13 +88,14 @@ def test_out_extension_picks_the_format_and_a_conflict_is_an_error(capsys, tmp_p
     assert t.read_text().startswith("# tau")
 
 
-def test_progress_lines_say_how_long_is_left():
+def test_progress_lines_are_plain_and_say_when_done():
+    # the time left, after a warm-up, is checked on a synthetic clock in tests/test_progress.py
     buf = io.StringIO()
     with Progress(10, "stringstab x", unit="runs", stream=buf, every=0.0, tty=False) as p:
         for _ in range(10):
             p.update(1)
     lines = buf.getvalue().splitlines()
-    assert lines[0].startswith("stringstab x: 1/10 runs (10%), ") and "left" in lines[0]
+    assert lines[0].startswith("stringstab x: 1/10 runs (10%), ") and "\r" not in buf.getvalue()
     assert lines[-1].startswith("stringstab x: 10/10 runs done in ")
     silent = io.StringIO()
     with Progress(10, "x", stream=silent, every=0.0, tty=False, enabled=False) as p:
@@ -114,7 +115,7 @@ def test_evaluate_records_the_policy_refuses_mixing_and_names_a_stale_evaluation
     ev = ["evaluate", str(run), "--leaders", str(lead), "--platoon", "none"]
     assert main(ev) == 1  # an acceleration policy has no gains to certify
     err = capsys.readouterr().err
-    assert "stringstab evaluate: 1/1 vehicle-runs done in" in err  # progress, not a terminal
+    assert "stringstab evaluate: 301/301 vehicle-steps done in" in err  # 30 s at 0.1 s
     assert "warning: the leader reaches 34.7 m/s" in err
     man = json.loads((run / "evaluation" / MANIFEST).read_text())
     assert man["command"] == "evaluate" and man["policy"]["steps"] == 64
@@ -148,11 +149,15 @@ def test_hcfs_verify_and_compare_report_progress_off_a_terminal(capsys, tmp_path
     monkeypatch.setattr(Progress, "EVERY", 0.0)
     out = tmp_path / "h"
     assert main(["hcfs", "verify", "-J", "2.5", "--followers", "2", "--policy", "stand-in",
-                 "--leader", "stop-and-go", "braking", "--duration", "15", "--no-figures",
+                 "--leader", "stop-and-go", "braking", "--duration", "15",
                  "--out", str(out)]) in (0, 1)
     err = capsys.readouterr().err
-    assert "stringstab hcfs verify: 1/2 leaders (50%), " in err and "left" in err
+    assert "stringstab hcfs verify: 1/2 leaders (50%), " in err and "\r" not in err
     assert "stringstab hcfs verify: 2/2 leaders done in " in err
+    # the figures are counted too (they took 85 s after "2/2 leaders done", silently)
+    n_fig = len(list(out.glob("*.png")))
+    assert n_fig > 1 and f"stringstab hcfs verify: figures: 1/{n_fig} figures " in err
+    assert f"stringstab hcfs verify: figures: {n_fig}/{n_fig} figures done in " in err
 
 
 def test_demo_takes_the_limits(capsys, tmp_path):

@@ -112,7 +112,7 @@ def _writes(path: str) -> None:
 
 def test_background_process_reports_its_failure(tmp_path):
     from stringstab.errors import StringStabError
-    from stringstab.regions.pool import in_background
+    from stringstab.parallel import in_background
 
     join = in_background(_writes, str(tmp_path / "f.txt"))
     join()

@@ -10,8 +10,8 @@ Helmert vectors — integers, exactly orthogonal to 1 and to each other — Q = 
 invertible, and for θ ≠ 0, S = diag(1/(z − 1), I) makes
 
 .. math::
-    M(θ) = S^* Q^T (I − G^*G) Q S = \begin{bmatrix} m_{ee} & m_{eV} \\ m_{eV}^* & V^T(I − G^*G)V
-    \end{bmatrix},
+    M(θ) = S^* Q^T (I − G^*G) Q S,\qquad
+    M_{11} = m_{ee},\quad M_{12} = M_{21}^* = m_{eV},\quad M_{22} = V^T(I − G^*G)V,
 
     m_{ee} = 2\,\mathrm{Re}\,(γ(z) + c_1(z)) − γ(1) − \|\dot G(z) e\|^2,\qquad
     m_{eV} = z\, e^T \dot G(z) V − (\dot G(z) e)^* G(z) V,

@@ -4,9 +4,9 @@ H(z) of :mod:`stringstab.certify.zoh` is a product of a factor of the follower's
 factor of what it receives from its predecessor:
 
 .. math::
-    H(z) = \underbrace{\frac{φ_1}{Δ(w)}}_{τ,\ T^*}\;
-           \underbrace{\frac{n(w) + z^{-(m+1)} k_a w^2 \ell(w)}{φ_{1p}}}_{τ_p,\ δ},
+    H(z) = \frac{φ_1}{Δ(w)}\;\cdot\;\frac{n(w) + z^{-(m+1)} k_a w^2 \ell(w)}{φ_{1p}},
 
+the first factor depending on τ and T* only, the second on τ_p and δ only:
 Δ depending on the follower's lag τ and headway T* (through c = k_v + T*k_x), n, ℓ and
 φ1p on the predecessor's lag τ_p and the delay δ = (m + ε)H.  On the unit circle
 (ρ = 4 sin²(θ/2)), with Δ̂ = Δ/(φ1H²) and N̂ = (n + z^{−(m+1)}k_a w²ℓ)/(φ1pH²) (both → the

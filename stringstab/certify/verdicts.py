@@ -250,7 +250,7 @@ def one_triple(fn: str, batch_fn: str, **gains: Any) -> None:
 
 
 def chunks(n: int, chunk: int, *, progress: bool = False, desc: str = "certify") -> Iterable[slice]:
-    """Consecutive slices of ``chunk`` rows covering ``range(n)`` (a tqdm bar with ``progress``).
+    """Consecutive slices of ``chunk`` rows covering ``range(n)`` (with their ``progress``).
 
     Parameters
     ----------
@@ -259,22 +259,26 @@ def chunks(n: int, chunk: int, *, progress: bool = False, desc: str = "certify")
     chunk : int
         Rows per slice (the last may be shorter).
     progress : bool
-        Show a tqdm bar over the chunks.
+        Report the chunks done (:class:`stringstab.progress.Progress`: a bar on a terminal,
+        plain lines otherwise).
     desc : str
-        Label of the bar.
+        Label of the progress.
 
     Yields
     ------
     slice
         ``slice(s, min(s + chunk, n))`` for s = 0, chunk, 2·chunk, …
     """
-    starts: Iterable[int] = range(0, n, chunk)
-    if progress:
-        from tqdm.auto import tqdm
+    if not progress:
+        for s0 in range(0, n, chunk):
+            yield slice(s0, min(s0 + chunk, n))
+        return
+    from ..progress import Progress  # a bar on a terminal, plain lines otherwise
 
-        starts = tqdm(starts, total=math.ceil(n / chunk), desc=desc, unit="chunk")
-    for s0 in starts:
-        yield slice(s0, min(s0 + chunk, n))
+    with Progress(math.ceil(n / chunk), desc, unit="chunks") as bar:
+        for s0 in range(0, n, chunk):
+            yield slice(s0, min(s0 + chunk, n))
+            bar.update(1)
 
 
 class SingleResult:

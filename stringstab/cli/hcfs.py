@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import shlex
 from pathlib import Path
@@ -187,8 +188,15 @@ def run_verify(args: argparse.Namespace) -> int:
         ver = verify(leaders, policy, jerk_limits=Js, n_followers=args.followers, beta=beta,
                      progress=bar.update, accel_min=limits.accel_min,
                      accel_max=limits.accel_max, speed_max=limits.speed_max)
-    with out:
-        files = write_report(ver, out, figures=not args.no_figures, command=command, started=t0)
+    with contextlib.ExitStack() as stack:  # the figures are counted too: no silent minute
+        def figures(total: int) -> Any:
+            return stack.enter_context(Progress(
+                total, "stringstab hcfs verify: figures", unit="figures",
+                enabled=not args.no_progress and total > 0)).update
+
+        with out:
+            files = write_report(ver, out, figures=not args.no_figures, command=command,
+                                 started=t0, progress=figures)
     print(f"HCFS jerk theorem, {args.followers} followers, beta = {beta:g}, a1 = {ver.runs[0].params['policy_label']}")
     for x in ver.results:
         if x["mode"] in ("paper", "safe"):

@@ -110,8 +110,9 @@ def add_parser(sub: Any) -> None:
                    help="gain trajectory (.csv/.json/.npz as for certify) drawn on the 2-D map")
     p.add_argument("--out", "-o", default="maps", metavar="DIR", help="output directory (default: maps)")
     p.add_argument("--prefix", default="region", metavar="NAME", help="file name stem (default: region)")
-    p.add_argument("--format", default="png,pdf", metavar="F[,F...]",
-                   help="figure formats among png, pdf, svg (default: png,pdf)")
+    p.add_argument("--format", default="png", metavar="F[,F...]",
+                   help="figure formats among png, pdf, svg (default: png; e.g. png,pdf for "
+                        "print-ready copies too)")
     p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
     p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
     p.add_argument("--scheduler", metavar="ADDRESS|local",
@@ -234,14 +235,6 @@ def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, fl
     return axes, fixed
 
 
-def _warm_up_outputs() -> None:
-    from ..io.text_formats import warm_up as warm_up_writer
-    from ..plots import warm_up as warm_up_plots
-
-    warm_up_plots()
-    warm_up_writer()
-
-
 @contextlib.contextmanager
 def _executor(scheduler: str | None, workers: int | None) -> Iterator[tuple[Any, int | None]]:
     """(executor, its workers) of ``--scheduler``, or (None, None): the local process pool."""
@@ -325,14 +318,12 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     out = OutputDir(args.out, command="region", what="--out")
 
-    # while the map is computed (in worker processes), a thread here imports the plotting code
-    # and draws once (fonts, mathtext), and imports the CSV writer's pyarrow, so the outputs
-    # (here and in the process forked to share them) do not pay for it afterwards
-    import threading
+    # the process that draws the figures starts first, while this process is single-threaded
+    # (stringstab.parallel: no fork while a thread runs), and imports and warms up the
+    # plotting code while the map is computed in the worker pool
+    from ..plots import start_output_helper
 
-    warm = threading.Thread(target=_warm_up_outputs, name="stringstab-output-warm-up", daemon=True)
-    warm.start()
-    try:
+    with start_output_helper() as helper:
         # region_map validates the methods before computing anything
         with _executor(args.scheduler, workers) as (executor, n_dask):
             if thetas is not None:  # -- one map per θ_r (issue 25 part 2)
@@ -343,7 +334,6 @@ def run(args: argparse.Namespace) -> int:
                                        sample_time=H, methods=methods,
                                        workers=n_dask or workers, executor=executor,
                                        progress=False if args.no_progress else None)
-                rmap = sweep.maps[0]
             else:
                 rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
                                   headway=model.headway, sample_time=H, methods=methods,
@@ -351,28 +341,32 @@ def run(args: argparse.Namespace) -> int:
                                   progress=False if args.no_progress else None,
                                   reaction_delay=model.reaction_delay,
                                   message_period=None if N is None else args.message_period)
-    finally:
-        warm.join()
-    if thetas is not None:
-        return _write_sweep(sweep, out, args, formats, dpi, t0)
+        if thetas is not None:  # each map's figures in its own helper (save_region_outputs)
+            return _write_sweep(sweep, out, args, formats, dpi, t0)
+        written = _write(rmap, out, args, formats, gains, dpi, helper, t0)
+    print(rmap.report())
+    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
+    return 0
+
+
+def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], gains: Any,
+           dpi: int, helper: Any, t0: float) -> list[Path]:
+    """The map's files (shared with ``helper``) and the report, all-or-nothing in ``out``."""
+    from ..plots import save_region_outputs
+
     verdicts = None
     if gains is not None:  # compute, then draw: the overlay's own exact verdicts
         from ..plots import trajectory_verdicts
 
         verdicts = trajectory_verdicts(rmap, gains)
-
-    from ..plots import save_region_outputs
-
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi)
+                                      verdicts=verdicts, dpi=dpi, helper=helper)
         from ..report import command_line
         from ..report.commands import region_report
 
         region_report(rmap, written, command=command_line(args), started=t0).write(out)
-    print(rmap.report())
-    print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
-    return 0
+    return written
 
 
 def _write_sweep(sweep: Any, out: Any, args: argparse.Namespace, formats: list[str], dpi: int,

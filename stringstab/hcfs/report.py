@@ -244,7 +244,8 @@ def report_markdown(ver: Verification, *, command: str | None = None,
 
 
 def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: bool = True,
-                 command: str | None = None, started: float | None = None) -> dict[str, str]:
+                 command: str | None = None, started: float | None = None,
+                 progress: Any = None) -> dict[str, str]:
     """Write ``report.md``, ``report.json`` and (optionally) the figures into ``out``.
 
     ``out`` is a folder path or an open :class:`~stringstab.io.OutputDir`; a path is written
@@ -265,6 +266,10 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
         The command that reproduces the run, shown in the report.
     started : float, optional
         ``time.perf_counter()`` at the start of the run, for the report's wall time.
+    progress : callable, optional
+        ``progress(total)`` is called once with the number of figures to draw (0 without
+        figures) and returns a callable called with 1 after each figure (e.g. a
+        :class:`stringstab.progress.Progress`'s ``update``).
 
     Returns
     -------
@@ -273,9 +278,11 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
     """
     if not isinstance(out, OutputDir):
         with OutputDir(out, command="hcfs verify") as od:
-            return write_report(ver, od, figures=figures, command=command, started=started)
+            return write_report(ver, od, figures=figures, command=command, started=started,
+                                progress=progress)
     files: dict[str, str] = {}
     figs = _figure_names(ver) if figures else None
+    done = None if progress is None else progress(sum(len(n) for _, _, n in figs or []))
     if figs:
         from matplotlib.figure import Figure
 
@@ -291,6 +298,8 @@ def write_report(ver: Verification, out: str | Path | OutputDir, *, figures: boo
                 plot_figure(ver.runs[r], J, kind, fig=fig)
                 fig.savefig(out.path(name), dpi=110)
                 files[name] = name
+                if done is not None:
+                    done(1)
     out.write_json("report.json", report_dict(ver, command=command))
     files["json"] = "report.json"
     from ..report import Report, caption_for

@@ -24,6 +24,7 @@ module / function              shows
 **files of a map**             (:mod:`stringstab.plots.outputs`)
 :func:`save_figures`           the standard figures of a map, in every format
 :func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
+:func:`start_output_helper`    the second of those processes, started (and warming up) early
 **gain repair**                (:mod:`stringstab.plots.tuning`)
 :func:`moves_projection`       the certified region over the repairs' k_a (compute)
 :func:`plot_moves`             repairs K0 → K over the certified region
@@ -45,7 +46,13 @@ from __future__ import annotations
 from ..io.figures import FIGURE_FORMATS
 from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
 from .mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
-from .outputs import draw_figure, figure_stems, save_figures, save_region_outputs
+from .outputs import (
+    draw_figure,
+    figure_stems,
+    save_figures,
+    save_region_outputs,
+    start_output_helper,
+)
 from .reaction_sweep import plot_certified_share, save_reaction_sweep_outputs
 from .region_sets import plot_boundaries, plot_facets
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
@@ -83,6 +90,7 @@ __all__ = [
     "save_figures",
     "save_reaction_sweep_outputs",
     "save_region_outputs",
+    "start_output_helper",
     "trajectory_verdicts",
     "warm_up",
 ]

@@ -2,15 +2,17 @@
 
 :func:`figure_stems` names the standard figures of a map and :func:`draw_figure` draws one;
 :func:`save_figures` draws them and saves each in every format (:func:`stringstab.io.save_figure`),
-optionally in forked processes (:func:`stringstab.regions.pool.map_forked`).
+optionally in worker processes (:func:`stringstab.parallel.map_processes`).
 
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
 CSV table (2-D maps) and the standard figures — and splits that work between this process
-and one forked process (on a machine with two cores, writing is then about half as long):
-the tasks (the NPZ, the CSV, one task per figure) are dealt out by their estimated cost, the
-larger first, each to the process with less work so far (the longest-processing-time rule);
-each task writes its own file.  Files are staged in a :class:`stringstab.io.OutputDir` or
-written into a folder.
+and a helper process: this one writes the data files (the NPZ, the CSV), the helper the
+figures, shared among processes forked from it (two on a machine with two cores), which
+inherit its warm plotting code: matplotlib is imported once.  The helper is a
+:func:`stringstab.parallel.start_helper` (the package's start-method policy);
+:func:`start_output_helper` starts one early, before a map's worker pool, so that it imports
+and warms up the plotting code while the map is computed.  Files are staged in a
+:class:`stringstab.io.OutputDir` or written into a folder.
 
 Every function here draws results computed beforehand: a gain trajectory comes with its
 verdicts (:func:`~stringstab.plots.trajectory_verdicts`).
@@ -26,8 +28,8 @@ from typing import Any
 
 from ..errors import StringStabError
 from ..io.figures import check_figure_formats, figure_metadata, save_figure
+from ..parallel import Helper, cpu_count, map_processes, start_helper
 from ..regions import RegionMap
-from ..regions.pool import in_background, map_forked
 from ._common import pyplot
 from .map_axes import method_title
 from .projection import plot_projected_region, projected_region
@@ -35,7 +37,8 @@ from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
 from .trajectory import gain_rows, plot_trajectory
 
-__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs"]
+__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs",
+           "start_output_helper"]
 
 
 def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
@@ -159,8 +162,8 @@ def save_figures(
     dpi : int
         Resolution of raster formats.
     workers : int
-        Processes drawing the figures (forked, :func:`stringstab.regions.pool.map_forked`;
-        1 draws them here, one after another).
+        Processes drawing the figures (:func:`stringstab.parallel.map_processes`; 1 draws
+        them here, one after another).
     stems : sequence of str, optional
         Draw only these of :func:`figure_stems`.
 
@@ -184,7 +187,7 @@ def save_figures(
     elif any(s not in every for s in stems):
         raise StringStabError(f"figures must be among {every}; got {list(stems)}")
     jobs = [(stem, [(f, _stage(out, f"{prefix}_{stem}.{f}")) for f in formats]) for stem in stems]
-    map_forked(_FigureJob(rmap, gains, verdicts, dpi), jobs, workers)
+    map_processes(_FigureJob(rmap, gains, verdicts, dpi), jobs, workers)
     return [_final(out, f"{prefix}_{stem}.{f}") for stem in stems for f in formats]
 
 
@@ -212,53 +215,62 @@ def _need_verdicts(gains: Any, verdicts: Any) -> None:
                               "stringstab.plots.trajectory_verdicts(rmap, gains)); got none")
 
 
-#: Estimated costs (s) on one core: per grid point of the NPZ archive and per CSV row and
-#: column; per figure file; importing pyplot in a process.  Only their ratios matter.
-_NPZ_PER_POINT = 0.35e-6
-_CSV_PER_CELL = 0.075e-6
-_FIGURE_FILE = {"png": 0.3, "pdf": 0.4, "svg": 0.55}
-_PYPLOT = 0.3
+def _warm_up_outputs() -> None:
+    """Import and warm up what drawing a map's figures needs: pyplot (Agg), a first figure.
+
+    Run in the helper of :func:`start_output_helper` while the map is computed.
+    """
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    from ._common import warm_up
+
+    warm_up()
 
 
-def _plan(rmap: RegionMap, stems: Sequence[str], formats: Sequence[str],
-          processes: int) -> list[list[tuple[Any, ...]]]:
-    """The tasks of each process (0 is this one), dealt out by estimated cost."""
-    tasks: list[tuple[float, tuple[Any, ...]]] = [(_NPZ_PER_POINT * rmap.size, ("npz",))]
+def start_output_helper() -> Helper:
+    """Start the helper process of :func:`save_region_outputs`, warming up now.
+
+    Start it before the map's worker pool (both are then started from a single-threaded
+    process, :mod:`stringstab.parallel`): it imports the plotting code and draws once while
+    the map is computed, so that the figures it draws afterwards do not wait for that.
+
+    Returns
+    -------
+    stringstab.parallel.Helper
+        To pass to :func:`save_region_outputs` (``helper=``); use it as a context manager
+        (leaving by an error stops it).
+    """
+    return start_helper(_warm_up_outputs, preload=("stringstab.plots.outputs",))
+
+
+#: Drawing cost of a figure relative to a class map (measured on an 801² map: the sup|Γ| heat
+#: map with its certified boundary, about twice as long); the costliest are drawn first.
+_FIGURE_COST = {"sup_gain": 2.0, "overlay": 2.0}
+
+
+def _draw_all(rmap: RegionMap, folder: Path, prefix: str, formats: Sequence[str],
+              stems: Sequence[str], gains: Any, verdicts: Any, dpi: int, drawers: int) -> None:
+    """The figures (in the helper): shared by ``drawers`` processes forked from it, warm.
+
+    The costliest first (the longest-processing-time rule), so that no drawer is left with a
+    long figure at the end while the others wait.
+    """
+    import matplotlib
+
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    order = sorted(stems, key=lambda s: -_FIGURE_COST.get(s, 1.0))
+    save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
+                 dpi=dpi, stems=order, workers=drawers)
+
+
+def _write_data(rmap: RegionMap, folder: Path, prefix: str) -> None:
+    """The NPZ archive and, for a 2-D map, the CSV table."""
+    rmap.save_npz(folder / f"{prefix}.npz")
     if rmap.ndim == 2:
-        tasks.append((_CSV_PER_CELL * rmap.n_columns * rmap.size, ("csv",)))
-    tasks += [(sum(_FIGURE_FILE[f] for f in formats), ("fig", s)) for s in stems]
-    load = [0.0] * processes
-    plan: list[list[tuple[Any, ...]]] = [[] for _ in range(processes)]
-    cold = "matplotlib.pyplot" not in sys.modules  # else forked processes inherit it
-
-    def cost_in(k: int, cost: float, task: tuple[Any, ...]) -> float:
-        # the first figure of a process also pays for importing pyplot there
-        first = task[0] == "fig" and not any(t[0] == "fig" for t in plan[k])
-        return cost + (_PYPLOT if first and cold else 0.0)
-
-    for cost, task in sorted(tasks, key=lambda t: -t[0]):
-        k = min(range(processes), key=lambda i: load[i] + cost_in(i, cost, task))
-        load[k] += cost_in(k, cost, task)
-        plan[k].append(task)
-    return plan
-
-
-def _run(tasks: Sequence[tuple[Any, ...]], rmap: RegionMap, out: Any, prefix: str,
-         formats: Sequence[str], gains: Any, verdicts: Any, dpi: int) -> None:
-    """Do ``tasks`` (in this process or a forked one): each writes its own staged file."""
-    stems = [t[1] for t in tasks if t[0] == "fig"]
-    for t in tasks:
-        if t[0] == "npz":
-            rmap.save_npz(_stage(out, f"{prefix}.npz"))
-        elif t[0] == "csv":
-            rmap.save_csv(_stage(out, f"{prefix}.csv"))
-    if stems:
-        import matplotlib
-
-        if "matplotlib.pyplot" not in sys.modules:
-            matplotlib.use("Agg")
-        save_figures(rmap, out, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
-                     dpi=dpi, stems=stems)
+        rmap.save_csv(folder / f"{prefix}.csv")
 
 
 def _stage(out: Any, name: str) -> Path:
@@ -274,6 +286,7 @@ def _final(out: Any, name: str) -> Path:
 def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
+    helper: Helper | None = None,
 ) -> list[Path]:
     """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps) and the standard figures.
 
@@ -287,7 +300,12 @@ def save_region_outputs(
     prefix, formats, gains, verdicts, dpi
         As for :func:`save_figures` (``verdicts`` are required with ``gains``).
     processes : int
-        1 writes everything here; 2 (default) shares the work with one forked process.
+        1 writes everything here; 2 (default) shares the work with a helper process
+        (:func:`stringstab.parallel.start_helper`, started now unless ``helper`` is given),
+        which draws the figures in processes forked from it while this one writes the data.
+    helper : stringstab.parallel.Helper, optional
+        A helper started earlier by :func:`start_output_helper` (warm); it draws the figures
+        (whatever ``processes``), and is done with when this returns.
 
     Returns
     -------
@@ -314,14 +332,18 @@ def save_region_outputs(
     stems = figure_stems(rmap, gains is not None)
     names = [f"{prefix}.npz", *([f"{prefix}.csv"] if rmap.ndim == 2 else []),
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]
+    folder = Path()
     for name in names:  # register every output here, whichever process writes it
-        _stage(out, name)
-    plan = _plan(rmap, stems, formats, max(1, int(processes)))
-    args = (rmap, out, prefix, formats, gains, verdicts, dpi)
-    join = in_background(_run, plan[1], *args) if len(plan) > 1 and plan[1] else None
-    try:
-        _run(plan[0], *args)
-    finally:
-        if join is not None:
-            join()
+        folder = _stage(out, name).parent
+    figures = (rmap, folder, prefix, formats, stems, gains, verdicts, dpi)
+    if helper is None and (int(processes) <= 1 or not stems):
+        _write_data(rmap, folder, prefix)
+        _draw_all(*figures, 1)
+        return [_final(out, n) for n in names]
+    if helper is None:
+        helper = start_helper()
+    with helper:  # the figures there (in its forked drawers), the data files here
+        helper.submit(_draw_all, *figures, min(max(2, cpu_count() - 1), len(stems)))
+        _write_data(rmap, folder, prefix)
+        helper.result()
     return [_final(out, n) for n in names]

@@ -13,8 +13,8 @@ beside a sampled one as the ``continuous`` method.
 
 from __future__ import annotations
 
+import contextlib
 import math
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -26,9 +26,10 @@ from ..certify.criteria import hurwitz, proposition1, stability_type
 from ..certify.verdicts import codes
 from ..derive import generated as _gen
 from ..errors import StringStabError
+from ..parallel import cpu_count, in_daemon
 from ..params import Box, Params, parameter_model
 from ..params import sample_time as _sample_time
-from .pool import cpu_count, in_daemon, run_blocks
+from .pool import run_blocks
 from .result import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE, RegionMap
 
 __all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
@@ -321,8 +322,8 @@ def region_map(
         Grid points per block (bounds the working memory); default 16 384 with
         ``exact``, 2¹⁹ otherwise.
     progress : bool, optional
-        tqdm progress bar on standard error; default: on for maps estimated to
-        take more than 5 s.
+        Progress on standard error (:class:`stringstab.progress.Progress`: a bar on a
+        terminal, plain lines otherwise); default: on for maps estimated to take more than 5 s.
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently.
     executor : concurrent.futures.Executor, optional
@@ -417,21 +418,16 @@ def region_map(
         res["sup_gain"] = np.empty(shape3)
         res["margin"] = np.empty(shape3)
 
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
+    # plain lines off a terminal, a bar without a monitor thread on one (stringstab.progress)
+    from ..progress import Progress
 
-        bar = tqdm(total=n, desc="region map", unit="pt", unit_scale=True, file=sys.stderr)
-    try:
-        for (i0, i1, j0, j1), out in run_blocks(_eval_block, spec, blocks, workers, warm=_warm,
-                                                executor=executor):
+    blocks_done = run_blocks(_eval_block, spec, blocks, workers, warm=_warm, executor=executor)
+    with Progress(n, "region map", unit="points", enabled=bool(progress)) as bar, \
+            contextlib.closing(blocks_done):
+        for (i0, i1, j0, j1), out in blocks_done:
             for k, v in out.items():
                 res[k][i0:i1, j0:j1] = v
-            if bar is not None:
-                bar.update((i1 - i0) * (j1 - j0) * n2)
-    finally:
-        if bar is not None:
-            bar.close()
+            bar.update((i1 - i0) * (j1 - j0) * n2)
 
     grid_shape = tuple(a.size for a in coords.values())
 

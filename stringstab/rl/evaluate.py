@@ -353,7 +353,8 @@ def evaluate(strategy: Policy | str, leaders: Sequence[Any], *, tau: float, delt
 
 def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: float,
                  headway: float, dt: float = 0.1, hold: float = 100.0,
-                 standstill: float = STANDSTILL, limits: Any = None) -> dict[str, Any]:
+                 standstill: float = STANDSTILL, limits: Any = None,
+                 progress: Any = None) -> dict[str, Any]:
     """``n_vehicles`` running ``strategy`` behind the §5.1-style leader: m_p per vehicle and more.
 
     Parameters
@@ -377,6 +378,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
         Standstill distance l_0 (eq 3), m; the platoon starts in equilibrium l_0 + T* v.
     limits : Limits, optional
         Bounds on the followers (default IDL Table 2).
+    progress : callable, optional
+        Called with 1 at each simulated step (a progress report's count).
 
     Returns
     -------
@@ -393,7 +396,8 @@ def platoon_test(strategy: Policy | str, n_vehicles: int, *, tau: float, delta: 
     leader = paper_mix(dt=dt).hold(hold)
     ctrl = controller_for(strategy, headway=headway, standstill=standstill)
     res = simulate(leader, ctrl, n_vehicles, tau=tau, delta=delta,
-                   initial_gap=standstill + headway * float(leader.speed[0]), limits=limits)
+                   initial_gap=standstill + headway * float(leader.speed[0]), limits=limits,
+                   progress=progress)
     m = platoon_metrics(res, certificate=False)
     out = {"n": n_vehicles, "leader": f"{leader.name} (+{hold:g} s hold)", "m_p": m["m_p"],
            "max_m_p": m["max_m_p"], "M_lss": m["M_lss"], "collisions": m["collisions"],

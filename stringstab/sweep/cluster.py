@@ -69,7 +69,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None) -> Ite
         with client:
             yield client
         return
-    from ..regions.pool import cpu_count
+    from ..parallel import cpu_count
 
     n = cpu_count() if workers is None else int(workers)
     if n < 1:

@@ -9,7 +9,7 @@ collisions are described in :mod:`stringstab.traffic.dynamics`) with a controlle
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -68,7 +68,7 @@ def simulate(
     initial_gap: npt.ArrayLike | None = None,
     initial_speed: npt.ArrayLike | None = None,
     record: bool = True,
-    progress: bool | None = None,
+    progress: bool | Callable[[int], None] | None = None,
     fractional_delay: FractionalDelay = "linear",
     position_update: PositionUpdate = "exact",
     reaction_delay: npt.ArrayLike = 0.0,
@@ -104,7 +104,9 @@ def simulate(
         Keep full trajectories (memory P·(N+1)·T·8 bytes per quantity); if False only the
         summaries (collisions, minimum gaps, Σa² for m_p) are kept.
     progress : bool, optional
-        Show a tqdm bar; by default only for long runs (over 10⁸ vehicle-steps).
+        Show progress (:class:`stringstab.progress.Progress`: a bar on a terminal, plain lines
+        otherwise); by default only for long runs (over 10⁸ vehicle-steps).  A callable is
+        called with 1 at each step instead (the caller reports).
     fractional_delay : {"linear", "exact"}
         A delay that is not a multiple of Δt: interpolated linearly between received samples
         (default), or the predecessor's exact acceleration inside the step, the loop the
@@ -175,13 +177,13 @@ def simulate(
     sumsq = np.zeros((P, N + 1))
     min_gap = np.full((P, N), np.inf)
     gains_rec: Array | None = None
-    show_bar = (P * N * T > 1e8) if progress is None else bool(progress)
-    steps: Any = range(T)
-    if show_bar:
-        from tqdm.auto import tqdm
+    from ..progress import Progress  # a bar on a terminal, plain lines otherwise
 
-        steps = tqdm(steps, total=T, unit="step", desc=f"simulate {P}x{N}", mininterval=0.5)
-    for k in steps:
+    show_bar = (P * N * T > 1e8) if progress is None else progress is True
+    meter = Progress(T, f"simulate {P}x{N}", unit="steps", enabled=show_bar)
+    each_step = progress if callable(progress) else meter.update  # the caller's own count
+    for k in range(T):
+        each_step(1)
         obs = plat.observe(LX[k], LV[k], LA[k])
         u = controller.command(obs)
         if controller.time_varying:
@@ -209,8 +211,7 @@ def simulate(
             ul = np.clip(u, lim.accel_min, lim.accel_max)
         if record:
             cmd[k] = ul
-    if show_bar:
-        steps.close()
+    meter.close()
 
     def lead(a: Array | None, axes: tuple[int, ...]) -> Array | None:
         if a is None:
