@@ -98,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     check_output_dir(args.out, what="--out")
     claim_folder(args.out, command="sweep", what="--out")
     if args.scheduler is None:  # the local cluster shares this machine's memory among its workers
-        from ..regions.pool import cpu_count
+        from ..parallel import cpu_count
 
         n = workers or cpu_count()
         refuse_points_too_big(spec.points, available_bytes() / n,
