@@ -85,7 +85,7 @@ def bad_files(tmp_path):
     (["--file", "{d}/gains.txt"], "unsupported file extension '.txt'; expected .csv, .json or .npz"),
     (["--file", "{d}/latin.csv"], "not UTF-8 text"),
     (["--file", "{d}"], "unsupported file extension"),
-    (["1,1,1", "--out", "{d}/no/such/dir.json"], "expected a file path in an existing directory"),
+    (["1,1,1", "--out", "{d}/empty.csv/x.json"], "empty.csv' in "),  # a path through a file
 ])
 def test_bad_input_exit_2(capsys, bad_files, argv, message):
     argv = [a.replace("{d}", str(bad_files)) for a in argv]

@@ -29,6 +29,13 @@ def _one_line(capsys, argv, code, starts, match=""):
     (["certify", "1,1,1", "--tau", "1e300"], "actuator lag tau = 1e+300 s is far outside"),
     (["certify", "1,1,1", "--tau", "0.1:1e200"], "actuator lag tau = 1e+200 s"),
     (["certify", "1,1,1", "--sample-time", "1e6"], "--sample-time = 1e+06 s is far outside"),
+    (["certify", "1.2,0.5,0.6", "--sample-time", "1e-300"],
+     "--sample-time = 1e-300 s is far outside the physically meaningful range (sensible: 0.001 to "
+     "1 s; refused below 0.0001 s)"),
+    (["tune", "0.9,-0.5,1.1", "--sample-time", "5e-5"], "--sample-time = 5e-05 s is far outside"),
+    (["simulate", "--dt", "2.2250738585072014e-308", "--out", "unused"],  # fuzz: OverflowError
+     "--dt = 2.22507e-308 s is far outside the physically meaningful range (sensible: 0.001 to 1 "
+     "s; refused below 0.0001 s)"),
     (["certify", "1,1,1", "--delta", "1e5"], "communication delay delta = 100000 s"),
     (["tune", "7,1,1", "--method", "both"], "expected K0 within [-6, 6]"),
     (["tune", "0.9,-0.5,1.1", "--bounds", "-1e308,1e308"], "--bounds = -1e+308 is far outside"),
@@ -67,6 +74,28 @@ def test_sensible_range_warnings(capsys):
     err = capsys.readouterr().err
     assert rc in (0, 1)
     assert "stringstab certify: warning: --tau = 3 s is outside the sensible range (up to 2 s)" in err
+
+
+def test_a_sample_time_between_the_floors_is_warned_and_certified(capsys):
+    """1e-4 <= H < 1e-3 s runs (the certificate answers) with a warning naming the range."""
+    rc = main(["certify", "1.2,0.5,0.6", "--sample-time", "5e-4", "--format", "json"])
+    out, err = capsys.readouterr()
+    assert rc in (0, 1) and '"verdict"' in out
+    assert ("stringstab certify: warning: --sample-time = 0.0005 s is outside the sensible range "
+            "(0.001 to 1 s)") in err
+
+
+@pytest.mark.parametrize("value", [1e-300, 1e-8, 9.9e-5])
+def test_the_library_refuses_a_sample_time_below_the_floor(value):
+    """The library's way in holds the same floor as the command line (1e-300 divided by zero)."""
+    from stringstab.certify.api import Loop
+    from stringstab.params import sample_time
+
+    with pytest.raises(StringStabError, match=r"refused below 0\.0001 s"):
+        sample_time(value)
+    with pytest.raises(StringStabError, match=r"refused below 0\.0001 s"):
+        Loop.of(0.1, 0.2, 1.1, sample_time=value)
+    assert sample_time(1e-4) == 1e-4
 
 
 def test_region_grid_too_big_is_refused_with_the_estimate(capsys, tmp_path):
@@ -203,11 +232,95 @@ def test_interrupted_training_leaves_a_resumable_folder_with_its_log(capsys, tmp
     assert "trained ddpg: 64 steps" in capsys.readouterr().out
 
 
+def _ctrl_c_twice_at(env, at_call):
+    """``env.step`` presses Ctrl-C twice on its call ``at_call``: recorded, then raised at once."""
+    step, calls = env.step, {"n": 0}
+
+    def stepped(actions):
+        calls["n"] += 1
+        if calls["n"] == at_call:
+            signal.raise_signal(signal.SIGINT)  # the first: recorded (stop at the next step)
+            signal.raise_signal(signal.SIGINT)  # the second: KeyboardInterrupt here, mid-step
+        return step(actions)
+
+    env.step = stepped
+    return env
+
+
+def _tiny(**kw):
+    from stringstab.rl import config_for
+
+    return config_for("ddpg", total_steps=64, learning_starts=16, batch_size=8, num_envs=4, seed=0,
+                      **kw)
+
+
+def test_a_second_ctrl_c_before_the_first_checkpoint_leaves_no_folder(capsys, tmp_path, monkeypatch):
+    """The window of the flaky fuzz case: the folder used to exist from before the loop."""
+    pytest.importorskip("torch")
+    import importlib
+
+    rl_envs = importlib.import_module("stringstab.rl.envs")
+    real = rl_envs.make_env
+    monkeypatch.setattr(rl_envs, "make_env", lambda c, leaders=None: _ctrl_c_twice_at(real(c, leaders), 1))
+    handler = signal.getsignal(signal.SIGINT)
+    out = tmp_path / "run"
+    rc = main(["train", "--algo", "ddpg", "--steps", "64", "--num-envs", "4", "--out", str(out),
+               "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 130 and "interrupted; nothing partial was written" in err, err
+    assert not out.exists(), sorted(p.name for p in out.iterdir())  # (was run.json, config.json)
+    assert signal.getsignal(signal.SIGINT) is handler
+
+
+def test_a_second_ctrl_c_after_a_checkpoint_leaves_a_resumable_folder(tmp_path):
+    pytest.importorskip("torch")
+    import json
+
+    from stringstab.rl import train
+    from stringstab.rl.envs import make_env
+
+    config = _tiny(checkpoint_every=16)
+    out = tmp_path / "run"
+    with pytest.raises(KeyboardInterrupt):  # on the 7th vector step (24 steps; checkpoint at 16)
+        train(config, envs=_ctrl_c_twice_at(make_env(config), 7), out=out, progress=False)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["steps"] == 16 and summary["stopped_by"] == "checkpoint", summary
+    assert (out / "train_log.csv").is_file() and (out / "policy.json").is_file()
+    assert not (out / "rolling_reward.png").exists()  # the figure is the end's
+    res = train(config, out=out, resume=True, progress=False)  # it resumes, to the end
+    assert res.steps == 64 and res.stopped_by == "steps"
+    assert json.loads((out / "summary.json").read_text())["stopped_by"] == "steps"
+    uninterrupted = train(config, out=tmp_path / "whole", progress=False)
+    assert [e["return"] for e in res.episodes] == [e["return"] for e in uninterrupted.episodes]
+
+
+def test_ctrl_c_twice_while_a_checkpoint_is_written_is_held(tmp_path, monkeypatch):
+    pytest.importorskip("torch")
+    import json
+
+    from stringstab.rl import checkpoint as ckpt
+    from stringstab.rl import train
+
+    real = ckpt.write_checkpoint
+
+    def pressed(*a, **kw):
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)  # held: the checkpoint's files are written whole
+        return real(*a, **kw)
+
+    monkeypatch.setattr(ckpt, "write_checkpoint", pressed)
+    out = tmp_path / "run"
+    res = train(_tiny(checkpoint_every=16), out=out, progress=False)
+    assert res.stopped_by == "interrupted" and res.steps == 16  # stopped at the next step boundary
+    assert json.loads((out / "summary.json").read_text())["stopped_by"] == "interrupted"
+    assert (out / "rolling_reward.png").is_file()
+
+
 def test_a_batch_file_too_big_for_memory_is_refused(capsys, tmp_path, monkeypatch):
     """The estimate (4.5 kB per row) against the memory available, before certifying."""
     import numpy as np
 
-    import stringstab.cli._budget as budget
+    import stringstab.memory as budget
 
     monkeypatch.setattr(budget, "available_bytes", lambda: 200_000_000)  # a small machine
     f = tmp_path / "big.npz"

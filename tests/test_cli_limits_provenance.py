@@ -149,7 +149,7 @@ def test_hcfs_verify_and_compare_report_progress_off_a_terminal(capsys, tmp_path
     monkeypatch.setattr(Progress, "EVERY", 0.0)
     out = tmp_path / "h"
     assert main(["hcfs", "verify", "-J", "2.5", "--followers", "2", "--policy", "stand-in",
-                 "--leader", "stop-and-go", "braking", "--duration", "10",
+                 "--leader", "stop-and-go", "braking", "--duration", "15",
                  "--out", str(out)]) in (0, 1)
     err = capsys.readouterr().err
     assert "stringstab hcfs verify: 1/2 leaders (50%), " in err and "\r" not in err

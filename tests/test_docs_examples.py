@@ -62,6 +62,9 @@ PLACEHOLDERS: dict[str, str] = {
                 "(tests/test_sweep_spec.py)",
     "bad2.toml": "docs/sweeps.md's example of a spec with a bad value (tests/test_sweep_spec.py)",
     "bad3.toml": "docs/sweeps.md's example of an empty axis (tests/test_sweep_spec.py)",
+    "big.toml": "docs/sweeps.md's example of a spec whose certify point (n = 100000) no worker "
+                "can hold; the numbers in its error line depend on the machine's memory "
+                "(tests/test_cli_inputs.py refuses such a sweep before dispatch)",
 }
 
 #: Examples not run, by the start of the command (after `stringstab`), with the reason.
@@ -129,9 +132,10 @@ SHRINK: list[tuple[str, Callable[[list[str]], list[str]], str]] = [
     ("hcfs verify ", lambda a: _set(_set(a, "--duration", "20"), "--no-figures", None),
      "20 s of each leader, no figures (tests/test_hcfs_closed_loop.py writes them)"),
     ("radio ", lambda a: _set(_set(_set(_set(_set(_set(a, "--seeds", "2"), "--loss", "0,0.1"),
-                                             "--burst", "1"), "--duration", "5"), "--hold", "0"),
+                                             "--burst", "1"), "--duration", "20"), "--hold", "0"),
                               "--followers", "3"),
-     "2 seeds, loss 0 and 0.1 (independent), 5 s of the leader, 3 followers: the same command "
+     "2 seeds, loss 0 and 0.1 (independent), 20 s of the leader (a leader under 10 s or the "
+     "CACC's settling time, 10.4 s here, is refused), 3 followers: the same command "
      "on a grid of 2 points instead of 14 x 20 runs of 10 followers (minutes; "
      "tests/test_radio_study.py runs the study and checks its numbers)"),
     ("simulate ", lambda a: _set(_set(a, "--no-figures", None), "--duration", "200"),

@@ -345,9 +345,11 @@ def test_write_results_atomic(tmp_path):
     write_results(RECORDS, out, "json", params=PARAMS, summary=SUMMARY)
     assert json.loads(out.read_text())["summary"] == SUMMARY
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json"]  # no temp file left
-    with pytest.raises(StringStabError, match=r"cannot write .*No such file"):
-        write_results(RECORDS, tmp_path / "no" / "dir.json", "json")
-    assert not (tmp_path / "no").exists()
+    with pytest.raises(StringStabError, match=r"cannot write .*Not a directory"):
+        write_results(RECORDS, tmp_path / "r.json" / "no" / "dir.json", "json")  # through a file
+    write_results(RECORDS, tmp_path / "no" / "dir.json", "json")  # missing folders are created
+    write_results(RECORDS, tmp_path / "here.json", "json")
+    assert (tmp_path / "no" / "dir.json").read_bytes() == (tmp_path / "here.json").read_bytes()
     buf = io.StringIO()
     write_results(RECORDS, buf, "csv")
     assert buf.getvalue().startswith("t,k_x,k_v,k_a,hurwitz")

@@ -269,7 +269,7 @@ def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one
 #: The package root: the façade and the shared basics; every other module lives in a
 #: subpackage whose ``__init__`` says what is there.
 ROOT_MODULES = {"__init__.py", "__main__.py", "_version.py", "params.py", "ranges.py",
-                "constants.py", "errors.py", "progress.py", "parallel.py"}
+                "constants.py", "errors.py", "progress.py", "memory.py", "parallel.py"}
 
 
 def test_the_root_holds_the_facade_and_the_shared_basics_only():

@@ -26,16 +26,32 @@ ROOT = os.geteuid() == 0 if hasattr(os, "geteuid") else False
 
 def test_check_output_file_cases(tmp_path: Path) -> None:
     assert check_output_file(tmp_path / "x.json") == tmp_path / "x.json"
-    with pytest.raises(StringStabError, match=r"folder '.*missing' of .* does not exist"):
-        check_output_file(tmp_path / "missing" / "x.json")
+    # one rule with output folders (issue 29): missing folders are created when written
+    assert check_output_file(tmp_path / "missing" / "x.json") == tmp_path / "missing" / "x.json"
+    assert not (tmp_path / "missing").exists()  # nothing created by the check
     with pytest.raises(StringStabError, match=r"expected a file; .* is a folder"):
         check_output_file(tmp_path)
     f = tmp_path / "file"
     f.write_text("x")
     with pytest.raises(StringStabError, match="is a file, not a folder"):
         check_output_file(f / "x.json")
+    with pytest.raises(StringStabError, match=r"'.*file' in .* is a file, not a folder"):
+        check_output_file(f / "y" / "z.json")
     with pytest.raises(StringStabError, match="expected a file name"):
         check_output_file("")
+
+
+def test_atomic_write_creates_missing_folders_and_removes_them_on_failure(tmp_path: Path) -> None:
+    from stringstab.io import atomic_path
+
+    target = tmp_path / "a" / "b" / "x.txt"
+    atomic_write_text(target, "ok")
+    assert target.read_text() == "ok"
+    other = tmp_path / "c" / "d" / "y.txt"
+    with pytest.raises(RuntimeError), atomic_path(other) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("the writer failed")
+    assert not (tmp_path / "c").exists()  # the folders it created are gone with the file
 
 
 def test_check_output_dir_cases(tmp_path: Path) -> None:

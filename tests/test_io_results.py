@@ -138,7 +138,7 @@ def test_write_is_atomic(tmp_path: Path):
     write_results({"a": [1.0]}, out, "csv")
     assert out.read_text() == "a\n1.0\n"
     with pytest.raises(StringStabError, match="cannot write"):
-        write_results({"a": [1.0]}, tmp_path / "missing" / "r.csv", "csv")
+        write_results({"a": [1.0]}, tmp_path / "r.csv" / "missing" / "r.csv", "csv")  # a file
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv"]
 
 

@@ -205,6 +205,18 @@ def test_simulate_needs_an_identify_json(tmp_path):
         leader_of(read_vehicles(_identify_json(tmp_path, [1, 2])))
 
 
+@pytest.mark.parametrize("gains, bounds", [("5,1,0.6", "-2:2"), ("0.5,1,0.6", "-0.5:0.5"),
+                                            ("0.001,1,0.6", "-2:2")])
+def test_given_cav_gains_outside_the_bounds_are_refused_not_clipped(tmp_path, gains, bounds):
+    out = tmp_path / "o"
+    code, stdout, err = run("platoon", "simulate", "--from", _identify_json(tmp_path, [1, 2]),
+                            "--cav-at", "2", "--cav-gains", gains, "--gain-bounds", bounds,
+                            "--no-figures", "--out", str(out))
+    assert code == 2 and stdout == "" and len(err.strip().splitlines()) == 1, err
+    assert f"--cav-gains {gains}: expected gains within --gain-bounds {bounds}" in err, err
+    assert not out.exists() or not any(out.iterdir())
+
+
 @pytest.mark.slow
 def test_the_recorded_leader_replayed_in_sumo_matches_the_toolkit(tmp_path):
     """The replay's two simulators, SUMO and the toolkit's exact-ZOH one, agree (issue 27, item 4)."""

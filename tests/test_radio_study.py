@@ -147,6 +147,12 @@ def test_cli_writes_the_study(tmp_path, capsys):
     (["--message-period", "0.015"], "--message-period"),
     (["--seeds", "1"], "--seeds"),
     (["--loss", "0,nan"], "--loss must be a number in [0, 1]"),
+    # simulate's own step check (cli.simulate.check_step): a step longer than τ or δ
+    (["--dt", "0.2", "--tau", "0.1", "--delta", "0.3"],
+     "--dt 0.2 s is longer than the actuator lag tau = 0.1 s: "),
+    (["--dt", "0.05", "--tau", "0.1", "--delta", "0.02"], "longer than the delay delta = 0.02 s"),
+    (["--dt", "1e-300"], "--dt = 1e-300 s is far outside"),
+    (["--length", "1e300"], "--length = 1e+300 m is far outside"),
 ])
 def test_cli_bad_input_is_one_line_exit_2(tmp_path, capsys, extra, match):
     out = tmp_path / "o"

@@ -307,7 +307,7 @@ def test_cli_train_evaluate_compare(tmp_path, capsys):
               "summary.json", "run.json", "config.json", "checkpoint/latest.json"):
         assert (run / f).is_file(), f
     leader = tmp_path / "lead.csv"
-    tr = sinusoid(omega=0.8, amplitude=2.0, speed=15.0, duration=8.0)
+    tr = sinusoid(omega=0.8, amplitude=2.0, speed=15.0, duration=20.0)  # > the CACC settling time
     leader.write_text("t,v\n" + "".join(f"{t:.1f},{v:.6f}\n" for t, v in zip(tr.t, tr.speed)))
     code = main(["evaluate", str(run), "--leaders", str(leader), "--platoon", "none"])
     assert code in (0, 1)

@@ -59,7 +59,7 @@ def test_vehicle_removed_mid_run(monkeypatch, capsys, tmp_path):
     _bad(["sumo", "run", "--leader", "udds", "--duration", "20", "--followers", "3",
           "--out", str(out)], "'F2'", capsys, out)
     # libsumo was closed: another simulation starts in this process
-    assert main(["sumo", "check", "--leader", "udds", "--duration", "5", "--followers", "1"]) == 0
+    assert main(["sumo", "check", "--leader", "udds", "--duration", "10", "--followers", "1"]) == 0
 
 
 def test_ctrl_c_stops_sumo_and_writes_nothing(monkeypatch, capsys, tmp_path):

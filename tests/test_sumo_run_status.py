@@ -31,7 +31,8 @@ def _err_lines(capsys: pytest.CaptureFixture[str]) -> list[str]:
 
 
 def test_collisions_exit_1_like_simulate(tmp_path, capsys):
-    args = ["--leader", "udds", "--duration", "50", "--followers", "3", "--gains", UNSTABLE,
+    # 60 s: at least these gains' settling time (51.4 s), which the leader check asks for
+    args = ["--leader", "udds", "--duration", "60", "--followers", "3", "--gains", UNSTABLE,
             "--no-figures"]
     assert main(["simulate", *args, "--out", str(tmp_path / "sim")]) == 1
     sim_err = _err_lines(capsys)

@@ -77,8 +77,13 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = NEGATIVE_NUMBER  # "-0.5,1,1" is a value
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.print_usage(sys.stderr)
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        """One line on stderr, exit 2: what was wrong, where the options are listed."""
+        import re
+
+        message = re.sub(r"invalid (int|float) value: (.*)$",  # argparse's type errors, as
+                         lambda m: ("expected an integer" if m[1] == "int" else "expected a number")
+                         + f"; got {m[2]}", message)
+        self.exit(2, f"{self.prog}: error: {message} (options: {self.prog} --help)\n")
 
 
 def _chosen(argv: Sequence[str]) -> str | None:
@@ -156,7 +161,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = _chosen(argv)
     parser = build_parser(command, lazy=True)
     args = parser.parse_args(argv)
-    from ..io.outputs import invocation
+    from ..io.manifest import invocation
     from ._provenance import provenance
 
     hook = sys.unraisablehook

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +55,7 @@ __all__ = [
 NEGATIVE_NUMBER = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
 
-def integer(name: str, text: Any, minimum: int) -> int:
+def integer(name: str, text: Any, minimum: int, kind: str | None = None) -> int:
     """A command-line integer >= ``minimum`` (a step budget, a seed, a count).
 
     Parameters
@@ -65,6 +66,9 @@ def integer(name: str, text: Any, minimum: int) -> int:
         The value as given (its ``str`` is parsed as a base-10 integer).
     minimum : int
         The smallest value accepted.
+    kind : str, optional
+        A key of :data:`stringstab.ranges.COUNTS`: the largest value accepted
+        (:func:`~stringstab.ranges.check_count`).
 
     Returns
     -------
@@ -74,7 +78,7 @@ def integer(name: str, text: Any, minimum: int) -> int:
     Raises
     ------
     StringStabError
-        When it is not an integer or is below ``minimum``.
+        When it is not an integer, is below ``minimum`` or above the largest count of ``kind``.
 
     Examples
     --------
@@ -91,6 +95,10 @@ def integer(name: str, text: Any, minimum: int) -> int:
         raise StringStabError(f"{name} must be an integer >= {minimum}; got {text!r}") from e
     if v < minimum:
         raise StringStabError(f"{name} must be an integer >= {minimum}; got {v}")
+    if kind is not None:
+        from ..ranges import check_count
+
+        check_count(kind, v, name=name)
     return v
 
 
@@ -187,7 +195,7 @@ def loop_params(args: argparse.Namespace) -> tuple[Params | Box, float | None]:
     return model, H
 
 
-def warn_beyond_sensible(args: Any, values: list[tuple[str, float | None, str]]) -> None:
+def warn_beyond_sensible(args: Any, values: Sequence[tuple[str, float | None, str]]) -> None:
     """One warning line on stderr per value beyond its sensible range (:mod:`stringstab.ranges`).
 
     Parameters
@@ -199,12 +207,17 @@ def warn_beyond_sensible(args: Any, values: list[tuple[str, float | None, str]])
     """
     import sys
 
+    from ..ranges import COUNTS, count_warning
+
+    sub = getattr(args, "hcfs_command", None)
+    command = f"{getattr(args, 'command', '')}{' ' + sub if sub else ''}"
     for kind, value, option in values:
         if value is None:
             continue
-        w = sensible_warning(kind, value, name=option)
+        w = (count_warning(kind, int(value), name=option) if kind in COUNTS
+             else sensible_warning(kind, value, name=option))
         if w is not None:
-            print(f"stringstab {getattr(args, 'command', '')}: warning: {w}", file=sys.stderr)
+            print(f"stringstab {command}: warning: {w}", file=sys.stderr)
 
 
 def shown_params(model: Params | Box, H: float | None) -> dict[str, Any]:
@@ -328,7 +341,7 @@ def check_output(args: Any) -> Path | None:
                 f"--format {args.format} writes a binary file; expected --out FILE, got none"
             )
         return None
-    return check_output_file(args.out, what="--out (expected a file path in an existing directory)")
+    return check_output_file(args.out, what="--out")
 
 
 #: The format a known ``--out`` extension names.
@@ -515,17 +528,21 @@ def limits_from_args(args: Any) -> Any:
     return Limits(accel_min=a_min, accel_max=a_max, speed_max=v_max)
 
 
-def checked_leaders(args: Any, leaders: Any, limits: Any) -> list[str]:
+def checked_leaders(args: Any, leaders: Any, limits: Any, *,
+                    settling: float | None = None) -> list[str]:
     """:func:`stringstab.traffic.check_leader` on every leader, its warnings printed (stderr).
 
     Parameters
     ----------
     args : argparse.Namespace
         The command's arguments (``args.command`` names it in the warnings).
-    leaders : sequence of Trajectory
-        The leaders the command will run.
+    leaders : sequence of Trajectory or FollowingPair
+        The leaders the command will run (a recorded leader-follower pair: its leader).
     limits : Limits
         The followers' limits.
+    settling : float, optional
+        The controller's settling time, s (:func:`stringstab.traffic.limits.settling_time`):
+        a shorter leader is refused, as is one shorter than 10 s.
 
     Returns
     -------
@@ -535,15 +552,17 @@ def checked_leaders(args: Any, leaders: Any, limits: Any) -> list[str]:
     Raises
     ------
     StringStabError
-        A physically absurd leader (above 70 m/s or beyond ±15 m/s²).
+        A physically absurd leader (above 70 m/s or beyond ±15 m/s²), or one shorter than
+        10 s or than ``settling``.
     """
     import sys
 
     from ..traffic.limits import check_leader
 
+    leaders = [getattr(x, "leader", x) for x in leaders]  # a FollowingPair: its leader
     out: list[str] = []
     for leader in leaders:
-        for w in check_leader(leader, limits):
+        for w in check_leader(leader, limits, settling=settling):
             text = w if len(leaders) == 1 else f"{leader.name}: {w}"
             if text not in out:
                 out.append(text)

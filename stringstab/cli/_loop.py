@@ -122,9 +122,16 @@ _DOMAINS = {
 _KIND = {"message_period": "pos", "loss": "unit", "burst": "ge1", "stale_after": "pos",
          "noise_gap": "nonneg", "noise_gap_rate": "nonneg", "noise_speed": "nonneg",
          "noise_correlation": "pos", "noise_filter": "pos"}
+#: The magnitude of each (:data:`stringstab.ranges.RANGES`): warned beyond the sensible range,
+#: refused beyond the valid one.
+_RANGE = {"message_period": "duration", "burst": "burst", "stale_after": "duration",
+          "noise_gap": "length", "noise_gap_rate": "speed_noise", "noise_speed": "speed_noise",
+          "noise_correlation": "duration", "noise_filter": "duration"}
 
 
-def _float(name: str, text: Any) -> float:
+def _float(name: str, text: Any, notes: list[tuple[str, float | None, str]]) -> float:
+    from ..ranges import check_magnitude
+
     ok, words = _DOMAINS[_KIND[name]]
     try:
         x = float(text)
@@ -132,6 +139,9 @@ def _float(name: str, text: Any) -> float:
         raise StringStabError(f"{_flag(name)} must be {words}; got {show(text)}") from e
     if not ok(x):
         raise StringStabError(f"{_flag(name)} must be {words}; got {show(text)}")
+    if name in _RANGE:
+        check_magnitude(_RANGE[name], x, name=_flag(name))
+        notes.append((_RANGE[name], x, _flag(name)))
     return x
 
 
@@ -154,6 +164,12 @@ def _fallback_gains(text: str) -> tuple[float, float]:
     if len(values) != 2:
         raise StringStabError(f"--fallback-gains must be K_X,K_V (two numbers; the fallback has k_a = 0); "
                               f"got {text!r}")
+    if not all(math.isfinite(v) for v in values):
+        raise StringStabError(f"--fallback-gains must be two finite numbers K_X,K_V; got {text!r}")
+    from ..ranges import check_magnitude
+
+    for name, v in zip(("k_x", "k_v"), values):
+        check_magnitude("gain", v, name=f"--fallback-gains {name}")
     return values[0], values[1]
 
 
@@ -183,8 +199,9 @@ def radio_from_args(args: Any, dt: float) -> tuple[Any, Any]:
     """
     from ..traffic import Radio, SensorNoise
     from ..traffic.radio import message_steps
-    from ._common import integer
+    from ._common import integer, warn_beyond_sensible
 
+    notes: list[tuple[str, float | None, str]] = []  # (kind, value, option) for the range notes
     radio_names = ("message_period", "message_phase", "loss", "burst", "stale_after", "fallback_gains")
     noise_names = ("noise_gap", "noise_gap_rate", "noise_speed", "noise_correlation", "noise_filter")
     needs = [("message_phase", "message_period"), ("burst", "loss"), ("fallback_gains", "stale_after")]
@@ -202,12 +219,12 @@ def radio_from_args(args: Any, dt: float) -> tuple[Any, Any]:
         if not (_given(args, "loss") or sigmas):
             raise StringStabError("--radio-seed seeds the message loss (--loss) and the sensor noise "
                                   f"(--noise-*); expected one of them with it, got --radio-seed {args.radio_seed}")
-        seed = integer("--radio-seed", args.radio_seed, 0)
+        seed = integer("--radio-seed", args.radio_seed, 0, "seed")
     radio = sensors = None
     if _given(args, *radio_names):
         kw: dict[str, Any] = {"seed": seed}
         if _given(args, "message_period"):
-            P = _float("message_period", args.message_period)
+            P = _float("message_period", args.message_period, notes)
             try:
                 n = message_steps(P, dt)
             except StringStabError as e:
@@ -221,7 +238,7 @@ def radio_from_args(args: Any, dt: float) -> tuple[Any, Any]:
                 kw["message_phase"] = phase
         for name in ("loss", "burst", "stale_after"):
             if _given(args, name):
-                kw[name] = _float(name, getattr(args, name))
+                kw[name] = _float(name, getattr(args, name), notes)
         period = kw.get("message_period")
         if "stale_after" in kw and period is not None and kw["stale_after"] < period * (1 - 1e-12):
             raise StringStabError(f"--stale-after {kw['stale_after']:g} s is shorter than the message period "
@@ -238,9 +255,10 @@ def radio_from_args(args: Any, dt: float) -> tuple[Any, Any]:
         for name, field in (("noise_gap", "gap"), ("noise_gap_rate", "gap_rate"), ("noise_speed", "speed"),
                             ("noise_correlation", "correlation_time"), ("noise_filter", "filter_time")):
             if _given(args, name):
-                kn[field] = _float(name, getattr(args, name))
+                kn[field] = _float(name, getattr(args, name), notes)
         try:
             sensors = SensorNoise(**kn)
         except StringStabError as e:
             raise StringStabError(f"--noise-*: {e}") from e
+    warn_beyond_sensible(args, notes)
     return radio, sensors

@@ -48,7 +48,9 @@ def message_from_args(args: argparse.Namespace, H: float | None) -> tuple[int | 
     ------
     StringStabError
         ``--message-period`` without ``--sample-time``, not a whole multiple of it, ≤ 0, not
-        a number; ``--message-phase`` without ``--message-period`` or outside 0..N − 1.
+        a number, or more than the largest N of :data:`stringstab.ranges.COUNTS`
+        (``message_steps``: the lifted link's memory grows with N); ``--message-phase`` without
+        ``--message-period`` or outside 0..N − 1.
     """
     from ..certify.message import message_phase, message_steps
 
@@ -62,4 +64,9 @@ def message_from_args(args: argparse.Namespace, H: float | None) -> tuple[int | 
         raise StringStabError(f"--message-period needs the control period: expected --sample-time H "
                               f"with it, got --message-period {P} alone")
     N = message_steps(P, H, name="--message-period")
+    from ..ranges import check_count
+    from ._common import warn_beyond_sensible
+
+    check_count("message_steps", N, name=f"--message-period {P} / --sample-time {H:g}")
+    warn_beyond_sensible(args, [("message_steps", N, f"--message-period {P} / --sample-time {H:g}")])
     return N, (0 if phase is None else message_phase(phase, N, name="--message-phase"))

@@ -3,7 +3,7 @@
 Every argument of the command that names an existing file is recorded with its SHA-256; one
 that names a run folder (a ``policy.json`` in it) with its policy's hash and the training steps
 behind it.  :func:`stringstab.cli.main` hands :func:`provenance` to
-:func:`stringstab.io.outputs.invocation`, so every :class:`~stringstab.io.OutputDir` manifest
+:func:`stringstab.io.manifest.invocation`, so every :class:`~stringstab.io.OutputDir` manifest
 records them without a line in the commands.
 """
 

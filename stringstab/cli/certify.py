@@ -49,7 +49,7 @@ BYTES_BASE = 150e6
 
 
 def _available() -> float:
-    from ._budget import available_bytes
+    from ..memory import available_bytes
 
     return float(available_bytes())
 
@@ -142,7 +142,9 @@ def _pade_order(text: str) -> int:
         raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}") from e
     if n < 1:
         raise StringStabError(f"--pade-order must be an integer >= 1; got {show(text)}")
-    return n
+    from ..ranges import check_count
+
+    return check_count("order", n, name="--pade-order")
 
 
 def _warn_disagreements(records: list[dict[str, Any]], order: int) -> None:
@@ -207,7 +209,7 @@ def run(args: argparse.Namespace) -> int:
         return _run_identified(args, out, H, Box.of(model).reaction_delay[0])
     table = gains_from_args(args)
     check_horizon(H, table)
-    from ._budget import refuse_if_too_big
+    from ..memory import refuse_if_too_big
 
     n_rows = len(table)
     refuse_if_too_big(f"{args.file or 'the triples'} ({n_rows} rows)",
@@ -285,6 +287,10 @@ def _run_max_period(args: argparse.Namespace, loop: Any, table: Any, out: Any) -
     if not cap >= loop.sample_time or cap != cap or cap == float("inf"):
         raise StringStabError(f"--max-message-period must be a finite number of seconds >= "
                               f"--sample-time {loop.sample_time:g}; got {args.max_message_period}")
+    from ..ranges import check_count
+
+    check_count("message_steps", int(cap / loop.sample_time + 1e-9),
+                name=f"--max-message-period {args.max_message_period} / --sample-time {loop.sample_time:g}")
     b = largest_message_period(loop, table.k_x, table.k_v, table.k_a, cap=cap)
     params = {**shown_params(loop.model, loop.sample_time), "max_message_period_cap": b.cap}
     summary = b.summary()

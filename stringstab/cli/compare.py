@@ -48,6 +48,32 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _check_reference(reference: str | None, runs: list[str], baselines: list[str]) -> None:
+    """Refuse a ``--reference`` that is none of the strategies, from the runs' ``run.json``.
+
+    Reading ``run.json`` costs milliseconds (loading a policy imports torch), so a typo is
+    refused at once; a run folder whose ``run.json`` cannot be read is left to
+    :func:`stringstab.rl.runs.open_run`, which says what is wrong with it.
+    """
+    from pathlib import Path
+
+    from ..rl.checkpoint import read_json
+    from ..rl.train import RUN_FORMAT
+
+    if reference is None:
+        return
+    algos = set()
+    for r in runs:
+        try:
+            algos.add(str(read_json(Path(r) / "run.json", fmt=RUN_FORMAT, what="run folder")["algo"]))
+        except (StringStabError, KeyError):
+            return
+    strategies = sorted(algos | set(baselines))
+    if reference not in strategies:
+        raise StringStabError(f"--reference {reference!r} is not among the strategies {strategies}; "
+                              "expected the --algo of a RUN or a baseline of --baselines")
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``compare``.
 
@@ -77,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
     bad = [b for b in base if b not in BASELINES]
     if bad:
         raise StringStabError(f"--baselines: expected names among {', '.join(BASELINES)}; got {bad}")
+    _check_reference(args.reference, args.runs, base)  # at once: before loading any policy
     opened = [open_run(r) for r in args.runs]
     params = {(p.info["tau"], p.info["delta"], p.info["headway"], p.info["dt"]) for _, p in opened}
     if len(params) != 1:
@@ -91,12 +118,22 @@ def run(args: argparse.Namespace) -> int:
             f"{[lp[3] or 'default' for lp in loops]}; expected one, or give the loop to compare "
             "in with --reaction-delay and the radio and sensor options")
     theta, radio, sensors, loop_doc = loops[0]
+    strategies = sorted({pol.algo for _, pol in opened} | set(base))
+    ref = args.reference or ("idl" if "idl" in strategies else None)
+    if ref is not None and ref not in strategies:  # (a run.json that lied about its algo)
+        raise StringStabError(f"--reference {ref!r} is not among the strategies {strategies}; "
+                              "expected the --algo of a RUN or a baseline of --baselines")
     leaders, desc = test_leaders(args.leaders, dt=dt)
     limits = limits_from_args(args)
     out = OutputDir(args.out, command="compare")
+    from ..rl.evaluate import controller_for
+    from ..traffic.limits import settling_time
     from ..traffic.synthetic import paper_mix
 
-    checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits)
+    times = [settling_time(controller_for(b, headway=headway), tau) for b in base]
+    settling = max((t for t in times if t is not None), default=None)
+    checked_leaders(args, [*leaders, *([paper_mix(dt=dt)] if args.platoon else [])], limits,
+                    settling=settling)
     groups: dict[str, list[Any]] = {}
     platoons: dict[str, Any] = {}
     kw: dict[str, Any] = {"tau": tau, "delta": delta, "headway": headway, "limits": limits}
@@ -121,9 +158,6 @@ def run(args: argparse.Namespace) -> int:
             if args.platoon:
                 platoons[b] = {"run": None, "tests": [platoon_test(b, 10, dt=dt, **kw)]}
                 bar.update(10)
-    ref = args.reference or ("idl" if "idl" in groups else None)
-    if ref is not None and ref not in groups:
-        raise StringStabError(f"--reference {ref!r} is not among the strategies {sorted(groups)}")
     with out:
         files = write_comparison(out, groups, reference=ref, tau=tau, delta=delta,
                                  headway=headway, platoons=platoons or None,

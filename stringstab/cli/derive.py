@@ -78,7 +78,38 @@ def _delay_order(text: str) -> int | None:
         raise StringStabError(f"--delay-order must be 'exact' or an integer >= 0; got {text!r}") from e
     if n < 0:
         raise StringStabError(f"--delay-order must be 'exact' or an integer >= 0; got {text!r}")
-    return n
+    from ..ranges import check_count
+
+    return check_count("order", n, name="--delay-order")
+
+
+#: The range (:data:`stringstab.ranges.RANGES`) of each symbol ``--substitute`` may set.
+_SUBSTITUTE_KINDS = {"tau": "tau", "tau_prev": "tau", "delta": "delta", "headway": "headway",
+                     "reaction_delay": "reaction_delay", "k_x": "gain", "k_v": "gain",
+                     "k_a": "gain"}
+
+
+def _check_substitutions(args: argparse.Namespace) -> None:
+    """Each ``--substitute NAME=VALUE`` number within its range (refused beyond, warned beyond sensible).
+
+    The syntax, the names and the signs are checked by the derivation
+    (:func:`stringstab.derive.symbolic.parse_substitutions`); a value that is not a number is
+    left to it.
+    """
+    from ..ranges import check_magnitude
+    from ._common import warn_beyond_sensible
+
+    for item in (args.substitute or "").split(","):
+        name, sep, value = item.partition("=")
+        kind = _SUBSTITUTE_KINDS.get(name.strip())
+        if not sep or kind is None:
+            continue
+        try:
+            x = float(value)
+        except ValueError:
+            continue
+        check_magnitude(kind, x, name=f"--substitute {name.strip()}")
+        warn_beyond_sensible(args, [(kind, x, f"--substitute {name.strip()}")])
 
 
 def run(args: argparse.Namespace) -> int:
@@ -100,6 +131,7 @@ def run(args: argparse.Namespace) -> int:
     from ..params import positive
 
     delay_order = _delay_order(args.delay_order)
+    _check_substitutions(args)
     theta = getattr(args, "reaction_delay", None)
     if theta is not None:  # θ_r (issue 25): checked as certify checks it, then substituted
         from ..params import check_reaction_delay
@@ -112,7 +144,13 @@ def run(args: argparse.Namespace) -> int:
         args.substitute = ",".join(x for x in (args.substitute, f"reaction_delay={theta}") if x)
     H = None
     if args.sample_time is not None:
-        H = positive("--sample-time (sampling period H)", args.sample_time, unit=" s")
+        from ..ranges import check_magnitude
+        from ._common import warn_beyond_sensible
+
+        H = check_magnitude("sample_time", positive("--sample-time (sampling period H)",
+                                                    args.sample_time, unit=" s"),
+                            name="--sample-time")
+        warn_beyond_sensible(args, [("sample_time", H, "--sample-time")])
         if args.errata or delay_order is not None:
             raise StringStabError(
                 "--errata and --delay-order are about the continuous loop's Ψ (IDL eqs 12-15); "

@@ -8,8 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
+from ..memory import refuse_platoon
 from ..progress import Progress
-from ._budget import refuse_platoon
 from ._common import add_limit_arguments, checked_leaders, limits_from_args
 
 __all__ = ["add_parser", "loop_of", "run"]

@@ -60,7 +60,8 @@ def add_parser(sub: Any) -> None:
         ),
     )
     v.add_argument("--jerk-limit", "-J", nargs="+", required=True, metavar="J",
-                   help="jerk limits J in m/s^3 (each finite and > 0)")
+                   help="jerk limits J in m/s^3 (each > 0 and at most 1e6; one above "
+                        "(a_max - a_min)/T, 30 at the defaults, never binds: a warning)")
     v.add_argument("--followers", "-N", type=int, default=8, metavar="N",
                    help="followers per platoon (the paper uses 4, 6, 8; default 8)")
     v.add_argument("--leader", nargs="+", default=["udds"], metavar="SPEC",
@@ -146,28 +147,30 @@ def run_verify(args: argparse.Namespace) -> int:
     from ..hcfs.verify import verify
     from ..io import OutputDir
     from ..params import positive
+    from ..ranges import check_magnitude
+    from ._common import integer, warn_beyond_sensible
 
     t0 = time.perf_counter()
-    Js = [positive("--jerk-limit J", s, unit=" m/s^3") for s in args.jerk_limit]
+    Js = [check_magnitude("jerk", positive("--jerk-limit J", s, unit=" m/s^3"), name="--jerk-limit J")
+          for s in args.jerk_limit]
     beta = check_beta(args.beta)
-    if args.followers < 1:
-        raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
+    integer("--followers", args.followers, 1)  # the memory estimate bounds it (below)
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise StringStabError(f"--duration must be a finite number of seconds > 0; got {args.duration!r}")
     if args.duration is not None:
-        from ..ranges import check_magnitude
-
         check_magnitude("duration", args.duration, name="--duration")
     out = OutputDir(args.out, command="hcfs verify", what="--out")  # checked before any work
     leaders = [hcfs_leader(s, dt=DT, duration=args.duration) for s in args.leader]
-    from ._budget import refuse_platoon
+    from ..memory import refuse_platoon
 
     refuse_platoon(args.followers * max(len(leaders), 1), max(len(ld.speed) for ld in leaders),
                    f"--followers {args.followers}")
     from ._common import checked_leaders, limits_from_args
 
     limits = limits_from_args(args)
-    checked_leaders(args, leaders, limits)
+    checked_leaders(args, leaders, limits, settling=cacc_settling_time())
+    warn_beyond_sensible(args, [("followers", args.followers, "--followers")])
+    _note_jerk_limits(args, Js, limits)
     policy = candidate(args.policy)
     command = shlex.join([
         "stringstab", "hcfs", "verify", "--jerk-limit", *[f"{J:g}" for J in Js],
@@ -215,6 +218,45 @@ def run_verify(args: argparse.Namespace) -> int:
     return 0 if ver.ok else 1
 
 
+def cacc_settling_time() -> float:
+    """The 2 % settling time of the HCFS CACC candidate, s: ln 50 / σ with σ = −ln ρ / T.
+
+    ρ is the spectral radius of the CACC's discrete closed loop
+    (:func:`stringstab.hcfs.cacc.closed_loop_matrix`, the same for every platoon size: the map
+    is block triangular with one 2 × 2 block per follower), T the frame (0.2 s): the slowest
+    mode decays as ρ^k = e^{−σ k T}.
+
+    Returns
+    -------
+    float
+        The settling time, s (about 14 s at the default gains, ρ = 0.947).
+    """
+    import numpy as np
+
+    from ..hcfs.cacc import closed_loop_matrix
+    from ..hcfs.constants import DT
+    from ..traffic.limits import SETTLING_FRACTION
+
+    rho = float(max(abs(np.linalg.eigvals(closed_loop_matrix(1)))))
+    return math.log(1.0 / SETTLING_FRACTION) / (-math.log(rho) / DT)
+
+
+def _note_jerk_limits(args: argparse.Namespace, Js: list[float], limits: Any) -> None:
+    """A note for each J that never binds: J T above the acceleration range a_max − a_min."""
+    import sys
+
+    from ..hcfs.constants import DT
+
+    loose = (limits.accel_max - limits.accel_min) / DT
+    for J in Js:
+        if J > loose:
+            print(f"stringstab hcfs verify: warning: --jerk-limit {J:g} m/s^3 is above the "
+                  f"sensible range (up to (a_max - a_min)/T = {loose:g} m/s^3): a rate limit of "
+                  f"{J * DT:g} m/s^2 per frame never binds within [{limits.accel_min:g}, "
+                  f"{limits.accel_max:g}] m/s^2, so the theorem holds by the acceleration bounds "
+                  "alone", file=sys.stderr)
+
+
 def run_train(args: argparse.Namespace) -> int:
     """Run ``hcfs train``: validate everything, train, write the run folder, compare.
 
@@ -233,16 +275,31 @@ def run_train(args: argparse.Namespace) -> int:
     from ..hcfs.constants import DT
     from ..hcfs.leaders import hcfs_leader
     from ..params import positive
+    from ..ranges import check_magnitude
+    from ._common import checked_leaders, warn_beyond_sensible
     from ._common import integer as _int
 
-    steps = _int("--steps", args.steps, 1)
-    seed = _int("--seed", args.seed, 0)
-    platoons = _int("--platoons", args.platoons, 1)
+    steps = _int("--steps", args.steps, 1, "steps")
+    seed = _int("--seed", args.seed, 0, "seed")
+    platoons = _int("--platoons", args.platoons, 1)  # the memory estimate bounds them (below)
     followers = _int("--followers", args.followers, 1)
-    seconds = positive("--episode-seconds", args.episode_seconds, unit=" s")
+    seconds = check_magnitude("duration", positive("--episode-seconds", args.episode_seconds,
+                                                   unit=" s"), name="--episode-seconds")
+    from ..memory import refuse_platoon
+
+    refuse_platoon(platoons * followers, round(seconds / DT) + 1,
+                   f"--platoons {platoons} --followers {followers}")
     out = Path(args.out)
     _check_new_folder(out)
     leaders = [hcfs_leader(s, dt=DT) for s in args.leader]
+    from ..hcfs.constants import ACCEL_MAX, ACCEL_MIN, SPEED_MAX
+    from ..traffic.limits import Limits
+
+    checked_leaders(args, leaders, Limits(accel_min=ACCEL_MIN, accel_max=ACCEL_MAX,
+                                          speed_max=SPEED_MAX), settling=cacc_settling_time())
+    warn_beyond_sensible(args, [("steps", steps, "--steps"), ("platoons", platoons, "--platoons"),
+                                ("followers", followers, "--followers"),
+                                ("duration", seconds, "--episode-seconds")])
     from ..hcfs.ddpg import train_hcfs_ddpg
     from ..hcfs.env import HCFSVectorEnv
 

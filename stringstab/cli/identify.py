@@ -18,7 +18,7 @@ import sys
 from typing import Any
 
 from ..errors import StringStabError, show
-from ._common import integer
+from ._common import integer, warn_beyond_sensible
 
 __all__ = ["add_parser", "run"]
 
@@ -137,11 +137,17 @@ def run(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     H = None if args.sample_time is None else _seconds("--sample-time", args.sample_time)
-    B = integer("--bootstrap", args.bootstrap, 0)
+    B = integer("--bootstrap", args.bootstrap, 0, "refits")
     block = _seconds("--block", args.block)
-    starts = integer("--starts", args.starts, 1)
-    seed = integer("--seed", args.seed, 0)
+    starts = integer("--starts", args.starts, 1, "starts")
+    seed = integer("--seed", args.seed, 0, "seed")
     min_seg = _seconds("--min-segment", args.min_segment)
+    from ..ranges import check_magnitude
+
+    for kind, v, option in (("sample_time", H, "--sample-time"), ("duration", block, "--block"),
+                            ("duration", min_seg, "--min-segment")):
+        if v is not None:
+            check_magnitude(kind, v, name=option)
     if (not args.log) == (args.example is None):
         raise StringStabError("expected a log file LOG or --example acc|human (one of the two); "
                               f"got {'both' if args.log else 'neither'}")
@@ -150,6 +156,8 @@ def run(args: argparse.Namespace) -> int:
 
     logs = [lg for path in (args.log or [example_log(args.example)])
             for lg in read_logs(path, min_duration=min_seg)]
+    warn_beyond_sensible(args, [("sample_time", H, "--sample-time"), ("refits", B, "--bootstrap"),
+                                ("starts", starts, "--starts")])
     if args.fit_delay and H is not None:
         raise StringStabError("--fit-delay certifies θ_r in continuous time only so far; expected it "
                               f"without --sample-time (got --sample-time {H:g})")

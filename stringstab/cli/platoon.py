@@ -219,13 +219,23 @@ def _cav_spec(args: argparse.Namespace) -> Any:
 
     tau, delta, headway = check_params(args.cav_tau, args.cav_delta, args.cav_headway)
     theta = check_reaction_delay(args.cav_reaction_delay, "--cav-reaction-delay")
+    from ..ranges import check_magnitude
+
     lo, hi = parse_interval(args.gain_bounds, "--gain-bounds")
     min_kx = positive("--min-kx", args.min_kx, allow_zero=True, unit=" 1/s²")
+    for name, v in (("--gain-bounds LO", lo), ("--gain-bounds HI", hi), ("--min-kx", min_kx)):
+        check_magnitude("gain", v, name=name)
     if max(lo, min_kx) > hi:
         raise StringStabError(f"--gain-bounds {args.gain_bounds} leaves no k_x >= --min-kx "
                               f"{min_kx:g}")
     return CavSpec(tau=tau, delta=delta, headway=headway, reaction_delay=theta, bounds=(lo, hi),
                    min_kx=min_kx)
+
+
+def _max_cavs(args: argparse.Namespace) -> int:
+    from ._common import integer
+
+    return integer("--max-cavs", args.max_cavs, 1, "followers")
 
 
 def _cav_positions(text: str, n: int) -> tuple[int, ...] | None:
@@ -259,10 +269,9 @@ def run_design(args: argparse.Namespace) -> int:
     """
     from ..mixed import read_vehicles
     from ..mixed.design import design_auto, design_cavs
-    from ._common import integer
 
     spec = _cav_spec(args)
-    max_cavs = integer("--max-cavs", args.max_cavs, 1)
+    max_cavs = _max_cavs(args)
     rec = read_vehicles(args.file, platoon=_platoon(args), positions=_span(args))
     pos = _cav_positions(args.cav_at, len(rec.vehicles))
     d = design_auto(rec.vehicles, spec, max_cavs=max_cavs) if pos is None else \
@@ -281,14 +290,13 @@ def run_design(args: argparse.Namespace) -> int:
 
 
 def _gains(text: str) -> tuple[float, float, float]:
-    parts = str(text).split(",")
-    try:
-        vals = tuple(float(x) for x in parts)
-    except ValueError as e:
-        raise StringStabError(f"--cav-gains must be KX,KV,KA (three numbers); got {text!r}") from e
-    if len(vals) != 3:
-        raise StringStabError(f"--cav-gains must be KX,KV,KA (three numbers); got {text!r}")
-    return vals  # type: ignore[return-value]
+    from ..io import parse_triple
+    from ..ranges import check_magnitude
+
+    K = parse_triple(str(text), where=f"--cav-gains {text!r}")
+    for name, v in zip(("k_x", "k_v", "k_a"), K):
+        check_magnitude("gain", v, name=f"--cav-gains {name}")
+    return K
 
 
 def run_simulate(args: argparse.Namespace) -> int:
@@ -319,6 +327,7 @@ def run_simulate(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     spec = _cav_spec(args)
+    _max_cavs(args)  # not used by a replay at given positions, but checked like design's
     rec = read_vehicles(args.file, platoon=_platoon(args), positions=_span(args))
     if rec.kind != "identify":
         raise StringStabError("platoon simulate replays the recorded leader: expected the "
@@ -332,7 +341,13 @@ def run_simulate(args: argparse.Namespace) -> int:
     if args.cav_gains is not None:
         if len(pos) != 1:
             raise StringStabError("--cav-gains gives one CAV's gains; got several --cav-at positions")
-        K = spec.clip(_gains(args.cav_gains))
+        given = _gains(args.cav_gains)
+        K = spec.clip(given)
+        if not np.array_equal(K, np.asarray(given)):  # a given gain is used as given, or refused
+            raise StringStabError(
+                f"--cav-gains {args.cav_gains}: expected gains within --gain-bounds "
+                f"{spec.bounds[0]:g}:{spec.bounds[1]:g} with k_x >= --min-kx {spec.min_kx:g}; got "
+                f"k_x, k_v, k_a = {', '.join(f'{v:g}' for v in given)} (widen --gain-bounds to use them)")
         vs = string_with_cavs(rec.vehicles, pos, [K], spec)
         cert = certify_string(vs)
         design = Design(pos, ((float(K[0]), float(K[1]), float(K[2])),), vs, cert, float("nan"),
@@ -442,6 +457,12 @@ def _loop_args(args: argparse.Namespace) -> tuple[float | None, float | None]:
     if args.leader_tau is not None and H is None:
         raise StringStabError("--leader-tau is for the sampled loop; give --sample-time too")
     lt = None if args.leader_tau is None else positive("--leader-tau", args.leader_tau, unit=" s")
+    from ..ranges import check_magnitude
+
+    if H is not None:
+        check_magnitude("sample_time", H, name="--sample-time")
+    if lt is not None:
+        check_magnitude("tau", lt, name="--leader-tau")
     return H, lt
 
 

@@ -29,6 +29,7 @@ from ._common import (
     checked_leaders,
     integer,
     limits_from_args,
+    warn_beyond_sensible,
 )
 from ._loop import add_loop_arguments, radio_from_args, reaction_from_args
 
@@ -137,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     from ..progress import Progress
     from ..traffic.leaders import leader_by_name
     from ..traffic.radio_study import run_radio_study
-    from .simulate import parse_gains
+    from .simulate import check_step, parse_gains
 
     t0 = time.perf_counter()
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
@@ -153,6 +154,11 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
     from ..ranges import check_magnitude
 
+    sizes = [("step", args.dt, "--dt"), ("length", args.standstill, "--standstill"),
+             ("length", args.length, "--length")]
+    for kind, v, opt in sizes:  # as simulate
+        check_magnitude(kind, v, name=opt)
+    check_step(args.dt, tau, delta)
     for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
         if v is not None and math.isfinite(v):
             check_magnitude("duration", v, name=opt)
@@ -173,7 +179,18 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(f"--followers {args.followers} x --seeds {seeds} = "
                               f"{args.followers * seeds} vehicles per batch; expected at most "
                               f"{MAX_VEHICLES} (each point is one batch of --seeds platoons)")
-    checked_leaders(args, [leader], limits)
+    from ..memory import refuse_platoon
+
+    refuse_platoon(args.followers * seeds, len(leader.speed),
+                   f"--followers {args.followers} x --seeds {seeds}")
+    from ..traffic.controllers import LinearController
+    from ..traffic.limits import settling_time
+
+    settle = [settling_time(LinearController(*K, headway=headway, standstill=args.standstill), tau)
+              for K in triples]  # the slowest triple's, as simulate's one controller
+    known = [x for x in settle if x is not None]
+    checked_leaders(args, [leader], limits, settling=max(known) if known else None)
+    warn_beyond_sensible(args, [("followers", args.followers, "--followers"), *sizes])
     total = len(triples) * len(bursts) * len(losses) * seeds
     seed = any_radio.seed
     with Progress(total, "stringstab radio", unit="platoon-runs", enabled=not args.no_progress) as bar:

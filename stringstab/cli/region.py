@@ -191,23 +191,16 @@ def _sizes(text: str | None, k: int, default: int) -> list[int]:
     return ns * k if len(ns) == 1 else ns
 
 
-#: Peak memory per grid point (measured: peak RSS 171 MB at 201², 465 MB at 801², all three
-#: methods and the figures: ~490 B per point) and the fixed part, rounded up.
-BYTES_PER_POINT = 600
-BYTES_BASE = 250e6
-
-
 def _check_size(sizes: list[int], args: argparse.Namespace) -> None:
     """Refuse a grid whose estimated memory exceeds what is available, before allocating it."""
-    from ._budget import available_bytes, refuse_if_too_big
+    from ..memory import available_bytes, grid_bytes, grid_fit, refuse_if_too_big
 
     points = float(np.prod(np.asarray(sizes, dtype=float)))
     cap = available_bytes()
-    fit = max(2, int(((cap - BYTES_BASE) / BYTES_PER_POINT) ** (1 / len(sizes))))
     refuse_if_too_big(
         f"--n {args.n}{' --3d' if args.three_d else ''} ({' x '.join(map(str, sizes))} = {points:.4g} "
-        "points)", BYTES_BASE + BYTES_PER_POINT * points,
-        f"expected at most about --n {fit} on this machine", limit=cap)
+        "points)", grid_bytes(points),
+        f"expected at most about --n {grid_fit(cap, len(sizes))} on this machine", limit=cap)
 
 
 def _grid(args: argparse.Namespace) -> tuple[dict[str, np.ndarray], dict[str, float]]:
@@ -303,8 +296,11 @@ def run(args: argparse.Namespace) -> int:
     for f in formats:
         if f not in FIGURE_FORMATS:
             raise StringStabError(f"--format must be among {', '.join(FIGURE_FORMATS)}; got {f!r}")
-    dpi = _int(args.dpi, "--dpi", 10)
-    workers = None if args.workers is None else _int(args.workers, "--workers", 1)
+    from ..ranges import check_count
+
+    dpi = check_count("dpi", _int(args.dpi, "--dpi", 10), name="--dpi")
+    workers = None if args.workers is None else check_count(
+        "workers", _int(args.workers, "--workers", 1), name="--workers")
     if not args.prefix or "/" in args.prefix or args.prefix.startswith("."):
         raise StringStabError(f"--prefix must be a plain file name stem; got {args.prefix!r}")
     gains = None

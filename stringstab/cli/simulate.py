@@ -20,12 +20,20 @@ import numpy as np
 from ..constants import ACCEL_MAX, ACCEL_MIN, DT, SPEED_MAX, TTC_STAR
 from ..errors import StringStabError, show
 from ..params import check_params
-from ..ranges import metric_caveat
-from ._common import add_limit_arguments, add_vehicle_arguments, checked_leaders, limits_from_args
+from ..ranges import check_magnitude, metric_caveat
+from ._common import (
+    add_limit_arguments,
+    add_vehicle_arguments,
+    checked_leaders,
+    integer,
+    limits_from_args,
+    warn_beyond_sensible,
+)
 from ._loop import add_loop_arguments, radio_from_args, reaction_from_args
 from ._outcome import collision_status
 
-__all__ = ["DEFAULT_GAINS", "add_parser", "first_collision", "parse_gains", "radio_line", "run"]
+__all__ = ["DEFAULT_GAINS", "add_parser", "check_step", "first_collision", "parse_gains", "radio_line",
+           "run"]
 
 #: A certified triple at the default τ, δ, T* (internally stable, sup_ω |Γ(jω)| = 1 at ω = 0).
 DEFAULT_GAINS = "1.2,0.5,0.6"
@@ -151,8 +159,22 @@ def _controller(args: argparse.Namespace, headway: float) -> Any:
                             standstill=args.standstill)
 
 
-def _check_step(dt: float, tau: float, delta: float) -> None:
-    """Refuse a step longer than the actuator lag or the delay (see the module docstring)."""
+def check_step(dt: float, tau: float, delta: float) -> None:
+    """Refuse a step ``--dt`` longer than the actuator lag τ or the delay δ (module docstring).
+
+    Parameters
+    ----------
+    dt : float
+        The simulation step, s (checked finite and > 0).
+    tau, delta : float
+        The actuator lag τ and the communication delay δ, s (checked).
+
+    Raises
+    ------
+    StringStabError
+        When dt > τ, or dt > δ > 0: the exact-ZOH step would hold the command over more than
+        one lag, or interpolate the delayed acceleration across a whole step.
+    """
     limit = min(tau, delta) if delta > 0 else tau
     if dt > limit * (1 + 1e-12):
         longer = [f"the actuator lag tau = {tau:g} s"] if dt > tau * (1 + 1e-12) else []
@@ -217,30 +239,35 @@ def run(args: argparse.Namespace) -> int:
     from ..traffic.platoon import simulate
 
     t0 = time.perf_counter()
+    if getattr(args, "vehicle", None) is not None and not getattr(args, "from_identify", None):
+        raise StringStabError(f"--vehicle picks a fitted vehicle of --from IDENTIFY_JSON: expected "
+                              f"--from with it; got --vehicle {args.vehicle} without --from")
     if getattr(args, "from_identify", None):
         _from_identified(args)
     tau, delta, headway = check_params(args.tau, args.delta, args.headway)
-    if args.followers < 1:
-        raise StringStabError(f"--followers must be an integer >= 1; got {args.followers}")
+    integer("--followers", args.followers, 1)  # the memory estimate bounds it (below)
     for name in ("dt", "standstill", "length", "ttc_star"):
         v = getattr(args, name)
         if not (math.isfinite(v) and (v > 0 or (name == "standstill" and v == 0))):
             raise StringStabError(
                 f"--{name.replace('_', '-')} must be a finite number > 0; got {show(v)}"
             )
+    sizes = [(kind, getattr(args, name), f"--{name.replace('_', '-')}")
+             for name, kind in (("standstill", "length"), ("length", "length"), ("ttc_star", "ttc"))]
+    for kind, v, option in [("step", args.dt, "--dt"), *sizes]:
+        check_magnitude(kind, v, name=option)
     if not (math.isfinite(args.hold) and args.hold >= 0):
         raise StringStabError(f"--hold must be a finite number of seconds >= 0; got {show(args.hold)}")
-    _check_step(args.dt, tau, delta)
+    check_step(args.dt, tau, delta)
     theta = reaction_from_args(args)
     radio, sensors = radio_from_args(args, args.dt)
-    from ..ranges import check_magnitude
 
     for opt, v in (("--duration", args.duration), ("--hold", args.hold)):
         if v is not None and math.isfinite(v):
             check_magnitude("duration", v, name=opt)
     out = OutputDir(args.out, command="simulate", owns=RUN_FILES, what="--out")
     leader = leader_by_name(args.leader, dt=args.dt, duration=args.duration).hold(args.hold)
-    from ._budget import refuse_platoon
+    from ..memory import refuse_platoon
 
     refuse_platoon(args.followers, len(leader.speed), f"--followers {args.followers}")
     limits = limits_from_args(args)
@@ -251,7 +278,12 @@ def run(args: argparse.Namespace) -> int:
             f"--gains-file {args.gains_file} has gain series for followers 1..{n_series}; "
             f"expected --followers {n_series}, got {args.followers}"
         )
-    warnings = checked_leaders(args, [leader], limits)
+    from ..traffic.limits import settling_time
+
+    settling = settling_time(controller, tau if args.model == "lag" else 0.0)
+    warnings = checked_leaders(args, [leader], limits, settling=settling)
+    warn_beyond_sensible(args, [("followers", args.followers, "--followers"),
+                                ("step", args.dt, "--dt"), *sizes])
     result = simulate(leader, controller, args.followers, tau=tau, delta=delta, model=args.model,
                       length=args.length, limits=limits, reaction_delay=theta, radio=radio,
                       sensors=sensors)

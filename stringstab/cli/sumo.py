@@ -206,16 +206,22 @@ def _case(args: argparse.Namespace, *, leader: bool = True) -> dict[str, Any]:
             DEFAULT_DELTA if args.delta is None else args.delta,
             DEFAULT_HEADWAY if args.headway is None else args.headway)
         dt = DT if args.dt is None else float(args.dt)
-    limit = min(tau, delta) if delta > 0 else tau
-    if dt > limit * (1 + 1e-12):
-        raise StringStabError(
-            f"--dt {dt:g} s is longer than the actuator lag tau = {tau:g} s or the delay "
-            f"delta = {delta:g} s: the run would not be the loop the certificate describes; "
-            f"expected --dt <= {limit:g} s")
+    from ..ranges import check_magnitude
+    from .simulate import check_step
+
+    sizes = [("step", dt, "--dt"), *[("length", getattr(args, n), f"--{n}") for n in ("standstill", "length")],
+             *[("duration", getattr(args, n, None), f"--{n}") for n in ("duration", "hold")]]
+    for kind, v, option in sizes:  # as simulate's
+        if v is not None:
+            check_magnitude(kind, v, name=option)
+    check_step(dt, tau, delta)
     limits = limits_from_args(args)
     lead, warnings = None, []
     if leader:
         lead = leader_by_name(args.leader, dt=dt, duration=args.duration).hold(args.hold)
+        from ..memory import refuse_platoon
+
+        refuse_platoon(args.followers, len(lead.speed), f"--followers {args.followers}")  # as simulate
         warnings = checked_leaders(args, [lead], limits)  # printed on stderr
     if policy is not None:
         from ..rl.evaluate import controller_for
@@ -330,6 +336,9 @@ def run_platoon(args: argparse.Namespace) -> int:
             raise StringStabError(f"{', '.join(given)}: simulated for a platoon behind a leader; "
                                   "expected none of them with --sumocfg")
         return _run_scenario(args)
+    if args.steps is not None:
+        raise StringStabError(f"--steps is for a scenario (--sumocfg); a platoon runs its leader's "
+                              f"length: expected no --steps without --sumocfg, got --steps {args.steps}")
     t0 = time.perf_counter()
     out = OutputDir(args.out, command="sumo run", owns=RUN_FILES, what="--out")
     case = _case(args)
@@ -409,8 +418,10 @@ def _run_scenario(args: argparse.Namespace) -> int:
     from ._outcome import collision_status
 
     t0 = time.perf_counter()
-    if args.steps is not None and args.steps < 1:
-        raise StringStabError(f"--steps must be an integer >= 1; got {args.steps}")
+    if args.steps is not None:
+        from ._common import integer
+
+        integer("--steps", args.steps, 1, "steps")
     ids = [i.strip() for i in str(args.controlled).split(",")]
     if not all(ids):
         raise StringStabError(f"--controlled: expected vehicle ids ID,ID,...; got {args.controlled!r}")

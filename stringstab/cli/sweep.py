@@ -8,6 +8,7 @@ import time
 from typing import Any
 
 from ._common import integer as _int
+from ._common import warn_beyond_sensible
 
 __all__ = ["add_parser", "run"]
 
@@ -78,20 +79,31 @@ def run(args: argparse.Namespace) -> int:
         :class:`~stringstab.errors.StringStabError` (exit 2 from
         :func:`stringstab.cli.main`).
     """
-    from ..io import check_output_dir
+    from ..io import check_output_dir, claim_folder
+    from ..memory import available_bytes, human_bytes
     from ..sweep import dask_client, load_spec, read_records, run_sweep
     from ..sweep.cluster import dashboard_address
+    from ..sweep.tasks import point_bytes, refuse_points_too_big
 
     t0 = time.perf_counter()
     spec = load_spec(args.spec)
     if args.check:
         print(f"{args.spec}: {len(spec)} points of kind {spec.kind}, study {spec.study}")
         for pt in spec.points:
-            print(f"  {pt.id}  {pt.label}  " + ", ".join(f"{k}={v}" for k, v in pt.varied.items()))
+            print(f"  {pt.id}  {pt.label}  " + ", ".join(f"{k}={v}" for k, v in pt.varied.items())
+                  + f"  (memory: about {human_bytes(point_bytes(pt.kind, pt.settings))})")
         return 0
-    workers = None if args.workers is None else _int("--workers", args.workers, 1)
-    retries = _int("--retries", args.retries, 0)
+    workers = None if args.workers is None else _int("--workers", args.workers, 1, "workers")
+    retries = _int("--retries", args.retries, 0, "retries")
     check_output_dir(args.out, what="--out")
+    claim_folder(args.out, command="sweep", what="--out")
+    if args.scheduler is None:  # the local cluster shares this machine's memory among its workers
+        from ..parallel import cpu_count
+
+        n = workers or cpu_count()
+        refuse_points_too_big(spec.points, available_bytes() / n,
+                              f"each of the {n} local worker(s) (the memory available, shared)")
+    warn_beyond_sensible(args, [("workers", workers, "--workers"), ("retries", retries, "--retries")])
     try:  # SIGTERM arrives as KeyboardInterrupt too (stringstab.cli.main)
         with dask_client(args.scheduler, workers) as client:
             dash = dashboard_address(client)

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import StringStabError
+from ._common import checked_leaders, warn_beyond_sensible
 from ._common import integer as _int
 
 __all__ = ["add_parser", "run"]
@@ -61,9 +62,6 @@ def add_parser(sub: Any) -> None:
 
 #: The largest step budget accepted (a year at ~300 steps/s).
 MAX_STEPS = 10**10
-#: Memory per parallel environment, rounded up from a measurement (train --algo idl, peak RSS
-#: 1022 MB with 4 and 1023 MB with 2048 environments: ~0.6 kB each).
-BYTES_PER_ENV = 2048
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,19 +84,16 @@ def run(args: argparse.Namespace) -> int:
     from ..rl.train import check_run_folder, train
 
     kw: dict[str, Any] = {"total_steps": _int("--steps", args.steps, 1),
-                          "seed": _int("--seed", args.seed, 0)}
+                          "seed": _int("--seed", args.seed, 0, "seed")}
     if kw["total_steps"] > MAX_STEPS:
         raise StringStabError(
             f"--steps {kw['total_steps']} is far beyond any training run (about a year at 300 "
             f"steps/s is 1e10); expected at most {MAX_STEPS:.0e}")
+    warn_beyond_sensible(args, [("steps", kw["total_steps"], "--steps")])
     if args.num_envs is not None:
         kw["num_envs"] = _int("--num-envs", args.num_envs, 1)
-        from ._budget import refuse_if_too_big
-
-        refuse_if_too_big(f"--num-envs {kw['num_envs']}", BYTES_PER_ENV * kw["num_envs"],
-                          "expected fewer parallel environments (8 by default)")
     if args.stop_episodes is not None:
-        kw["stop_episodes"] = _int("--stop-episodes", args.stop_episodes, 0)
+        kw["stop_episodes"] = _int("--stop-episodes", args.stop_episodes, 0, "episodes")
     if args.repair is not None:
         if args.algo != "idl":
             raise StringStabError(f"--repair applies to --algo idl; got --algo {args.algo}")
@@ -106,6 +101,12 @@ def run(args: argparse.Namespace) -> int:
     if args.paper and args.algo != "idl":
         raise StringStabError(f"--paper applies to --algo idl; got --algo {args.algo}")
     config, note = _with_loop(config_for(args.algo, paper=args.paper, **kw), args)
+    if args.num_envs is not None:
+        from ..memory import refuse_if_too_big, training_bytes
+
+        refuse_if_too_big(f"--num-envs {config.num_envs}",
+                          training_bytes(config.num_envs, config.buffer_size),
+                          "expected fewer parallel environments (8 by default)")
     out = Path(args.out)
     check_run_folder(out, resume=args.resume, config=config)
     leaders = None
@@ -114,6 +115,9 @@ def run(args: argparse.Namespace) -> int:
 
         leaders = leaders_from_files(args.leaders, "train", seconds=config.episode_seconds,
                                      dt=config.dt)
+        from ..traffic.limits import Limits
+
+        checked_leaders(args, leaders, Limits())  # the environments' limits: IDL Table 2
     res = train(config, out=out, resume=args.resume, progress=not args.no_progress,
                 leaders=leaders, log=print)
     if res.stopped_by == "interrupted":

@@ -206,6 +206,18 @@ def run(args: argparse.Namespace) -> int:
         raise StringStabError(
             f"--hurwitz-margin must be >= 0 and --eps > 0; got {args.hurwitz_margin!r}, {args.eps!r}"
         )
+    from ..ranges import check_count
+    from ._common import warn_beyond_sensible
+
+    checked = [*(("weight", w, "--weights") for w in weights), ("gain", r0, "--r0"),
+               ("margin", margin, "--hurwitz-margin"), ("margin", eps, "--eps")]
+    for kind, v, option in checked:  # refused far beyond sense (the solvers would not return)
+        check_magnitude(kind, v, name=option)
+    for kind, n, option in (("grid", grid, "--grid"), ("iterations", max_iter, "--max-iter")):
+        if n is not None:
+            check_count(kind, n, name=option)
+            checked.append((kind, n, option))
+    warn_beyond_sensible(args, checked)
     import time
 
     from ._common import resolve_format

@@ -459,11 +459,15 @@ def read_identified(path: str, *, vehicle: int | None = None) -> list[dict[str, 
     from ..errors import StringStabError
 
     need = ("position", "name", "k_x", "k_v", "k_a", "tau", "delta", "headway", "standstill")
+    from ..io.text_input import read_text
+
+    expected = "an identify.json written by 'stringstab identify'"
+    text = read_text(Path(path), label=f"--from {path!r}", expected=expected)
     try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError) as e:
-        raise StringStabError(f"--from {path!r}: expected an identify.json written by 'stringstab "
-                              f"identify'; cannot read it ({e})") from e
+        doc = json.loads(text)
+    except ValueError as e:
+        raise StringStabError(f"--from {path!r}: expected {expected}; got text that is not JSON "
+                              f"({e})") from e
     rows = doc.get("vehicles") if isinstance(doc, dict) else None
     if doc.get("command") != "identify" or not isinstance(rows, list) or not rows:  # type: ignore[union-attr]
         raise StringStabError(f"--from {path!r}: expected an identify.json with a non-empty 'vehicles' list")

@@ -7,7 +7,8 @@
 Parquet, NPZ) with one vectorised writer: the column model is :mod:`~stringstab.io.columns`,
 the renderers :mod:`~stringstab.io.table`, :mod:`~stringstab.io.text_formats` and
 :mod:`~stringstab.io.binary_formats`; :mod:`~stringstab.io.figures` saves a drawn figure in every
-format with its metadata.
+format with its metadata; :mod:`~stringstab.io.text_input` reads a user's text file
+(plain or gzip, by content) as UTF-8 or refuses it in one line; :mod:`~stringstab.io.manifest` says which command wrote a folder.
 
 Every command checks its output paths with :func:`check_output_file` or :class:`OutputDir`
 *before* it starts work, and writes through :func:`atomic_write_text`,
@@ -27,14 +28,15 @@ from .gains import (
     parse_triple,
     read_gains,
 )
+from .manifest import MANIFEST, claim_folder, read_manifest
 from .outputs import (
-    MANIFEST,
     OutputDir,
     atomic_path,
     atomic_write_bytes,
     atomic_write_text,
     check_output_dir,
     check_output_file,
+    write_manifest,
 )
 from .plain import dumps_json, to_plain
 from .platoon_logs import PlatoonLog, Segment, clean_segments, read_platoon_logs
@@ -61,6 +63,7 @@ __all__ = [
     "check_figure_formats",
     "check_output_dir",
     "check_output_file",
+    "claim_folder",
     "clean_segments",
     "columns_from_records",
     "dumps_json",
@@ -69,11 +72,13 @@ __all__ = [
     "format_results",
     "parse_triple",
     "read_gains",
+    "read_manifest",
     "read_platoon_logs",
     "records_from_columns",
     "render_table",
     "save_figure",
     "to_plain",
+    "write_manifest",
     "write_results",
     "write_text",
 ]

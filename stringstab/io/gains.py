@@ -45,6 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import StringStabError, show
+from .text_input import read_stream, read_text
 
 __all__ = [
     "GAIN_COLUMNS",
@@ -543,7 +544,8 @@ def _read_parquet(path: Path, source: str) -> GainTable:
     try:
         table = pq.read_table(path)
     except Exception as e:  # pyarrow raises its own ArrowInvalid / OSError types
-        raise StringStabError(f"{source}: not a readable Parquet file ({e})") from e
+        raise StringStabError(f"{source}: not a readable Parquet file; expected Parquet columns "
+                              f"k_x, k_v, k_a [, t, vehicle] ({e})") from e
     arrays = {name: np.asarray(table.column(name).to_numpy(zero_copy_only=False))
               for name in table.column_names}
     if not arrays:
@@ -609,6 +611,11 @@ def _from_arrays(arrays: dict[str, npt.NDArray[Any]], source: str) -> GainTable:
     )
 
 
+def _read_stream(stream: IO[str], name: str) -> str:
+    """All of a text stream (standard input: gzip by content, strict UTF-8), or a one-line refusal."""
+    return read_stream(stream, label=name, expected="a CSV or JSON gain file")
+
+
 def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = None) -> GainTable:
     r"""Read gain triples from a CSV, JSON, NPZ or Parquet file (see the module docstring).
 
@@ -662,7 +669,7 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
             raise StringStabError(
                 f"{name}: {fmt.upper()} cannot be read from a text stream; give a path"
             )
-        text = stream.read()
+        text = _read_stream(stream, name)
         if text.startswith("\ufeff"):
             text = text[1:]
         kind = fmt or ("json" if text.lstrip()[:1] in ("[", "{") else "csv")
@@ -690,12 +697,5 @@ def read_gains(source: str | os.PathLike[str] | IO[str], *, fmt: str | None = No
         return _read_npz(path, name)
     if kind == "parquet":
         return _read_parquet(path, name)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as e:
-        raise StringStabError(
-            f"{name}: not UTF-8 text (byte {e.start}); expected a UTF-8 {kind.upper()} file"
-        ) from e
-    except OSError as e:
-        raise StringStabError(f"{name}: cannot read the file ({e.strerror or e})") from e
+    text = read_text(path, label=name, expected=f"a {kind.upper()} gain file")
     return _read_json(text, name) if kind == "json" else _read_csv(text, name)

@@ -3,11 +3,13 @@
 Three guarantees, for every command of the toolkit:
 
 1. **Checked first.**  :func:`check_output_file` and :func:`check_output_dir` (and
-   :class:`OutputDir`, which calls the latter) refuse, with one sentence, an output path whose
-   folder does not exist, a folder where a file is wanted and the reverse, and a place where
-   nothing can be written — *before* any computation, so a long run never ends in a traceback.
-   Writability is probed by creating (and removing) a temporary file, which is the only test that
-   is right for root, ACLs and read-only file systems alike.
+   :class:`OutputDir`, which calls the latter) refuse, with one sentence, a folder where a file
+   is wanted and the reverse, a path through a file, and a place where nothing can be written —
+   *before* any computation, so a long run never ends in a traceback.  One rule for files and
+   folders alike: the missing folders on an output's path are created when the run succeeds
+   (never when it fails).  Writability is probed by creating (and removing) a temporary file in
+   the nearest existing folder, which is the only test that is right for root, ACLs and read-only
+   file systems alike.
 2. **Complete or absent.**  Files are written to a temporary name in the same folder and renamed
    into place (``os.replace``, atomic on POSIX), so a reader never sees half a file.
 3. **One run per folder.**  An :class:`OutputDir` writes every file of a run into a staging folder
@@ -15,7 +17,7 @@ Three guarantees, for every command of the toolkit:
    the folder's manifest, :data:`MANIFEST`) wrote and this one did not.  A command whose outputs
    have fixed names may instead declare them (``owns=``): then those of its names this run did
    not write are deleted.  Every run writes the manifest: the command, the version, the files
-   and, from the command line (:func:`invocation`), the arguments and the inputs' hashes (a
+   and, from the command line (:func:`~stringstab.io.manifest.invocation`), the arguments and the inputs' hashes (a
    policy's hash and step count for an evaluation).  A failed run leaves the
    previous outputs untouched; a folder written by a *different* command is refused; files the
    toolkit did not write are never deleted.
@@ -24,7 +26,6 @@ Three guarantees, for every command of the toolkit:
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import json
 import os
 import shutil
@@ -35,9 +36,9 @@ from types import TracebackType
 from typing import Any
 
 from ..errors import StringStabError
+from .manifest import MANIFEST, claim_folder, manifest_doc, read_manifest
 
 __all__ = [
-    "MANIFEST",
     "OutputDir",
     "atomic_path",
     "atomic_write_bytes",
@@ -45,11 +46,9 @@ __all__ = [
     "check_output_dir",
     "check_output_file",
     "deferred_interrupt",
-    "invocation",
+    "write_manifest",
 ]
 
-#: Name of the file in which an :class:`OutputDir` lists what it wrote.
-MANIFEST = ".stringstab-manifest.json"
 _STAGING_PREFIX = ".stringstab-staging-"
 
 
@@ -79,9 +78,10 @@ def _probe_writable(folder: Path, what: str) -> None:
 def check_output_file(path: str | os.PathLike[str], *, what: str = "output file") -> Path:
     """Check that a file can be written at ``path``, before any work is done.
 
-    The parent folder must exist (it is not created: a mistyped folder name should be an error,
-    not a new folder) and be writable; ``path`` itself must not be a folder. Writability is
-    probed by creating and removing a temporary file in the parent folder.
+    ``path`` must not be a folder, and the nearest existing folder on its path must be writable
+    (probed by creating and removing a temporary file there).  Nothing is created: the missing
+    folders are created when the file is written (:func:`atomic_path`), as an output folder's
+    are (:func:`check_output_dir`): one rule for every command.
 
     Parameters
     ----------
@@ -102,27 +102,27 @@ def check_output_file(path: str | os.PathLike[str], *, what: str = "output file"
 
     Examples
     --------
-    >>> check_output_file("/nonexistent-folder/x.json")
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "a-file"
+    >>> _ = f.write_text("x")
+    >>> check_output_file(f / "x.json")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    stringstab.errors.StringStabError: output file: the folder '/nonexistent-folder' of '/nonexistent-folder/x.json' does not exist; create it first or choose another path
+    stringstab.errors.StringStabError: output file: '...a-file' in '...a-file/x.json' is a file, not a folder
     """
     p = Path(path)
     if str(path) == "" or p.name in ("", ".", ".."):
         raise StringStabError(f"{what}: expected a file name; got {str(path)!r}")
     if p.is_dir():
         raise StringStabError(f"{what}: expected a file; {str(p)!r} is a folder")
-    parent = p.parent
-    if not parent.exists():
-        raise StringStabError(
-            f"{what}: the folder {str(parent)!r} of {str(p)!r} does not exist; "
-            "create it first or choose another path"
-        )
-    if not parent.is_dir():
-        raise StringStabError(f"{what}: {str(parent)!r} in {str(p)!r} is a file, not a folder")
+    probe = p.parent
+    while not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise StringStabError(f"{what}: {str(probe)!r} in {str(p)!r} is a file, not a folder")
     if p.exists() and not p.is_file():
         raise StringStabError(f"{what}: expected a regular file; {str(p)!r} is something else")
-    _probe_writable(parent, what)
+    _probe_writable(probe, what)
     return p
 
 
@@ -130,7 +130,8 @@ def check_output_dir(path: str | os.PathLike[str], *, what: str = "output folder
     """Check that a folder can be written (or created, with its parents) at ``path``.
 
     Nothing is created: the nearest existing ancestor must be a writable folder (probed with a
-    temporary file, removed at once).
+    temporary file, removed at once).  The missing folders are created when the run succeeds,
+    as an output file's are (:func:`check_output_file`): one rule for every command.
 
     Parameters
     ----------
@@ -186,7 +187,8 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
     Parameters
     ----------
     path : str or path-like
-        The final file; its folder must exist (the temporary file is created there).
+        The final file; its missing folders are created (the temporary file is created there)
+        and removed again if the block fails.
     what : str, default "output file"
         What the file is, as the first words of an error message.
 
@@ -211,9 +213,12 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
     [0, 1, 2]
     """
     p = Path(path)
+    created = [q for q in p.parents if not q.exists()]
     try:
+        p.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{p.stem}.", suffix=f".tmp{p.suffix}", dir=p.parent)
     except OSError as e:
+        _remove_empty(created)
         raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
     os.close(fd)
     tmp_path = Path(tmp)
@@ -223,10 +228,19 @@ def atomic_path(path: str | os.PathLike[str], *, what: str = "output file") -> I
         os.replace(tmp_path, p)
     except OSError as e:
         tmp_path.unlink(missing_ok=True)
+        _remove_empty(created)
         raise StringStabError(f"{what}: cannot write {str(p)!r} ({_reason(e)})") from e
     except BaseException:
         tmp_path.unlink(missing_ok=True)
+        _remove_empty(created)
         raise
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove the folders a failed write created (deepest first; only if still empty)."""
+    for q in folders:  # Path.parents order: deepest first
+        with contextlib.suppress(OSError):
+            q.rmdir()
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, what: str = "output file") -> Path:
@@ -283,40 +297,6 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, what: str = "o
     return atomic_write_bytes(path, text.encode("utf-8"), what=what)
 
 
-#: What produced the outputs being written (the command line and its inputs' hashes), set by
-#: the command-line entry point (:func:`invocation`) and copied into every manifest.
-_INVOCATION: contextvars.ContextVar[Any] = contextvars.ContextVar(
-    "stringstab_invocation", default=None)
-
-
-@contextlib.contextmanager
-def invocation(doc: Any) -> Iterator[None]:
-    """Within the block, every :class:`OutputDir` manifest also records ``doc``.
-
-    Parameters
-    ----------
-    doc : dict or callable
-        JSON-serialisable entries, e.g. ``{"argv": [...], "inputs": {...}}``, or a callable
-        returning them (called when a manifest is written: hashing inputs only when needed).
-
-    Yields
-    ------
-    None
-        Control returns to the block; the record is dropped when it ends.
-
-    Examples
-    --------
-    >>> with invocation({"argv": ["stringstab", "demo"]}):
-    ...     _INVOCATION.get()["argv"][1]
-    'demo'
-    """
-    token = _INVOCATION.set(doc)
-    try:
-        yield
-    finally:
-        _INVOCATION.reset(token)
-
-
 @contextlib.contextmanager
 def deferred_interrupt() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) until the block is done, then raise KeyboardInterrupt.
@@ -349,6 +329,29 @@ def deferred_interrupt() -> Iterator[None]:
         signal.signal(signal.SIGINT, old)
     if caught:
         raise KeyboardInterrupt
+
+
+def write_manifest(folder: str | os.PathLike[str], *, command: str, files: Iterable[str] = (),
+                   extra: dict[str, Any] | None = None, what: str = "output folder") -> None:
+    """Write a folder's manifest atomically (:func:`stringstab.io.manifest.manifest_doc`).
+
+    For a folder filled as it goes (a sweep's) rather than through :class:`OutputDir`.
+
+    Parameters
+    ----------
+    folder : path-like
+        An existing folder.
+    command : str
+        The command that wrote it.
+    files : iterable of str, default ()
+        The files it wrote (relative paths), which its next run may replace.
+    extra : dict, optional
+        More entries (e.g. the policy an evaluation is of).
+    what : str, default "output folder"
+        What the folder is, for an error message.
+    """
+    doc = manifest_doc(command, files, extra)
+    atomic_write_text(Path(folder) / MANIFEST, json.dumps(doc, indent=1) + "\n", what=what)
 
 
 class OutputDir:
@@ -400,13 +403,7 @@ class OutputDir:
         self._committed = False
         #: More manifest entries (e.g. the policy an evaluation is of): :meth:`record`.
         self.extra: dict[str, Any] = {}
-        old = self._read_manifest()
-        if old is not None and old.get("command") != command:
-            raise StringStabError(
-                f"{what}: {str(self.root)!r} holds the outputs of 'stringstab {old.get('command')}'; "
-                f"expected an empty folder or one written by 'stringstab {command}'; "
-                "choose another folder"
-            )
+        claim_folder(self.root, command=command, what=what)
 
     # -- manifest ---------------------------------------------------------------------------
     def record(self, **entries: Any) -> None:
@@ -418,14 +415,7 @@ class OutputDir:
         return self._read_manifest()
 
     def _read_manifest(self) -> dict[str, Any] | None:
-        m = self.root / MANIFEST
-        if not m.is_file():
-            return None
-        try:
-            doc = json.loads(m.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return None  # an unreadable manifest protects nothing; we will overwrite it
-        return doc if isinstance(doc, dict) else None
+        return read_manifest(self.root)
 
     # -- context ------------------------------------------------------------------------------
     def __enter__(self) -> OutputDir:
@@ -547,13 +537,8 @@ class OutputDir:
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.chmod(staging / name, mode)
                 os.replace(staging / name, dest)
-            from .._version import __version__
-
-            inv = _INVOCATION.get()
-            manifest = {"command": self.command, "version": __version__, "files": new,
-                        **((inv() if callable(inv) else inv) or {}), **self.extra}
-            atomic_write_text(self.root / MANIFEST, json.dumps(manifest, indent=1) + "\n",
-                              what=self.what)
+            write_manifest(self.root, command=self.command, files=new, extra=self.extra,
+                           what=self.what)
         except OSError as e:
             raise StringStabError(
                 f"{self.what}: cannot move the outputs into {str(self.root)!r} ({_reason(e)})"

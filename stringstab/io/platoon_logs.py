@@ -220,11 +220,12 @@ def _check_last_line(path: Path, n_rows: int) -> None:
     writes ends with a line break, so a missing one is taken as the sign of a cut.
     """
     try:
-        with open_text(path) as fh:
+        with open_text(path, label=_where(path),
+                       expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)") as fh:
             last = ""
             while chunk := fh.read(1 << 20):
                 last = chunk[-1]
-    except (OSError, UnicodeDecodeError):
+    except (OSError, StringStabError):
         return  # the reader has already read it; its own errors are reported there
     if last not in ("\n", "\r"):
         raise StringStabError(
@@ -244,13 +245,9 @@ def _cell(c: str) -> float:
 
 
 def _read_rows(path: Path) -> list[list[str]]:
-    try:
-        with open_text(path) as fh:  # plain or gzip-compressed (.csv.gz)
-            return [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-    except OSError as e:
-        raise StringStabError(f"cannot read {_where(path)}: {e.strerror or e}") from e
-    except UnicodeDecodeError as e:
-        raise StringStabError(f"{_where(path)}: expected a UTF-8 text (CSV) file; {e.reason}") from e
+    with open_text(path, label=_where(path),  # plain or gzip-compressed (.csv.gz)
+                   expected="a recorded platoon as CSV text (OpenACC, plain CSV or NGSIM)") as fh:
+        return [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
 
 
 def _numeric(rows: list[list[str]], ncol: int, path: Path, first_line: int) -> Array:

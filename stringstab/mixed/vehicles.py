@@ -192,8 +192,8 @@ def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None,
                                   f"(platoons {platoons}); choose one with --platoon")
         platoon = platoons[0] if platoons else 0
     elif platoon not in platoons:
-        raise StringStabError(f"{_where(path)}: --platoon {platoon} is not in the file; found "
-                              f"{platoons or 'none'}")
+        raise StringStabError(f"{_where(path)}: --platoon {platoon} is not in the file; expected "
+                              f"one of {platoons or 'none'}")
     rows = sorted((v for v in rows if int(v.get("platoon", 0)) == platoon),
                   key=lambda v: int(v.get("position", 0)))
     if not rows:
@@ -205,7 +205,8 @@ def _read_identify(path: Path, doc: dict[str, Any], platoon: int | None,
         if not any(r[0] <= a and b <= r[-1] for r in runs):
             raise StringStabError(
                 f"{_where(path)}: --positions {a}:{b} is not a run of consecutive identified "
-                f"followers; the runs are {', '.join(f'{r[0]}:{r[-1]}' for r in runs)}")
+                f"followers; expected A:B within one of the runs "
+                f"{', '.join(f'{r[0]}:{r[-1]}' for r in runs)}")
         chosen = list(range(a, b + 1))
     else:
         chosen = max(runs, key=len)  # the longest run (the first of equal ones)
@@ -263,13 +264,13 @@ def read_vehicles(path: str | Path, *, platoon: int | None = None,
     StringStabError
         One line naming the file and what was expected (module docstring).
     """
+    from ..io.text_input import read_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError as e:
-        raise StringStabError(f"{_where(p)}: no such file") from e
-    except (OSError, UnicodeDecodeError) as e:
-        raise StringStabError(f"{_where(p)}: cannot be read as text ({e})") from e
+    if not p.exists():
+        raise StringStabError(f"{_where(p)}: no such file")
+    text = read_text(p, label=_where(p), expected="an identify.json or a CSV list of followers "
+                     f"(columns {','.join(REQUIRED)})")
     if p.suffix.lower() == ".json" or text.lstrip().startswith("{"):
         try:
             doc = json.loads(text)

@@ -154,13 +154,12 @@ def read_json(path: str | os.PathLike[str], *, fmt: str, what: str) -> dict[str,
     StringStabError
         If the file is missing, not JSON, not an object, or has another format tag.
     """
+    from ..io.text_input import read_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError as e:
-        raise StringStabError(f"{what}: missing file {str(p)!r}") from e
-    except (OSError, UnicodeDecodeError) as e:
-        raise StringStabError(f"{what}: cannot read {str(p)!r} ({e})") from e
+    if not p.exists():
+        raise StringStabError(f"{what}: missing file {str(p)!r}")
+    text = read_text(p, label=f"{what}: {str(p)!r}", expected=f"a JSON file of format {fmt!r}")
     try:
         doc = json.loads(text)
     except ValueError as e:

@@ -144,11 +144,9 @@ def default_leaders(split: Split, *, seconds: float = 30.0, dt: float = 0.1) -> 
 
 
 def _is_ngsim(path: Path) -> bool:
-    try:
-        with open_text(path) as fh:  # plain or gzip-compressed (.csv.gz)
-            head = fh.readline()
-    except OSError as e:
-        raise StringStabError(f"cannot read leader file {str(path)!r}: {e.strerror or e}") from e
+    with open_text(path, label=f"leader file {str(path)!r}",  # plain or gzip (.csv.gz)
+                   expected="a 't, v' CSV or an NGSIM trajectory file") as fh:
+        head = fh.readline()
     return "vehicle_id" in head.lower()
 
 

@@ -15,7 +15,10 @@ Stopping (§4.1.2): after ``stop_episodes`` collision-free episode ends (700 in 
 With ``out``, the run folder holds a checkpoint every ``checkpoint_every`` steps and at the end
 (:mod:`~stringstab.rl.checkpoint`), the policy (:mod:`~stringstab.rl.policy`), the episode log
 (``train_log.csv``), the rolling-reward curve (``rolling_reward.png``, the paper's Fig. 3, window
-10) and ``summary.json``.  ``resume=True`` continues the newest checkpoint: networks, optimisers,
+10) and ``summary.json``.  The folder appears with the first checkpoint, and every checkpoint
+also writes the log and the summary (``stopped_by: "checkpoint"`` until the run ends), each file
+whole while Ctrl-C is held: whenever a run is stopped (a second Ctrl-C raises at once), it leaves
+no folder or a resumable one with its log and summary.  ``resume=True`` continues the newest checkpoint: networks, optimisers,
 the replay memory, the RNG states of NumPy, torch and the environments, the environments' state
 and every counter are restored, so an interrupted run ends bit for bit where an uninterrupted one
 would.
@@ -23,11 +26,13 @@ would.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import io
 import os
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,7 +44,7 @@ from ..io import atomic_path, atomic_write_text, check_output_dir, dumps_json
 from .config import TD3Config, config_from_dict, loop_info
 from .policy import Policy
 
-__all__ = ["RUN_FORMAT", "TrainResult", "train"]
+__all__ = ["RESUMABLE_FIELDS", "RUN_FORMAT", "TrainResult", "refuse_other_config", "train"]
 
 #: Format tag of a run folder's ``run.json``.
 RUN_FORMAT = "stringstab-rl-run/1"
@@ -130,6 +135,49 @@ def _write_log(rows: list[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
+#: The fields a resumed run may change: the step budget and the checkpoint interval.
+RESUMABLE_FIELDS = ("total_steps", "checkpoint_every")
+
+
+def refuse_other_config(saved: TD3Config, config: TD3Config) -> None:
+    """Refuse to resume a checkpoint written with another configuration, naming what differs.
+
+    Parameters
+    ----------
+    saved : TD3Config
+        The checkpoint's configuration.
+    config : TD3Config
+        The one asked for now.
+
+    Raises
+    ------
+    StringStabError
+        When a field other than :data:`RESUMABLE_FIELDS` differs (or the class does): each
+        field with the checkpoint's value (expected) and the one given (found).
+
+    Examples
+    --------
+    >>> from stringstab.rl import config_for
+    >>> refuse_other_config(config_for("ddpg", seed=0), config_for("ddpg", seed=1, num_envs=4))
+    Traceback (most recent call last):
+    ...
+    stringstab.errors.StringStabError: --resume: the checkpoint was written with another configuration; expected its seed = 0, num_envs = 8; got seed = 1, num_envs = 4 (only the step budget and the checkpoint interval may change on resume)
+    """
+    if type(saved) is not type(config):
+        raise StringStabError(f"--resume: the checkpoint is a {type(saved).__name__} run; expected "
+                              f"{type(saved).__name__}, got {type(config).__name__}")
+    differ = [f.name for f in dataclasses.fields(saved) if f.name not in RESUMABLE_FIELDS
+              and getattr(saved, f.name) != getattr(config, f.name)]
+    if differ:
+        def values(c: TD3Config) -> str:
+            return ", ".join(f"{n} = {getattr(c, n)!r}" for n in differ)
+
+        raise StringStabError(
+            "--resume: the checkpoint was written with another configuration; expected its "
+            f"{values(saved)}; got {values(config)} (only the step budget and the checkpoint "
+            "interval may change on resume)")
+
+
 def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
     """Before any work: a new run needs an empty or absent folder; a resumed one its own run.
 
@@ -146,17 +194,25 @@ def check_run_folder(out: Path, *, resume: bool, config: TD3Config) -> None:
     ------
     StringStabError
         If ``out`` cannot be an output folder, a new run's folder has visible files in it, or a
-        resumed folder holds no run or a run of another ``algo``.
+        resumed folder holds no run, a run of another ``algo`` or a checkpoint of another
+        configuration (:func:`refuse_other_config`).
     """
     check_output_dir(out, what="--out")
     if resume:
-        from .checkpoint import read_json
+        from .checkpoint import CHECKPOINT_FORMAT, LATEST_FORMAT, read_json
 
         run = read_json(out / "run.json", fmt=RUN_FORMAT, what="--resume")
         if run.get("algo") != config.algo:
             raise StringStabError(
                 f"--resume: {str(out)!r} holds a run of --algo {run.get('algo')!r}; "
                 f"expected --algo {config.algo!r}")
+        latest = out / "checkpoint" / "latest.json"
+        if latest.is_file():  # the configuration, before any work (the tensors are read later)
+            name = str(read_json(latest, fmt=LATEST_FORMAT, what="--resume").get("checkpoint"))
+            state = out / "checkpoint" / name / "state.json"
+            if "/" not in name and ".." not in name and state.is_file():
+                doc = read_json(state, fmt=CHECKPOINT_FORMAT, what="--resume").get("config")
+                refuse_other_config(config_from_dict(doc, source="checkpoint config"), config)
     elif out.exists() and any(not p.name.startswith(".") for p in out.iterdir()):
         raise StringStabError(f"--out: {str(out)!r} is not empty; choose a new folder, or pass "
                               "--resume to continue the run in it")
@@ -268,16 +324,8 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         from .checkpoint import latest_checkpoint
 
         state, tensors = latest_checkpoint(out_path / "checkpoint")
-        saved = config_from_dict(state.get("config"), source="checkpoint config")
-        if saved.replace(total_steps=config.total_steps,
-                         checkpoint_every=config.checkpoint_every) != config:
-            was, now = saved.as_dict(), config.as_dict()
-            changed = sorted(k for k in set(was) | set(now)
-                             if k not in ("total_steps", "checkpoint_every") and was.get(k) != now.get(k))
-            raise StringStabError(
-                "--resume: the checkpoint was written with another configuration (only the step "
-                "budget and the checkpoint interval may change on resume); changed: "
-                + ", ".join(f"{k} {was.get(k)!r} -> {now.get(k)!r}" for k in changed))
+        refuse_other_config(config_from_dict(state.get("config"), source="checkpoint config"),
+                            config)
         if not hasattr(envs, "load_state_dict"):
             raise StringStabError("resume: the environment has no load_state_dict()")
         agent.load_state(state["agent"], {k: torch.as_tensor(np.array(v))
@@ -297,11 +345,39 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         episodes = list(state["episodes"])
         returns = [float(r["return"]) for r in episodes]
 
-    def checkpoint() -> None:
+    def result_now(stopped_by: str) -> TrainResult:
+        seconds = time.perf_counter() - t_start
+        rep_s = (float(repair.stats["seconds"]) - rep0) if repair is not None else 0.0
+        timing = {"env_seconds": t_env, "repair_seconds": rep_s, "update_seconds": t_upd,
+                  "total_seconds": seconds,
+                  "steps_per_second": steps_here / seconds if seconds else 0.0,
+                  "repair_share": rep_s / seconds if seconds else 0.0}
+        return TrainResult(Policy(agent.actor, info_fn), config, step, episodes, stopped_by,
+                           seconds, timing, dict(repair.stats) if repair is not None else None,
+                           out_path)
+
+    def checkpoint(final: TrainResult | None = None) -> None:
+        """The run folder as it stands, its files written whole whatever Ctrl-C does meanwhile.
+
+        The folder is created at the first checkpoint (a run stopped before it leaves nothing),
+        and every checkpoint also writes ``train_log.csv`` and ``summary.json`` (``stopped_by``
+        ``"checkpoint"`` until the run ends): a second Ctrl-C, which raises at once, leaves a
+        resumable folder with its log and summary, or no folder.
+        """
         if out_path is None:
             return
+        with interrupt.held():
+            _checkpoint(final)
+
+    def _checkpoint(final: TrainResult | None) -> None:
+        assert out_path is not None
         from .checkpoint import write_checkpoint
 
+        if not resume and not (out_path / "run.json").is_file():
+            out_path.mkdir(parents=True, exist_ok=True)
+            atomic_write_text(out_path / "config.json", dumps_json(config.as_dict()))
+            atomic_write_text(out_path / "run.json", dumps_json(  # last: it makes a run folder
+                {"format": RUN_FORMAT, "algo": config.algo, "action": config.action}))
         agent_meta, agent_t = agent.state()
         arrs = {k: v.numpy() for k, v in agent_t.items()}
         arrs["rng.torch"] = torch.get_rng_state().numpy()
@@ -314,17 +390,14 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
               "counters": {"step": step, "clean_ends": clean_ends}, "episodes": episodes}
         write_checkpoint(out_path / "checkpoint", step, st, {"agent": arrs, "buffer": barr})
         Policy(agent.actor, info_fn).save(out_path)
+        _write_outputs(final or result_now("checkpoint"), figure=final is not None)
         if log is not None:
             log(f"checkpoint at step {step}: {len(episodes)} episodes, rolling return "
                 f"{_rolling(returns):.3f}")
 
     # Ctrl-C stops the loop at the next step boundary (interrupt.caught): the checkpoint,
-    # policy, log and summary are written as at the end of a budget, so resume continues there
-    if out_path is not None and not resume:
-        out_path.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(out_path / "run.json", dumps_json(
-            {"format": RUN_FORMAT, "algo": config.algo, "action": config.action}))
-        atomic_write_text(out_path / "config.json", dumps_json(config.as_dict()))
+    # policy, log and summary are written as at the end of a budget, so resume continues there;
+    # the run folder itself appears with the first checkpoint (checkpoint())
 
     # a bar on a terminal, one line every 10 s with the time left otherwise (False: silent)
     from ..progress import Progress
@@ -392,23 +465,19 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
     else:
         if config.stop_episodes and clean_ends >= config.stop_episodes:
             stopped_by = "episodes"
+    interrupt.hold()  # the last outputs: a further Ctrl-C would leave a folder without its summary
     meter.close()
-    seconds = time.perf_counter() - t_start
-    rep_s = (float(repair.stats["seconds"]) - rep0) if repair is not None else 0.0
-    timing = {"env_seconds": t_env, "repair_seconds": rep_s, "update_seconds": t_upd,
-              "total_seconds": seconds, "steps_per_second": steps_here / seconds if seconds else 0.0,
-              "repair_share": rep_s / seconds if seconds else 0.0}
-    policy = Policy(agent.actor, info_fn)
-    result = TrainResult(policy, config, step, episodes, stopped_by, seconds, timing,
-                         dict(repair.stats) if repair is not None else None, out_path)
-    if out_path is not None:
-        checkpoint()
-        _write_outputs(result)
+    result = result_now(stopped_by)
+    checkpoint(result)
     return result
 
 
 class _StepInterrupt:
-    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only."""
+    """SIGINT recorded instead of raised (a second Ctrl-C raises at once), main thread only.
+
+    Once the loop is over (:meth:`hold`), every Ctrl-C is recorded: the final checkpoint, log
+    and summary are written whole, so an interrupted run's folder is always resumable.
+    """
 
     def __init__(self, active: bool = True) -> None:
         import signal
@@ -425,6 +494,34 @@ class _StepInterrupt:
         self.caught = True
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
+    def _record(self, signum: int, frame: Any) -> None:
+        self.caught = True
+
+    def hold(self) -> None:
+        """From now on record every Ctrl-C (the last checkpoint, log and summary take a moment)."""
+        import signal
+
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._record)
+
+    @contextlib.contextmanager
+    def held(self) -> Iterator[None]:
+        """Record every Ctrl-C inside (a checkpoint's files written whole).
+
+        Afterwards Ctrl-C acts as before, or raises at once when one was caught meanwhile.
+        """
+        import signal
+
+        if self._old is None:
+            yield
+            return
+        before = signal.signal(signal.SIGINT, self._record)
+        try:
+            yield
+        finally:
+            if before != self._record:  # (after hold() every Ctrl-C is recorded to the end)
+                signal.signal(signal.SIGINT, signal.default_int_handler if self.caught else before)
+
     def restore(self) -> None:
         import signal
 
@@ -433,19 +530,20 @@ class _StepInterrupt:
             self._old = None
 
 
-def _write_outputs(result: TrainResult) -> None:
-    """``train_log.csv``, ``rolling_reward.png`` and ``summary.json`` of a run folder."""
+def _write_outputs(result: TrainResult, *, figure: bool = True) -> None:
+    """``train_log.csv``, ``rolling_reward.png`` (unless not ``figure``) and ``summary.json``."""
     out = result.out
     assert out is not None
     atomic_write_text(out / "train_log.csv", _write_log(result.episodes))
-    from matplotlib.figure import Figure
+    if figure:
+        from matplotlib.figure import Figure
 
-    from .plots import plot_rolling_reward
+        from .plots import plot_rolling_reward
 
-    fig = Figure(figsize=(6.4, 3.6), layout="constrained")
-    plot_rolling_reward(result.episodes, ax=fig.subplots(), label=result.config.algo)
-    with atomic_path(out / "rolling_reward.png") as tmp:
-        fig.savefig(tmp, dpi=110)
+        fig = Figure(figsize=(6.4, 3.6), layout="constrained")
+        plot_rolling_reward(result.episodes, ax=fig.subplots(), label=result.config.algo)
+        with atomic_path(out / "rolling_reward.png") as tmp:
+            fig.savefig(tmp, dpi=110)
     n = len(result.episodes)
     coll = sum(r["collision"] for r in result.episodes)
     summary = {

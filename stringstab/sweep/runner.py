@@ -30,11 +30,11 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..errors import StringStabError
-from ..io import atomic_write_text, check_output_dir, dumps_json
+from ..io import atomic_write_text, check_output_dir, claim_folder, dumps_json, write_manifest
 from ..progress import Progress
 from .records import POINT_FORMAT, read_records, record_path
 from .spec import SweepSpec
-from .tasks import interrupt_points, run_point
+from .tasks import interrupt_points, refuse_points_too_big, run_point
 
 __all__ = ["cancel_points", "run_sweep"]
 
@@ -181,8 +181,10 @@ def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retr
     Raises
     ------
     StringStabError
-        When ``out`` cannot be written.  KeyboardInterrupt passes through after the tasks in
-        flight are cancelled (the finished points are already on disk).
+        When ``out`` cannot be written or holds another command's outputs, or a point needs
+        more memory than the largest worker's limit (:func:`~stringstab.sweep.tasks.point_bytes`;
+        nothing dispatched).  KeyboardInterrupt passes through after the tasks in flight are
+        cancelled (the finished points are already on disk).
     """
     from distributed import as_completed
 
@@ -191,13 +193,19 @@ def run_sweep(spec: SweepSpec, out: str | os.PathLike[str], *, client: Any, retr
     if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
         raise StringStabError(f"retries must be an integer >= 0; got {retries!r}")
     root = check_output_dir(out, what="--out")
-    (root / "points").mkdir(parents=True, exist_ok=True)
-    atomic_write_text(root / "spec.toml", spec.text)
+    claim_folder(root, command="sweep", what="--out")
     before = read_records(root, spec)
     skipped = [pid for pid, r in before.items() if r.get("status") == "done"]
     todo = [p for p in spec.points if p.id not in set(skipped)]
+    workers = client.scheduler_info().get("workers", {})
+    n_workers = len(workers)
+    limits = [float(w["memory_limit"]) for w in workers.values() if w.get("memory_limit")]
+    if limits:  # before anything is dispatched (or written): a point no worker can hold
+        refuse_points_too_big(todo, max(limits), f"the largest of the {n_workers} Dask workers")
+    (root / "points").mkdir(parents=True, exist_ok=True)
+    atomic_write_text(root / "spec.toml", spec.text)
+    write_manifest(root, command="sweep", what="--out")
     t0 = time.perf_counter()
-    n_workers = len(client.scheduler_info().get("workers", {}))
     log(f"sweep {spec.name}: {len(spec)} points ({spec.kind}); {len(skipped)} finished before "
         f"(skipped), {len(todo)} to run on {n_workers} workers")
     bar = _Progress(len(spec), len(skipped), log, progress)

@@ -461,13 +461,9 @@ def load_spec(path: str | os.PathLike[str]) -> SweepSpec:
     StringStabError
         For a missing or unreadable file, or any error of :func:`parse_spec`.
     """
+    from ..io.text_input import read_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise StringStabError(f"spec {str(p)!r}: cannot read it ({e.strerror or e}); expected a "
-                              "TOML sweep spec") from e
-    except UnicodeDecodeError as e:
-        raise StringStabError(f"spec {str(p)!r}: not UTF-8 text; expected a TOML sweep spec") from e
+    text = read_text(p, label=f"spec {str(p)!r}", expected="a TOML sweep spec")
     return parse_spec(text, source=str(p))
 

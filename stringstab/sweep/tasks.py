@@ -33,9 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import StringStabError
+from ..errors import StringStabError, show
 
-__all__ = ["PointCancelled", "interrupt_points", "run_point"]
+__all__ = ["PointCancelled", "interrupt_points", "point_bytes", "refuse_points_too_big",
+           "run_point"]
 
 #: Metrics of a training point's evaluation copied into its record (IDL eqs 27-35).
 EVAL_METRICS = ("TIT", "M_CI", "M_effi", "M_lss", "m_fss", "m_fss_sampled", "collisions",
@@ -164,6 +165,91 @@ def _compute(point: dict[str, Any], root: str) -> dict[str, Any]:
                    traceback=traceback.format_exc())
     rec["seconds"] = time.perf_counter() - t0
     return rec
+
+
+# --------------------------------------------------------------------------- memory
+def point_bytes(kind: str, settings: dict[str, Any]) -> float:
+    """The peak memory one point of ``kind`` will need (:mod:`stringstab.memory`), bytes.
+
+    ``region``: the map's n² (with ``fix``) or n³ points (:func:`stringstab.memory.grid_bytes`,
+    the estimate ``stringstab region`` refuses with); ``certify``: n³ points, twice with a sample
+    time or an interval (the continuous map is held beside it); ``train``: the trainer, its
+    ``num_envs`` environments and its ``buffer_size`` replay buffer
+    (:func:`stringstab.memory.training_bytes`, as ``stringstab train``); ``probe``: nothing.
+
+    Parameters
+    ----------
+    kind : str
+        The point's kind (:data:`stringstab.sweep.spec.KINDS`).
+    settings : dict
+        Its resolved settings (:attr:`stringstab.sweep.spec.Point.settings`).
+
+    Returns
+    -------
+    float
+        Bytes.
+
+    Examples
+    --------
+    >>> from stringstab.memory import human_bytes
+    >>> human_bytes(point_bytes("certify", {"n": 100_000, "sample_time": None, "tau": 0.1,
+    ...                                     "delta": 0.2, "headway": 1.1}))
+    '532.9 PiB'
+    """
+    from ..memory import grid_bytes, training_bytes
+
+    if kind == "region":
+        return grid_bytes(float(settings["n"]) ** (2 if settings.get("fix") is not None else 3))
+    if kind == "certify":
+        special = settings.get("sample_time") is not None or any(
+            isinstance(settings.get(k), str) for k in ("tau", "delta", "headway"))
+        return grid_bytes((2 if special else 1) * float(settings["n"]) ** 3)
+    if kind == "train":
+        return training_bytes(int(settings["num_envs"]), int(settings["buffer_size"]))
+    return 0.0
+
+
+def refuse_points_too_big(points: Any, per_worker: float, where: str) -> None:
+    """Refuse a sweep with a point whose estimated memory exceeds what a worker has.
+
+    A Dask worker that outgrows its memory is killed by its nanny and the task retried on
+    the next worker until all are lost (``KilledWorker``); this refuses the sweep before
+    anything is dispatched, naming the largest point, its estimate and what a worker has.
+
+    Parameters
+    ----------
+    points : sequence of Point
+        The spec's points (:attr:`stringstab.sweep.spec.SweepSpec.points`).
+    per_worker : float
+        Bytes one worker may use.
+    where : str
+        What ``per_worker`` is, for the message (e.g. ``"each of the 2 local workers"``).
+
+    Raises
+    ------
+    StringStabError
+        When some point's estimate exceeds ``per_worker``; with the largest grid that fits
+        for ``region``/``certify`` points.
+    """
+    from ..memory import grid_fit, human_bytes
+
+    need = [(point_bytes(p.kind, p.settings), p) for p in points]
+    if not need:
+        return
+    nbytes, worst = max(need, key=lambda x: x[0])
+    if nbytes <= per_worker:
+        return
+    what = ", ".join(f"{k}={show(v)}" for k, v in worst.varied.items()) or "the base settings"
+    if worst.kind in ("region", "certify"):
+        dims = 2 if worst.kind == "region" and worst.settings.get("fix") is not None else 3
+        hint = f"expected n <= {grid_fit(per_worker, dims)} for this worker memory"
+    elif worst.kind == "train":
+        hint = "expected a smaller buffer_size or num_envs"
+    else:
+        hint = "expected a smaller point"
+    raise StringStabError(
+        f"sweep point {worst.id} ({worst.kind}, {what}) needs about {human_bytes(nbytes)} of "
+        f"memory; {where} has {human_bytes(per_worker)}; {hint} (or more memory per worker)")
 
 
 # --------------------------------------------------------------------------- kinds

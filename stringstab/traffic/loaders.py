@@ -2,12 +2,14 @@
 
 :func:`load_csv` reads a generic speed profile in SI units; :func:`load_ngsim_pairs` cuts
 the US-101 / I-80 trajectory files (IDL paper §4.1.1) into leader–follower pairs in SI units.
-Both read plain or gzip-compressed files (:func:`stringstab.io.text_input.open_text`).
+Both read plain or gzip-compressed files, strictly UTF-8, through the one reader
+(:mod:`stringstab.io.text_input`).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import math
 from dataclasses import dataclass
@@ -18,7 +20,7 @@ import numpy.typing as npt
 
 from ..constants import DT
 from ..errors import StringStabError, show
-from ..io.text_input import open_text
+from ..io.text_input import open_text, read_text
 from .trajectory import Trajectory, from_speed
 
 __all__ = ["FEET", "FollowingPair", "load_csv", "load_ngsim_pairs"]
@@ -49,15 +51,14 @@ def load_csv(path: str | Path, *, dt: float = DT, speed_max: float | None = None
     Raises
     ------
     StringStabError
-        If the file is missing or empty, its columns are not ``t, v`` or ``t, v, a``, a value is
-        not a finite number, times are not strictly increasing or a speed is negative.
+        If the file is missing, empty, binary or not UTF-8 text, its columns are not ``t, v`` or
+        ``t, v, a``, a value is not a finite number, times are not strictly increasing or a
+        speed is negative.
     """
     p = Path(path)
-    try:
-        with open_text(p) as fh:  # plain or gzip-compressed (.csv.gz)
-            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-    except OSError as e:
-        raise StringStabError(f"cannot read leader CSV {show(str(p))}: {e.strerror or e}") from e
+    text = read_text(p, label=f"leader CSV {show(str(p))}",  # plain or gzip (.csv.gz)
+                     expected="a CSV file with columns 't, v' or 't, v, a'")
+    rows = [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(c.strip() for c in r)]
     if not rows:
         raise StringStabError(f"leader CSV {show(str(p))} is empty; expected a header 't, v' or 't, v, a'")
     header = [c.strip().lower() for c in rows[0]]
@@ -174,14 +175,11 @@ def load_ngsim_pairs(
     Raises
     ------
     StringStabError
-        If the file cannot be read or lacks a required column.
+        If the file cannot be read, is not UTF-8 text or lacks a required column.
     """
     p = Path(path)
-    try:
-        fh = open_text(p)  # plain or gzip-compressed (.csv.gz)
-    except OSError as e:
-        raise StringStabError(f"cannot read NGSIM file {show(str(p))}: {e.strerror or e}") from e
-    with fh:
+    with open_text(p, label=f"NGSIM file {show(str(p))}",  # plain or gzip (.csv.gz)
+                   expected="an NGSIM US-101/I-80 trajectory CSV file") as fh:
         reader = csv.reader(fh)
         header = [c.strip().lower() for c in next(reader, [])]
         missing = [c for c in _NGSIM_REQUIRED if c.lower() not in header]
