@@ -47,9 +47,9 @@ from typing import Any
 
 from .errors import StringStabError
 
-__all__ = ["ENV", "Helper", "ThreadsRunning", "check_single_threaded", "cpu_count",
-           "die_with_parent", "in_background", "in_daemon", "map_processes", "process_pool",
-           "start_helper", "start_method"]
+__all__ = ["ENV", "HELD_SIGNALS", "Helper", "ThreadsRunning", "check_single_threaded",
+           "cpu_count", "die_with_parent", "in_background", "in_daemon", "map_processes",
+           "process_pool", "signals_held", "start_helper", "start_method"]
 
 #: The environment variable that asks for ``forkserver`` or ``spawn`` always (never ``fork``).
 ENV = "STRINGSTAB_START_METHOD"
@@ -229,10 +229,42 @@ def _alive(pid: int) -> bool:
     return True
 
 
+#: The signals held while children are forked (:func:`signals_held`).
+HELD_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held (blocked, not lost) in this thread while children are forked.
+
+    A forked child starts with its parent's signal handlers.  A signal landing between the
+    fork and :func:`_become_child` would run the parent's handler in the child (the command
+    line's, which raises), and an exception there makes multiprocessing's fork launcher
+    return from ``Process.start`` *in the child*: a copy of the parent running on (under
+    pytest-xdist, a second worker reporting the same test).  Held, the signal waits: the
+    child inherits the mask and receives it once its own handlers are set
+    (:func:`_become_child` releases it); the parent receives it on leaving this block.
+
+    Yields
+    ------
+    None
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _become_child(parent: int) -> None:
     """Signals and lifetime of a child started here (see the module docstring)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent stops its children
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's KeyboardInterrupt
+    if hasattr(signal, "pthread_sigmask"):  # held by the parent over the fork: ours now
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
     die_with_parent(parent)
 
 
@@ -314,7 +346,8 @@ def process_pool(workers: int, initializer: Callable[..., Any] | None = None,
     try:
         if ctx.get_start_method() == "fork":
             check_single_threaded("a process pool")
-            ex.submit(_nothing)  # forks every worker now, before the management thread starts
+            with signals_held():  # forks every worker now, before the management thread starts
+                ex.submit(_nothing)
         try:
             yield ex
         except cf.process.BrokenProcessPool as e:
@@ -551,7 +584,10 @@ def start_helper(warm: Callable[..., Any] | None = None, *warm_args: Any,
                        name="stringstab-helper", daemon=False)
     if ctx.get_start_method() == "fork":
         check_single_threaded("a helper process")
-    proc.start()
+        with signals_held():
+            proc.start()
+    else:
+        proc.start()
     there.close()
     return Helper(proc, here)
 
