@@ -436,7 +436,8 @@ INTS = ["nan", "inf", "-1", HUGE_INT]
 GAINS = ["nan,0.5,0.6", "inf,0.5,0.6", "1e300,0.5,0.6"]  # a negative gain is valid
 A_MIN = ["nan", "-inf", "1", "-1e300"]  # a braking limit is negative
 SAMPLE = [*FLOATS, "1e-300"]  # a sample time or step also has a floor (1e-300 divided by zero)
-#: The loop's flags (cli/_loop.py: θ_r, the radio, the sensors) of simulate (and sumo run).
+#: The loop's flags (cli/_loop.py: θ_r, the radio, the sensors) of simulate, sumo run, train,
+#: evaluate and compare.
 LOOP = {"--reaction-delay": FLOATS, "--message-period": FLOATS, "--message-phase": INTS,
         "--loss": FLOATS, "--burst": FLOATS, "--stale-after": FLOATS,
         "--fallback-gains": ["nan,0.5", "inf,0.5", "1e300,0.5"], "--noise-gap": FLOATS,
@@ -478,10 +479,11 @@ NUMERIC = {
                  "--length": FLOATS, "--dt": SAMPLE, "--duration": FLOATS, "--hold": FLOATS,
                  "--ttc-star": FLOATS, "--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS,
                  **LOOP},
-    "train": {"--steps": INTS, "--seed": INTS, "--num-envs": INTS, "--stop-episodes": INTS},
+    "train": {"--steps": INTS, "--seed": INTS, "--num-envs": INTS, "--stop-episodes": INTS,
+              **LOOP},
     "evaluate": {"--platoon": [f"{v},10" for v in INTS], "--v-max": FLOATS, "--a-min": A_MIN,
-                 "--a-max": FLOATS},
-    "compare": {"--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS},
+                 "--a-max": FLOATS, **LOOP},
+    "compare": {"--v-max": FLOATS, "--a-min": A_MIN, "--a-max": FLOATS, **LOOP},
     "hcfs verify": {"--jerk-limit": ["nan", "inf", "-1", "1e9"], "--followers": INTS,
                     "--duration": FLOATS, "--beta": FLOATS, "--v-max": FLOATS, "--a-min": A_MIN,
                     "--a-max": FLOATS},

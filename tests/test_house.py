@@ -290,6 +290,8 @@ LONG_MODULES = {
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
     "stringstab/params.py": "the model's parameters τ, δ, T*, θ_r: points, intervals, boxes, checked",
+    "stringstab/parallel.py": ("the one start-method policy: pools, helpers, and the signals and "
+                               "lifetime of every child process"),
     "stringstab/certify/api.py": ("the one way in to every certificate: Loop and the façade "
                                   "(certify, certify_batch, check, certify_string), mostly docstrings"),
 }

@@ -245,7 +245,7 @@ def test_resume_refuses_a_changed_loop(tmp_path):
 # ------------------------------------------------------------------ the command line
 def _leader_csv(tmp_path: Path) -> Path:
     f = tmp_path / "lead.csv"
-    tr = sinusoid(omega=0.8, amplitude=2.0, speed=15.0, duration=4.0)
+    tr = sinusoid(omega=0.8, amplitude=2.0, speed=15.0, duration=25.0)
     f.write_text("t,v\n" + "".join(f"{t:.1f},{v:.6f}\n" for t, v in zip(tr.t, tr.speed)))
     return f
 

@@ -146,7 +146,7 @@ def first_exceedance(losses: npt.ArrayLike, mean: npt.ArrayLike, lower: npt.Arra
     Examples
     --------
     >>> first_exceedance([0, 0.1, 0.2], [0.9, 0.98, 1.06], [0.89, 0.96, 1.02], [0.91, 1.0, 1.1])
-    {'loss': 0.125, 'loss_lo': 0.1, 'loss_hi': 0.15000000000000002}
+    {'loss': 0.125, 'loss_lo': 0.1, 'loss_hi': 0.16666666666666669}
     """
     p = np.asarray(losses, dtype=np.float64)
     out: dict[str, float | None] = {}
