@@ -264,6 +264,14 @@ def compare_report(markdown: str, files: Sequence[str], *, command: str,
     return rep
 
 
+def _identify_params(res: Any) -> dict[str, Any]:
+    """The parameter table of an identify report (per follower or per car): logs, model, H, bootstrap."""
+    st = res.settings
+    return {"logs": ", ".join(res.sources), "model": res.model,
+            "sample time H": res.sample_time or "continuous",
+            **{k: st[k] for k in ("bootstrap", "block", "starts", "seed", "min_duration") if k in st}}
+
+
 def identify_report(res: Any, files: Sequence[Any], *, command: str,
                     started: float | None = None) -> Report:
     """The report of ``stringstab identify``.
@@ -287,12 +295,8 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     Report
         The report.
     """
-    st = res.settings
     rep = Report("Identified followers", command=command,
-                 params={"logs": ", ".join(res.sources), "model": res.model,
-                         "sample time H": res.sample_time or "continuous",
-                         **{k: st[k] for k in ("bootstrap", "block", "starts", "seed", "min_duration")
-                            if k in st}},
+                 params=_identify_params(res),
                  intro="Each follower's controller is fitted to the logged speeds and gaps, its "
                        "gains are certified with the exact delay (‖Γ‖∞ ≤ 1, internally stable), "
                        "and moving-block bootstrap refits give the share of plausible fits that "
@@ -365,12 +369,8 @@ def cars_report(res: Any, files: Sequence[Any], *, command: str, started: float 
     Report
         The report.
     """
-    st = res.settings
     rep = Report("Identified cars (every log of a car and setting pooled)", command=command,
-                 params={"logs": ", ".join(res.sources), "model": res.model,
-                         "sample time H": res.sample_time or "continuous",
-                         **{k: st[k] for k in ("bootstrap", "block", "starts", "seed", "min_duration")
-                            if k in st}},
+                 params=_identify_params(res),
                  intro="Each car's controller is fitted jointly to every log of it at one distance "
                        "setting (one law, the initial state of every segment free), certified with "
                        "the exact delay, and bootstrapped over all its logs; a verdict is certified "
