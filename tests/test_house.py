@@ -276,7 +276,7 @@ def test_the_layer_table_places_every_module_once():
     assert [m for m in MODULES if layer_of(m, table) is None] == []
     # the root name stands for the façade only: a new root module must be placed by name
     assert layer_of("stringstab.newmodule", table) is None
-    assert layer_of("stringstab.certify.api", table)[1] == "certificates"  # type: ignore[index]
+    assert layer_of("stringstab.certify.api", table) == (3, "certificates")
 
 
 def test_the_layer_check_fails_on_a_planted_upward_import():
