@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ...errors import StringStabError, show
-from ...io.gains import GainTable
+from ...io.gain_table import GainTable
 from ...params import DEFAULT_HEADWAY, positive
 from .base import DEFAULT_STANDSTILL, Controller, Observation, time_headway_gap
 from .linear import linear_law
