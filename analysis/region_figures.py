@@ -38,7 +38,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from stringstab import plots
-from stringstab.io.gains import GainTable, read_gains
+from stringstab.io import GainTable, read_gains
 from stringstab.regions import region_map
 
 TAUS = (0.1, 0.2, 0.5)

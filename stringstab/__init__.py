@@ -36,7 +36,8 @@ from .certify.criteria import hurwitz, stability_type, taylor_criteria
 from .certify.frequency import gain, gamma_jw, margin_g
 from .certify.verdicts import VERDICTS, Check
 from .errors import StringStabError
-from .io.gains import GainTable, parse_triple, read_gains
+from .io.gain_table import GainTable
+from .io.gains import parse_triple, read_gains
 from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box, Params
 
 # ``from .certify import certify`` binds the name ``certify`` of this package to the function

@@ -45,3 +45,25 @@ def test_impacts_are_measured_shares():
         assert 0 < share < 1
     assert 0 < rows["gamma_denominator"].impact["hurwitz_disagreement"] < 1
     assert rows["proposition1"].impact["verdict_disagreement_printed_vs_derived"] > 0
+
+
+def test_proposition1_impact_agrees_with_the_taylor_verdicts_of_certify():
+    # derive computes the Proposition 1 row's impact from its own SymPy conditions on the
+    # generated Ψ (derive does not import certify); the Taylor verdicts of
+    # stringstab.certify.criteria (hand-written NumPy logic) must give the same shares
+    import numpy as np
+
+    from stringstab.certify.criteria import proposition1, taylor_criteria
+
+    params = {"tau": 0.1, "delta": 0.4, "headway": 0.5}
+    impact = {e.key: e for e in errata(**params)}["proposition1"].impact
+    g = np.linspace(-2.0, 2.0, 41)
+    kx, kv, ka = (a.ravel() for a in np.meshgrid(g, g, g, indexing="ij"))
+    ok_p = taylor_criteria(kx, kv, ka, source="printed", **params).stable
+    d = taylor_criteria(kx, kv, ka, source="derived", **params)
+    logic_only = proposition1(d.psi1, d.psi2, d.psi3, d.lam, source="printed")
+    assert impact["verdict_disagreement_printed_vs_derived"] == float(np.mean(ok_p != d.stable))
+    assert impact["verdict_disagreement_logic_only"] == float(np.mean(d.stable != logic_only))
+    # the check can fail: at these parameters the verdicts differ on part of the grid (both
+    # shares are neither 0 nor 1, so a wrong logic or a wrong Ψ would change them)
+    assert 0 < impact["verdict_disagreement_logic_only"] < impact["verdict_disagreement_printed_vs_derived"] < 1

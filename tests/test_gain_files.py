@@ -12,9 +12,8 @@ from numpy.testing import assert_array_equal
 
 from stringstab.certify.continuous import TABLE_COLUMNS
 from stringstab.errors import StringStabError
-from stringstab.io import columns_from_records
+from stringstab.io import GainTable, columns_from_records, parse_triple, read_gains
 from stringstab.io import results as io_results
-from stringstab.io.gains import GainTable, parse_triple, read_gains
 from stringstab.io.plain import to_plain
 
 

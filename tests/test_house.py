@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import ast
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -75,31 +76,41 @@ def _runtime_nodes(tree: ast.AST) -> list[ast.AST]:
     return out
 
 
+def imports_of(mod: str, nodes: list[ast.AST]) -> list[tuple[str, int]]:
+    """(package module, line) for each module of the package named by an import among ``nodes``.
+
+    ``import a.b.c`` names the longest prefix that is a module; ``from a.b import x`` names
+    ``a.b.x`` when it is a module (a submodule), else ``a.b`` (a name defined in ``a.b``).
+    """
+    out: list[tuple[str, int]] = []
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name == ROOT or alias.name.startswith(ROOT + "."):
+                    name = alias.name
+                    while name not in MODULES and "." in name:
+                        name = name.rsplit(".", 1)[0]
+                    if name != ROOT or alias.name == ROOT:  # else: not (yet) in the tree
+                        out.append((name, node.lineno))
+        elif isinstance(node, ast.ImportFrom):
+            base = _resolve(mod, node.level, node.module)
+            if not (base == ROOT or base.startswith(ROOT + ".")):
+                continue
+            for alias in node.names:
+                sub = f"{base}.{alias.name}"
+                # "from .pkg import submodule" imports the submodule; a name from pkg
+                # imports pkg itself
+                out.append((sub if sub in MODULES else base, node.lineno))
+    return [(t, line) for t, line in out if t in MODULES]
+
+
 def import_graph() -> dict[str, set[str]]:
     """Module → the package modules it imports (explicit imports anywhere in the file)."""
     graph: dict[str, set[str]] = {m: set() for m in MODULES}
     for mod, path in MODULES.items():
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-        for node in _runtime_nodes(tree):
-            if isinstance(node, ast.Import):
-                for alias in node.names:
-                    if alias.name == ROOT or alias.name.startswith(ROOT + "."):
-                        name = alias.name
-                        while name not in MODULES and "." in name:
-                            name = name.rsplit(".", 1)[0]
-                        if name != ROOT or alias.name == ROOT:  # else: not (yet) in the tree
-                            graph[mod].add(name)
-            elif isinstance(node, ast.ImportFrom):
-                base = _resolve(mod, node.level, node.module)
-                if not (base == ROOT or base.startswith(ROOT + ".")):
-                    continue
-                for alias in node.names:
-                    sub = f"{base}.{alias.name}"
-                    # "from .pkg import submodule" imports the submodule; a name from pkg
-                    # imports pkg itself
-                    graph[mod].add(sub if sub in MODULES else base)
+        graph[mod] = {t for t, _ in imports_of(mod, _runtime_nodes(tree))}
     for mod in graph:
-        graph[mod] &= set(MODULES)
         graph[mod] |= {p for t in graph[mod] for p in _implicit_parents(mod, t)}
         graph[mod].discard(mod)
     return graph
@@ -164,7 +175,7 @@ def upward(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
 def test_the_graph_sees_lazy_and_relative_imports():
     g = import_graph()
     assert "stringstab.certify.criteria" in g["stringstab.certify.continuous"]  # top-level relative import
-    assert "stringstab.certify.criteria" in g["stringstab.derive.symbolic"]  # inside lambdify_psi
+    assert "stringstab.derive.errata" in g["stringstab.derive.derivation"]  # inside derivation()
     assert "stringstab.derive.symbolic" in g["stringstab.derive.codegen"]  # "from . import symbolic as S"
     assert "stringstab.regions.report" in g["stringstab.regions.result"]
     assert "stringstab.tuning.projection" in g["stringstab.tuning"]  # from .projection import
@@ -189,6 +200,116 @@ def test_no_upward_import():
     found = upward(import_graph())
     assert found - KNOWN_UPWARD == set(), "upward imports"
     assert KNOWN_UPWARD - found == set(), "fixed: remove them from KNOWN_UPWARD"
+
+
+ARCHITECTURE = PKG.parent / "docs" / "architecture.md"
+
+
+def layer_table(text: str) -> list[tuple[str, tuple[str, ...]]]:
+    """The layer table of ``docs/architecture.md``, bottom layer first: (layer, module names).
+
+    Read from the rows ``| # | layer | modules | ... |`` of the section "## Layers"; the
+    module names are the backticked dotted names of the ``modules`` column.
+    """
+    section = text.split("\n## Layers\n", 1)[1].split("\n## ", 1)[0]
+    rows = []
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) >= 3 and cells[0].isdigit():
+            names = tuple(n for n in re.findall(r"`([\w.]+)`", cells[2])
+                          if n == ROOT or n.startswith(ROOT + "."))
+            rows.append((int(cells[0]), cells[1], names))
+    assert [r[0] for r in rows] == list(range(len(rows))), "layers numbered 0, 1, 2, ... from the bottom"
+    return [(name, names) for _, name, names in rows]
+
+
+def layer_of(mod: str, table: list[tuple[str, tuple[str, ...]]]) -> tuple[int, str] | None:
+    """(number, name) of the layer holding ``mod``: the longest name of the table that is
+    ``mod`` or a package containing it (the root ``stringstab`` stands for the façade only)."""
+    best: tuple[int, int, str] | None = None
+    for i, (layer, names) in enumerate(table):
+        for n in names:
+            if mod == n or (n != ROOT and mod.startswith(n + ".")):
+                if best is None or len(n) > best[0]:
+                    best = (len(n), i, layer)
+    return None if best is None else (best[1], best[2])
+
+
+def layer_violations(sources: dict[str, tuple[str, str]],
+                     table: list[tuple[str, tuple[str, ...]]]) -> list[str]:
+    """Every import of a module in a higher layer, one line each: file, line, both layers.
+
+    ``sources`` maps a module name to (its file, its source).  Every import counts: at
+    module level, inside a function, or under ``if TYPE_CHECKING:``.
+    """
+    out = []
+    for mod, (file, text) in sorted(sources.items()):
+        here = layer_of(mod, table)
+        if here is None:
+            out.append(f"{file}: {mod} is in no layer of docs/architecture.md")
+            continue
+        nodes = list(ast.walk(ast.parse(text, filename=file)))
+        for target, line in sorted(set(imports_of(mod, nodes)), key=lambda e: (e[1], e[0])):
+            there = layer_of(target, table)
+            if there is not None and there[0] > here[0]:
+                out.append(f"{file}:{line}: {mod} (layer {here[0]}, {here[1]}) imports {target} "
+                           f"(layer {there[0]}, {there[1]}), a higher layer")
+    return out
+
+
+def _package_sources() -> dict[str, tuple[str, str]]:
+    return {mod: (str(path.relative_to(PKG.parent)), path.read_text(encoding="utf-8"))
+            for mod, path in MODULES.items()}
+
+
+def test_the_imports_obey_the_layer_table():
+    table = layer_table(ARCHITECTURE.read_text(encoding="utf-8"))
+    found = layer_violations(_package_sources(), table)
+    assert found == [], "imports climbing a layer of docs/architecture.md:\n" + "\n".join(found)
+
+
+def test_the_layer_table_places_every_module_once():
+    table = layer_table(ARCHITECTURE.read_text(encoding="utf-8"))
+    names = [n for _, ns in table for n in ns]
+    assert len(names) == len(set(names)), "a name in two layers"
+    assert set(names) <= set(MODULES), "names in the table that are no module of the package"
+    assert [m for m in MODULES if layer_of(m, table) is None] == []
+    # the root name stands for the façade only: a new root module must be placed by name
+    assert layer_of("stringstab.newmodule", table) is None
+    assert layer_of("stringstab.certify.api", table) == (3, "certificates")
+
+
+def test_the_layer_check_fails_on_a_planted_upward_import():
+    table = layer_table(ARCHITECTURE.read_text(encoding="utf-8"))
+    sources = _package_sources()
+    # plant, in a copy of the sources (the package is not edited), an import of the
+    # certificates into the formulas: at module level, inside a function, relative and absolute
+    file, text = sources["stringstab.derive.errata"]
+    sources["stringstab.derive.errata"] = (file, text + (
+        "\n\ndef _planted():\n    from ..certify.criteria import psi\n    return psi\n"))
+    line = len(text.splitlines()) + 4
+    sources["stringstab.io.planted"] = ("stringstab/io/planted.py",
+                                        '"""Planted."""\nimport stringstab.traffic.platoon\n')
+    sources["stringstab.plots.planted"] = ("stringstab/plots/planted.py",
+                                           "from stringstab import certify\nfrom .. import cli\n")
+    found = layer_violations(sources, table)
+    assert found == [
+        f"stringstab/derive/errata.py:{line}: stringstab.derive.errata (layer 2, formulas) imports "
+        "stringstab.certify.criteria (layer 3, certificates), a higher layer",
+        "stringstab/io/planted.py:2: stringstab.io.planted (layer 1, files) imports "
+        "stringstab.traffic.platoon (layer 6, platoons), a higher layer",
+        "stringstab/plots/planted.py:2: stringstab.plots.planted (layer 5, figures) imports "
+        "stringstab.cli (layer 10, entry points), a higher layer",
+    ]
+    # the façade is the top layer: importing a name from it climbs too
+    sources = {"stringstab.tuning.planted": ("p.py", "from stringstab import Params\n")}
+    assert layer_violations(sources, table) == [
+        "p.py:1: stringstab.tuning.planted (layer 4, maps and tuning) imports stringstab "
+        "(layer 10, entry points), a higher layer"]
+    # a module placed in no layer is reported too
+    sources = {"stringstab.newmodule": ("stringstab/newmodule.py", "")}
+    assert layer_violations(sources, table) == [
+        "stringstab/newmodule.py: stringstab.newmodule is in no layer of docs/architecture.md"]
 
 
 def test_no_library_module_imports_the_cli_or_the_demo():
@@ -286,7 +407,6 @@ def test_every_subpackage_says_what_lives_there():
 #: listed here with its one job (the test fails when one is added unlisted, or shrinks).
 LONG = 600
 LONG_MODULES = {
-    "stringstab/io/gains.py": "reading gain triples K = [k_x, k_v, k_a]: every format, one reader",
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
     "stringstab/params.py": "the model's parameters τ, δ, T*, θ_r: points, intervals, boxes, checked",
@@ -351,8 +471,6 @@ def test_stringstab_certify_stays_the_function():
 def test_no_source_reaches_certify_modules_through_the_function():
     # "import stringstab.certify.x as m" and "stringstab.certify.x.f" look up the attribute
     # ``certify`` of the package, which is the function: both fail at run time
-    import re
-
     bad = re.compile(r"^\s*import stringstab\.certify\.\w+ as |(?<![\w.`:])stringstab\.certify\.\w+\.\w+\(")
     roots = [PKG, PKG.parent / "tests", PKG.parent / "analysis"]
     hits = [f"{p}:{i}" for r in roots if r.exists() for p in r.rglob("*.py")

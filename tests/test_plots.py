@@ -18,7 +18,7 @@ from numpy.testing import assert_array_equal
 from stringstab import plots
 from stringstab.certify.api import certify_batch
 from stringstab.errors import StringStabError
-from stringstab.io.gains import GainTable
+from stringstab.io import GainTable
 from stringstab.regions import EXACT_CLASSES, TYPE_CLASSES, region_map
 
 P = dict(tau=0.1, delta=0.2, headway=1.1)

@@ -23,3 +23,5 @@ def test_ci_runs_the_readme_test_command():
     ci = [ln for ln in (ROOT / ".ci" / "run").read_text().splitlines()
           if ln.strip() and not ln.startswith("#") and not ln.startswith(("set ", "cd "))]
     assert ci == [test_cmd]
+    # the suite's slowest 15 tests are printed in CI (issue 32)
+    assert "--durations=15" in test_cmd.split()

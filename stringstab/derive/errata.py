@@ -17,7 +17,7 @@ import numpy as np
 import sympy as sp
 
 from .printed import PRINTED
-from .symbolic import GAINS, PARAMS, derived_psi, gamma, gradients, hurwitz_conditions
+from .symbolic import GAINS, PARAMS, derived_psi, gamma, gradients, hurwitz_conditions, lambdify_psi
 
 __all__ = ["Erratum", "errata", "proposition1_conditions"]
 
@@ -232,17 +232,19 @@ def _proposition1_row(params: dict[str, float]) -> Erratum:
     p1, p2, p3, lam = sp.symbols("psi1 psi2 psi3 lambda_")
     printed_c = proposition1_conditions(p1, p2, p3, lam, printed=True)
     derived_c = proposition1_conditions(p1, p2, p3, lam, printed=False)
-    # impact: verdict disagreement between printed logic on printed Ψ and
-    # corrected logic on derived Ψ (criteria.taylor_criteria), on the grid
-    from ..certify.criteria import proposition1, taylor_criteria
-
+    # impact: verdict disagreement between printed logic on printed Ψ and corrected logic
+    # on derived Ψ, on the grid: the two conditions above, evaluated by NumPy on the Ψ of
+    # the generated code (the Taylor verdicts of stringstab.certify.criteria, from the same
+    # expressions: tests/test_errata.py checks they agree)
+    printed_logic, derived_logic = (
+        sp.lambdify([p1, p2, p3, lam], c, modules="numpy") for c in (printed_c, derived_c))
     kx, kv, ka = _grid()
-    kw = {"tau": params["tau"], "delta": params["delta"], "headway": params["headway"]}
-    ok_p = taylor_criteria(kx, kv, ka, source="printed", **kw).stable
-    derived = taylor_criteria(kx, kv, ka, source="derived", **kw)
-    ok_d = derived.stable
-    ok_printed_logic_on_derived = proposition1(derived.psi1, derived.psi2, derived.psi3,
-                                               derived.lam, source="printed")
+    args = (kx, kv, ka, params["tau"], params["delta"], params["headway"])
+    psi_p = lambdify_psi("printed")(*args)
+    psi_d = lambdify_psi("derived")(*args)
+    ok_p = np.asarray(printed_logic(*psi_p))
+    ok_d = np.asarray(derived_logic(*psi_d))
+    ok_printed_logic_on_derived = np.asarray(printed_logic(*psi_d))
     return Erratum(
         equation="Proposition 1",
         name="Proposition 1 (logic)",

@@ -463,7 +463,8 @@ def lambdify_psi(
     delay_order : int or None
         Only for ``"derived"``; see :func:`margin_series`.  ``None`` and the
         printed forms use the code generated from these expressions
-        (:func:`stringstab.certify.criteria.psi`); other orders are lambdified here.
+        (:mod:`stringstab.derive.generated`, as :func:`stringstab.certify.criteria.psi`
+        evaluates it); other orders are lambdified here.
 
     Returns
     -------
@@ -480,15 +481,18 @@ def lambdify_psi(
     if source not in ("derived", "printed"):
         raise StringStabError(f"source must be 'derived' or 'printed'; got {source!r}")
     if source == "printed" or delay_order is None:
-        # the generated code of these two (stringstab.derive.generated, tested against SymPy)
-        from functools import partial
+        # the generated code of these two (stringstab.derive.generated, tested against SymPy),
+        # evaluated as stringstab.certify.criteria.psi does (float inputs, broadcast outputs)
+        from . import generated
 
-        from ..certify.criteria import psi as _psi
-
-        fn = partial(_psi, source=source)
+        fn = generated.psi_printed if source == "printed" else generated.psi_derived
 
         def psi(k_x, k_v, k_a, tau, delta, headway):  # type: ignore[no-untyped-def]
-            return fn(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway)
+            args = (k_x, k_v, k_a, tau, delta, headway)
+            shape = np.broadcast_shapes(*(np.shape(v) for v in args))
+            p1, p2, p3 = (np.broadcast_to(np.asarray(o, dtype=float), shape)
+                          for o in fn(*(np.asarray(v, dtype=float) for v in args)))
+            return p1, p2, p3, p2 * p2 - 4.0 * p1 * p3
 
         psi.__doc__ = f"(Ψ1, Ψ2, Ψ3, Λ) from the {source} forms (generated code)."
         return psi

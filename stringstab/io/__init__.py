@@ -1,6 +1,8 @@
 """The I/O home: result tables, JSON-safe values and safe, all-or-nothing output files and folders.
 
-:mod:`~stringstab.io.gains` reads gain files for every command;
+:mod:`~stringstab.io.gains` reads gain files for every command (the table and its checks in
+:mod:`~stringstab.io.gain_table`, the readers of CSV and JSON in :mod:`~stringstab.io.gain_text`
+and of NPZ and Parquet in :mod:`~stringstab.io.gain_arrays`);
 :mod:`~stringstab.io.platoon_logs` reads recorded platoons (OpenACC, plain CSV, NGSIM pairs) for
 ``stringstab identify``;
 :mod:`~stringstab.io.results` writes every command's result columns (table, JSON, CSV,
@@ -20,14 +22,8 @@ from __future__ import annotations
 
 from .columns import Categorical, columns_from_records, flatten_columns, records_from_columns
 from .figures import FIGURE_FORMATS, check_figure_formats, figure_metadata, save_figure
-from .gains import (
-    GAIN_COLUMNS,
-    INPUT_FORMATS,
-    OPTIONAL_COLUMNS,
-    GainTable,
-    parse_triple,
-    read_gains,
-)
+from .gain_table import GAIN_COLUMNS, OPTIONAL_COLUMNS, GainTable
+from .gains import INPUT_FORMATS, parse_triple, read_gains
 from .manifest import MANIFEST, claim_folder, read_manifest
 from .outputs import (
     OutputDir,

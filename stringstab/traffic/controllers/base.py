@@ -18,13 +18,42 @@ import numpy.typing as npt
 from ...constants import STANDSTILL
 from ...params import DEFAULT_HEADWAY
 
-__all__ = ["DEFAULT_STANDSTILL", "Controller", "Observation"]
+__all__ = ["DEFAULT_STANDSTILL", "Controller", "Observation", "time_headway_gap"]
 
 Array = npt.NDArray[np.float64]
 
 
 #: Standstill spacing l_0, m (IDL paper Table 2).
 DEFAULT_STANDSTILL = STANDSTILL
+
+
+def time_headway_gap(speed: npt.ArrayLike, *, headway: float, standstill: float) -> Array:
+    """The constant time-headway spacing policy l_0 + T* v (IDL eq 3), m.
+
+    The gap at which the eq-4 law commands u = 0 behind an equal-speed leader: the
+    equilibrium gap of every controller with this spacing policy
+    (:meth:`Controller.equilibrium_gap`).
+
+    Parameters
+    ----------
+    speed : array_like
+        Cruise speed v, m/s.
+    headway : float
+        Desired time headway T*, s.
+    standstill : float
+        Standstill spacing l_0, m.
+
+    Returns
+    -------
+    array
+        l_0 + T* v, m, shaped like ``speed``.
+
+    Examples
+    --------
+    >>> time_headway_gap([0.0, 20.0], headway=1.1, standstill=2.0).tolist()
+    [2.0, 24.0]
+    """
+    return standstill + headway * np.asarray(speed, dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,7 +129,7 @@ class Controller:
         array
             The equilibrium gap, m, shaped like ``speed``.
         """
-        return DEFAULT_STANDSTILL + DEFAULT_HEADWAY * np.asarray(speed, dtype=np.float64)
+        return time_headway_gap(speed, headway=DEFAULT_HEADWAY, standstill=DEFAULT_STANDSTILL)
 
     def gains(self, obs: Observation) -> Array | None:
         """The eq-4 gain vector K = (k_x, k_v, k_a) in force, shape ``(..., 3)``, or None.

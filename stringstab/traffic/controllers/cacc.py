@@ -84,7 +84,7 @@ class CACCController(Controller):
         array
             u, m/s²: the smaller of the speed-control and the gap-control accelerations.
         """
-        r_ref = np.maximum(self.r_min, self.t_system * obs.speed)
+        r_ref = self.equilibrium_gap(obs.speed)  # max(r_min, t_system v)
         a_d = (self.k_a * obs.pred_accel_delayed + self.k_v * obs.rel_speed
                + self.k_d * (obs.gap - r_ref))
         return np.minimum(self.k * (self.speed_intended - obs.speed), a_d)

@@ -12,7 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ...params import DEFAULT_HEADWAY
-from .base import DEFAULT_STANDSTILL, Controller, Observation
+from .base import DEFAULT_STANDSTILL, Controller, Observation, time_headway_gap
 
 __all__ = ["FunctionController"]
 
@@ -63,4 +63,4 @@ class FunctionController(Controller):
         array
             The gap a platoon starts with, m.
         """
-        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+        return time_headway_gap(speed, headway=self._headway, standstill=self.standstill)

@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ...params import DEFAULT_HEADWAY, as_gains, positive
-from .base import DEFAULT_STANDSTILL, Controller, Observation
+from .base import DEFAULT_STANDSTILL, Controller, Observation, time_headway_gap
 
 __all__ = ["LinearController", "linear_law"]
 
@@ -133,7 +133,7 @@ class LinearController(Controller):
         array
             The equilibrium gap, m.
         """
-        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+        return time_headway_gap(speed, headway=self._headway, standstill=self.standstill)
 
     def gains(self, obs: Observation) -> Array:
         """The fixed gains.

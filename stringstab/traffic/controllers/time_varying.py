@@ -15,9 +15,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ...errors import StringStabError, show
-from ...io.gains import GainTable
+from ...io.gain_table import GainTable
 from ...params import DEFAULT_HEADWAY, positive
-from .base import DEFAULT_STANDSTILL, Controller, Observation
+from .base import DEFAULT_STANDSTILL, Controller, Observation, time_headway_gap
 from .linear import linear_law
 
 __all__ = ["TimeVaryingLinearController"]
@@ -253,7 +253,7 @@ class TimeVaryingLinearController(Controller):
         array
             The equilibrium gap, m.
         """
-        return self.standstill + self._headway * np.asarray(speed, dtype=np.float64)
+        return time_headway_gap(speed, headway=self._headway, standstill=self.standstill)
 
     def describe(self) -> dict[str, Any]:
         """A JSON-ready description of the law (without the gains, which change over time).
