@@ -131,13 +131,13 @@ class Loop:
             raise StringStabError(
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
-        # -- the reaction delay θ_r (issue 25): the continuous point loop only, until part 2
-        if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0):
-            lo, hi = self.model.reaction_delay
+        # -- the reaction delay θ_r (issue 25): over a box, in continuous time (item 4)
+        if box and self.model.reaction_delay != (0.0, 0.0) and H is not None:  # type: ignore[union-attr]
+            lo, hi = self.model.reaction_delay  # type: ignore[union-attr]
             raise StringStabError(
-                "reaction_delay > 0 is certified in continuous time only so far; got "
-                f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a parameter "
-                "box" + (f" and sample_time={H!r}" if H is not None else ""))
+                "θ_r over a parameter box is certified in continuous time; with sample_time="
+                f"{H!r} certify points of θ_r; got reaction_delay={lo:g}"
+                + (f":{hi:g}" if hi != lo else "") + " with a parameter box")
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
             raise StringStabError(
