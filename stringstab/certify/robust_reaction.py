@@ -396,13 +396,19 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
     excess = np.where(v == CERTIFIED, 0.0, np.inf)
     rep = np.flatnonzero((v != CERTIFIED) & ~unstable_w & np.isfinite(w)
                          & np.all(np.isfinite(member), axis=1))
-    for i in rep:  # |Γ| at the witness (member, ω), its excess without cancellation
+    for i in rep:  # |Γ| at the witness member: its largest excess near ω_w and on a log grid
         t, d, h, th = member[i]
-        e2 = reaction.excess_squared(np.array([w[i]]), kx[i:i + 1], kv[i:i + 1], ka[i:i + 1],
-                                     t, d, h, th)[0]
-        if np.isfinite(e2) and e2 > -1.0:
-            sup[i] = np.sqrt(1.0 + e2)
-            excess[i] = e2 / (1.0 + sup[i])
+        W = np.concatenate([[w[i]], w[i] * 10.0 ** np.linspace(-2.0, 0.5, 26),
+                            10.0 ** np.linspace(-8.0, 1.0 + np.log10(max(w[i], 1.0)), 181)])
+        W = W[W > 0] if w[i] > 0 else W[1:]
+        e2 = reaction.excess_squared(W, kx[i:i + 1], kv[i:i + 1], ka[i:i + 1], t, d, h, th)
+        e2 = np.where(np.isfinite(e2), e2, -np.inf)
+        j = int(np.argmax(e2))
+        if e2[j] > -1.0:
+            sup[i] = np.sqrt(1.0 + e2[j])
+            excess[i] = e2[j] / (1.0 + sup[i])
+            if e2[j] > 0:  # the frequency where |Γ| > 1 is seen (also when ω_w = 0)
+                w[i] = W[j]
     return {
         "verdict": v, "stable": stable, "margin": margin, "omega": w, "theta": np.full(n, np.nan),
         "tau": member[:, 0], "tau_prev": member[:, 0].copy(), "delta": member[:, 1],
