@@ -132,8 +132,8 @@ class Loop:
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
         # -- the reaction delay θ_r (issue 25): over a box, in continuous time (item 4)
-        if box and self.model.reaction_delay != (0.0, 0.0) and H is not None:  # type: ignore[union-attr]
-            lo, hi = self.model.reaction_delay  # type: ignore[union-attr]
+        if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0) and H is not None:
+            lo, hi = self.model.reaction_delay
             raise StringStabError(
                 "θ_r over a parameter box is certified in continuous time; with sample_time="
                 f"{H!r} certify points of θ_r; got reaction_delay={lo:g}"

@@ -351,8 +351,8 @@ def certify_kernel(
     RobustCertificateBatch
     """
     n = kx.size
-    keys = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev", "delta",
-            "headway", "n_evals", "sup_gain", "sup_gain_excess")
+    keys: tuple[str, ...] = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev",
+                             "delta", "headway", "n_evals", "sup_gain", "sup_gain_excess")
     reacting = box.reaction_delay != (0.0, 0.0)
     if reacting:
         if H is not None:
