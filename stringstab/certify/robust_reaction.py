@@ -324,9 +324,11 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
                          max_cells: int) -> dict[str, Array]:
     """The robust certificate of the continuous loop over a box with θ_r, for a chunk of triples.
 
-    Internal stability over the box (:func:`stringstab.certify.box_axis.axis_free` and the
-    count at the box's centre), then g_θ ≥ 0 over cells of the box (module docstring), then
-    the point certificate at members of the boxes left inconclusive.
+    The root count at the box's centre, then g_θ ≥ 0 over cells of the box (module
+    docstring), then internal stability of every member
+    (:func:`stringstab.certify.box_axis.axis_free`; not asked where a member already violates
+    |Γ| ≤ 1: ``stable`` is then False, not proven), then the point certificate at members of
+    the boxes left inconclusive.
 
     Parameters
     ----------
@@ -365,16 +367,17 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
     unstable = ~pos | rc.unstable
     stable = np.zeros(n, dtype=bool)
     n_evals = rc.n_evals.copy()
-    cand = np.flatnonzero(pos & rc.stable)
+    rows = np.flatnonzero(~unstable)
+    mc = _margin_cells(kx, kv, ka, box, rows, n_grid=n_grid, max_rounds=max_rounds,
+                       max_intervals=max_intervals, max_splits=max_splits, max_cells=max_cells)
+    n_evals += mc["n_evals"]
+    # every member stable: asked only where the margin did not already give a witness
+    cand = np.flatnonzero(pos & rc.stable & (mc["status"] != NOT_CERTIFIED))
     if cand.size:
         ax = axis_free(kx[cand], kv[cand], box, max_rounds=max_rounds + 30,
                        max_cells=4 * max_intervals)
         stable[cand] = ax.free
         n_evals[cand] += ax.n_evals
-    rows = np.flatnonzero(~unstable)
-    mc = _margin_cells(kx, kv, ka, box, rows, n_grid=n_grid, max_rounds=max_rounds,
-                       max_intervals=max_intervals, max_splits=max_splits, max_cells=max_cells)
-    n_evals += mc["n_evals"]
     v = np.full(n, INCONCLUSIVE, dtype=np.int8)
     v[stable & (mc["status"] == CERTIFIED)] = CERTIFIED
     v[unstable | (mc["status"] == NOT_CERTIFIED)] = NOT_CERTIFIED
