@@ -12,7 +12,9 @@ This module is the way in (:func:`certify_robust_batch`, :func:`certify_robust`,
 :func:`check_robust`) and the result types; the certificates themselves are
 :mod:`stringstab.certify.robust_continuous` (the exact minimum of g over the box at each ω,
 :func:`robust_margin`) and :mod:`stringstab.certify.robust_sampled` (bisection of cells of
-parameters, in the interval arithmetic of :mod:`stringstab.certify.interval`).
+parameters, in the interval arithmetic of :mod:`stringstab.certify.interval`); a box with a
+reaction delay θ_r ≠ (0, 0) goes to :mod:`stringstab.certify.robust_reaction` (continuous time
+only; its results carry the witness member's θ_r, :class:`RobustReactionCertificateBatch`).
 
 Verdicts: ``certified`` (proven for the whole box), ``not_certified`` (a member that is
 not internally stable, or a member and a frequency with |Γ| > 1: the witness),
