@@ -61,7 +61,7 @@ def test_box_containing_a_point_that_is_not_certified() -> None:
     assert ss.certify(1.2, 0.5, 0.6, tau=0.15, delta=0.2, headway=1.1,
                       reaction_delay=0.15).verdict == "not_certified"
     c = ss.certify(1.2, 0.5, 0.6, tau="0.1:0.2", delta=0.2, headway=1.1, reaction_delay="0.05:0.3")
-    assert c.verdict == "not_certified"  # (stable is not asked once a member violates)
+    assert c.verdict == "not_certified" and c.stable
     assert 0.05 <= c.witness_reaction_delay <= 0.3 and 0.1 <= c.witness_tau <= 0.2
     member = dict(tau=c.witness_tau, delta=c.witness_delta, headway=c.witness_headway,
                   reaction_delay=c.witness_reaction_delay)
@@ -174,3 +174,22 @@ def test_small_seeded_run_of_the_independent_check(check: Any) -> None:
     c = out["counts"]
     assert c["unsound"] == 0 and c["false_witness"] == 0
     assert c["certified"] >= 5 and c["not_certified"] >= 5  # both kinds were checked
+
+
+def test_region_maps_a_box_with_theta(tmp_path: Path) -> None:
+    """``region`` over a box with θ_r draws the box certificate's verdicts (it dropped θ_r to 0
+    before the box certificate existed, had the refusal been lifted): the map equals
+    certify_batch at the grid's triples."""
+    from stringstab.cli import main
+
+    out = tmp_path / "reg"
+    main(["region", "--fix", "k_a=0.5", "--tau", "0.1:0.2", "--reaction-delay", "0.1", "--n", "7",
+          "--out", str(out)])
+    d = np.load(out / "region.npz")
+    kx, kv = np.meshgrid(d["axis_k_x"], d["axis_k_v"], indexing="ij")
+    b = ss.certify_batch(kx.ravel(), kv.ravel(), 0.5, tau=(0.1, 0.2), delta=0.2, headway=1.1,
+                         reaction_delay=0.1)
+    codes = np.array([["certified", "not_certified", "inconclusive"].index(v) for v in b.verdict])
+    assert np.array_equal(np.asarray(d["verdict_exact"]).ravel(), codes)
+    assert np.array_equal(np.asarray(d["hurwitz"]).ravel(), b.stable)
+    assert 0 < codes.tolist().count(0) < codes.size  # some certified, some not

@@ -326,8 +326,7 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
 
     The root count at the box's centre, then g_θ ≥ 0 over cells of the box (module
     docstring), then internal stability of every member
-    (:func:`stringstab.certify.box_axis.axis_free`; not asked where a member already violates
-    |Γ| ≤ 1: ``stable`` is then False, not proven), then the point certificate at members of
+    (:func:`stringstab.certify.box_axis.axis_free`), then the point certificate at members of
     the boxes left inconclusive.
 
     Parameters
@@ -371,8 +370,9 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
     mc = _margin_cells(kx, kv, ka, box, rows, n_grid=n_grid, max_rounds=max_rounds,
                        max_intervals=max_intervals, max_splits=max_splits, max_cells=max_cells)
     n_evals += mc["n_evals"]
-    # every member stable: asked only where the margin did not already give a witness
-    cand = np.flatnonzero(pos & rc.stable & (mc["status"] != NOT_CERTIFIED))
+    # every member stable (asked also where a member violates |Γ| ≤ 1: ``stable`` is an answer
+    # of its own, the region maps' "not internally stable" class)
+    cand = np.flatnonzero(pos & rc.stable)
     if cand.size:
         ax = axis_free(kx[cand], kv[cand], box, max_rounds=max_rounds + 30,
                        max_cells=4 * max_intervals)
