@@ -193,3 +193,26 @@ def test_region_maps_a_box_with_theta(tmp_path: Path) -> None:
     assert np.array_equal(np.asarray(d["verdict_exact"]).ravel(), codes)
     assert np.array_equal(np.asarray(d["hurwitz"]).ravel(), b.stable)
     assert 0 < codes.tolist().count(0) < codes.size  # some certified, some not
+
+
+def test_the_box_tails_hold_for_every_member() -> None:
+    """Beyond box_margin_tail every member's g_θ > 0, and beyond box_tail every member's
+    |τs³ + s²| > |cs + k_x| on jℝ (random members, frequencies up to 50 Ω)."""
+    from stringstab.certify.margin_reaction import g
+
+    rng = np.random.default_rng(5)
+    box = check_box("0.05:0.3", "0:0.4", "0.5:2", "0:0.5")
+    lo, hi = np.array([0.05, 0.0, 0.5, 0.0]), np.array([0.3, 0.4, 2.0, 0.5])
+    for _ in range(10):
+        k = rng.uniform([-1.0, -2.0, -1.5], [2.0, 2.0, 1.5])
+        if abs(k[0]) < 1e-3:
+            continue
+        Om = robust_reaction.box_margin_tail(*(np.array([v]) for v in k), box)[0]
+        Od = box_axis.box_tail(np.array([k[0]]), np.array([k[1]]), box)[0]
+        p = lo + (hi - lo) * rng.uniform(size=(100, 4))
+        w = np.linspace(Om, 50 * Om, 400)[None, :]
+        assert np.all(g(w, *k, tau=p[:, :1], delta=p[:, 1:2], headway=p[:, 2:3],
+                        reaction_delay=p[:, 3:]) > 0)
+        w = np.linspace(Od, 50 * Od, 400)[None, :]
+        c = k[1] + p[:, 2:3] * k[0]
+        assert np.all(np.abs(p[:, :1] * (1j * w) ** 3 + (1j * w) ** 2) > np.abs(c * 1j * w + k[0]))

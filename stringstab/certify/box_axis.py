@@ -54,7 +54,7 @@ import numpy.typing as npt
 from ..params import Box
 from .quasipolynomial import denominator_at, tail_frequency
 
-__all__ = ["AxisCheck", "axis_free"]
+__all__ = ["AxisCheck", "axis_free", "box_tail"]
 
 Array = npt.NDArray[np.float64]
 

@@ -58,15 +58,13 @@ from .branch_bound import PENDING, branch_and_bound
 from .quasipolynomial import count_unstable_roots
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, Check, Verdict
 
-__all__ = ["cell_cost", "certify_box_reaction"]
+__all__ = ["box_margin_tail", "cell_cost", "certify_box_reaction"]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
 
 #: Relative widening of the computed mean-value costs (sums of positive terms).
 _COST_WIDEN = 1.0 + 1e-12
-#: The parameters of a cell, in this order: τ, δ, T*, θ_r.
-PARAMETERS = ("tau", "delta", "headway", "reaction_delay")
 
 
 def _worst(kx: Array, kv: Array, lo: Array, hi: Array) -> tuple[Array, Array]:
