@@ -379,11 +379,13 @@ def check(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -468,11 +470,13 @@ def certify_batch(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -567,11 +571,13 @@ def certify(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 
