@@ -465,7 +465,9 @@ NUMERIC = {
     "derive": {"--delay-order": INTS, "--sample-time": SAMPLE, "--reaction-delay": FLOATS,
                "--substitute": [f"{k}={v}" for k in ("tau", "reaction_delay") for v in FLOATS]},
     "certify": {"K_X,K_V,K_A": GAINS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
-                "--sample-time": SAMPLE, "--pade-order": INTS, "--reaction-delay": FLOATS},
+                "--sample-time": SAMPLE, "--pade-order": INTS,
+                # θ_r as an interval: the box certificate (issue 25, item 4)
+                "--reaction-delay": [*FLOATS, "0.3:0.1", "-0.1:0.2", "nan:0.2", "0.1:1e300"]},
     "region": {"--fix": ["k_a=nan", "k_a=inf", "k_a=1e300"], "--range": ["nan,2", "-inf,2", "-1e300,2"],
                "--n": INTS, "--tau": FLOATS, "--delta": FLOATS, "--headway": FLOATS,
                "--sample-time": SAMPLE, "--dpi": INTS, "--workers": INTS, "--reaction-delay": FLOATS},

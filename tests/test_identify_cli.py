@@ -180,6 +180,8 @@ def test_identify_fit_delay_cli(tmp_path: Path, capsys: pytest.CaptureFixture[st
     c = ss.certify(r["k_x"], r["k_v"], r["k_a"], tau=r["tau"], delta=r["delta"], headway=r["headway"],
                    reaction_delay=r["reaction_delay"])
     assert c.verdict == r["verdict"] and float(c.sup_gain) == pytest.approx(r["sup_gain"], rel=1e-12)
+    # the box certificate now covers θ_r's bootstrap interval too (issue 25, item 4)
+    assert r["box_verdict"] in ("certified", "not_certified", "inconclusive")
     main(["certify", "--from", str(out / "identify.json"), "--format", "json"])
     [cr] = json.loads(capsys.readouterr().out)["results"]
     assert cr["verdict"] == r["verdict"] and cr["sup_gain"] == pytest.approx(r["sup_gain"], rel=1e-9)

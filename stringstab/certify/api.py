@@ -131,13 +131,13 @@ class Loop:
             raise StringStabError(
                 "method='pade' (python-control's cross-check) is for the continuous loop at one "
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
-        # -- the reaction delay θ_r (issue 25): the continuous point loop only, until part 2
-        if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0):
+        # -- the reaction delay θ_r (issue 25): over a box, in continuous time (item 4)
+        if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0) and H is not None:
             lo, hi = self.model.reaction_delay
             raise StringStabError(
-                "reaction_delay > 0 is certified in continuous time only so far; got "
-                f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a parameter "
-                "box" + (f" and sample_time={H!r}" if H is not None else ""))
+                "θ_r over a parameter box is certified in continuous time; with sample_time="
+                f"{H!r} certify points of θ_r; got reaction_delay={lo:g}"
+                + (f":{hi:g}" if hi != lo else "") + " with a parameter box")
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
             raise StringStabError(
@@ -379,11 +379,13 @@ def check(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -468,11 +470,13 @@ def certify_batch(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -567,11 +571,13 @@ def certify(
     heterogeneous : bool
         Sampled box only: the predecessor's lag ranges over the τ box independently of the
         follower's (default; a platoon of different vehicles), or equals it.
-    reaction_delay : float
+    reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
         certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
+        θ_r with intervals of τ, δ, T*, is the box certificate
+        (:mod:`stringstab.certify.robust_reaction`).
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 

@@ -23,7 +23,8 @@ distance of a boundary: the smallest |D(jω)| met (a root near the axis) or the 
 found (|Γ| = 1 touched).  The ``reason`` column says which, in words.
 
 θ_r = 0 never comes here: :mod:`stringstab.certify.continuous` certifies it with today's code,
-bit for bit.  The sampled and robust certificates refuse θ_r > 0 so far (part 2 of issue 25).
+bit for bit.  Boxes with θ_r (a point θ_r > 0 or an interval) are certified by
+:mod:`stringstab.certify.robust_reaction`; the sampled certificates refuse θ_r > 0 so far.
 
 References
 ----------

@@ -12,7 +12,9 @@ This module is the way in (:func:`certify_robust_batch`, :func:`certify_robust`,
 :func:`check_robust`) and the result types; the certificates themselves are
 :mod:`stringstab.certify.robust_continuous` (the exact minimum of g over the box at each ω,
 :func:`robust_margin`) and :mod:`stringstab.certify.robust_sampled` (bisection of cells of
-parameters, in the interval arithmetic of :mod:`stringstab.certify.interval`).
+parameters, in the interval arithmetic of :mod:`stringstab.certify.interval`); a box with a
+reaction delay θ_r ≠ (0, 0) goes to :mod:`stringstab.certify.robust_reaction` (continuous time
+only; its results carry the witness member's θ_r, :class:`RobustReactionCertificateBatch`).
 
 Verdicts: ``certified`` (proven for the whole box), ``not_certified`` (a member that is
 not internally stable, or a member and a frequency with |Γ| > 1: the witness),
@@ -26,6 +28,7 @@ R. E. Moore, R. B. Kearfott, M. J. Cloud, *Introduction to Interval Analysis*, S
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -33,6 +36,7 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 
+from ..errors import StringStabError
 from ..io import TableColumn
 from ..params import Box, as_gains, check_box
 from ..params import sample_time as _sample_time
@@ -51,6 +55,8 @@ __all__ = [
     "TABLE_COLUMNS",
     "RobustCertificate",
     "RobustCertificateBatch",
+    "RobustReactionCertificate",
+    "RobustReactionCertificateBatch",
     "certify_kernel",
     "certify_robust",
     "certify_robust_batch",
@@ -213,6 +219,55 @@ class RobustCertificateBatch(BatchResult):
 RobustCertificate.BATCH = RobustCertificateBatch
 
 
+@dataclass(frozen=True)
+class RobustReactionCertificate(RobustCertificate):
+    """The robust certificate of one triple over a box that includes the reaction delay θ_r.
+
+    The fields of :class:`RobustCertificate`, and the witness member's θ_r (issue 25, item 4).
+
+    Attributes
+    ----------
+    witness_reaction_delay : float
+        θ_r of the witness member, s.
+    """
+
+    witness_reaction_delay: float = 0.0
+
+
+#: The robust table with the witness member's θ_r.
+REACTION_TABLE_COLUMNS: list[TableColumn] = [
+    *TABLE_COLUMNS[:-1], TableColumn("θ_r", "witness.reaction_delay", "%.4g"), TABLE_COLUMNS[-1],
+]
+
+
+@dataclass(frozen=True)
+class RobustReactionCertificateBatch(RobustCertificateBatch):
+    """Robust certificates over a box with θ_r: :class:`RobustCertificateBatch` plus θ_r."""
+
+    SINGLE: ClassVar[type[RobustCertificate]] = RobustReactionCertificate
+    TABLE: ClassVar[Sequence[TableColumn]] = REACTION_TABLE_COLUMNS
+
+    witness_reaction_delay: Array = dataclasses.field(default_factory=lambda: np.zeros(0))
+
+    def __getitem__(self, i: int) -> RobustReactionCertificate:
+        return super().__getitem__(i)  # type: ignore[return-value]
+
+    def columns(self) -> dict[str, Any]:
+        """The columns of :meth:`RobustCertificateBatch.columns` with ``witness.reaction_delay``.
+
+        Returns
+        -------
+        dict
+            Column name to ndarray; ``witness`` and ``box`` map to dicts of ndarrays.
+        """
+        cols = super().columns()
+        cols["witness"]["reaction_delay"] = self.witness_reaction_delay
+        return cols
+
+
+RobustReactionCertificate.BATCH = RobustReactionCertificateBatch
+
+
 def certify_robust_batch(
     k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
     *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
@@ -298,14 +353,27 @@ def certify_kernel(
     RobustCertificateBatch
     """
     n = kx.size
-    keys = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev", "delta",
-            "headway", "n_evals", "sup_gain", "sup_gain_excess")
+    keys: tuple[str, ...] = ("verdict", "stable", "margin", "theta", "omega", "tau", "tau_prev",
+                             "delta", "headway", "n_evals", "sup_gain", "sup_gain_excess")
+    reacting = box.reaction_delay != (0.0, 0.0)
+    if reacting:
+        if H is not None:
+            raise StringStabError(
+                "θ_r over a parameter box is certified in continuous time; with sample_time="
+                f"{H!r} certify points of θ_r; got reaction_delay={box.reaction_delay}")
+        keys += ("reaction_delay",)
     acc: dict[str, list[Array]] = {k: [] for k in keys}
     if H is not None:
         # the sampled loop's arithmetic is imported only when a sample time is given
         from .robust_sampled import certify_box_sampled
     for sl in chunks(n, chunk, progress=progress, desc="certify (robust)"):
-        if H is None:
+        if reacting:  # θ_r over a box (issue 25): cells of the box, continuous time
+            from .robust_reaction import certify_box_reaction
+
+            r = certify_box_reaction(kx[sl], kv[sl], ka[sl], box, n_grid=n_grid or 64,
+                                     max_rounds=max_rounds, max_intervals=max_intervals,
+                                     max_splits=max_splits, max_cells=max_cells)
+        elif H is None:
             r = certify_box_continuous(kx[sl], kv[sl], ka[sl], box, n_grid=n_grid or 64,
                                        max_rounds=max_rounds, max_intervals=max_intervals)
         else:
@@ -319,7 +387,7 @@ def certify_kernel(
     def cat(k: str, dtype: Any = float) -> Any:
         return np.concatenate(acc[k]).astype(dtype) if acc[k] else np.zeros(0, dtype=dtype)
 
-    return RobustCertificateBatch(
+    fields = dict(
         k_x=kx, k_v=kv, k_a=ka, box=box, sample_time=H, heterogeneous=bool(heterogeneous),
         stable=cat("stable", bool), verdict=names(cat("verdict", np.int8)),
         sup_gain=cat("sup_gain"), margin=cat("margin"), witness_tau=cat("tau"),
@@ -328,6 +396,10 @@ def certify_kernel(
         witness_theta=cat("theta"), n_evals=cat("n_evals", np.int64),
         sup_gain_excess=cat("sup_gain_excess"),
     )
+    if reacting:
+        return RobustReactionCertificateBatch(**fields,
+                                              witness_reaction_delay=cat("reaction_delay"))
+    return RobustCertificateBatch(**fields)
 
 
 def certify_robust(

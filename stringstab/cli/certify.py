@@ -120,7 +120,8 @@ def add_parser(sub: Any) -> None:
                         f"(default {DEFAULT_CAP:g}) such that every N'*H, N' <= N, is certified")
     p.add_argument("--reaction-delay", metavar="SECONDS",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
-                        "(τ a' = u(t − θ_r) − a); continuous time only so far (default: 0)")
+                        "(τ a' = u(t − θ_r) − a), or LO:HI for the robust certificate over a "
+                        "box (continuous time; default: 0)")
     p.add_argument("--method", choices=("exact", "pade"), default="exact",
                    help="exact: the sound certificate (default); pade: the same, plus "
                         "python-control's Padé + norm('inf') numbers, warning where they disagree")
@@ -324,15 +325,18 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
 
         tau, delta, headway = (given.get(k, r[k]) for k in ("tau", "delta", "headway"))
         # each vehicle at its own fitted θ_r (identify --fit-delay) unless --reaction-delay is given
-        theta_r = theta if getattr(args, "reaction_delay", None) is not None else r["reaction_delay"]
+        # (a LO:HI interval of θ_r is passed on as it is: the box certificate, issue 25 item 4)
+        given_theta = getattr(args, "reaction_delay", None)
+        theta_r: Any = (r["reaction_delay"] if given_theta is None
+                        else str(given_theta) if ":" in str(given_theta) else theta)
         loop = Loop(parameter_model(tau, delta, headway, theta_r), H)
         b = loop.certify_batch([r["k_x"]], [r["k_v"]], [r["k_a"]])
         c: dict[str, Any] = b.records()[0]
         rec: dict[str, Any] = {"position": r["position"], "name": r["name"]}
         for k in ("tau", "delta", "headway"):
             rec[k] = given.get(k, f"{r[k]:.6g}")
-        if theta_r:
-            rec["reaction_delay"] = f"{theta_r:.6g}"
+        if isinstance(theta_r, str) or theta_r:
+            rec["reaction_delay"] = theta_r if isinstance(theta_r, str) else f"{theta_r:.6g}"
         for k in ("k_x", "k_v", "k_a", "verdict", "sup_gain", "peak_omega"):
             if k in c:
                 rec[k] = c[k]

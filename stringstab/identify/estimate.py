@@ -18,7 +18,7 @@ one log, or every log of one car pooled: :mod:`stringstab.identify.cars`):
    whose refits start from the point estimate *and* from a random draw (the better optimum
    kept, so a second optimum is seen), each certified;
 5. the **box certificate** at the point gains over the bootstrap's 5-95 % intervals of τ, T*
-   (and δ) — not with θ_r fitted: the θ_r certificate takes points only so far;
+   (and δ, and θ_r when fitted: the θ_r box certificate);
 6. the **profiles** over T* (when weakly determined) and over θ_r (when fitted);
 7. the data's own **empirical transfer** (:mod:`stringstab.identify.empirical`) and, on
    request, the **baselines** (:mod:`stringstab.identify.baselines`).
@@ -367,14 +367,11 @@ def estimate(data: FollowerData, s: Settings, rng: np.random.Generator,
     step("fitted")
     cert = certify_fit(fit.params, s.sample_time)
     boot, verdicts, second = _bootstrap(data, s, fit, box, rng, step)
-    box_cert = _box(fit.params, boot, s) if s.bootstrap >= 2 and not s.fit_delay else None
+    box_cert = _box(fit.params, boot, s) if s.bootstrap >= 2 else None
     emp = empirical_transfer(data.v_pred, data.v, data.segments, data.dt)
     est = Estimate(fit, list(data.segments), cert, boot, verdicts, box_cert, emp, data, policy=policy,
                    free_fit=free, second_optimum=second)
     est.notes += pre
-    if s.fit_delay and s.bootstrap >= 2:
-        est.notes.append("no box certificate: the θ_r certificate takes points only so far (each "
-                         "bootstrap refit is certified at its own θ_r instead)")
     if s.bootstrap and second:
         est.notes.append(f"in {second} of {s.bootstrap} bootstrap refits the random start reached an "
                          "optimum lower by more than 0.1 % than the start at the point estimate: the "
@@ -506,7 +503,11 @@ def _separation_note(rows: list[dict[str, Any]], best_rmse: float) -> str:
 
 
 def _box(p: dict[str, float], bp: dict[str, Array], s: Settings) -> Any:
-    """The robust certificate at the point gains over the 5-95 % bootstrap box of τ, T* (δ, θ_r)."""
+    """The robust certificate at the point gains over the 5-95 % bootstrap box of τ, T* (δ, θ_r).
+
+    θ_r's interval when it is fitted (``fit_delay``); a sampled loop with θ_r is refused by the
+    way in, and then there is no box certificate (None), as for any refused box.
+    """
     from ..certify import api as ss
 
     def iv(k: str) -> Any:
@@ -515,9 +516,11 @@ def _box(p: dict[str, float], bp: dict[str, Array], s: Settings) -> Any:
         return (lo, hi) if hi > lo else p[k]
 
     delta = iv("delta") if s.model == "cacc" else p["delta"]
+    # θ_r fitted: its bootstrap interval too (the θ_r box certificate, issue 25 item 4)
+    theta = iv("reaction_delay") if s.fit_delay else p.get("reaction_delay", 0.0)
     try:
         return ss.certify(p["k_x"], p["k_v"], p["k_a"], tau=iv("tau"), delta=delta,
-                          headway=iv("headway"), sample_time=s.sample_time)
+                          headway=iv("headway"), sample_time=s.sample_time, reaction_delay=theta)
     except StringStabError:
         return None
 

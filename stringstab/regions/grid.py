@@ -96,9 +96,9 @@ class _Spec:
                 and not self.params.reaction_delay)
 
 
-def _reaction(p: Params | Box) -> float:
-    """θ_r of a point (0 for a box: a box with θ_r > 0 is refused before any work)."""
-    return p.reaction_delay if isinstance(p, Params) else 0.0
+def _reaction(p: Params | Box) -> Any:
+    """θ_r of a point, or of a box: its interval (the θ_r box certificate, issue 25 item 4)."""
+    return p.reaction_delay
 
 
 def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, int]) -> dict[str, Any]:

@@ -170,8 +170,11 @@ class LoopConstraints:
             from ..certify.api import Loop
 
             Loop(params, sample_time)
-            raise StringStabError(  # pragma: no cover - Loop refuses first
-                f"reaction_delay={lo:g}:{hi:g} is not tuned for this loop")
+            # a box with θ_r is certified (continuous time) but its constraints are not written
+            raise StringStabError(
+                "tuning takes θ_r at a point in continuous time (the box certificate with θ_r is "
+                "certify's); expected a point τ, δ, T* with reaction_delay, got "
+                f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a box")
         #: The reaction delay θ_r (s) of the continuous point loop (issue 25); 0 otherwise.
         self.reaction_delay = float(lo)
 
