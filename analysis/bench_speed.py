@@ -24,7 +24,9 @@ load (``os.getloadavg()``), and the table keeps, per side, the round whose figur
    700-clean-episodes rule; about 211,000 steps).  The share is the repair's CPU time (this
    process; ``GainRepair.__call__`` wrapped in the worker, the same wrapper before and after)
    over the run's, and train's own wall-clock ``repair_share`` next to it; the training env
-   steps/s (wall);
+   steps/s (wall); the share so far at 20,000, 50,000, 100,000, 150,000, ... steps (printed
+   to stderr as the run goes, and with the share over each stretch in the summary): whether
+   it is flat or falling along the run;
 5. IDL environment steps/s with one environment: ``make_env(config_for("idl", num_envs=1))``
    (the car-following env in the repair wrapper) stepped with the last ``--env-steps``
    proposals recorded from a training run of this checkout (past its random first 2,000
@@ -270,6 +272,10 @@ def work_train(inp: dict, out: dict) -> None:
     # shared machine the wall time of each part also counts the other jobs' time slices
     cpu = [0.0]
     orig = rp.GainRepair.__call__
+    # the share so far at these steps (each call repairs one proposal per env): whether it
+    # is flat or falling along the run, printed as it goes (stderr) and returned
+    marks = [20_000, 50_000, 100_000, 150_000, 200_000, 250_000, 300_000]
+    seen, points = [0], []
 
     def call(self, K):
         c = time.process_time()
@@ -277,6 +283,14 @@ def work_train(inp: dict, out: dict) -> None:
             return orig(self, K)
         finally:
             cpu[0] += time.process_time() - c
+            seen[0] += int(np.asarray(K).size // 3)
+            if marks and seen[0] >= marks[0]:
+                marks.pop(0)
+                total = time.process_time() - c0
+                points.append([seen[0], cpu[0], total])
+                print(f"# train: {seen[0]} steps, repair {cpu[0]:.1f} of {total:.1f} CPU s "
+                      f"({100 * cpu[0] / total:.1f} %), load {os.getloadavg()[0]:.1f}",
+                      file=sys.stderr, flush=True)
 
     rp.GainRepair.__call__ = call  # type: ignore[method-assign]
     load0 = os.getloadavg()
@@ -290,7 +304,7 @@ def work_train(inp: dict, out: dict) -> None:
     out.update(repair_share=t["repair_share"], steps_per_second=t["steps_per_second"],
                total_seconds=t["total_seconds"], repair_seconds=t["repair_seconds"],
                cells_seconds=cells, cpu_seconds=c_total, repair_cpu_seconds=cpu[0],
-               repair_cpu_share=cpu[0] / c_total, steps=res.steps,
+               repair_cpu_share=cpu[0] / c_total, steps=res.steps, checkpoints=points,
                load=[load0, os.getloadavg()])
 
 
@@ -492,6 +506,14 @@ def main(argv=None):
         c = a.get("cells_seconds", 0.0)
         rows.append(f"| of which the proofs of the repair's cells (wall) | – | "
                     f"{100 * c / a['total_seconds']:.1f} % of the time | | |")
+        for side, r in (("before", b), ("after", a)):
+            pts = r.get("checkpoints") or []
+            prev = (0, 0.0, 0.0)
+            for st, rep, tot in pts:  # the share so far, and over the steps since the last
+                print(f"# {part} {side}: {st} steps: repair {100 * rep / tot:.1f} % of the CPU "
+                      f"so far, {100 * (rep - prev[1]) / (tot - prev[2]):.1f} % since "
+                      f"{prev[0]} steps")
+                prev = (st, rep, tot)
         rows.append(f"| IDL training env steps/s (wall; CPU s of the run) | "
                     f"{b['steps_per_second']:.0f} ({b['cpu_seconds']:.0f} s) | "
                     f"{a['steps_per_second']:.0f} ({a['cpu_seconds']:.0f} s) | "
