@@ -140,10 +140,9 @@ class Loop:
                 "box" + (f" and sample_time={H!r}" if H is not None else ""))
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
-            raise StringStabError(
-                "reaction_delay > 0 is certified in continuous time only so far; got "
-                f"reaction_delay={theta:g} with sample_time={H!r}"
-                + (f" and a message every {self.message_steps} steps" if self.message_steps else ""))
+            from .lifting_reaction import check_reaction_sampled
+
+            check_reaction_sampled(theta, H, self.message_steps)
         if theta and self.method == "pade":
             raise StringStabError(
                 "method='pade' (python-control's cross-check) has no reaction delay; expected "
@@ -174,8 +173,8 @@ class Loop:
         method : {"exact", "pade"}
             The method of :func:`certify_batch`.
         reaction_delay : float
-            θ_r ≥ 0 (s), the delay on the whole command (issue 25); > 0 is certified in
-            continuous time only so far (a sampled or box loop refuses it).
+            θ_r ≥ 0 (s), the delay on the whole command (issue 25): certified in continuous
+            time and with ``sample_time`` (not with a box or a message period yet).
         message_period, message_phase, fallback_gains : optional
             The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 
@@ -290,6 +289,12 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
         return robust.check_of(robust.certify_kernel(
             kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, n_grid=n_grid,
             max_rounds=max_rounds, max_intervals=max_intervals))
+    if H is not None and model.reaction_delay:  # θ_r > 0 sampled (issue 25 item 3)
+        from . import sampled_reaction
+
+        return sampled_reaction.check_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, n_grid=n_grid, max_rounds=max_rounds,
+            max_intervals=max_intervals)
     if H is not None:
         from . import sampled
 
@@ -322,6 +327,12 @@ def _certify(
         return robust.certify_kernel(
             kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, progress=progress,
             chunk=chunk, n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    if H is not None and model.reaction_delay:  # θ_r > 0 sampled (issue 25 item 3)
+        from . import sampled_reaction
+
+        return sampled_reaction.certify_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, progress=progress, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals)
     if H is not None:
         from . import sampled
 
