@@ -68,12 +68,11 @@ def test_params_and_boxes_carry_theta_when_nonzero():
 
 
 @pytest.mark.parametrize("kw, found", [
-    ({"sample_time": 0.1}, "reaction_delay=0.2 with sample_time=0.1"),
     ({"tau": (0.1, 0.2)}, "reaction_delay=0.2 with a parameter box"),
     ({"reaction_delay": (0.1, 0.3)}, "reaction_delay=0.1:0.3 with a parameter box"),
     ({"reaction_delay": "0.1:0.3", "sample_time": 0.1}, "reaction_delay=0.1:0.3 with a parameter box and sample_time=0.1"),
 ])
-def test_the_sampled_and_robust_certificates_refuse_theta_so_far(kw, found):
+def test_the_robust_certificate_refuses_theta_so_far(kw, found):
     args = {**P, "reaction_delay": 0.2, **kw}
     with pytest.raises(StringStabError, match="reaction_delay > 0 is certified in continuous "
                                               "time only so far; got " + found.replace("(", r"\(")):
@@ -186,9 +185,13 @@ def test_cli_bad_reaction_delays_exit_2_in_one_line(value):
     assert len(err.strip().splitlines()) == 1 and "reaction_delay" in err
 
 
-def test_cli_sampled_with_theta_exits_2():
+def test_cli_sampled_with_theta_certifies():
+    # issue 25 item 3: the sampled certificate with θ_r (tests/test_sampled_reaction.py)
     rc, out, err = _run("certify", "1,0.5,0.2", "--reaction-delay", "0.2", "--sample-time", "0.1")
-    assert rc == 2 and "continuous time only so far" in err and out == ""
+    assert rc == 0 and err == "" and " certified " in out
+    rc, out, err = _run("certify", "1,0.5,0.2", "--reaction-delay", "0.2", "--sample-time", "1e-5")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "at most 2000 whole samples" in err and "20000 samples" in err
 
 
 def test_derive_shows_the_theta_forms():
