@@ -190,7 +190,7 @@ def simulate(tau: float, delta: float, T: float, H: float, theta: float, k: np.n
         cmd[0, kstep] = math.sin(w * kstep * H)
         # the delayed sample a_{i-1}(kH − δ): fine index kH − δ on the fine grid (exact at
         # multiples of dt: δ rounded to it, the check's resolution)
-        idx = fine - int(round((m + eps) * sub))
+        idx = fine - round((m + eps) * sub)
         a_d = a_hist[idx] if idx >= 0 else 0.0
         gap = xs[0, 0] - xs[1, 0] - 10.0 - T * xs[1, 1]
         cmd[1, kstep] = k[0] * gap + k[1] * (xs[0, 1] - xs[1, 1]) + k[2] * a_d
@@ -230,20 +230,14 @@ def boundary_headway(v: Vehicle, k: np.ndarray) -> float | None:
     return 0.5 * (lo + hi)
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=2000, help="cases (groups of 10)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--simulate-every", type=int, default=100,
-                    help="simulate one case in this many (0: none)")
-    a = ap.parse_args()
-    rng = np.random.default_rng(a.seed)
-    t0 = time.perf_counter()
+def run(n: int, seed: int, simulate_every: int) -> tuple[dict[str, int], dict[int, list[int]]]:
+    """The check of n cases (groups of 10): the counts, and per q [cases, unsound, conservative]."""
+    rng = np.random.default_rng(seed)
     rows = {"cases": 0, "certified": 0, "not_certified": 0, "inconclusive": 0,
             "near_boundary": 0, "truth_ss": 0, "unsound": 0, "wrong_not_certified": 0,
             "conservative": 0, "simulated": 0, "sim_mismatch": 0}
     by_q: dict[int, list[int]] = {}
-    groups = max(1, a.n // 10)
+    groups = max(1, n // 10)
     for g in range(groups):
         tau = float(rng.uniform(0.05, 1.0))
         H = float(rng.choice(HS))
@@ -295,12 +289,24 @@ def main() -> None:
             if ss_true and verdict != "certified":
                 rows["conservative"] += 1
                 cell[2] += 1
-            if a.simulate_every and rows["cases"] % a.simulate_every == 0 and st and where > 0.05:
+            if simulate_every and rows["cases"] % simulate_every == 0 and st and where > 0.05:
                 r = simulate(tau, delta, T, H, theta, K[i], where)
                 rows["simulated"] += 1
                 if abs(r - sup) > 0.02 * max(1.0, sup):
                     rows["sim_mismatch"] += 1
                     print("SIM", tau, delta, T, H, theta, K[i].tolist(), r, sup, where)
+    return rows, by_q
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=2000, help="cases (groups of 10)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--simulate-every", type=int, default=100,
+                    help="simulate one case in this many (0: none)")
+    a = ap.parse_args()
+    t0 = time.perf_counter()
+    rows, by_q = run(a.n, a.seed, a.simulate_every)
     el = time.perf_counter() - t0
     print(f"\nsampled θ_r check: seed {a.seed}, {rows['cases']} cases, {el:.0f} s, "
           f"load {os.getloadavg()[0]:.2f}")

@@ -63,7 +63,7 @@ from .lifting import LiftedLink, message_buffer
 from .verdicts import ROUNDOFF_SLACK
 from .zoh import phi, split_delay
 
-__all__ = ["MAX_HELD_STEPS", "check_reaction_sampled", "follower_block", "held_steps", "held_piece", "lift_reaction"]
+__all__ = ["MAX_HELD_STEPS", "check_reaction_sampled", "follower_block", "held_piece", "held_steps", "lift_reaction"]
 
 Array = npt.NDArray[np.float64]
 
