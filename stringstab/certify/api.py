@@ -393,8 +393,9 @@ def check(
     reaction_delay : float
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and with
+        a sample time (:mod:`stringstab.certify.sampled_reaction`); with a box or a message
+        period: refused.
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -482,8 +483,9 @@ def certify_batch(
     reaction_delay : float
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and with
+        a sample time (:mod:`stringstab.certify.sampled_reaction`); with a box or a message
+        period: refused.
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -581,8 +583,9 @@ def certify(
     reaction_delay : float
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time or a box: refused).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and with
+        a sample time (:mod:`stringstab.certify.sampled_reaction`); with a box or a message
+        period: refused.
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 
