@@ -113,7 +113,7 @@ def test_bad_schedules_are_refused_with_what_was_expected(kw, match):
     (["--sample-time", "0.01", "--message-period", "0.1", "--reaction-delay", "0.1"],
      "not with a message period yet"),
     (["--sample-time", "0.01", "--max-message-period", "--reaction-delay", "0.1"],
-     "continuous time only so far"),
+     "not with a message period yet"),
 ])
 def test_bad_command_lines_are_one_line_exit_2_and_no_file(tmp_path, capsys, flags, says):
     out = tmp_path / "o.json"

@@ -170,8 +170,10 @@ class LoopConstraints:
             from ..certify.api import Loop
 
             Loop(params, sample_time)
-            raise StringStabError(  # pragma: no cover - Loop refuses first
-                f"reaction_delay={lo:g}:{hi:g} is not tuned for this loop")
+            raise StringStabError(  # a sampled point loop: certified, not tuned yet
+                "reaction_delay > 0 with a sample time is certified (certify, check) but not "
+                "tuned yet; expected reaction_delay=0 with a sample time; got "
+                f"reaction_delay={hi:g} with sample_time={sample_time!r}")
         #: The reaction delay θ_r (s) of the continuous point loop (issue 25); 0 otherwise.
         self.reaction_delay = float(lo)
 
