@@ -64,7 +64,7 @@ def test_projection_certifies_with_the_reaction_delay():
 
 
 def test_the_refusals_pass_through():
-    with pytest.raises(ss.StringStabError, match="with a sample time is certified .* not tuned yet"):
+    with pytest.raises(ss.StringStabError, match=r"with a sample time is certified .* not tuned yet"):
         Projector(**P, sample_time=0.1, reaction_delay=0.2)
     with pytest.raises(ss.StringStabError, match="continuous time only so far"):
         project(K0, tau=(0.1, 0.2), delta=0.2, headway=1.1, reaction_delay=0.2)
