@@ -69,14 +69,16 @@ def test_params_and_boxes_carry_theta_when_nonzero():
 
 
 @pytest.mark.parametrize("kw, found", [
-    ({"sample_time": 0.1}, "reaction_delay > 0 is certified in continuous time only so far; got "
-                           "reaction_delay=0.2 with sample_time=0.1"),
-    # boxes with θ_r are certified in continuous time (issue 25, item 4: test_robust_reaction.py)
+    # points with a sample time are certified (issue 25 item 3: test_sampled_reaction.py), boxes
+    # in continuous time (item 4: test_robust_reaction.py); a θ_r box with a sample time is refused
     ({"reaction_delay": "0.1:0.3", "sample_time": 0.1},
      "θ_r over a parameter box is certified in continuous time; with sample_time=0.1 certify "
      "points of θ_r; got reaction_delay=0.1:0.3 with a parameter box"),
+    ({"tau": (0.1, 0.2), "sample_time": 0.1},
+     "θ_r over a parameter box is certified in continuous time; with sample_time=0.1 certify "
+     "points of θ_r; got reaction_delay=0.2 with a parameter box"),
 ])
-def test_the_sampled_certificates_refuse_theta_so_far(kw, found):
+def test_a_theta_box_with_a_sample_time_is_refused(kw, found):
     args = {**P, "reaction_delay": 0.2, **kw}
     with pytest.raises(StringStabError, match=re.escape(found)):
         ss.certify_batch([1.0], [0.5], [0.2], **args)
@@ -188,9 +190,14 @@ def test_cli_bad_reaction_delays_exit_2_in_one_line(value):
     assert len(err.strip().splitlines()) == 1 and "reaction_delay" in err
 
 
-def test_cli_sampled_with_theta_exits_2():
+def test_cli_sampled_with_theta_certifies():
+    # issue 25 item 3: the sampled certificate with θ_r (tests/test_sampled_reaction.py)
     rc, out, err = _run("certify", "1,0.5,0.2", "--reaction-delay", "0.2", "--sample-time", "0.1")
-    assert rc == 2 and "continuous time only so far" in err and out == ""
+    assert rc == 0 and err == "" and " certified " in out
+    rc, out, err = _run("certify", "1,0.5,0.2", "--reaction-delay", "2.5", "--sample-time", "0.001")
+    errors = [line for line in err.splitlines() if "error:" in line]  # (a range warning first)
+    assert rc == 2 and out == "" and len(errors) == 1
+    assert "at most 2000 whole samples" in errors[0] and "2500 samples" in err
 
 
 def test_derive_shows_the_theta_forms():
@@ -210,7 +217,7 @@ def test_the_tuning_keeps_theta_on_the_point_and_refuses_it_elsewhere():
     from stringstab.tuning.constraints import LoopConstraints
 
     assert LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), None).reaction_delay == 0.2
-    with pytest.raises(StringStabError, match=r"continuous time only so far; got "
+    with pytest.raises(StringStabError, match=r"not tuned yet; .*got "
                                               r"reaction_delay=0\.2 with sample_time=0\.1"):
         LoopConstraints(ss.Params(0.1, 0.2, 1.1, reaction_delay=0.2), 0.1)
     with pytest.raises(StringStabError, match=r"tuning takes θ_r at a point in continuous time"):

@@ -139,11 +139,11 @@ def test_cli_sweep_writes_slices_table_and_figure(tmp_path, capsys):
         (["--reaction-delay", "nan"], "reaction delay θ_r"),
         (["--reaction-delay", "101"], "reaction"),
         (["--reaction-delay", "0.2", "--sample-time", "0.1"],
-         "reaction_delay > 0 is certified in continuous time only so far"),
+         "reaction_delay > 0 with a sample time is certified"),
         # a box with θ_r (--tau 0.1:0.2 with θ_r, --reaction-delay 0.1:0.3) is mapped by the
         # θ_r box certificate: tests/test_robust_reaction.py
         (["--reaction-delay", "0,0.2", "--sample-time", "0.1"],
-         "reaction_delay > 0 is certified in continuous time only so far"),
+         "reaction_delay > 0 with a sample time is certified"),
         (["--reaction-delay", "0,0.2", "--delta", "0.1:0.2"], "needs one τ, δ, T*"),
         (["--reaction-delay", "0,-0.2"], "reaction delay θ_r"),
         (["--reaction-delay", "0.2,0.1"], "strictly increasing"),

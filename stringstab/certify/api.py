@@ -140,10 +140,9 @@ class Loop:
                 + (f":{hi:g}" if hi != lo else "") + " with a parameter box")
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
-            raise StringStabError(
-                "reaction_delay > 0 is certified in continuous time only so far; got "
-                f"reaction_delay={theta:g} with sample_time={H!r}"
-                + (f" and a message every {self.message_steps} steps" if self.message_steps else ""))
+            from .lifting_reaction import check_reaction_sampled
+
+            check_reaction_sampled(theta, H, self.message_steps)
         if theta and self.method == "pade":
             raise StringStabError(
                 "method='pade' (python-control's cross-check) has no reaction delay; expected "
@@ -174,8 +173,8 @@ class Loop:
         method : {"exact", "pade"}
             The method of :func:`certify_batch`.
         reaction_delay : float
-            θ_r ≥ 0 (s), the delay on the whole command (issue 25); > 0 is certified in
-            continuous time only so far (a sampled or box loop refuses it).
+            θ_r ≥ 0 (s), the delay on the whole command (issue 25): certified in continuous
+            time and with ``sample_time`` (not with a box or a message period yet).
         message_period, message_phase, fallback_gains : optional
             The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 
@@ -290,6 +289,12 @@ def _check(loop: Loop, kx: Array, kv: Array, ka: Array, *, n_grid: int | None,
         return robust.check_of(robust.certify_kernel(
             kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, n_grid=n_grid,
             max_rounds=max_rounds, max_intervals=max_intervals))
+    if H is not None and model.reaction_delay:  # θ_r > 0 sampled (issue 25 item 3)
+        from . import sampled_reaction
+
+        return sampled_reaction.check_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, n_grid=n_grid, max_rounds=max_rounds,
+            max_intervals=max_intervals)
     if H is not None:
         from . import sampled
 
@@ -322,6 +327,12 @@ def _certify(
         return robust.certify_kernel(
             kx, kv, ka, model, H, heterogeneous=loop.heterogeneous, progress=progress,
             chunk=chunk, n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals)
+    if H is not None and model.reaction_delay:  # θ_r > 0 sampled (issue 25 item 3)
+        from . import sampled_reaction
+
+        return sampled_reaction.certify_kernel(
+            kx, kv, ka, model, H, loop.predecessor_lag, progress=progress, n_grid=n_grid,
+            max_rounds=max_rounds, max_intervals=max_intervals)
     if H is not None:
         from . import sampled
 
@@ -382,10 +393,11 @@ def check(
     reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
-        θ_r with intervals of τ, δ, T*, is the box certificate
-        (:mod:`stringstab.certify.robust_reaction`).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and, at a
+        point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
+        interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
+        box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
+        with a message period: refused.
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -473,10 +485,11 @@ def certify_batch(
     reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
-        θ_r with intervals of τ, δ, T*, is the box certificate
-        (:mod:`stringstab.certify.robust_reaction`).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and, at a
+        point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
+        interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
+        box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
+        with a message period: refused.
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -574,10 +587,11 @@ def certify(
     reaction_delay : float, (float, float) or str
         θ_r ≥ 0 (s): the vehicle applies its whole command θ_r late (issue 25; symbol θ_r,
         docs/conventions.md).  0 (default) is today's model and code, bit for bit; > 0 is
-        certified exactly (:mod:`stringstab.certify.reaction`), in continuous time only so
-        far (with a sample time: refused); an interval ``(lo, hi)`` or ``"LO:HI"``, or a point
-        θ_r with intervals of τ, δ, T*, is the box certificate
-        (:mod:`stringstab.certify.robust_reaction`).
+        certified exactly in continuous time (:mod:`stringstab.certify.reaction`) and, at a
+        point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
+        interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
+        box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
+        with a message period: refused.
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 

@@ -65,6 +65,7 @@ __all__ = [
     "certify_kernel",
     "check_kernel",
     "decide",
+    "decide_lifted",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -177,15 +178,43 @@ def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
     -------
     Decision
     """
-    n = kx.size
     co, _ = point_coefficients(kx, kv, ka, p, H, p.tau)
     sure, fail = schur_bands(co.delta)
     link = lift(kx, kv, ka, p, H, N)
+    verdict, margin, argmin, n_evals, grid = decide_lifted(
+        link, sure, fail, n_grid=n_grid or _default_grid(N), max_rounds=max_rounds,
+        max_intervals=max_intervals)
+    return Decision(verdict, sure, fail, margin, argmin, n_evals, grid, link,
+                    [d.lo for d in co.delta])
+
+
+def decide_lifted(link: LiftedLink, sure: npt.NDArray[np.bool_], fail: npt.NDArray[np.bool_], *,
+                  n_grid: int, max_rounds: int = 30, max_intervals: int = 1024,
+                  ) -> tuple[npt.NDArray[np.int8], Array, Array, npt.NDArray[np.int64], Array]:
+    """The frequency half of :func:`decide` on a lifted link whose stability is decided.
+
+    Parameters
+    ----------
+    link : LiftedLink
+        The lifted link of n triples (any per-step model: :mod:`stringstab.certify.lifting`
+        or :mod:`stringstab.certify.lifting_reaction`).
+    sure, fail : ndarray of bool
+        Its state matrix surely Schur; surely not.
+    n_grid, max_rounds, max_intervals : int
+        Initial intervals on [0, π], refinement rounds, cap on undecided intervals per triple.
+
+    Returns
+    -------
+    (ndarray of int8, ndarray, ndarray, ndarray of int, ndarray)
+        Verdict codes, the smallest λ_min(M̂(θ)) found and where (NaN when not surely
+        Schur), points evaluated, and the initial grid (n, n_grid + 1).
+    """
+    n = sure.size
     verdict = np.where(fail, NOT_CERTIFIED, INCONCLUSIVE).astype(np.int8)
     margin = np.full(n, np.nan)
     argmin = np.zeros(n)
     n_evals = np.zeros(n, dtype=np.int64)
-    ng = n_grid or _default_grid(N)
+    ng = n_grid
     grid = np.broadcast_to(np.linspace(0.0, np.pi, ng + 1), (n, ng + 1))
     idx = np.flatnonzero(sure)
     if idx.size:
@@ -214,8 +243,7 @@ def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
             ne_[grp] += b2.n_evals
         v[~pr.ok & (v == CERTIFIED)] = INCONCLUSIVE
         verdict[idx], margin[idx], argmin[idx], n_evals[idx] = v, mn, am, ne_
-    return Decision(verdict, sure, fail, margin, argmin, n_evals, grid, link,
-                    [d.lo for d in co.delta])
+    return verdict, margin, argmin, n_evals, grid
 
 
 def _peak(link: LiftedLink, grid: Array, worst: Array) -> tuple[Array, Array]:

@@ -120,8 +120,8 @@ def add_parser(sub: Any) -> None:
                         f"(default {DEFAULT_CAP:g}) such that every N'*H, N' <= N, is certified")
     p.add_argument("--reaction-delay", metavar="SECONDS",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
-                        "(τ a' = u(t − θ_r) − a), or LO:HI for the robust certificate over a "
-                        "box (continuous time; default: 0)")
+                        "(τ a' = u(t − θ_r) − a), also with --sample-time; or LO:HI for the "
+                        "robust certificate over a box (continuous time; default: 0)")
     p.add_argument("--method", choices=("exact", "pade"), default="exact",
                    help="exact: the sound certificate (default); pade: the same, plus "
                         "python-control's Padé + norm('inf') numbers, warning where they disagree")

@@ -170,11 +170,16 @@ class LoopConstraints:
             from ..certify.api import Loop
 
             Loop(params, sample_time)
-            # a box with θ_r is certified (continuous time) but its constraints are not written
-            raise StringStabError(
-                "tuning takes θ_r at a point in continuous time (the box certificate with θ_r is "
-                "certify's); expected a point τ, δ, T* with reaction_delay, got "
-                f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a box")
+            if not isinstance(params, Params):
+                # a box with θ_r is certified (continuous time) but its constraints are not written
+                raise StringStabError(
+                    "tuning takes θ_r at a point in continuous time (the box certificate with θ_r "
+                    "is certify's); expected a point τ, δ, T* with reaction_delay, got "
+                    f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a box")
+            raise StringStabError(  # a sampled point loop: certified, not tuned yet
+                "reaction_delay > 0 with a sample time is certified (certify, check) but not "
+                "tuned yet; expected reaction_delay=0 with a sample time; got "
+                f"reaction_delay={hi:g} with sample_time={sample_time!r}")
         #: The reaction delay θ_r (s) of the continuous point loop (issue 25); 0 otherwise.
         self.reaction_delay = float(lo)
 

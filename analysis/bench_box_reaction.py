@@ -13,7 +13,7 @@ Two samples of gains: the IDL range K ∈ [−2, 2]³ (half has k_x < 0: decided
 range where certified gains are common (k_x ∈ [0.05, 1.2], k_v ∈ [0, 2], k_a ∈ [−0.5, 1]).
 The machine load (``os.getloadavg()``) is printed before and after; nothing is asserted.
 
-    nice -n 5 python analysis/bench_reaction.py --n 1000      # the docs' table
+    nice -n 5 python analysis/bench_box_reaction.py --n 1000      # the docs' table
 """
 
 from __future__ import annotations
