@@ -8,7 +8,7 @@ the faster peak search; written by ``python tests/test_multirate_peak.py --write
 * the verdicts are the same (the peak search never enters a verdict; this is the check that
   the change left the decision alone);
 * the reported peak is no lower than the old one beyond 10⁻⁸ relative (the old search zoomed
-  to θ steps of 8.9·10⁻⁷ rad, the new one brackets to 4.6·10⁻⁷ rad or finer);
+  to θ steps of 8.9·10⁻⁷ rad, the new one brackets to 5.8·10⁻⁸ rad at N = 10);
 * independent truth: a sweep of σ_max(G(e^{jθ})) (numpy's SVD of the directly solved lifted
   response on 1,001 θ, not the peak search's Schur-basis response) never exceeds the reported
   peak (the sup over [0, π] is at least every sampled value) beyond rounding, 10⁻¹² relative —

@@ -14,7 +14,7 @@ where the upper bound reaches the row's largest lower bound — so the best cand
 same as with σ_max everywhere.  (2) The bracket around the best candidate is bisected
 :data:`ROUNDS` times (two new points per round, again skipping a point whose upper bound
 cannot beat the best value): the local maximum is located to within (π/n)/2^ROUNDS rad,
-n the grid's intervals (4.6·10⁻⁷ rad at the default 52 intervals of N = 10).  (3) The value
+n the grid's intervals (5.8·10⁻⁸ rad at the default 52 intervals of N = 10).  (3) The value
 reported is σ_max at the reported θ recomputed by numpy's 2-norm of
 :func:`stringstab.certify.lifting.lifted_response` (the directly solved response).
 
