@@ -16,7 +16,8 @@ sup_θ σ_max(G(e^{jθ})) = σ_max(G(1)) = 1.  ``not_certified``: Δ not Schur (
 ≥ 1: ``spectral_radius``), or a θ with λ_min(M(θ)) < −slack — so σ_max(G(e^{jθ})) > 1 (for
 θ = 0, on a neighbourhood of it, by continuity).  ``inconclusive``: neither within the budget
 (a tangency, e.g. Ψ3 = 0, stays inconclusive).  The reported peak (``sup_gain``,
-``peak_theta``) is located by a grid and zooming on σ_max(Ĝ) and never enters a verdict.
+``peak_theta``) is located by a grid and a bisected bracket on σ_max(Ĝ)
+(:mod:`stringstab.certify.lifted_peak`) and never enters a verdict.
 
 **The fallback mode** (ACC: the message is not used, k_a = 0, optionally other gains) is an
 LTI loop, the sampled certificate of (k_x, k_v, 0) (:mod:`stringstab.certify.sampled`),
@@ -39,9 +40,10 @@ import numpy.typing as npt
 
 from ..io import TableColumn
 from ..params import Box, Params
-from .branch_bound import Evaluate, branch_and_bound, verdict_codes, zoom_max
+from .branch_bound import Evaluate, branch_and_bound, verdict_codes
 from .lifted_frequency import LOCAL, Prepared, curvature, evaluate, prepare
-from .lifting import LiftedLink, lift, lifted_response
+from .lifted_peak import lifted_peak
+from .lifting import LiftedLink, lift
 from .schur import schur_bands, spectral_radius_of
 from .verdicts import (
     CERTIFIED,
@@ -244,32 +246,6 @@ def decide_lifted(link: LiftedLink, sure: npt.NDArray[np.bool_], fail: npt.NDArr
         v[~pr.ok & (v == CERTIFIED)] = INCONCLUSIVE
         verdict[idx], margin[idx], argmin[idx], n_evals[idx] = v, mn, am, ne_
     return verdict, margin, argmin, n_evals, grid
-
-
-def _peak(link: LiftedLink, grid: Array, worst: Array) -> tuple[Array, Array]:
-    """sup_θ σ_max(Ĝ(e^{jθ})) and where: the grid and the witness, refined by zooming (reporting)."""
-    n = link.N
-    cand = np.concatenate([grid, worst[:, None]], axis=1)
-    best = np.empty(cand.shape[0])
-    where = np.empty(cand.shape[0])
-    for s in range(0, cand.shape[0], 256):
-        sl = slice(s, s + 256)
-        sub = link.take(np.arange(cand.shape[0])[sl])
-
-        def sig(th: Array, sub: LiftedLink = sub) -> Array:
-            G = lifted_response(sub, th)
-            bad = np.asarray(~np.isfinite(G).all(axis=(-2, -1)))
-            S = np.linalg.norm(np.where(bad[..., None, None], 0.0, G), 2, axis=(-2, -1))
-            return np.asarray(np.where(bad, np.inf, S))  # a pole on the circle
-
-        S = sig(cand[sl])
-        j = np.argmax(S, axis=1)
-        rows = np.arange(S.shape[0])
-        b, x = zoom_max(sig, cand[sl][rows, j], S[rows, j],
-                        np.full(S.shape[0], np.pi / cand.shape[1]), lo=0.0, hi=np.pi)
-        best[sl], where[sl] = b, x
-    del n
-    return best, where
 
 
 # ---------------------------------------------------------------------------
@@ -538,7 +514,7 @@ def certify_kernel(
         rad[sl] = spectral_radius_of(d.delta)
         need = np.flatnonzero(d.verdict != CERTIFIED)
         if need.size:
-            s_, w_ = _peak(d.link.take(need), d.grid[need], d.argmin[need])
+            s_, w_ = lifted_peak(d.link.take(need), d.grid[need], d.argmin[need])
             sup[sl][need], peak[sl][need] = s_, w_
     fx = kx if fallback is None else np.full(n, float(fallback[0]))
     fv = kv if fallback is None else np.full(n, float(fallback[1]))
