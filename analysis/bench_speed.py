@@ -41,7 +41,7 @@ load (``os.getloadavg()``), and the table keeps, per side, the round whose figur
 
 Prints the table (before, after, ratio after/before, target) and the loads; asserts nothing
 about time.  ``--write-fixture PATH`` writes a sample of the inputs with the base verdicts
-(the fixture of ``tests/test_speed_verdicts.py``).  Examples::
+(the fixture of ``tests/certify/test_speed_verdicts.py``).  Examples::
 
     python analysis/bench_speed.py                                  # everything, ~1.5-2 h
     python analysis/bench_speed.py --parts certify,env,train,verdicts   # without trainfull
@@ -625,7 +625,7 @@ def verify_new_decisions(inputs: dict, before: dict, after: dict) -> str:
 
 
 def write_fixture(path: str, inputs: dict, before: dict, rng: np.random.Generator) -> None:
-    """A sample of each set with the base verdicts, as CSV (tests/test_speed_verdicts.py)."""
+    """A sample of each set with the base verdicts, as CSV (tests/certify/test_speed_verdicts.py)."""
     lines = ["set,k_x,k_v,k_a,base_verdict"]
     for name, v in sorted(before.items()):
         K = inputs[name]

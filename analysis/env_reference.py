@@ -1,4 +1,4 @@
-"""Record the IDL training environment's outputs for ``tests/test_env_reference.py``.
+"""Record the IDL training environment's outputs for ``tests/rl/test_env_reference.py``.
 
 Steps ``make_env(config_for("idl", num_envs=n, seed=0, repair="off"))`` (the car-following
 env behind the clip and rate-limit wrapper, no repair) ``--steps`` times with seeded random

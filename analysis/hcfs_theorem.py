@@ -10,7 +10,7 @@ Part 1 (P3 dropped): an exhaustive search over all 2-frame sequences on a lattic
 satisfying P1 and P2 (start values in [−J T, J T] and steps on the lattice, every eq-12 choice
 and previous choice, β = 0.5), for q = 2 … 12 (:func:`stringstab.hcfs.lattice_search`); the
 smallest counterexample (smallest |a1_{k−1} − a2_{k−1}|) is printed.  The Hypothesis search is a
-test: ``pytest -q -s tests/test_hcfs_theorem.py -k hypothesis`` prints the example it finds.
+test: ``pytest -q -s tests/hcfs/test_hcfs_theorem.py -k hypothesis`` prints the example it finds.
 
 Part 2: the closed loop of HCFS §IV (T = 0.2 s, 5 ms V2V delay) behind the bundled cycles,
 synthetic leaders and the three held-out cases (UDDS at half speed) for N = 4, 6, 8 followers

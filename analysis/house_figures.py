@@ -5,7 +5,7 @@ main branch before a change; the layer table is always this tree's ``docs/archit
 
 * the modules at the package root;
 * the largest module (lines);
-* import circles and upward arrows (the graph of ``tests/test_house.py``, lazy imports included):
+* import circles and upward arrows (the graph of ``tests/house/test_house.py``, lazy imports included):
   a module importing a package that contains it;
 * **arrows that run back up**: every import of a module in a higher layer of the layer table
   of ``docs/architecture.md`` (``tests/test_house.layer_violations``: file, line, both layers);
@@ -25,7 +25,7 @@ main branch before a change; the layer table is always this tree's ``docs/archit
   (``==``, ``!=``, ``in``, ``not in``, ``is``, ``is not``) with a verdict word as a string
   literal on either side or inside a literal tuple, list or set; a ``case "certified":``; a call
   of ``equal``, ``not_equal`` or ``isin`` with such a literal argument;
-* the modules over 500 lines, each with its job where ``tests/test_house.py`` lists one;
+* the modules over 500 lines, each with its job where ``tests/house/test_house.py`` lists one;
 * the test files: flat (``tests/test_*.py``) and in folders (``tests/**/test_*.py``).
 
 Run: ``python analysis/house_figures.py [--tree PATH] [--json]`` (``--json``: one
@@ -41,7 +41,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(HERE / "tests"))
+sys.path.insert(0, str(HERE / "tests" / "house"))
 
 import test_house as H  # noqa: E402
 

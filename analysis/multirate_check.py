@@ -27,7 +27,7 @@ loops the truth finds string stable (sup ≤ 1 + 10⁻⁹) that the certificate 
     python analysis/multirate_check.py --groups 100 --per-group 100 --seed 0
 
 (10,000 random cases; N ∈ {1, 2, 5, 10, 20}, H ∈ {0.01, 0.02, 0.05, 0.1} s, δ a whole or a
-fractional number of steps.)  ``tests/test_multirate_check.py`` runs a small seeded version.
+fractional number of steps.)  ``tests/certify/test_multirate_check.py`` runs a small seeded version.
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ peak is 1 ± 10^u, u uniform in [−9, −3]).  Conservatism: the inconclusive s
 finds stable with a peak ≤ 1.
 
 Prints a table and the machine load; asserts nothing (the test
-``tests/test_platoon_certify.py`` runs a small seeded version and asserts 0 unsound).
+``tests/certify/test_platoon_certify.py`` runs a small seeded version and asserts 0 unsound).
 
 Example::
 

@@ -42,7 +42,7 @@ small positive k_x, k_v, where certified gains exist).
     python analysis/reaction_check.py --n 100000 --seed 0        # the closing figures
     python analysis/reaction_check.py --n 2000                   # a quick look
 
-``tests/test_reaction_check.py`` runs a seeded few hundred cases of the same code.
+``tests/certify/test_reaction_check.py`` runs a seeded few hundred cases of the same code.
 
 References
 ----------

@@ -8,7 +8,7 @@ heterogeneous lags and gains, speed and acceleration limits, a collision, the CA
 time-varying and mixed controllers, batches and ``record=False``) the SHA-256 of every array of
 the :class:`~stringstab.traffic.PlatoonResult` (its bytes as little-endian float64 / int64 /
 bool), the sum of each array (to see how far a failing run is off), ``params`` and the IDL
-metrics as JSON text.  ``tests/test_simulate_reference.py`` recomputes them with no new option,
+metrics as JSON text.  ``tests/traffic/test_simulate_reference.py`` recomputes them with no new option,
 with ``reaction_delay=0`` and with the radio at one message per step, no loss and no noise.
 Re-running it on a later commit would overwrite the reference with that commit's outputs, so it
 refuses to unless ``--force`` is given.

@@ -3,7 +3,7 @@
 Run once, at commit f6db69e of ``main`` (before the reaction delay θ_r existed), to write
 ``tests/data/theta_zero_f6db69e/``: the columns of ``certify_batch``, the verdicts of ``check``
 and the rows of ``certify`` on a seeded set of gain triples at four (τ, δ, T*), and the files
-``stringstab certify --file`` writes in each text format.  ``tests/test_reaction_zero.py``
+``stringstab certify --file`` writes in each text format.  ``tests/certify/test_reaction_zero.py``
 compares today's outputs with them, bit for bit, with and without ``reaction_delay=0.0``.
 Re-running it on a later commit would overwrite the reference with that commit's outputs, so it
 refuses to unless ``--force`` is given.

@@ -1,7 +1,7 @@
 """The command-line reference (``docs/cli.md``), generated from the argparse parsers.
 
 A script beside the pages (not part of the package): ``python docs/gen_cli.py > docs/cli.md``
-regenerates the page, and a test (tests/test_docs_site.py) checks that the page is current.  Each command's description and every argument
+regenerates the page, and a test (tests/docs/test_docs_site.py) checks that the page is current.  Each command's description and every argument
 (flags, value, default, help) are read from the parser the ``stringstab`` command itself uses,
 so the page cannot drift from the tool; the text does not depend on the Python version or the
 terminal width (argparse's own ``--help`` layout does).

@@ -42,11 +42,11 @@ from .params import DEFAULT_DELTA, DEFAULT_HEADWAY, DEFAULT_TAU, Box, Params
 
 # ``from .certify import certify`` binds the name ``certify`` of this package to the function
 # (the way in), not to the subpackage stringstab.certify of the same name: reach the modules
-# of that subpackage with ``from stringstab.certify import sampled`` (tests/test_house.py
+# of that subpackage with ``from stringstab.certify import sampled`` (tests/house/test_house.py
 # checks that the name stays the function).
 #
 # Importing stringstab (and certifying) loads NumPy only: no SymPy, matplotlib, CasADi,
-# python-control or gymnasium (tests/test_house.py checks it), and the sampled-data and
+# python-control or gymnasium (tests/house/test_house.py checks it), and the sampled-data and
 # robust certificates (stringstab.certify.sampled, stringstab.certify.robust) only when
 # certify, certify_batch or check is asked for a sample time or a parameter interval.  The
 # errata (SymPy, stringstab.derive) are loaded on first use of their names below; the

@@ -16,7 +16,7 @@ box of parameters — and :func:`certified_lattice` applies it to the lattice of
   (of the same loop, far cheaper than the robust one) picks the rows the robust certificate
   decides.  That step is sound only as far as the point certificate is never inconclusive
   where the robust one (with its looser bounds) certifies: not proven, never observed
-  (``tests/test_certify_grid.py`` compares with the robust certificate on every row);
+  (``tests/certify/test_certify_grid.py`` compares with the robust certificate on every row);
 * the sampled-data loop: its own sound screen (:class:`stringstab.certify.screen.SampledScreen`:
   g_H below its threshold at a fixed frequency, |H| > 1 there) drops rows, then its certificate
   decides the rest (the continuous screen says nothing about it), after the continuous
@@ -25,7 +25,7 @@ box of parameters — and :func:`certified_lattice` applies it to the lattice of
 
 The region map (:func:`stringstab.regions.region_map`) reports every point's verdict,
 sup |Γ| and margin rather than the certified points, so it runs the full certificate;
-``tests/test_certify_grid.py`` checks that it certifies exactly the points this helper returns.
+``tests/certify/test_certify_grid.py`` checks that it certifies exactly the points this helper returns.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ The generated functions use only ``+ - * /``, ``abs`` and the ``cos``/``sin`` th
 are handed (NumPy's by default), so the *same* code evaluates NumPy arrays
 (vectorised), Python floats (pass ``math.cos, math.sin``: the scalar form of the
 inner loops) and CasADi symbols (pass ``casadi.cos, casadi.sin``: the projection
-NLP).  ``tests/test_margin.py`` checks that the committed file equals a fresh
+NLP).  ``tests/derive/test_margin.py`` checks that the committed file equals a fresh
 generation and that every generated form agrees with the SymPy derivation.
 
 References
@@ -57,7 +57,7 @@ _HEADER = '''\
 """Numeric code generated from the symbolic derivation: DO NOT EDIT.
 
 Written by ``python -m stringstab.derive.codegen`` from :mod:`stringstab.derive.symbolic` (and the
-printed Ψ of :mod:`stringstab.derive.printed`); ``tests/test_margin.py`` checks that this file
+printed Ψ of :mod:`stringstab.derive.printed`); ``tests/derive/test_margin.py`` checks that this file
 equals a fresh generation and agrees with SymPy.  Only arithmetic, ``abs`` and the
 ``cos``/``sin`` passed in are used, so every function evaluates NumPy arrays (the
 default), Python floats (``cos=math.cos, sin=math.sin``) and CasADi symbols

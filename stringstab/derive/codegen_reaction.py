@@ -4,7 +4,7 @@
 θ_r formulas (:mod:`stringstab.derive.reaction`) come from :func:`reaction_blocks`, which it
 calls with its own source printer.  The same rules hold: plain arithmetic, ``abs`` and the
 ``cos``/``sin`` handed in, so the numeric certificate (:mod:`stringstab.certify.quasipolynomial`,
-:mod:`stringstab.certify.margin_reaction`) never imports SymPy, and ``tests/test_margin.py``
+:mod:`stringstab.certify.margin_reaction`) never imports SymPy, and ``tests/derive/test_margin.py``
 checks the committed file against a fresh generation.
 
 References

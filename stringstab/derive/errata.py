@@ -235,7 +235,7 @@ def _proposition1_row(params: dict[str, float]) -> Erratum:
     # impact: verdict disagreement between printed logic on printed Ψ and corrected logic
     # on derived Ψ, on the grid: the two conditions above, evaluated by NumPy on the Ψ of
     # the generated code (the Taylor verdicts of stringstab.certify.criteria, from the same
-    # expressions: tests/test_errata.py checks they agree)
+    # expressions: tests/derive/test_errata.py checks they agree)
     printed_logic, derived_logic = (
         sp.lambdify([p1, p2, p3, lam], c, modules="numpy") for c in (printed_c, derived_c))
     kx, kv, ka = _grid()

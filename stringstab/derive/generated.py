@@ -1,7 +1,7 @@
 """Numeric code generated from the symbolic derivation: DO NOT EDIT.
 
 Written by ``python -m stringstab.derive.codegen`` from :mod:`stringstab.derive.symbolic` (and the
-printed Ψ of :mod:`stringstab.derive.printed`); ``tests/test_margin.py`` checks that this file
+printed Ψ of :mod:`stringstab.derive.printed`); ``tests/derive/test_margin.py`` checks that this file
 equals a fresh generation and agrees with SymPy.  Only arithmetic, ``abs`` and the
 ``cos``/``sin`` passed in are used, so every function evaluates NumPy arrays (the
 default), Python floats (``cos=math.cos, sin=math.sin``) and CasADi symbols

@@ -23,7 +23,7 @@ Nothing here is typed in: :func:`gamma_reaction` closes the loop of the state-sp
 (e^{−θ_r s} ≈ 1 − θ_r s, or Padé(1,1)) would make of internal stability: a cubic or quartic
 Hurwitz test, which is *not* a certificate (the quasi-polynomial has infinitely many roots).
 At θ_r = 0 every expression reduces to the one of :mod:`stringstab.derive.symbolic`
-(``tests/test_reaction_derive.py``).
+(``tests/derive/test_reaction_derive.py``).
 
 The symbol θ_r is ``reaction_delay`` (θ alone is the sampled certificate's normalised frequency
 ωH; docs/conventions.md).

@@ -28,7 +28,7 @@ Chosen (Tables I-III lost)
       (:mod:`stringstab.hcfs.cacc`): with T = 0.2 s this is a = 0.5 e_x + 2 e_v + 0.25 e_x0 +
       1.0 e_v0 (s⁻², s⁻¹); the discrete closed loop of 8 followers has spectral radius 0.947
       (internally stable), and on the bundled cycles the spacing errors shrink along the
-      platoon (tested in ``tests/test_hcfs_model.py``).
+      platoon (tested in ``tests/hcfs/test_hcfs_model.py``).
     * ``LENGTH`` = 5 m (the toolkit's vehicle length) and ``SPACING`` h = 5 m: eq 1's "vehicle
       length L plus safe space headway h" is a constant-spacing policy; with leader information
       (eq 11's k3, k4 terms) constant spacing can be string stable.

@@ -24,12 +24,12 @@ with A(h), b(h) the step above over a duration h; commands before t_0 are the in
 acceleration a_0 (the car was holding it).  The loop is then of order q + 4; it is computed in
 two filter passes: the commands u_k = K x_k + w_k through the closed loop's characteristic
 polynomial D(z) = z^{q+1} det(zI − A) − K adj(zI − A)(z Γ_0 + Γ_1), then the states through
-the open-loop lag and integrators.  ``tests/test_identify_delay.py`` checks it against a direct
+the open-loop lag and integrators.  ``tests/identify/test_identify_delay.py`` checks it against a direct
 time-stepping of the model (matrix exponentials over each sub-step).  Without the simulator's limits this is a linear time-invariant
 system x_{k+1} = F x_k + b w_k + e_1 d_k in the state x = (s, v, a), with
 w_k = k_v v_{p,k} − k_x l_0 + k_a a_p(t_k − δ); its response is computed with
 :func:`scipy.signal.lfilter` (compiled) instead of a Python loop over samples, which makes it
-cheap enough for the inner loop of a least-squares fit.  ``tests/test_identify.py`` checks it
+cheap enough for the inner loop of a least-squares fit.  ``tests/identify/test_identify.py`` checks it
 against :func:`stringstab.traffic.simulate` on the same predecessor.
 """
 

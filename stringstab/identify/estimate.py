@@ -66,7 +66,7 @@ PROFILE_GRID = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
 DELAY_GRID = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.5)
 #: Widening (s) of the spacing policy's T* interval on each side when it constrains the fit: the
 #: quasi-steady stretches still carry small transients, which bias the straight line by a few
-#: thousandths of a second on noise-free simulated logs (tests/test_identify_cars.py) — a bias
+#: thousandths of a second on noise-free simulated logs (tests/identify/test_identify_cars.py) — a bias
 #: the bootstrap does not see, and which, forced on the fit, moves τ and θ_r along their ridge.
 SPACING_MARGIN = 0.1
 #: Parameters with bootstrap intervals.

@@ -1,0 +1,163 @@
+"""The reaction delay θ_r on `stringstab region` (issue 25 part 2): one θ_r, θ_r as a map axis.
+
+Independent truths: the map with ``--reaction-delay 0`` against the map of the command without
+the flag (bit for bit); the per-θ_r shares of a sweep against separate single-θ_r maps; the
+certified points of a θ_r map against a fine frequency sweep of |Γ(jω)| written here from the
+model of issue 25 (complex arithmetic, not the generated code).
+"""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+import stringstab as ss
+from stringstab.certify.verdicts import codes
+from stringstab.cli import main
+from stringstab.regions import load_npz, reaction_sweep, region_map
+from stringstab.regions.reaction_sweep import parse_reaction_delays
+
+P = {"tau": 0.1, "delta": 0.2, "headway": 1.1}
+BASE = ["region", "--fix", "k_a=0.5", "--n", "7", "--format", "png", "--dpi", "20",
+        "--no-progress"]
+
+
+def gamma_abs(omega, kx, kv, ka, *, tau, delta, headway, theta):
+    """|Γ(jω)| of issue 25's model, from its transfer function in complex arithmetic."""
+    s = 1j * np.asarray(omega)
+    num = np.exp(-theta * s) * (kx + kv * s + ka * s**2 * np.exp(-delta * s))
+    den = tau * s**3 + s**2 + np.exp(-theta * s) * ((kx * headway + kv) * s + kx)
+    return np.abs(num / den)
+
+
+def _files(out):
+    return {p.name: p for p in out.iterdir()}
+
+
+@pytest.mark.slow  # 20.3 s alone at load ≈ 24 on 2 shared cores (two CLI runs with figures)
+def test_reaction_delay_zero_writes_what_the_command_without_it_writes(tmp_path, capsys):
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert main([*BASE, "--out", str(a)]) == 0
+    out_a = capsys.readouterr().out
+    assert main([*BASE, "--reaction-delay", "0", "--out", str(b)]) == 0
+    out_b = capsys.readouterr().out
+    assert out_a.replace(str(a), "DIR") == out_b.replace(str(b), "DIR")
+    fa, fb = _files(a), _files(b)
+    assert set(fa) == set(fb)
+    assert fa["region.csv"].read_bytes() == fb["region.csv"].read_bytes()
+    ma, mb = load_npz(fa["region.npz"]), load_npz(fb["region.npz"])
+    assert ma.metadata() == mb.metadata() and "reaction_delay" not in ma.metadata()["params"]
+    for k, v in ma.fields().items():
+        assert np.array_equal(v, mb.fields()[k], equal_nan=True), k
+
+
+def test_one_reaction_delay_maps_the_certificate_with_it(tmp_path, capsys):
+    out = tmp_path / "m"
+    assert main([*BASE, "--reaction-delay", "0.2", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    head = text.splitlines()[0]
+    assert head.endswith("τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, θ_r = 0.2 s"), head
+    m = load_npz(out / "region.npz")
+    assert m.metadata()["params"] == {**P, "reaction_delay": 0.2}
+    assert m.methods == ("exact",) and m.type is None
+    kx, kv, ka = (g.ravel() for g in m.gains())
+    ref = ss.certify_batch(kx, kv, ka, **P, reaction_delay=0.2)
+    assert np.array_equal(m.verdict["exact"].ravel(), codes(ref.verdict))
+    zero = ss.certify_batch(kx, kv, ka, **P)
+    assert (zero.verdict == "certified").sum() > (ref.verdict == "certified").sum()
+    # independent: every certified point has |Γ(jω)| ≤ 1 on a fine sweep (closed form)
+    w = np.linspace(1e-4, 30.0, 30_001)
+    for i in np.flatnonzero(ref.verdict == "certified"):
+        peak = gamma_abs(w, kx[i], kv[i], ka[i], **P, theta=0.2).max()
+        assert peak <= 1.0 + 1e-9, (kx[i], kv[i], ka[i], peak)
+    for i in np.flatnonzero((ref.verdict == "not_certified") & ref.stable):
+        peak = gamma_abs(w, kx[i], kv[i], ka[i], **P, theta=0.2).max()
+        assert peak > 1.0, (kx[i], kv[i], ka[i], peak)  # the certificate's witness is real
+    assert {"region_class_exact.png", "region_sup_gain.png", "region.csv"} <= set(_files(out))
+
+
+def test_parse_reaction_delays():
+    np.testing.assert_allclose(parse_reaction_delays("0:0.3:7"), np.linspace(0, 0.3, 7),
+                               rtol=0, atol=1e-12)
+    assert parse_reaction_delays("0:0.3:4").tolist() == parse_reaction_delays("0,0.1,0.2,0.3").tolist()
+    assert parse_reaction_delays("0.1,0.2").tolist() == [0.1, 0.2]
+    assert parse_reaction_delays("0.2") is None and parse_reaction_delays("0.1:0.3") is None
+
+
+# the IDL grid case: an 11³ sub-lattice of the 81³ grid of docs/theory.md over [−2, 2]³
+IDL_AXES = {g: np.linspace(-2.0, 2.0, 11) for g in ("k_x", "k_v", "k_a")}
+THETAS = [0.0, 0.1, 0.2, 0.3]
+
+
+def test_sweep_shares_equal_single_maps_and_do_not_increase_on_the_idl_grid():
+    s = reaction_sweep(IDL_AXES, reaction_delays=THETAS, **P, workers=1, progress=False)
+    shares = s.certified_shares()
+    for th, share, m in zip(THETAS, shares, s.maps):
+        single = region_map(IDL_AXES, **P, methods="exact", reaction_delay=th, workers=1,
+                            progress=False)
+        assert np.array_equal(single.verdict["exact"], m.verdict["exact"])
+        assert share == single.verdict_shares()["exact"]["certified"]
+    assert shares[0] > 0.05  # a region to lose (≈ 9 % on the 81³ grid)
+    assert np.all(np.diff(shares) <= 0), shares  # non-increasing on this grid
+    assert np.all(np.diff(shares) < 0), shares  # ... and strictly here
+    # nested, too: no triple certified at a larger θ_r that was not at the smaller one
+    for a, b in zip(s.maps, s.maps[1:]):
+        assert not np.any(b.stable("exact") & ~a.stable("exact"))
+
+
+@pytest.mark.slow  # 17.5 s alone at load ≈ 24 on 2 shared cores (two CLI runs with figures)
+def test_cli_sweep_writes_slices_table_and_figure(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    assert main([*BASE, "--reaction-delay", "0:0.2:3", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    files = _files(out)
+    for th in ("0", "0.1", "0.2"):
+        assert f"region_theta_r_{th}.npz" in files and f"region_theta_r_{th}_class_exact.png" in files
+    assert "region_share_vs_theta_r.png" in files and "report.md" in files
+    with open(files["region_share_vs_theta_r.csv"], newline="") as fh:
+        rows = list(csv.DictReader(r for r in fh if not r.startswith("#")))
+    assert [float(r["reaction_delay"]) for r in rows] == [0.0, 0.1, 0.2]
+    axes = {"k_x": np.linspace(-2, 2, 7), "k_v": np.linspace(-2, 2, 7)}
+    for r in rows:
+        th = float(r["reaction_delay"])
+        single = region_map(axes, {"k_a": 0.5}, **P, methods="exact", reaction_delay=th,
+                            workers=1, progress=False)
+        assert float(r["certified_share"]) == single.verdict_shares()["exact"]["certified"]
+        assert int(r["certified"]) == int(single.stable("exact").sum())
+        m = load_npz(files[f"region_theta_r_{th:g}.npz"])
+        assert np.array_equal(m.verdict["exact"], single.verdict["exact"])
+        assert m.metadata()["params"] == ({**P, "reaction_delay": th} if th else P)
+    assert "certified share vs θ_r:" in text
+
+
+@pytest.mark.parametrize(
+    "argv,match",
+    [
+        (["--reaction-delay", "-0.1"], "reaction delay θ_r"),
+        (["--reaction-delay", "nan"], "reaction delay θ_r"),
+        (["--reaction-delay", "101"], "reaction"),
+        (["--reaction-delay", "0.2", "--sample-time", "0.1"],
+         "reaction_delay > 0 with a sample time is certified"),
+        # a box with θ_r (--tau 0.1:0.2 with θ_r, --reaction-delay 0.1:0.3) is mapped by the
+        # θ_r box certificate: tests/certify/test_robust_reaction.py
+        (["--reaction-delay", "0,0.2", "--sample-time", "0.1"],
+         "reaction_delay > 0 with a sample time is certified"),
+        (["--reaction-delay", "0,0.2", "--delta", "0.1:0.2"], "needs one τ, δ, T*"),
+        (["--reaction-delay", "0,-0.2"], "reaction delay θ_r"),
+        (["--reaction-delay", "0.2,0.1"], "strictly increasing"),
+        (["--reaction-delay", "0:0.3:1"], "N >= 2"),
+        (["--reaction-delay", "0:0.3:x"], "count N"),
+        (["--reaction-delay", "0.2", "--method", "taylor"], "without reaction delay"),
+        (["--reaction-delay", "0,0.2", "--method", "exact,taylor"], "evaluates 'exact'"),
+        (["--reaction-delay", "0.2", "--overlay", "x.csv"], "--overlay"),
+    ],
+)
+def test_bad_reaction_delay_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, argv, match):
+    out = tmp_path / "maps"
+    assert main([*BASE, *argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stringstab region: error:") and match in err, err
+    assert err.count("\n") == 1
+    assert not out.exists()
