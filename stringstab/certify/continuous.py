@@ -77,6 +77,7 @@ from .verdicts import (
     BatchResult,
     Check,
     SingleResult,
+    Verdict,
     chunks,
     names,
     num,
@@ -350,7 +351,7 @@ class CertificateBatch(BatchResult):
     def _excess(self) -> Array:
         if self.sup_gain_excess is not None:
             return self.sup_gain_excess
-        return np.where(np.asarray(self.verdict) == "certified", 0.0, self.sup_gain - 1.0)
+        return np.where(np.asarray(self.verdict) == Verdict.CERTIFIED, 0.0, self.sup_gain - 1.0)
 
     # -- result rendering: the rows, columns and totals every output format is written from --
 

@@ -350,7 +350,9 @@ def _run_identified(args: argparse.Namespace, out: Any, H: float | None, theta: 
         table.insert(8, TableColumn("θ_r[s]", "reaction_delay", "%s"))
         for r in records:
             r.setdefault("reaction_delay", "0")
-    n_ok = sum(r["verdict"] == "certified" for r in records)
+    from ..certify.verdicts import Verdict
+
+    n_ok = sum(r["verdict"] == Verdict.CERTIFIED for r in records)
     write_results(columns_from_records(records), out, args.format,
                   params={"from": args.from_identify, "sample_time": H},
                   summary={"n": len(records), "certified": n_ok}, table=table, what="--out")

@@ -152,7 +152,7 @@ class Estimate:
     def certified_share(self) -> float:
         """Share of bootstrap fits certified (NaN without bootstrap)."""
         n = len(self.boot_verdicts)
-        return sum(v == "certified" for v in self.boot_verdicts) / n if n else math.nan
+        return sum(v == Verdict.CERTIFIED for v in self.boot_verdicts) / n if n else math.nan
 
     @property
     def verdict(self) -> Verdict:
@@ -199,7 +199,7 @@ class Estimate:
             "sup_gain": float(c.sup_gain), "peak_omega": float(c.peak_omega),
             "verdict": c.verdict, "statement": self.statement(),
             "certified_share": self.certified_share, "n_bootstrap": n,
-            "not_certified_share": (sum(v == "not_certified" for v in self.boot_verdicts) / n) if n else math.nan,
+            "not_certified_share": (sum(v == Verdict.NOT_CERTIFIED for v in self.boot_verdicts) / n) if n else math.nan,
             "box_verdict": None if self.box is None else self.box.verdict,
             "empirical_gain": e.gain, "empirical_omega": e.gain_omega,
             "empirical_gain_error": 2 * e.gain_error * e.gain, "data_amplifies": e.amplifies,
@@ -532,7 +532,7 @@ def _disagreement(v: Estimate) -> list[str]:
     """
     e = v.empirical
     sup = float(v.certificate.sup_gain)
-    model_amplifies = v.certificate.verdict == "not_certified"
+    model_amplifies = v.certificate.verdict == Verdict.NOT_CERTIFIED
     shown = f"max |Ĝ| = {e.gain:.3g} ± {2 * e.gain_error * e.gain:.2g} at {e.gain_omega:.3g} rad/s"
     if not math.isfinite(e.gain):
         return ["the measured transfer has no frequency with coherence >= 0.5 below 1 rad/s: the "

@@ -91,7 +91,7 @@ def statement(point_verdict: str, boot: Sequence[str], at_bound: Sequence[str] =
                  "inconclusive": "inconclusive"}[str(point_verdict)]
         text = f"{words} at the point estimate (no bootstrap: no uncertainty measured)"
     else:
-        c = sum(str(v) == "certified" for v in boot)
+        c = sum(str(v) == Verdict.CERTIFIED for v in boot)
         v = supported_verdict(point_verdict, boot)
         if v is Verdict.CERTIFIED:
             text = f"string stable in {n} of {n} bootstrap fits"
@@ -130,7 +130,7 @@ def model_only(verdict: str, peak_omega: float, lowest_resolved: float) -> str:
     >>> model_only("not_certified", 0.05, 0.12)
     'model-only: the peak at 0.05 rad/s is below the lowest frequency the log resolves, 0.12 rad/s'
     """
-    if (str(verdict) == "not_certified" and math.isfinite(peak_omega) and math.isfinite(lowest_resolved)
+    if (str(verdict) == Verdict.NOT_CERTIFIED and math.isfinite(peak_omega) and math.isfinite(lowest_resolved)
             and 0 < peak_omega < lowest_resolved):
         return (f"model-only: the peak at {peak_omega:.3g} rad/s is below the lowest frequency the "
                 f"log resolves, {lowest_resolved:.3g} rad/s")

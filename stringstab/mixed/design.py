@@ -42,6 +42,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify.head_to_tail import Vehicle
+from ..certify.verdicts import Verdict
 from .attenuation import (
     attenuation_margin,
     cav_forms,
@@ -482,7 +483,7 @@ def design_auto(vehicles: Sequence[Vehicle], spec: CavSpec | None = None, *, max
             best = max(found, key=lambda d: d.margin)
             return replace(best, tried=tried,
                            note=best.note + f"; the fewest CAVs that certify: {k} "
-                           f"({sum(1 for t in tried if t['verdict'] == 'certified')} of "
+                           f"({sum(1 for t in tried if t['verdict'] == Verdict.CERTIFIED)} of "
                            f"{len(tried)} sets tried certify)")
     assert best_fail is not None
     return replace(best_fail, tried=tried,

@@ -303,7 +303,7 @@ class RegionMap:
         for m in self.methods:
             counts = np.bincount(self.verdict[m].ravel(), minlength=3)
             out[m] = {lab: float(c) / self.size for lab, c in zip(VERDICT_LABELS[m], counts)
-                      if m in _CERTIFICATES or lab != "inconclusive"}
+                      if m in _CERTIFICATES or lab != Verdict.INCONCLUSIVE}
         return out
 
     def disagreements(self) -> dict[str, int]:

@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..certify.verdicts import Verdict
 from ..ranges import metric_caveat
 from .render import Report
 
@@ -125,7 +126,7 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
     if cert:
         theta = f", reaction delay θ_r = {cert['reaction_delay']:g} s" if cert.get("reaction_delay") else ""
         sec.verdict(f"K = ({cert['k_x']:g}, {cert['k_v']:g}, {cert['k_a']:g}) certified string "
-                    f"stable (exact delay{theta})", cert["verdict"] == "certified",
+                    f"stable (exact delay{theta})", cert["verdict"] == Verdict.CERTIFIED,
                     f"{cert['verdict']}; sup|Γ| = {cert['sup_gain']:.4g}"
                     + (f"; scope: {cert['scope']}" if cert.get("scope") else ""))
     else:
@@ -308,7 +309,7 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
         r = v.row()
         sv = r["supported_verdict"]  # yes/no only where every bootstrap fit agrees (issue 28)
         sec.verdict(f"{v.position} {v.name}: fitted gains certified string stable (exact delay)",
-                    None if sv == "inconclusive" else sv == "certified",
+                    None if sv == Verdict.INCONCLUSIVE else sv == Verdict.CERTIFIED,
                     f"{v.statement()}; the point fit: {r['verdict']}, sup|Γ| = {r['sup_gain']:.4g}")
     rows = []
     for v in res.vehicles:
@@ -381,7 +382,7 @@ def cars_report(res: Any, files: Sequence[Any], *, command: str, started: float 
     for c in res.cars:
         r = c.row()
         sec.verdict(f"{c.car} ({c.setting}, {len(c.logs)} log{'s' if len(c.logs) != 1 else ''}): string "
-                    "stable (exact delay)", None if r["verdict"] == "inconclusive" else r["verdict"] == "certified",
+                    "stable (exact delay)", None if r["verdict"] == Verdict.INCONCLUSIVE else r["verdict"] == Verdict.CERTIFIED,
                     f"{c.statement()}; sup|Γ| = {r['sup_gain']:.4g}"
                     + ("" if not all(math.isfinite(x) for x in r["sup_gain_interval"])
                        else f" ({r['sup_gain_interval'][0]:.3g}-{r['sup_gain_interval'][1]:.3g})"))

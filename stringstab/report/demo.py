@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..certify.verdicts import Verdict
 from ..ranges import metric_caveat
 from .maths import inline_tex
 from .render import Report, Section
@@ -93,7 +94,7 @@ def _certify(rep: Report, s: Mapping[str, Any]) -> None:
     rows = []
     misled = 0
     for t in s.get("triples", []):
-        exact = t["verdict"] == "certified"
+        exact = t["verdict"] == Verdict.CERTIFIED
         printed = t["taylor_printed"] == "stable"
         misled += printed and not exact
         rows.append({"K = (k_x, k_v, k_a)": _k(t["K"]), "exact verdict": t["verdict"],

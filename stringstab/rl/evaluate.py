@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..certify.verdicts import Verdict
 from ..constants import STANDSTILL, TTC_STAR
 from ..errors import StringStabError
 from ..traffic.metrics import (
@@ -129,7 +130,7 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         uniq, inverse = np.unique(K[rows], axis=0, return_inverse=True)
         cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
                            headway=headway, sample_time=float(h))
-        ok_s[rows] = np.asarray(cs.verdict == "certified")[np.ravel(inverse)]
+        ok_s[rows] = np.asarray(cs.verdict == Verdict.CERTIFIED)[np.ravel(inverse)]
     return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
             "m_fss_sampled": float(ok_s.mean()), "n": int(K.shape[0]),
             "certificate": "exact (continuous time); sampled-data (ZOH) at dt beside it",

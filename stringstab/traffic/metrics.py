@@ -55,6 +55,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import constants
+from ..certify.verdicts import Verdict
 from ..errors import StringStabError
 from ..params import positive
 
@@ -411,7 +412,7 @@ def fss_ratio(k_x: ArrayLike, k_v: ArrayLike, k_a: ArrayLike, *, tau: float, del
     uniq, inverse = np.unique(K, axis=0, return_inverse=True)
     cert = certify_batch(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway,
                          reaction_delay=reaction_delay)
-    ok = np.asarray(cert.verdict == "certified")[np.ravel(inverse)]
+    ok = np.asarray(cert.verdict == Verdict.CERTIFIED)[np.ravel(inverse)]
     return float(ok.mean())
 
 

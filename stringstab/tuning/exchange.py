@@ -22,6 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify import margin as _margin
+from ..certify.verdicts import Verdict
 from ..params import Params
 from .constraints import Member, Slot, evaluate_forms
 from .nlp import SLOT_SIZES
@@ -78,7 +79,7 @@ def exchange(
         if not np.all(np.isfinite(x)):
             break
         outcome = step(x)
-        if outcome == "certified":
+        if outcome == Verdict.CERTIFIED:
             return x, x, n_solves, iters, statuses
         if outcome == "stuck":
             break

@@ -19,6 +19,7 @@ import numpy.typing as npt
 
 from ..certify import margin as _margin
 from ..certify.criteria import HURWITZ_LABELS, hurwitz_gradients
+from ..certify.verdicts import Verdict
 from ..params import Params
 from .inputs import GAIN_NAMES
 
@@ -283,7 +284,7 @@ def predict(k0: Array, pred: list[float], omegas: list[float], *, params: Params
         nxt = most_violated(x, om_arr)
         if nxt is None:
             verdict, hz, wit = check(x)
-            if verdict == "certified":
+            if verdict == Verdict.CERTIFIED:
                 return x, [c[3] if c[0] == "lin" else "psi3 >= eps" if c[0] == "g0" else
                            f"g >= eps at the dip omega = {c[1]!r}" for c in cons]
             if not hz:

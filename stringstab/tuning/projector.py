@@ -23,6 +23,7 @@ from ..certify.api import certify, check
 from ..certify.grid import certified_lattice
 from ..certify.screen import surely_uncertifiable
 from ..certify.screen import violating_dips as screen_dips
+from ..certify.verdicts import Verdict
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Box, Params, parameter_model, positive
@@ -265,7 +266,7 @@ class Projector:
         bad, dips = _surely_uncertifiable(k0, p)
         if not bad:
             verdict0, hz0, wit0 = self._check(k0)
-            if verdict0 == "certified":
+            if verdict0 == Verdict.CERTIFIED:
                 self._remember(key, k0, use_state)
                 return make_result(method, k0, k0, CERTIFIED_BY_CHECK, "unchanged", w, 0, t0,
                                "already certified by the exact certificate; returned unchanged")
@@ -323,7 +324,7 @@ class Projector:
             # frequency (|Γ| > 1 there) and the violating dips of a cheap scan are added
             nonlocal omegas
             verdict, hz, wit = self._check(x)
-            if verdict == "certified":
+            if verdict == Verdict.CERTIFIED:
                 return "certified"
             new = [wit] if hz and wit > 0 else []
             new += violating_dips(x, p, threshold=0.0)[1]
@@ -341,7 +342,7 @@ class Projector:
         fallback = False
         if im >= 0 and (best is None or float(wdist(best, k0, w)) > float(dm[im])):
             # the nearest certified map point is nearer (or the exchange failed): use it
-            if self._check(M[im])[0] == "certified":
+            if self._check(M[im])[0] == Verdict.CERTIFIED:
                 best = M[im].copy()
                 fallback = True
                 self.stats["fallbacks"] += 1
@@ -407,7 +408,7 @@ class Projector:
         """
         method, w = "projection", self.weights
         verdict0, _, wit0 = loop.check(k0)
-        if verdict0 == "certified":
+        if verdict0 == Verdict.CERTIFIED:
             self._remember(key, k0, use_state)
             return make_result(method, k0, k0, CERTIFIED_BY_CHECK, "unchanged", w, 0, t0,
                                f"already certified for the {self._loop_name()} loop; returned unchanged")
@@ -429,7 +430,7 @@ class Projector:
         def step(x: Array) -> str:
             nonlocal slots, eps
             verdict, stable, wits = loop.check(x)
-            if verdict == "certified":
+            if verdict == Verdict.CERTIFIED:
                 return "certified"
             new: list[Slot] = []
             for m, f in wits:
@@ -442,7 +443,7 @@ class Projector:
                 # the worst member of a box is usually a corner: the frequency there too
                 new += [loop.margin_slot(c, f) for c in loop.extreme_members()]
             grown = dedupe_slots([*slots, *new])
-            if verdict == "inconclusive" and stable and eps < _EPS_MAX:
+            if verdict == Verdict.INCONCLUSIVE and stable and eps < _EPS_MAX:
                 # a margin too thin for the certificate to decide (a near-tangency): widen it
                 eps = min(10.0 * eps, _EPS_MAX)
             elif len(grown) == len(slots):
