@@ -3,11 +3,11 @@
 Same run, same machine load, arms of the IDL trainer for ``--steps`` environment steps: no
 repair (the ablation, the baseline of the ratio); the default repair (certified lookup
 projection, continuous and sampled-data certificates); the same with the sampled-data check as
-it was before the point-path fix of issue 11 phase 2 ("before": the lag primitives of ``check_sampled`` built as
+it was before the point-path fix of issue 11 phase 2 ("before": the lag primitives of the sampled ``check`` built as
 zero-width intervals, reproduced here by forcing the interval path of the first two
 ``phi_interval`` calls of each build, :mod:`stringstab.certify.zoh`); the continuous certificate alone (``repair_sampled=False``);
 and the exact projection (:class:`stringstab.tuning.Projector`) for a shorter stretch.  Also
-``check_sampled`` per call on 8 triples (one control step of 8 environments), before and after.
+the sampled ``check`` per call on 8 triples (one control step of 8 environments), before and after.
 Also the repair's per-triple latency against :func:`stringstab.tuning.project` on the same
 uncertified proposals, and how much farther from the proposal the lookup lands than the exact
 projection.  Ratios are what count: the 2 cores are shared.
@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from stringstab.certify import sampled, zoh
+from stringstab.certify import zoh
+from stringstab.certify.api import check
 from stringstab.rl import config_for, train
 from stringstab.rl.repair import GainRepair
 from stringstab.tuning import project
@@ -50,7 +51,7 @@ def arm(name: str, steps: int, **kw: object) -> dict[str, float]:
 
 @contextlib.contextmanager
 def sampled_before() -> Iterator[None]:
-    """``check_sampled`` as before the point-path fix: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
+    """The sampled ``check`` as before the point-path fix: φ1, ψ2, ψ3 of τ and τ_p as zero-width intervals."""
     prim, phi = zoh.primitives, zoh.phi_interval
     left = [0]
 
@@ -72,13 +73,13 @@ def sampled_before() -> Iterator[None]:
 
 
 def per_call(n_calls: int = 200) -> float:
-    """Seconds per ``check_sampled`` call on 8 triples near the certified set."""
+    """Seconds per sampled ``check`` call on 8 triples near the certified set."""
     rng = np.random.default_rng(0)
     K = np.array([1.14, 1.03, 0.02]) + rng.normal(0.0, 0.05, (8, 3))
-    sampled.check_sampled(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    check(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     t0 = time.perf_counter()
     for _ in range(n_calls):
-        sampled.check_sampled(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+        check(*K.T, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     return (time.perf_counter() - t0) / n_calls
 
 
@@ -90,7 +91,7 @@ def main() -> None:
     with sampled_before():
         before_call = per_call()
     after_call = per_call()
-    print(f"check_sampled, 8 triples: before {1e3 * before_call:.2f} ms, after "
+    print(f"check (sampled), 8 triples: before {1e3 * before_call:.2f} ms, after "
           f"{1e3 * after_call:.2f} ms per call, ratio {before_call / after_call:.1f}x "
           f"(load {os.getloadavg()[0]:.2f})")
     # the certified lattice is built once per process (lru_cache) by the first arm that repairs;

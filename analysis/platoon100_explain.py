@@ -27,7 +27,6 @@ import time
 import numpy as np
 
 from stringstab.certify.api import check
-from stringstab.certify.sampled import check_sampled
 from stringstab.constants import DELTA, HEADWAY, STANDSTILL, TAU
 from stringstab.rl import load_policy
 from stringstab.rl.evaluate import controller_for
@@ -84,8 +83,8 @@ def main() -> None:
                 Km = np.median(G, axis=0)
                 dK = np.abs(np.diff(np.asarray(res.gains), axis=-2)).sum(-1)  # type: ignore[attr-defined]
                 v = [np.ravel(check(*Km, tau=TAU, delta=DELTA, headway=HEADWAY).verdict)[0],
-                     np.ravel(check_sampled(*Km, tau=TAU, delta=DELTA, headway=HEADWAY,
-                                            sample_time=0.1).verdict)[0]]
+                     np.ravel(check(*Km, tau=TAU, delta=DELTA, headway=HEADWAY,
+                                    sample_time=0.1).verdict)[0]]
                 print(f"  median executed K = {np.round(Km, 3).tolist()} ({v[0]}, sampled {v[1]}); "
                       f"mean Σ|ΔK| per step {dK.mean():.4f}")
             t0 = time.perf_counter()

@@ -462,8 +462,8 @@ def certify_batch(
 
     With point parameters and no sample time this is the continuous-time certificate of
     stringstab.certify.continuous; ``sample_time`` certifies the sampled-data loop
-    (:func:`stringstab.certify.sampled.certify_sampled_batch`) and any interval the whole box
-    (:func:`stringstab.certify.robust.certify_robust_batch`), with the same three verdicts.
+    (:func:`stringstab.certify.sampled.certify_kernel`) and any interval the whole box
+    (:func:`stringstab.certify.robust.certify_kernel`), with the same three verdicts.
 
     Parameters
     ----------

@@ -8,8 +8,8 @@ function depends only on its own τ, δ, T* (and, sampled, its predecessor's lag
 certificate over the box covers a heterogeneous platoon whose vehicles each lie in it:
 every |Γ_i(jω)| ≤ 1, so the product along the platoon is ≤ 1 too.
 
-This module is the way in (:func:`certify_robust_batch`, :func:`certify_robust`,
-:func:`check_robust`) and the result types; the certificates themselves are
+This module holds the kernel the way in calls (:func:`certify_kernel`, through
+:mod:`stringstab.certify.api`) and the result types; the certificates themselves are
 :mod:`stringstab.certify.robust_continuous` (the exact minimum of g over the box at each ω,
 :func:`robust_margin`) and :mod:`stringstab.certify.robust_sampled` (bisection of cells of
 parameters, in the interval arithmetic of :mod:`stringstab.certify.interval`); a box with a
@@ -38,8 +38,7 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..io import TableColumn
-from ..params import Box, as_gains, check_box
-from ..params import sample_time as _sample_time
+from ..params import Box
 from .robust_continuous import certify_box_continuous
 from .verdicts import (
     ROW_COLUMNS,
@@ -48,7 +47,6 @@ from .verdicts import (
     SingleResult,
     chunks,
     names,
-    one_triple,
 )
 
 __all__ = [
@@ -58,10 +56,7 @@ __all__ = [
     "RobustReactionCertificate",
     "RobustReactionCertificateBatch",
     "certify_kernel",
-    "certify_robust",
-    "certify_robust_batch",
     "check_of",
-    "check_robust",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -189,7 +184,8 @@ class RobustCertificateBatch(BatchResult):
 
         Examples
         --------
-        >>> b = certify_robust_batch([1.2], [0.5], [0.6], tau=(0.1, 0.3), delta=0.2, headway=1.1)
+        >>> from stringstab.certify.api import certify_batch
+        >>> b = certify_batch([1.2], [0.5], [0.6], tau=(0.1, 0.3), delta=0.2, headway=1.1)
         >>> c = b.columns()
         >>> c["verdict"].tolist(), c["box"]["tau_hi"].tolist(), c["sample_time"].tolist()
         (['certified'], [0.3], [nan])
@@ -268,23 +264,26 @@ class RobustReactionCertificateBatch(RobustCertificateBatch):
 RobustReactionCertificate.BATCH = RobustReactionCertificateBatch
 
 
-def certify_robust_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: Any, delta: Any, headway: Any, sample_time: float | None = None,
-    heterogeneous: bool = True, chunk: int = 4096, n_grid: int | None = None,
-    max_rounds: int = 30, max_intervals: int = 1024, max_splits: int = 48,
-    max_cells: int = 4096, progress: bool = False,
+def certify_kernel(
+    kx: Array, kv: Array, ka: Array, box: Box, H: float | None, *, heterogeneous: bool = True,
+    chunk: int = 4096, n_grid: int | None = None, max_rounds: int = 30,
+    max_intervals: int = 1024, max_splits: int = 48, max_cells: int = 4096,
+    progress: bool = False,
 ) -> RobustCertificateBatch:
     """Certify gain triples for every τ, δ, T* in a box (module docstring).
 
+    Inputs already checked by :func:`stringstab.certify.api.certify_batch` or
+    :meth:`stringstab.certify.api.Loop.certify_batch` (the way in): nothing is validated
+    again here.
+
     Parameters
     ----------
-    k_x, k_v, k_a : array_like
-        Gains, broadcast together and flattened.
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        The box; a plain number is a point interval.  τ_lo > 0, δ_lo ≥ 0, T*_lo ≥ 0.
-    sample_time : float, optional
-        H > 0 for the sampled-data loop; None (default) for continuous time.
+    kx, kv, ka : ndarray of float64
+        The gains, finite, one-dimensional, of one length.
+    box : Box
+        The box of τ, δ, T* (checked on construction).
+    H : float or None
+        Sampling period H > 0 (s), or None for continuous time.
     heterogeneous : bool
         Sampled only: let the predecessor's lag range over the τ box independently of the
         follower's (a platoon of different vehicles); False ties it to τ.
@@ -298,55 +297,6 @@ def certify_robust_batch(
         before the triple is inconclusive.
     progress : bool
         Show a tqdm progress bar over chunks.
-
-    Returns
-    -------
-    RobustCertificateBatch
-
-    Raises
-    ------
-    StringStabError
-        On a malformed box (lo > hi, a negative end, τ reaching 0), a sample time that is
-        not a finite number > 0, or non-finite gains.
-
-    Examples
-    --------
-    >>> b = certify_robust_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3),
-    ...                          delta="0.1:0.3", headway=1.1)
-    >>> b.verdict.tolist()
-    ['certified', 'not_certified']
-    >>> bool(b[1].sup_gain > 1), b[1].witness_tau >= 0.1
-    (True, True)
-    """
-    box = check_box(tau, delta, headway)
-    H = None if sample_time is None else _sample_time(sample_time)
-    kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
-    return certify_kernel(kx, kv, ka, box, H, heterogeneous=heterogeneous, chunk=chunk,
-                          n_grid=n_grid, max_rounds=max_rounds, max_intervals=max_intervals,
-                          max_splits=max_splits, max_cells=max_cells, progress=progress)
-
-
-def certify_kernel(
-    kx: Array, kv: Array, ka: Array, box: Box, H: float | None, *, heterogeneous: bool = True,
-    chunk: int = 4096, n_grid: int | None = None, max_rounds: int = 30,
-    max_intervals: int = 1024, max_splits: int = 48, max_cells: int = 4096,
-    progress: bool = False,
-) -> RobustCertificateBatch:
-    """The robust certificates of many triples: the kernel of :func:`certify_robust_batch`.
-
-    Inputs already checked by :func:`stringstab.certify.certify_batch` (the way in) or
-    :func:`certify_robust_batch`: nothing is validated again here.
-
-    Parameters
-    ----------
-    kx, kv, ka : ndarray of float64
-        The gains, finite, one-dimensional, of one length.
-    box : Box
-        The box of τ, δ, T* (checked on construction).
-    H : float or None
-        Sampling period H > 0 (s), or None for continuous time.
-    heterogeneous, chunk, n_grid, max_rounds, max_intervals, max_splits, max_cells, progress
-        As for :func:`certify_robust_batch`.
 
     Returns
     -------
@@ -402,97 +352,8 @@ def certify_kernel(
     return RobustCertificateBatch(**fields)
 
 
-def certify_robust(
-    k_x: float, k_v: float, k_a: float, *, tau: Any, delta: Any, headway: Any,
-    sample_time: float | None = None, heterogeneous: bool = True,
-) -> RobustCertificate:
-    """Certify one gain triple over a parameter box (see :func:`certify_robust_batch`).
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : float
-        One gain triple of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless).
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        The box of actuator lag τ, delay δ and desired headway T*, s; a plain number is a
-        point interval.  τ_lo > 0, δ_lo ≥ 0, T*_lo ≥ 0.
-    sample_time : float, optional
-        H > 0, s, for the sampled-data loop; None (default) for continuous time.
-    heterogeneous : bool
-        Sampled only: let the predecessor's lag range over the τ box independently of the
-        follower's; False ties it to τ.
-
-    Returns
-    -------
-    RobustCertificate
-
-    Raises
-    ------
-    StringStabError
-        On a malformed box, a bad sample time or gains, or arrays instead of one triple.
-
-    Examples
-    --------
-    >>> c = certify_robust(1.2, 0.5, 0.6, tau="0.1:0.2", delta="0.15:0.25", headway=1.1,
-    ...                    sample_time=0.1)
-    >>> c.verdict
-    'certified'
-    """
-    one_triple("certify_robust", "certify_robust_batch", k_x=k_x, k_v=k_v, k_a=k_a)
-    return certify_robust_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
-                                sample_time=sample_time, heterogeneous=heterogeneous)[0]
-
-
-def check_robust(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike, *, tau: Any, delta: Any,
-    headway: Any, sample_time: float | None = None, heterogeneous: bool = True,
-    n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
-) -> Check:
-    """The robust certificate's verdicts and witnesses, as a :class:`~stringstab.certify.verdicts.Check`.
-
-    The decision of :func:`certify_robust_batch`; ``hurwitz`` is stability of every member,
-    and the witness member (τ, τ_prev, δ, T*) and frequency (ω, and θ when sampled) of each
-    triple are those of the batch.
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : array_like
-        Gains of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless), broadcast together.
-    tau, delta, headway : float, (lo, hi) or "LO:HI"
-        The box of actuator lag τ, delay δ and desired headway T*, s; a plain number is a
-        point interval.
-    sample_time : float, optional
-        H > 0, s, for the sampled-data loop; None (default) for continuous time.
-    heterogeneous : bool
-        Sampled only: the predecessor's lag ranges over the τ box independently of the
-        follower's; False ties it to τ.
-    n_grid, max_rounds, max_intervals : int
-        Branch-and-bound budgets, as for :func:`certify_robust_batch`.
-
-    Returns
-    -------
-    Check
-        Verdict, stability, margin and witness (member and frequency) of each triple.
-
-    Raises
-    ------
-    StringStabError
-        On a malformed box, a bad sample time or bad gains.
-
-    Examples
-    --------
-    >>> c = check_robust([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=(0.1, 0.3), delta=0.2,
-    ...                  headway=1.1)
-    >>> c.verdict.tolist(), bool(0.1 <= c.witness_tau[1] <= 0.3)
-    (['certified', 'not_certified'], True)
-    """
-    b = certify_robust_batch(k_x, k_v, k_a, tau=tau, delta=delta, headway=headway,
-                             sample_time=sample_time, heterogeneous=heterogeneous, n_grid=n_grid,
-                             max_rounds=max_rounds, max_intervals=max_intervals)
-    return check_of(b)
-
-
 def check_of(b: RobustCertificateBatch) -> Check:
-    """The verdict-only answer of a robust batch (what :func:`check_robust` returns).
+    """The verdict-only answer of a robust batch (what :func:`stringstab.certify.api.check` returns).
 
     Parameters
     ----------

@@ -55,7 +55,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..io import TableColumn
-from ..params import Box, Params, as_gains
+from ..params import Box, Params
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes
 from .excess import EXCESS_SEARCH, searched_excess
 from .sampled_excess import peak_gain, violation_peak
@@ -71,9 +71,8 @@ from .verdicts import (
     SingleResult,
     chunks,
     names,
-    one_triple,
 )
-from .zoh import Coefficients, coefficients, loop_parameters, point_coefficients, split_delay
+from .zoh import Coefficients, coefficients, point_coefficients, split_delay
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -81,11 +80,8 @@ __all__ = [
     "SampledCertificateBatch",
     "SampledCheck",
     "certify_kernel",
-    "certify_sampled",
-    "certify_sampled_batch",
     "check_kernel",
     "check_members",
-    "check_sampled",
 ]
 
 Array = npt.NDArray[np.float64]
@@ -121,7 +117,7 @@ def _bnb_points(
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SampledCheck(Check):
-    """The verdicts of the sampled certificate alone (see :func:`check_sampled`).
+    """The verdicts of the sampled certificate alone (:func:`stringstab.certify.api.check`).
 
     A :class:`~stringstab.certify.verdicts.Check` whose ``hurwitz`` is Schur stability of
     Δ(z), with ``sample_time`` and ``witness_theta`` filled.
@@ -146,67 +142,22 @@ class SampledCheck(Check):
         return self.hurwitz
 
 
-def _prepare(k_x: Any, k_v: Any, k_a: Any, tau: Any, delta: Any, headway: Any,
-             sample_time: Any, tau_prev: Any) -> tuple[Array, Array, Array, Params, float, float]:
-    """The gains flattened and the loop's parameters, validated."""
-    p, H, tp = loop_parameters(tau, delta, headway, sample_time, tau_prev)
-    kx, kv, ka = (np.ascontiguousarray(v, dtype=float).ravel() for v in as_gains(k_x, k_v, k_a))
-    return kx, kv, ka, p, H, tp
-
-
 def _default_grid(m: int) -> int:
     """Initial intervals on [0, π]: more for a longer delay (cos mθ oscillates m/2 times)."""
     return 64 + 8 * m
-
-
-def check_sampled(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: float, delta: float, headway: float, sample_time: float,
-    tau_prev: float | None = None, n_grid: int | None = None, max_rounds: int = 30,
-    max_intervals: int = 1024,
-) -> SampledCheck:
-    """The sampled certificate's verdicts alone, for inner loops.
-
-    The same sound decision as :func:`certify_sampled_batch` without the peak search and
-    the spectral radii.
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : array_like
-        Gains, broadcast together and flattened.
-    tau, delta, headway : float
-        Lag τ > 0, delay δ ≥ 0 (any real), headway T* ≥ 0 (seconds).
-    sample_time : float
-        Sampling period H > 0, s.
-    tau_prev : float, optional
-        The predecessor's lag (default τ).
-    n_grid, max_rounds, max_intervals : int
-        Initial intervals on [0, π] (default 64 + 8m), refinement rounds, and the cap on
-        undecided intervals per triple beyond which it is inconclusive.
-
-    Returns
-    -------
-    SampledCheck
-
-    Examples
-    --------
-    >>> check_sampled([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2, headway=1.1,
-    ...               sample_time=0.1).verdict.tolist()
-    ['certified', 'not_certified']
-    """
-    kx, kv, ka, p, H, tp = _prepare(k_x, k_v, k_a, tau, delta, headway, sample_time, tau_prev)
-    return check_kernel(kx, kv, ka, p, H, tp, n_grid=n_grid, max_rounds=max_rounds,
-                        max_intervals=max_intervals)
 
 
 def check_kernel(
     kx: Array, kv: Array, ka: Array, p: Params, H: float, tp: float, *,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
 ) -> SampledCheck:
-    """The sampled verdicts alone: the kernel of :func:`check_sampled`.
+    """The sampled verdicts alone, for inner loops.
 
-    Inputs already checked by :func:`stringstab.certify.check` (the way in) or
-    :func:`check_sampled`: nothing is validated again here.
+    The same sound decision as :func:`certify_kernel` without the peak search and the
+    spectral radii.
+
+    Inputs already checked by :func:`stringstab.certify.api.check` or
+    :meth:`stringstab.certify.api.Loop.check` (the way in): nothing is validated again here.
 
     Parameters
     ----------
@@ -219,7 +170,8 @@ def check_kernel(
     tp : float
         The predecessor's lag τ_p > 0, s.
     n_grid, max_rounds, max_intervals : int
-        As for :func:`check_sampled`.
+        Initial intervals on [0, π] (default 64 + 8m), refinement rounds, and the cap on
+        undecided intervals per triple beyond which it is inconclusive.
 
     Returns
     -------
@@ -239,8 +191,8 @@ def check_members(kx: Array, kv: Array, ka: Array, *, tau: Array, tau_prev: Arra
                   headway: Array, H: float) -> tuple[npt.NDArray[np.int8], Array, Array]:
     """The point certificate of :func:`check_kernel` at one member (τ, τ_p, δ, T*) per row.
 
-    Row i is decided exactly as ``check_sampled(kx[i], kv[i], ka[i], tau=tau[i],
-    delta=delta[i], headway=headway[i], sample_time=H, tau_prev=tau_prev[i])`` decides it
+    Row i is decided exactly as ``check(kx[i], kv[i], ka[i], tau=tau[i], delta=delta[i],
+    headway=headway[i], sample_time=H, tau_prev=tau_prev[i])`` (the way in) decides it
     (the same coefficients, Schur test and branch and bound, grouped by m = ⌊δ/H⌋): what a
     box's members say of themselves (:mod:`stringstab.certify.robust_sampled`).
 
@@ -407,8 +359,9 @@ class SampledCertificateBatch(BatchResult):
 
         Examples
         --------
-        >>> b = certify_sampled_batch([1.2], [0.5], [0.6], tau=0.1, delta=0.2, headway=1.1,
-        ...                           sample_time=0.1)
+        >>> from stringstab.certify.api import certify_batch
+        >>> b = certify_batch([1.2], [0.5], [0.6], tau=0.1, delta=0.2, headway=1.1,
+        ...                   sample_time=0.1)
         >>> c = b.columns()
         >>> c["verdict"].tolist(), c["sample_time"].tolist(), c["box"]["delta_hi"].tolist()
         (['certified'], [0.1], [0.2])
@@ -433,62 +386,16 @@ class SampledCertificateBatch(BatchResult):
 SampledCertificate.BATCH = SampledCertificateBatch
 
 
-def certify_sampled_batch(
-    k_x: npt.ArrayLike, k_v: npt.ArrayLike, k_a: npt.ArrayLike,
-    *, tau: float, delta: float, headway: float, sample_time: float,
-    tau_prev: float | None = None, chunk: int = 4096, n_grid: int | None = None,
-    max_rounds: int = 30, max_intervals: int = 1024, progress: bool = False,
-) -> SampledCertificateBatch:
-    """Certify many gain triples for the sampled-data loop (sound; module docstring).
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : array_like
-        Gains, broadcast together and flattened.
-    tau, delta, headway : float
-        Lag τ > 0, delay δ ≥ 0 (any real, exact between samples), headway T* ≥ 0 (s).
-    sample_time : float
-        Sampling period H > 0 of every vehicle, s.
-    tau_prev : float, optional
-        The predecessor's lag (default τ, a homogeneous platoon).
-    chunk : int
-        Triples per vectorised chunk.
-    n_grid, max_rounds, max_intervals : int
-        See :func:`check_sampled`.
-    progress : bool
-        Show a tqdm progress bar over chunks.
-
-    Returns
-    -------
-    SampledCertificateBatch
-
-    Raises
-    ------
-    StringStabError
-        On non-finite gains, parameters out of range, or a sample time that is not a
-        finite number > 0.
-
-    Examples
-    --------
-    >>> b = certify_sampled_batch([1.2, 0.9], [0.5, -0.5], [0.6, 1.1], tau=0.1, delta=0.2,
-    ...                           headway=1.1, sample_time=0.1)
-    >>> b.verdict.tolist(), np.round(b.sup_gain, 4).tolist()
-    (['certified', 'not_certified'], [1.0, 1.0911])
-    """
-    kx, kv, ka, p, H, tp = _prepare(k_x, k_v, k_a, tau, delta, headway, sample_time, tau_prev)
-    return certify_kernel(kx, kv, ka, p, H, tp, chunk=chunk, n_grid=n_grid,
-                          max_rounds=max_rounds, max_intervals=max_intervals, progress=progress)
-
-
 def certify_kernel(
     kx: Array, kv: Array, ka: Array, p: Params, H: float, tp: float, *, chunk: int = 4096,
     n_grid: int | None = None, max_rounds: int = 30, max_intervals: int = 1024,
     progress: bool = False,
 ) -> SampledCertificateBatch:
-    """The sampled-data certificates of many triples: the kernel of :func:`certify_sampled_batch`.
+    """The sampled-data certificates of many triples (sound; module docstring).
 
-    Inputs already checked by :func:`stringstab.certify.certify_batch` (the way in) or
-    :func:`certify_sampled_batch`: nothing is validated again here.
+    Inputs already checked by :func:`stringstab.certify.api.certify_batch` or
+    :meth:`stringstab.certify.api.Loop.certify_batch` (the way in): nothing is validated
+    again here.
 
     Parameters
     ----------
@@ -500,8 +407,12 @@ def certify_kernel(
         Sampling period H > 0, s.
     tp : float
         The predecessor's lag τ_p > 0, s.
-    chunk, n_grid, max_rounds, max_intervals, progress
-        As for :func:`certify_sampled_batch`.
+    chunk : int
+        Triples per vectorised chunk.
+    n_grid, max_rounds, max_intervals : int
+        As for :func:`check_kernel`.
+    progress : bool
+        Show a tqdm progress bar over chunks.
 
     Returns
     -------
@@ -553,44 +464,3 @@ def certify_kernel(
         peak_theta=peak, peak_omega=peak / H, margin=margin, n_evals=n_evals,
         sup_gain_excess=excess,
     )
-
-
-def certify_sampled(
-    k_x: float, k_v: float, k_a: float, *, tau: float, delta: float, headway: float,
-    sample_time: float, tau_prev: float | None = None,
-) -> SampledCertificate:
-    """Certify one gain triple for the sampled-data loop (see :func:`certify_sampled_batch`).
-
-    Parameters
-    ----------
-    k_x, k_v, k_a : float
-        One gain triple of IDL eq 4 (k_x in 1/s², k_v in 1/s, k_a dimensionless).
-    tau : float
-        Actuator lag τ > 0, s.
-    delta : float
-        Communication delay δ ≥ 0, s.
-    headway : float
-        Desired time headway T* ≥ 0, s.
-    sample_time : float
-        Sampling period H > 0 of every vehicle, s.
-    tau_prev : float, optional
-        The predecessor's lag, s (default τ, a homogeneous platoon).
-
-    Returns
-    -------
-    SampledCertificate
-
-    Raises
-    ------
-    StringStabError
-        On bad parameters or gains, or arrays instead of one triple.
-
-    Examples
-    --------
-    >>> c = certify_sampled(1.2, 0.5, 0.6, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
-    >>> c.verdict, c.sup_gain, c.schur
-    ('certified', 1.0, True)
-    """
-    one_triple("certify_sampled", "certify_sampled_batch", k_x=k_x, k_v=k_v, k_a=k_a)
-    return certify_sampled_batch([k_x], [k_v], [k_a], tau=tau, delta=delta, headway=headway,
-                                 sample_time=sample_time, tau_prev=tau_prev)[0]

@@ -85,7 +85,6 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
     import numpy as np
 
     from ..certify.api import certify_batch
-    from ..certify.continuous import TABLE_COLUMNS
     from ..io import GainTable, parse_triple, read_gains, write_results
 
     params = {**PARAMS, "method": "exact"}
@@ -99,7 +98,7 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
         for fmt in ("json", "table") if name == "triples" else ("json", "csv", "table"):
             fname = f"{name}.{'txt' if fmt == 'table' else fmt}"
             write_results(columns, out / fname, fmt, params=params, summary=b.summary(),
-                          table=TABLE_COLUMNS)
+                          table=b.table_columns())
             files.append(fname)
     triples = batches["triples"]
     for i in range(len(triples)):
@@ -148,8 +147,8 @@ def _step_simulate(out: Path, log: Log, limits: Any = None) -> dict[str, Any]:
         result = simulate(leader, controller, 10, tau=TAU, delta=DELTA, limits=limits)
         doc = run_document(result, leader=leader, controller=controller, spec="mix",
                            warnings=warnings)
-        label = ("K = (1.2, 0.5, 0.6), certified" if name == "certified"
-                 else "CACC (gains not of the eq-4 form)")
+        label = ("CACC (gains not of the eq-4 form)" if name == "cacc"
+                 else "K = (1.2, 0.5, 0.6), certified")
         files = write_run(result, out / name, metrics=doc, title=f"{leader.name}: 10 followers, {label}")
         cert = doc["certificate"] or {}
         m_p = ", ".join("n/a" if v is None else f"{v:.2f}" for v in doc["m_p"])

@@ -98,7 +98,7 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         certificate (IDL eqs 27-28 without the ×100 %, :func:`stringstab.traffic.metrics.fss_ratio`);
         ``"m_fss_sampled"``: the fraction certified by the
         sampled-data certificate of the zero-order-hold loop at each triple's own ``dt``
-        (:func:`stringstab.certify.sampled.check_sampled`); ``"n"``: the number of triples;
+        (:func:`stringstab.certify.api.check`); ``"n"``: the number of triples;
         ``"certificate"``, ``"dt"``: what was checked (the step, or the sorted list of steps).
 
     Raises
@@ -106,7 +106,7 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     StringStabError
         If there is no gain triple, or ``dt`` is an array of another length.
     """
-    from ..certify.sampled import check_sampled
+    from ..certify.api import check
 
     K = np.asarray(gains, dtype=np.float64).reshape(-1, 3)
     if not K.shape[0]:
@@ -128,8 +128,8 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
     for h in np.unique(steps):  # each triple at the step it ran at
         rows = np.flatnonzero(steps == h)
         uniq, inverse = np.unique(K[rows], axis=0, return_inverse=True)
-        cs = check_sampled(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta,
-                           headway=headway, sample_time=float(h))
+        cs = check(uniq[:, 0], uniq[:, 1], uniq[:, 2], tau=tau, delta=delta, headway=headway,
+                   sample_time=float(h))
         ok_s[rows] = np.asarray(cs.verdict == Verdict.CERTIFIED)[np.ravel(inverse)]
     return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway),
             "m_fss_sampled": float(ok_s.mean()), "n": int(K.shape[0]),

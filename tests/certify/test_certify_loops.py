@@ -13,21 +13,12 @@ import pytest
 from numpy.testing import assert_allclose
 
 import stringstab
-from stringstab.certify.api import certify, certify_batch, check
+from stringstab.certify import robust, sampled
+from stringstab.certify.api import certify, certify_batch, check, gains
 from stringstab.certify.continuous import Certificate, CertificateBatch
 from stringstab.certify.criteria import psi
-from stringstab.certify.robust import (
-    RobustCertificate,
-    RobustCertificateBatch,
-    certify_robust_batch,
-)
-from stringstab.certify.sampled import (
-    SampledCertificate,
-    SampledCertificateBatch,
-    SampledCheck,
-    certify_sampled_batch,
-    check_sampled,
-)
+from stringstab.certify.robust import RobustCertificate, RobustCertificateBatch
+from stringstab.certify.sampled import SampledCertificate, SampledCertificateBatch, SampledCheck
 from stringstab.certify.verdicts import VERDICTS
 from stringstab.errors import StringStabError
 from stringstab.params import Box, Params, parameter_model
@@ -59,12 +50,12 @@ def test_point_parameters_without_sample_time_are_the_continuous_certificate():
 
 def test_sample_time_dispatches_to_the_sampled_certificate():
     b = certify_batch(*K.T, sample_time=0.1, **P)
-    d = certify_sampled_batch(*K.T, sample_time=0.1, **P)
+    d = sampled.certify_kernel(*gains(*K.T), Params(**P), 0.1, P["tau"])  # the kernel it calls
     assert type(b) is SampledCertificateBatch
     for f in ("verdict", "sup_gain", "peak_theta", "peak_omega", "margin", "schur"):
         assert np.array_equal(getattr(b, f), getattr(d, f)), f
     c = check(*K.T, sample_time=0.1, **P)
-    dc = check_sampled(*K.T, sample_time=0.1, **P)
+    dc = sampled.check_kernel(*gains(*K.T), Params(**P), 0.1, P["tau"])
     assert isinstance(c, SampledCheck) and c.sample_time == 0.1
     assert np.array_equal(c.verdict, b.verdict) and np.array_equal(c.verdict, dc.verdict)
     assert np.array_equal(c.schur, b.schur) and np.array_equal(c.stable, b.stable)
@@ -78,7 +69,7 @@ def test_intervals_dispatch_to_the_robust_certificate(H):
     k = K[:30] if H else K
     box = dict(tau=(0.1, 0.2), delta="0.15:0.25", headway=1.1)
     b = certify_batch(*k.T, sample_time=H, **box)
-    d = certify_robust_batch(*k.T, sample_time=H, **box)
+    d = robust.certify_kernel(*gains(*k.T), parameter_model(**box), H)  # the kernel it calls
     assert type(b) is RobustCertificateBatch and b.box == Box((0.1, 0.2), (0.15, 0.25), (1.1, 1.1))
     assert np.array_equal(b.verdict, d.verdict)
     c = check(*k.T, sample_time=H, **box)

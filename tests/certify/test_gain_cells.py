@@ -10,7 +10,7 @@ import pytest
 
 from stringstab.certify.api import check
 from stringstab.certify.gain_cells import CertifiedCells, continuous_cells, sampled_cells
-from stringstab.certify.sampled import check_members, check_sampled
+from stringstab.certify.sampled import check_members
 from stringstab.certify.screen import SampledScreen
 from stringstab.params import Params
 from stringstab.rl.repair import GainRepair
@@ -87,7 +87,7 @@ def test_cell_of_a_gain_on_a_face_contains_it():
 
 
 def test_sampled_screen_flags_only_gains_the_certificate_rejects():
-    """Sound: a flagged row is never certified by check_sampled (random and near the
+    """Sound: a flagged row is never certified by check with a sample time (random and near the
     boundary); and it flags every Schur-stable row whose violation the certificate finds
     (there are 1,253 here: the screen is not a no-op)."""
     s = SampledScreen(P, 0.1)
@@ -95,7 +95,7 @@ def test_sampled_screen_flags_only_gains_the_certificate_rejects():
     K = np.concatenate([RNG.uniform(-2, 2, (3000, 3)),
                         np.array([1.1, 0.9, 0.3]) + RNG.normal(0, 0.3, (3000, 3))])
     flag = s.surely_uncertifiable(K)
-    c = check_sampled(*K.T, **P.as_dict(), sample_time=0.1)
+    c = check(*K.T, **P.as_dict(), sample_time=0.1)
     assert not np.any(flag & (c.verdict == "certified"))
     violated = (c.verdict == "not_certified") & c.schur
     assert violated.sum() > 1000 and flag[violated].mean() >= 0.95
@@ -107,8 +107,8 @@ def test_check_members_is_the_point_certificate_row_by_row():
     d, h = RNG.uniform(0, 0.5, 40), RNG.uniform(0.5, 2, 40)
     v, g, _ = check_members(*K.T.copy(), tau=tau, tau_prev=tp, delta=d, headway=h, H=0.1)
     for i in range(40):
-        c = check_sampled(*K[i], tau=tau[i], delta=d[i], headway=h[i], sample_time=0.1,
-                          tau_prev=tp[i])
+        c = check(*K[i], tau=tau[i], delta=d[i], headway=h[i], sample_time=0.1,
+                  tau_prev=tp[i])
         assert ["certified", "not_certified", "inconclusive"][v[i]] == c.verdict[0]
         assert g[i] == c.margin[0]
 
@@ -116,7 +116,7 @@ def test_check_members_is_the_point_certificate_row_by_row():
 @pytest.mark.parametrize("sample_time", [0.1, None])
 def test_repair_executes_only_certified_gains(sample_time):
     """Whatever the proposals (uniform, near the boundary), every executed triple is
-    certified by check (and by check_sampled at Δt with the sampled repair)."""
+    certified by check (and by check at Δt with the sampled repair)."""
     rep = GainRepair(tau=0.1, delta=0.2, headway=1.1, resolution=0.25, sample_time=sample_time)
     K = np.concatenate([RNG.uniform(-2, 2, (60, 3)),
                         np.array([1.1, 0.9, 0.3]) + RNG.normal(0, 0.3, (60, 3))])

@@ -14,11 +14,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from stringstab.certify.api import certify, certify_batch
+from stringstab.certify.api import Loop, certify, certify_batch, check
 from stringstab.certify.frequency import margin_g
-from stringstab.certify.robust import certify_robust, certify_robust_batch
 from stringstab.certify.robust_continuous import box_margin, robust_margin
-from stringstab.certify.sampled import certify_sampled, check_sampled
 from stringstab.errors import StringStabError
 from stringstab.params import Box, as_interval, check_box, parse_interval
 from tests._sampled_truth import pair_response, pair_roots
@@ -62,14 +60,14 @@ def test_parse_interval_rejects(text, msg):
 def test_bad_box(kw, msg):
     p = {"tau": 0.1, "delta": 0.2, "headway": 1.1, **kw}
     with pytest.raises(StringStabError, match=msg):
-        certify_robust(1.0, 0.5, 0.2, **p)
+        certify(1.0, 0.5, 0.2, **p)
 
 
 @pytest.mark.parametrize("H", [0.0, -0.1, float("nan"), float("inf")])
 def test_bad_sample_time(H):
     with pytest.raises(StringStabError, match="sample_time"):
-        certify_robust_batch([1.0], [0.5], [0.2], tau=(0.1, 0.2), delta=0.2, headway=1.1,
-                             sample_time=H)
+        certify_batch([1.0], [0.5], [0.2], tau=(0.1, 0.2), delta=0.2, headway=1.1,
+                      sample_time=H)
 
 
 def test_box_helpers():
@@ -108,7 +106,7 @@ def test_continuous_robust_verdict_against_a_dense_grid(box):
     rng = np.random.default_rng(8)
     K = rng.uniform(-2, 2, (150, 3))
     K[:50, 0] = np.abs(K[:50, 0])  # more stable triples
-    b = certify_robust_batch(*K.T, tau=box[0], delta=box[1], headway=box[2])
+    b = Loop(check_box(*box)).certify_batch(*K.T)  # a point box too
     members = list(itertools.product(grid(*box[0], 4), grid(*box[1], 4), grid(*box[2], 3)))
     verdicts = np.array([certify_batch(*K.T, tau=t, delta=d, headway=h).verdict
                          for t, d, h in members])
@@ -134,17 +132,17 @@ def test_continuous_robust_verdict_against_a_dense_grid(box):
 def test_point_box_equals_the_nominal_certificates():
     rng = np.random.default_rng(9)
     K = rng.uniform(-2, 2, (300, 3))
-    r = certify_robust_batch(*K.T, tau=0.1, delta=0.2, headway=1.1)
+    r = Loop(check_box(0.1, 0.2, 1.1)).certify_batch(*K.T)  # the box of one member
     c = certify_batch(*K.T, tau=0.1, delta=0.2, headway=1.1)
     assert r.verdict.tolist() == c.verdict.tolist()
-    rs = certify_robust_batch(*K[:60].T, tau=0.1, delta=0.25, headway=1.1, sample_time=0.1)
-    cs = check_sampled(*K[:60].T, tau=0.1, delta=0.25, headway=1.1, sample_time=0.1)
+    rs = Loop(check_box(0.1, 0.25, 1.1), sample_time=0.1).certify_batch(*K[:60].T)
+    cs = check(*K[:60].T, tau=0.1, delta=0.25, headway=1.1, sample_time=0.1)
     assert rs.verdict.tolist() == cs.verdict.tolist()
 
 
 def test_hurwitz_worst_corner():
     # stable at (τ_lo, h_hi) but not at (τ_hi, h_lo): k_v + (T* − τ) k_x changes sign
-    c = certify_robust(1.0, 0.2, 0.0, tau=(0.1, 0.5), delta=0.2, headway=(0.2, 1.1))
+    c = certify(1.0, 0.2, 0.0, tau=(0.1, 0.5), delta=0.2, headway=(0.2, 1.1))
     assert c.verdict == "not_certified" and not c.stable
     assert (c.witness_tau, c.witness_headway) == (0.5, 0.2)
     assert np.any(np.roots([0.5, 1.0, 0.2 + 0.2 * 1.0, 1.0]).real >= 0)
@@ -161,15 +159,15 @@ def test_sampled_robust_against_a_grid_of_members(heterogeneous):
     """δ ∈ [0.15, 0.25] crosses the multiple 0.2 of H = 0.1: both pieces are covered."""
     box = dict(tau=(0.1, 0.2), delta=(0.15, 0.25), headway=(1.0, 1.2))
     K = np.array(SAMPLED_K)
-    b = certify_robust_batch(*K.T, sample_time=0.1, heterogeneous=heterogeneous, **box)
+    b = certify_batch(*K.T, sample_time=0.1, heterogeneous=heterogeneous, **box)
     taus = grid(0.1, 0.2, 3)
     members = [(t, tp, d, h) for t in taus for tp in (taus if heterogeneous else [None])
                for d in grid(0.15, 0.25, 5) for h in grid(1.0, 1.2, 3)]
     for i, k in enumerate(K):
         if b.verdict[i] == "certified":
             for t, tp, d, h in members:
-                v = check_sampled([k[0]], [k[1]], [k[2]], tau=t, delta=d, headway=h,
-                                  sample_time=0.1, tau_prev=tp).verdict[0]
+                v = check([k[0]], [k[1]], [k[2]], tau=t, delta=d, headway=h,
+                          sample_time=0.1, tau_prev=tp).verdict[0]
                 assert v == "certified", (k, t, tp, d, h)
         elif b.verdict[i] == "not_certified" and b.stable[i]:
             t, tp, d, h = (b.witness_tau[i], b.witness_tau_prev[i], b.witness_delta[i],
@@ -187,8 +185,8 @@ def test_sampled_robust_against_a_grid_of_members(heterogeneous):
 def test_heterogeneous_box_contains_the_homogeneous_one():
     K = np.array(SAMPLED_K)
     box = dict(tau=(0.1, 0.2), delta=0.2, headway=1.1, sample_time=0.1)
-    het = certify_robust_batch(*K.T, heterogeneous=True, **box)
-    hom = certify_robust_batch(*K.T, heterogeneous=False, **box)
+    het = certify_batch(*K.T, heterogeneous=True, **box)
+    hom = certify_batch(*K.T, heterogeneous=False, **box)
     for a, b in zip(het.verdict, hom.verdict):
         if a == "certified":
             assert b != "not_certified"
@@ -201,25 +199,25 @@ def test_sampled_robust_schur_over_the_box():
     kx, kv = 2.0, 0.3
     r = [np.max(np.abs(pair_roots(kx, kv, t, 0.3, 0.1))) for t in (0.1, 0.6)]
     assert r[0] < 1 < r[1]
-    c = certify_robust(kx, kv, 0.0, tau=(0.1, 0.6), delta=0.2, headway=0.3, sample_time=0.1)
+    c = certify(kx, kv, 0.0, tau=(0.1, 0.6), delta=0.2, headway=0.3, sample_time=0.1)
     assert c.verdict == "not_certified" and not c.stable and c.sup_gain == np.inf
     assert np.max(np.abs(pair_roots(kx, kv, c.witness_tau, c.witness_headway, 0.1))) >= 1
-    assert certify_sampled(kx, kv, 0.0, tau=0.1, delta=0.2, headway=0.3, sample_time=0.1).schur
+    assert certify(kx, kv, 0.0, tau=0.1, delta=0.2, headway=0.3, sample_time=0.1).schur
 
 
 def test_records_are_strict_json():
-    b = certify_robust_batch([1.2, 0.0], [0.5, 1.0], [0.6, 0.5], tau=(0.1, 0.2), delta=0.2,
-                             headway=1.1)
+    b = certify_batch([1.2, 0.0], [0.5, 1.0], [0.6, 0.5], tau=(0.1, 0.2), delta=0.2,
+                      headway=1.1)
     rows = json.loads(json.dumps(b.records()))
     assert rows[0]["verdict"] == "certified" and rows[1]["sup_gain"] is None
     assert set(rows[0]["witness"]) == {"tau", "tau_prev", "delta", "headway", "omega", "theta"}
     assert b.summary()["n"] == 2
 
 
-def test_certify_robust_matches_batch_and_nominal():
-    c = certify_robust(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
+def test_the_box_of_one_member_matches_the_nominal_certificate():
+    c = Loop(check_box(0.1, 0.2, 1.1)).certify_batch(0.9, -0.5, 1.1)[0]  # the box of one member
     n = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
     assert c.verdict == n.verdict == "not_certified"
     assert_allclose(c.sup_gain, n.sup_gain, rtol=1e-6)
     with pytest.raises(StringStabError, match="one triple"):
-        certify_robust([1.0, 2.0], 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1)
+        certify([1.0, 2.0], 0.5, 0.2, tau=(0.1, 0.2), delta=0.2, headway=1.1)

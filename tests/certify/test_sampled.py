@@ -17,9 +17,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from stringstab.certify import sampled as sampled_module
-from stringstab.certify.api import certify_batch
+from stringstab.certify.api import certify, certify_batch, check
 from stringstab.certify.frequency import gain, margin_g
-from stringstab.certify.sampled import certify_sampled, certify_sampled_batch, check_sampled
 from stringstab.certify.sampled_frequency import sampled_margin, sampled_response
 from stringstab.certify.schur import schur, spectral_radius
 from stringstab.certify.zoh import split_delay
@@ -49,7 +48,7 @@ def truth(kx, kv, ka, tau, delta, headway, H, tp):
 @example(kx=1.875, kv=-1.875, ka=1.1875, p=(0.05, 0.4, 1.5, 0.05, None))
 def test_verdict_agrees_with_direct_sweep_and_roots(kx, kv, ka, p):
     tau, delta, headway, H, tp = p
-    c = certify_sampled(kx, kv, ka, tau=tau, delta=delta, headway=headway, sample_time=H,
+    c = certify(kx, kv, ka, tau=tau, delta=delta, headway=headway, sample_time=H,
                         tau_prev=tp)
     peak, radius, rel = truth(kx, kv, ka, tau, delta, headway, H, tp)
     if c.verdict == "certified":  # soundness
@@ -100,9 +99,9 @@ def test_check_and_batch_agree_and_do_not_depend_on_chunking():
     K = rng.uniform(-2, 2, (400, 3))
     K[:40, 2] = (2 - K[:40, 0] * 1.1**2 - 2 * K[:40, 1] * 1.1) / 2  # Ψ3 = 0: tangent at θ = 0
     kw = dict(tau=0.1, delta=0.25, headway=1.1, sample_time=0.1)
-    a = certify_sampled_batch(*K.T, **kw)
-    b = certify_sampled_batch(*K.T, chunk=7, **kw)
-    c = check_sampled(*K.T, **kw)
+    a = certify_batch(*K.T, **kw)
+    b = certify_batch(*K.T, chunk=7, **kw)
+    c = check(*K.T, **kw)
     assert a.verdict.tolist() == b.verdict.tolist() == c.verdict.tolist()
     assert_allclose(a.margin, c.margin, rtol=0, atol=0)
     s = a.summary()
@@ -166,7 +165,7 @@ def test_continuous_limit_away_from_the_boundary():
     K = rng.uniform(-2, 2, (600, 3))
     kw = dict(tau=0.1, delta=0.2, headway=1.1)
     c = certify_batch(*K.T, **kw)
-    s = certify_sampled_batch(*K.T, sample_time=0.005, **kw)
+    s = certify_batch(*K.T, sample_time=0.005, **kw)
     W = np.concatenate([np.geomspace(1e-3, 1, 200), np.linspace(1, 80, 3000)])
     G = gain(W[None, :], K[:, :1], K[:, 1:2], K[:, 2:], **kw)
     rel = np.min((1 - G**2) / np.minimum(1, W**2), axis=1)
@@ -201,7 +200,7 @@ def test_no_false_certificate_across_the_psi3_boundary(tau, delta, headway, H):
     eps = np.array([-1e-3, -1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6, 1e-3])
     KX, KV = np.repeat(kx, eps.size), np.repeat(kv, eps.size)
     KA = (ka_star[:, None] + eps[None, :]).ravel()
-    b = certify_sampled_batch(KX, KV, KA, tau=tau, delta=delta, headway=headway, sample_time=H)
+    b = certify_batch(KX, KV, KA, tau=tau, delta=delta, headway=headway, sample_time=H)
     psi3 = KX * (KX * headway**2 + 2 * KV * headway + 2 * KA - 2)
     assert not np.any(b.certified & (psi3 < 0))
     for i in np.flatnonzero(b.certified):
@@ -222,7 +221,7 @@ def test_schur_and_spectral_radius():
     want = [np.max(np.abs(pair_roots(a, b, 0.1, 1.1, 0.1))) for a, b in zip(kx, kv)]
     assert_allclose(r, want, rtol=1e-9)
     assert s.tolist() == [True, False, False, False]
-    c = certify_sampled(0.0, 1.0, 0.5, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    c = certify(0.0, 1.0, 0.5, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     assert c.verdict == "not_certified" and not c.schur and c.as_dict()["sup_gain"] is None
 
 
@@ -253,14 +252,14 @@ def test_no_sympy_on_the_numeric_path():
 def test_bad_input(kwargs, msg):
     p = {"tau": 0.1, "delta": 0.2, "headway": 1.1, "sample_time": 0.1, **kwargs}
     with pytest.raises(StringStabError, match=msg):
-        certify_sampled(1.0, 0.5, 0.2, **p)
+        certify(1.0, 0.5, 0.2, **p)
     with pytest.raises(StringStabError, match=msg):
-        check_sampled([1.0], [0.5], [0.2], **p)
+        check([1.0], [0.5], [0.2], **p)
 
 
 def test_bad_gains():
     with pytest.raises(StringStabError, match="k_a must be finite"):
-        certify_sampled_batch([1.0], [0.5], [np.nan], tau=0.1, delta=0.2, headway=1.1,
+        certify_batch([1.0], [0.5], [np.nan], tau=0.1, delta=0.2, headway=1.1,
                               sample_time=0.1)
     with pytest.raises(StringStabError, match="one triple"):
-        certify_sampled([1.0, 2.0], 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+        certify([1.0, 2.0], 0.5, 0.2, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)

@@ -1,6 +1,6 @@
 """The sampled certificate's point path: point parameters give point coefficients.
 
-``check_sampled`` (the repair's inner loop in :mod:`stringstab.rl.repair`) builds its
+The sampled ``check`` (the repair's inner loop in :mod:`stringstab.rl.repair`) builds its
 coefficients with the interval type of :mod:`stringstab.certify.interval` (:mod:`stringstab.certify.zoh`); with point parameters every
 coefficient must be a point, or each operation pays for interval arithmetic (four products and
 a min/max) on intervals of zero width.  The verdicts of both paths are equal (the interval

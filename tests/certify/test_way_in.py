@@ -18,7 +18,7 @@ import pytest
 import stringstab
 from stringstab import params
 from stringstab.certify import continuous, robust, sampled
-from stringstab.certify.api import Loop
+from stringstab.certify.api import Loop, certify_batch
 from stringstab.certify.verdicts import BatchResult
 from stringstab.cli import main
 from stringstab.errors import StringStabError
@@ -86,27 +86,27 @@ def test_the_command_line_checks_the_sampled_loop_once():
 
 
 def test_the_count_can_fail():
-    # the validating entry point of the sampled module, given the way in's values, checks again
+    # the way in, given the values of a loop it has already checked, checks them again
     def twice():
         loop = Loop.of(**P, sample_time=0.1)
-        sampled.certify_sampled_batch(*K.T, tau=loop.model.tau, delta=loop.model.delta,
-                                      headway=loop.model.headway, sample_time=0.1)
+        certify_batch(*K.T, tau=loop.model.tau, delta=loop.model.delta,
+                      headway=loop.model.headway, sample_time=0.1)
 
     assert _validations(twice)["check_params"] > 1
 
 
-def test_the_kernels_give_the_validating_entry_points_results():
+def test_the_kernels_give_the_way_ins_results():
     kx, kv, ka = (np.ascontiguousarray(c) for c in K.T)
     p = params.Params(**P)
     a = sampled.certify_kernel(kx, kv, ka, p, 0.1, 0.1)
-    b = sampled.certify_sampled_batch(kx, kv, ka, sample_time=0.1, **P)
+    b = certify_batch(kx, kv, ka, sample_time=0.1, **P)
     ca, cb = dict(_flat(a.columns())), dict(_flat(b.columns()))
     assert ca.keys() == cb.keys()
     for k, v in cb.items():
         np.testing.assert_array_equal(ca[k], v, err_msg=k)
     box = params.Box((0.1, 0.2), (0.2, 0.2), (1.1, 1.1))
     r = robust.certify_kernel(kx[:10], kv[:10], ka[:10], box, None)
-    r2 = robust.certify_robust_batch(kx[:10], kv[:10], ka[:10], tau=(0.1, 0.2), delta=0.2, headway=1.1)
+    r2 = certify_batch(kx[:10], kv[:10], ka[:10], tau=(0.1, 0.2), delta=0.2, headway=1.1)
     assert np.array_equal(r.verdict, r2.verdict) and np.array_equal(r.sup_gain, r2.sup_gain)
 
 

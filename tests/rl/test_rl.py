@@ -91,13 +91,13 @@ def test_repair_executes_only_certified_gains(props):
 @settings(max_examples=15, deadline=None)
 @given(st.lists(st.tuples(*(st.floats(-2.0, 2.0),) * 3), min_size=1, max_size=6))
 def test_repair_with_sample_time_certifies_the_sampled_loop_too(props):
-    from stringstab.certify.sampled import check_sampled
+    from stringstab.certify.api import check
 
     rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
                      sample_time=0.1)
     K = rep(np.array(props))
-    v = check_sampled(K[:, 0], K[:, 1], K[:, 2], tau=TAU, delta=DELTA, headway=HEADWAY,
-                      sample_time=0.1).verdict
+    v = check(K[:, 0], K[:, 1], K[:, 2], tau=TAU, delta=DELTA, headway=HEADWAY,
+              sample_time=0.1).verdict
     assert (v == "certified").all()
     for k in K:
         assert independent_certified(k), k
@@ -684,7 +684,7 @@ def test_replay_buffer_batch_larger_than_capacity_keeps_its_newest_transitions()
 
 
 def test_fss_certifies_each_triple_at_the_step_it_ran_at():
-    from stringstab.certify.sampled import check_sampled
+    from stringstab.certify.api import check
     from stringstab.rl.evaluate import fss
 
     rng = np.random.default_rng(3)
@@ -693,7 +693,7 @@ def test_fss_certifies_each_triple_at_the_step_it_ran_at():
     p = dict(tau=0.3, delta=0.2, headway=1.0)
     f = fss(K, **p, dt=steps)
     # the reference: the sampled certificate of each group at its own step, pooled by count
-    want = sum(int(np.sum(check_sampled(*K[steps == h].T, **p, sample_time=h).verdict
+    want = sum(int(np.sum(check(*K[steps == h].T, **p, sample_time=h).verdict
                           == "certified")) for h in (0.1, 0.4)) / 300
     assert f["m_fss_sampled"] == want and f["dt"] == [0.1, 0.4]
     # a scalar step is the same as that step for every row; min(dt) for all would differ here
