@@ -606,7 +606,7 @@ def certify(
     >>> c.verdict, c.sup_gain
     ('certified', 1.0)
     >>> c = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1)
-    >>> c.verdict, c.type, c.taylor_printed["verdict"]
+    >>> c.verdict, c.type, c.taylor_printed["sign"]
     ('not_certified', 'IV', 'stable')
     >>> s = certify(0.9, -0.5, 1.1, tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
     >>> s.verdict, round(s.sup_gain, 4), round(s.peak_omega, 3), round(s.peak_theta, 4)

@@ -229,8 +229,9 @@ class Certificate(SingleResult):
         min_ω g(ω) = min (|D|² − |N|²)/ω² found (≥ 0 iff |Γ| ≤ 1); an upper
         bound on the true minimum.
     taylor_derived, taylor_printed : dict
-        Ψ1, Ψ2, Ψ3, Λ, Proposition-1 verdict and type from the derived and
-        the printed formulas (:func:`stringstab.certify.criteria.taylor_criteria`).
+        Ψ1, Ψ2, Ψ3, Λ, Proposition 1's answer from their signs (``"sign"``: ``"stable"`` /
+        ``"unstable"``, not a verdict) and type from the derived and the printed formulas
+        (:func:`stringstab.certify.criteria.taylor_criteria`).
     method : str
         ``"exact"``.
     omega_max : float
@@ -296,8 +297,8 @@ TABLE_COLUMNS: list[TableColumn] = [
     TableColumn("sup|Γ|-1", "sup_gain_excess", "%.3g", missing="inf"),
     TableColumn("ω_peak[rad/s]", "peak_omega", "%.4g"),
     TableColumn("margin", "margin", "%.3g"),
-    TableColumn("taylor(derived)", "taylor_derived.verdict"),
-    TableColumn("taylor(printed)", "taylor_printed.verdict"),
+    TableColumn("taylor(derived)", "taylor_derived.sign"),
+    TableColumn("taylor(printed)", "taylor_printed.sign"),
     TableColumn("pade", "pade.verdict"),
     TableColumn("pade ‖Γ‖∞", "pade.hinf", "%.6g", missing="inf"),
 ]
@@ -366,7 +367,7 @@ class CertificateBatch(BatchResult):
         --------
         >>> from stringstab import certify_batch
         >>> b = certify_batch([1.5, -0.5], [0.3, 1.0], [-0.1, 1.0], tau=0.1, delta=0.2, headway=1.1)
-        >>> b.columns()["sup_gain"].tolist(), b.columns()["taylor_printed"]["verdict"].tolist()
+        >>> b.columns()["sup_gain"].tolist(), b.columns()["taylor_printed"]["sign"].tolist()
         ([1.0, inf], ['stable', 'unstable'])
         """
         n = len(self)
@@ -396,7 +397,7 @@ def _taylor_columns(tc: TaylorCriteria) -> dict[str, Any]:
     """The columns of :meth:`TaylorCriteria.row`, for every triple at once."""
     names = np.array(["", *(TYPE_NAMES[k] for k in sorted(TYPE_NAMES))])
     return {"psi1": tc.psi1, "psi2": tc.psi2, "psi3": tc.psi3, "lambda": tc.lam,
-            "verdict": np.where(tc.stable, "stable", "unstable"),
+            "sign": np.where(tc.stable, "stable", "unstable"),
             "type": names[np.asarray(tc.type, dtype=np.intp)]}
 
 

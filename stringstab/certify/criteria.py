@@ -394,7 +394,12 @@ def stability_type(psi2: npt.ArrayLike, psi3: npt.ArrayLike, lam: npt.ArrayLike)
 
 @dataclass(frozen=True)
 class TaylorCriteria:
-    """Ψ1, Ψ2, Ψ3, Λ, the Proposition-1 verdict and the type, as arrays."""
+    """Ψ1, Ψ2, Ψ3, Λ, the Proposition-1 sign test's answer and the type, as arrays.
+
+    The answer (``stable``, output key ``"sign"``) of a test on a Taylor approximation of the
+    delay is ``"stable"`` / ``"unstable"``, never a certificate's verdict (IDL Proposition 1:
+    the signs of Ψ1, Ψ2, Ψ3 and Λ).
+    """
 
     source: str
     psi1: Array
@@ -405,7 +410,7 @@ class TaylorCriteria:
     type: npt.NDArray[np.int8]
 
     def row(self, i: Any) -> dict[str, Any]:
-        """The JSON object ``{"psi1","psi2","psi3","lambda","verdict","type"}`` of element i.
+        """The JSON object ``{"psi1","psi2","psi3","lambda","sign","type"}`` of element i.
 
         Parameters
         ----------
@@ -415,15 +420,15 @@ class TaylorCriteria:
         Returns
         -------
         dict
-            Ψ1, Ψ2, Ψ3, Λ as floats, the verdict (``"stable"``/``"unstable"``) and the type
-            (``"I"``-``"IV"``).
+            Ψ1, Ψ2, Ψ3, Λ as floats, Proposition 1's answer from their signs (``"sign"``:
+            ``"stable"``/``"unstable"``, not a verdict) and the type (``"I"``-``"IV"``).
         """
         return {
             "psi1": float(self.psi1[i]),
             "psi2": float(self.psi2[i]),
             "psi3": float(self.psi3[i]),
             "lambda": float(self.lam[i]),
-            "verdict": "stable" if bool(self.stable[i]) else "unstable",
+            "sign": "stable" if bool(self.stable[i]) else "unstable",
             "type": TYPE_NAMES[int(self.type[i])],
         }
 

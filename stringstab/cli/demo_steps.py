@@ -105,7 +105,7 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
         c = triples[i]
         sup = f"{c.sup_gain:.4g}"
         log(f"K=({c.k_x:g}, {c.k_v:g}, {c.k_a:g}): {c.verdict} (sup|Γ| = {sup}); "
-            f"printed Proposition 1: {c.taylor_printed['verdict']}")
+            f"printed Proposition 1: {c.taylor_printed['sign']}")
     roll, g = batches["rollout"], tables["rollout"]
     s = roll.summary()
     first_bad: dict[str, float] = {}
@@ -121,7 +121,7 @@ def _step_certify(out: Path, log: Log) -> dict[str, Any]:
         "triples": [{"K": [float(triples.k_x[i]), float(triples.k_v[i]), float(triples.k_a[i])],
                      "verdict": str(triples.verdict[i]),
                      "sup_gain": float(triples.sup_gain[i]),
-                     "taylor_printed": triples[i].taylor_printed["verdict"]}
+                     "taylor_printed": triples[i].taylor_printed["sign"]}
                     for i in range(len(triples))],
         "rollout": s,
         "rollout_first_uncertified_t": first_bad,

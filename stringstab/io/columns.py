@@ -257,8 +257,8 @@ def flatten_columns(columns: Columns, sep: str = "_") -> dict[str, npt.NDArray[A
 
     Examples
     --------
-    >>> flatten_columns({"k_x": [1.0], "taylor": {"verdict": ["stable"]}})
-    {'k_x': array([1.]), 'taylor_verdict': array(['stable'], dtype='<U6')}
+    >>> flatten_columns({"k_x": [1.0], "taylor": {"sign": ["stable"]}})
+    {'k_x': array([1.]), 'taylor_sign': array(['stable'], dtype='<U6')}
     """
     return {k: leaf.values for k, leaf in flat_leaves(normalise_columns(columns), sep).items()}
 

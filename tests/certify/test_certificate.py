@@ -129,14 +129,14 @@ DISAGREE = [
 def test_printed_and_exact_disagree_both_ways(K, exact, derived, printed):
     c = certify(*K, tau=0.1, delta=0.2, headway=1.1)
     assert c.verdict == exact
-    assert c.taylor_derived["verdict"] == derived
-    assert c.taylor_printed["verdict"] == printed
+    assert c.taylor_derived["sign"] == derived
+    assert c.taylor_printed["sign"] == printed
     # independent truth
     stable = roots_stable(K[0], K[1], 0.1, 1.1)[0]
     peak = sweep_peak(*K, 0.1, 0.2, 1.1)
     assert (stable and peak <= 1 + 1e-9) == (exact == "certified")
     row = c.as_dict()
-    assert set(row["taylor_derived"]) == {"psi1", "psi2", "psi3", "lambda", "verdict", "type"}
+    assert set(row["taylor_derived"]) == {"psi1", "psi2", "psi3", "lambda", "sign", "type"}
 
 
 def test_sup_gain_and_peak_match_sweep_for_uncertified():

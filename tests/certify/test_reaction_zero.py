@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -50,14 +51,16 @@ def test_the_api_is_unchanged_at_reaction_delay_zero(run, extra):
     assert np.all(sure | fail)
     b = ss.certify_batch(*K.T, **p, **extra)
     got = _flat(b.columns())
-    assert set(got) == set(run["batch"])
-    diff = [k for k in run["batch"] if not _same(got[k], run["batch"][k])]
+    ref = {_renamed_key(k): v for k, v in run["batch"].items()}
+    assert set(got) == set(ref)
+    diff = [k for k in ref if not _same(got[k], ref[k])]
     assert diff == []
     c = ss.check(*K.T, **p, **extra)
     assert _same({"verdict": c.verdict.tolist(), "hurwitz": c.hurwitz.tolist(),
                   "margin": c.margin.tolist(), "witness_omega": c.witness_omega.tolist()},
                  run["check"])
-    assert _same([ss.certify(*k, **p, **extra).as_dict() for k in K[:6]], run["certify"])
+    assert _same([ss.certify(*k, **p, **extra).as_dict() for k in K[:6]],
+                 [_renamed_row(r) for r in run["certify"]])
     assert b.summary() == _renamed(run["summary"])
 
 
@@ -72,16 +75,30 @@ def test_the_command_line_files_are_unchanged_at_reaction_delay_zero(fmt, extra)
     assert out.getvalue() == _renamed_text((REF / f"certify.{fmt}").read_text(encoding="utf-8"))
 
 
-# The one deliberate change since f6db69e (issue 30): the summary's share of certified rows is
-# named ``certified_row_share`` (``m_fss`` is the time-weighted eq-27 metric only).  The recorded
-# files keep the old name; it is renamed here, and nothing else is.
+# The deliberate changes since f6db69e: the summary's share of certified rows is named
+# ``certified_row_share`` (issue 30; ``m_fss`` is the time-weighted eq-27 metric only), and the
+# Taylor groups' "stable"/"unstable" answer is keyed ``sign``, no longer ``verdict`` (issue 32,
+# item 4).  The recorded files keep the old names; they are renamed here, and nothing else is.
 def _renamed(summary):
     return {("certified_row_share" if k == "m_fss" else k): v for k, v in summary.items()}
 
 
+def _renamed_key(key):
+    return {"taylor_derived.verdict": "taylor_derived.sign",
+            "taylor_printed.verdict": "taylor_printed.sign"}.get(key, key)
+
+
+def _renamed_row(row):
+    return {k: ({("sign" if g == "verdict" else g): x for g, x in v.items()}
+                if k in ("taylor_derived", "taylor_printed") else v) for k, v in row.items()}
+
+
 def _renamed_text(text):
-    return text.replace('"m_fss":', '"certified_row_share":').replace(", m_fss = ",
+    text = text.replace('"m_fss":', '"certified_row_share":').replace(", m_fss = ",
                                                                        ", certified_row_share = ")
+    for group in ("taylor_derived", "taylor_printed"):
+        text = text.replace(f"{group}_verdict", f"{group}_sign")  # the CSV header
+    return re.sub(r'("lambda": [^,]+, )"verdict": ', r'\1"sign": ', text)  # the JSON groups
 
 
 def test_params_and_boxes_at_zero_print_as_before():

@@ -22,7 +22,7 @@ UNSTABLE = "-0.5,1,1"
 
 RESULT_KEYS = {"k_x", "k_v", "k_a", "hurwitz", "verdict", "type", "sup_gain", "peak_omega",
                "margin", "hurwitz_margin", "taylor_derived", "taylor_printed", "method"}
-TAYLOR_KEYS = {"psi1", "psi2", "psi3", "lambda", "verdict", "type"}
+TAYLOR_KEYS = {"psi1", "psi2", "psi3", "lambda", "sign", "type"}
 SUMMARY_KEYS = {"n", "certified", "not_certified", "inconclusive", "certified_row_share"}
 
 
@@ -144,7 +144,7 @@ def test_exit_1_and_verdicts_against_a_sweep(capsys):
     assert_allclose(bad["peak_omega"], w_peak, atol=1e-3)
     assert bad["margin"] < 0
     # the printed Proposition 1 (IDL eqs 12-15) says stable here: the tool reports both
-    assert bad["taylor_printed"]["verdict"] == "stable"
+    assert bad["taylor_printed"]["sign"] == "stable"
     assert not _sweep((-0.5, 1.0, 1.0))[2]
     assert unstable["verdict"] == "not_certified" and unstable["hurwitz"] is False
     assert unstable["sup_gain"] is None  # ‖Γ‖∞ = ∞ is JSON null
@@ -209,7 +209,7 @@ def test_csv_output_round_trips(capsys, tmp_path):
     assert "2 of 3 certified" in err
     rows = list(csv.DictReader(io.StringIO(out_file.read_text())))
     assert [r["verdict"] for r in rows] == ["certified", "certified", "not_certified"]
-    assert {r["tau"] for r in rows} == {str(TAU)} and rows[2]["taylor_printed_verdict"] == "stable"
+    assert {r["tau"] for r in rows} == {str(TAU)} and rows[2]["taylor_printed_sign"] == "stable"
     back = read_gains(out_file)  # the output is itself a valid gain file
     assert_allclose(back.K, [[1.3, 0, 0.6], [0.45, 0.6, 0.3], [0.9, -0.5, 1.1]], rtol=0, atol=0)
 

@@ -37,7 +37,7 @@ def test_parquet_keeps_types_and_params(tmp_path, capsys):
     assert t.column("verdict").to_pylist() == ["certified", "not_certified", "not_certified"]
     assert t.column("hurwitz").to_pylist() == [True, True, False]
     assert t.column("sup_gain").to_pylist()[2] == float("inf")
-    assert t.column("taylor_printed_verdict").to_pylist()[1] == "stable"
+    assert t.column("taylor_printed_sign").to_pylist()[1] == "stable"
     assert json.loads(t.schema.metadata[b"stringstab.params"])["tau"] == 0.1
     assert json.loads(t.schema.metadata[b"stringstab.summary"])["certified_row_share"] == pytest.approx(1 / 3)
 

@@ -302,9 +302,9 @@ def test_round_trip_every_format(tmp_path_factory, K, with_t, vehicles):
 
 RECORDS = [
     {"t": 0.5, "k_x": 1.0, "k_v": 0.5, "k_a": 0.2, "hurwitz": True, "verdict": "certified",
-     "sup_gain": 1.0, "margin": 0.1, "taylor_derived": {"verdict": "stable", "psi3": 0.7}},
+     "sup_gain": 1.0, "margin": 0.1, "taylor_derived": {"sign": "stable", "psi3": 0.7}},
     {"t": 0.6, "k_x": -1.0, "k_v": 0.5, "k_a": 0.2, "hurwitz": False, "verdict": "not_certified",
-     "sup_gain": None, "margin": float("-inf"), "taylor_derived": {"verdict": "unstable", "psi3": -1.0}},
+     "sup_gain": None, "margin": float("-inf"), "taylor_derived": {"sign": "unstable", "psi3": -1.0}},
 ]
 PARAMS = {"tau": 0.1, "delta": 0.2, "headway": 1.1, "method": "exact"}
 SUMMARY = {"n": 2, "certified": 1, "not_certified": 1, "inconclusive": 0, "certified_row_share": 0.5}
@@ -315,14 +315,14 @@ def test_format_json_is_strict_json():
     doc = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
     assert list(doc) == ["params", "results", "summary"]
     assert doc["results"][1]["sup_gain"] is None and doc["results"][1]["margin"] is None
-    assert doc["results"][0]["taylor_derived"] == {"verdict": "stable", "psi3": 0.7}
+    assert doc["results"][0]["taylor_derived"] == {"sign": "stable", "psi3": 0.7}
     assert text.splitlines()[3].startswith('  {"t": 0.5,')  # one result per line
     assert json.loads(format_results([], "json")) == {"results": []}
 
 
 def test_format_csv_flattens_and_repeats_params():
     rows = list(csv.DictReader(io.StringIO(format_results(RECORDS, "csv", params=PARAMS))))
-    assert rows[0]["taylor_derived_verdict"] == "stable"
+    assert rows[0]["taylor_derived_sign"] == "stable"
     assert rows[1]["sup_gain"] == "" and rows[1]["tau"] == "0.1" and rows[1]["method"] == "exact"
     assert float(rows[0]["taylor_derived_psi3"]) == 0.7
 

@@ -71,10 +71,10 @@ def test_map_equals_single_point_certificates(which, slice_map, volume_map):
         tie = _ties(kx[i], kv[i], ka[i], p.tau, p.delta, p.headway, "derived")
         if not tie:
             assert TYPE_NAMES[int(m.type[i])] == c.type, i
-            assert m.prop1["taylor"][i] == (c.taylor_derived["verdict"] == "stable"), i
+            assert m.prop1["taylor"][i] == (c.taylor_derived["sign"] == "stable"), i
         if not _ties(kx[i], kv[i], ka[i], p.tau, p.delta, p.headway, "printed"):
             assert TYPE_NAMES[int(m.type_printed[i])] == c.taylor_printed["type"], i
-            assert m.prop1["printed"][i] == (c.taylor_printed["verdict"] == "stable"), i
+            assert m.prop1["printed"][i] == (c.taylor_printed["sign"] == "stable"), i
         # the map's Taylor verdicts include internal stability
         assert m.verdict["taylor"][i] == (0 if (m.prop1["taylor"][i] and m.hurwitz[i]) else 1)
 
