@@ -233,7 +233,7 @@ def test_theta_is_checked_once_on_the_way_in():
     seen: list[str] = []
 
     def prof(frame, event, arg):
-        if (event == "call" and frame.f_code.co_filename == params.__file__
+        if (event == "call" and frame.f_code.co_filename == params.points.__file__
                 and frame.f_code.co_name in ("check_reaction_delay", "check_params")):
             seen.append(frame.f_code.co_name)
 

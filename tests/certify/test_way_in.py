@@ -30,12 +30,12 @@ VALIDATORS = {"check_params", "sample_time", "as_gains", "check_box", "parameter
 
 
 def _validations(fn) -> collections.Counter[str]:
-    """Calls of the validators of stringstab/params.py made by ``fn()``, by name."""
+    """Calls of the validators of stringstab/params/ made by ``fn()``, by name."""
     seen: collections.Counter[str] = collections.Counter()
-    target = params.__file__
+    target = {params.points.__file__, params.intervals.__file__}
 
     def prof(frame, event, arg):
-        if event == "call" and frame.f_code.co_filename == target and frame.f_code.co_name in VALIDATORS:
+        if event == "call" and frame.f_code.co_filename in target and frame.f_code.co_name in VALIDATORS:
             seen[frame.f_code.co_name] += 1
 
     # import the lazily loaded certificates first, so only the certificate's own calls count

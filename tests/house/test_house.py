@@ -389,7 +389,7 @@ def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one
 
 #: The package root: the façade and the shared basics; every other module lives in a
 #: subpackage whose ``__init__`` says what is there.
-ROOT_MODULES = {"__init__.py", "__main__.py", "_version.py", "params.py", "ranges.py",
+ROOT_MODULES = {"__init__.py", "__main__.py", "_version.py", "ranges.py",
                 "constants.py", "errors.py", "progress.py", "memory.py", "parallel.py"}
 
 
@@ -409,7 +409,6 @@ LONG = 600
 LONG_MODULES = {
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
-    "stringstab/params.py": "the model's parameters τ, δ, T*, θ_r: points, intervals, boxes, checked",
     "stringstab/parallel.py": ("the one start-method policy: pools, helpers, and the signals and "
                                "lifetime of every child process"),
     "stringstab/certify/api.py": ("the one way in to every certificate: Loop and the façade "
