@@ -12,99 +12,33 @@ Per follower (a vehicle whose predecessor and gap are in the log):
 
 The verdict is worded no more confidently than the bootstrap allows
 (:mod:`stringstab.identify.wording`).  :func:`stringstab.identify.cars.identify_cars` pools the
-logs of each car instead.
+logs of each car instead.  The results it returns are :mod:`stringstab.identify.results`
+(importable from here too).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 from ..errors import StringStabError, show
 from ..io.platoon_logs import PlatoonLog
 from ..progress import Progress
-from .estimate import Estimate, Settings, estimate
+from .estimate import Settings, estimate
 from .fit import PARAMETERS
 from .record import follower_record, missing_vehicles
+from .results import IdentifyResult as IdentifyResult
+from .results import VehicleResult as VehicleResult
 from .spacing import distance_setting
 
-__all__ = ["DEFAULT_BLOCK", "DEFAULT_BOOTSTRAP", "FitProgress", "IdentifyResult", "VehicleResult",
-           "check_settings", "identify"]
+__all__ = ["DEFAULT_BLOCK", "DEFAULT_BOOTSTRAP", "FitProgress", "check_settings", "identify"]
 
 #: Default number of bootstrap refits per follower.
 DEFAULT_BOOTSTRAP = 50
 #: Default block length of the moving-block bootstrap, s.
 DEFAULT_BLOCK = 20.0
-
-
-@dataclass(kw_only=True)
-class VehicleResult(Estimate):
-    """Everything identified about one follower of one log (see :func:`identify`)."""
-
-    platoon: int
-    position: int
-    name: str
-    predecessor: str
-    setting: str = "unknown"
-    distance_setting: str = ""
-
-    def row(self) -> dict[str, Any]:
-        """The JSON/CSV row: who (platoon, position, name, predecessor), then the estimate."""
-        return {"platoon": self.platoon, "position": self.position, "name": self.name,
-                "predecessor": self.predecessor, **self.fields(), "setting": self.setting,
-                "distance_setting": self.distance_setting}
-
-
-@dataclass
-class IdentifyResult:
-    """The identification of every follower of one or more logs.
-
-    Attributes
-    ----------
-    vehicles : list of VehicleResult
-        In (log, position) order.
-    model : str
-        ``"acc"`` or ``"cacc"``.
-    sample_time : float or None
-        H of the sampled certificate, or None (continuous time).
-    settings : dict
-        Bootstrap count, block length, starts, seed, minimum segment length, ...
-    sources : list of str
-        The files read.
-    skipped : list of str
-        Followers not identified, and vehicles absent from a log, with the reason.
-    """
-
-    vehicles: list[VehicleResult]
-    model: str
-    sample_time: float | None
-    settings: dict[str, Any]
-    sources: list[str]
-    skipped: list[str] = field(default_factory=list)
-
-    def rows(self) -> list[dict[str, Any]]:
-        """One row per follower (:meth:`VehicleResult.row`)."""
-        return [v.row() for v in self.vehicles]
-
-    def document(self) -> dict[str, Any]:
-        """The ``identify.json`` document: settings, ``vehicles`` (with ``segments`` and notes)."""
-        vehicles = []
-        for v in self.vehicles:
-            r = v.row()
-            r["segments"] = [{"start": s.start, "stop": s.stop, "t_start": float(s.start * v.data.dt),
-                              "samples": len(s)} for s in v.segments]
-            r["notes"] = v.fit.notes + v.notes
-            r["correlation"] = v.fit.correlation
-            r["headway_profile"] = v.profile
-            r["delay_profile"] = v.delay_profile
-            vehicles.append(r)
-        return {"command": "identify", "model": self.model, "sample_time": self.sample_time,
-                "sources": self.sources, "settings": self.settings, "skipped": self.skipped,
-                "vehicles": vehicles}
 
 
 class FitProgress:
