@@ -405,14 +405,36 @@ def test_every_subpackage_says_what_lives_there():
 
 #: "No module over ~500 lines doing more than one job": a module over :data:`LONG` lines is
 #: listed here with its one job (the test fails when one is added unlisted, or shrinks).
-LONG = 600
+LONG = 500
 LONG_MODULES = {
+    "stringstab/certify/api.py": ("the one way in to every certificate: Loop and the façade "
+                                  "(certify, certify_batch, check, certify_string), mostly docstrings"),
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
     "stringstab/parallel.py": ("the one start-method policy: pools, helpers, and the signals and "
                                "lifetime of every child process"),
-    "stringstab/certify/api.py": ("the one way in to every certificate: Loop and the façade "
-                                  "(certify, certify_batch, check, certify_string), mostly docstrings"),
+    "stringstab/identify/estimate.py": "one follower's estimate: fit, certificate, bootstrap, profiles",
+    "stringstab/cli/platoon.py": "the `stringstab platoon` command: head-to-tail verdicts of recorded strings",
+    "stringstab/certify/continuous.py": "the exact continuous-time certificate: its results and kernels",
+    "stringstab/certify/zoh.py": "the zero-order-hold discretisation: the coefficients of H(z) and of g_H",
+    "stringstab/certify/margin.py": "the margin g(ω) and everything computed from it",
+    "stringstab/report/commands.py": "the reports of the commands that write a folder",
+    "stringstab/traffic/dynamics.py": "the platoon's stepping core, many platoons at once",
+    "stringstab/certify/lifted_frequency.py": "proven bounds on λ_min of the lifted link's margin M(θ)",
+    "stringstab/identify/fit.py": "the closed-loop simulation-error fit of the eq-4 law to one record",
+    "stringstab/cli/sumo.py": "the `stringstab sumo` command: the controllers inside Eclipse SUMO",
+    "stringstab/rl/train.py": "the training loop: train(config) -> TrainResult, resumable",
+    "stringstab/rl/config.py": "the trainer's configuration: IDL Table 1 as defaults, one field per choice",
+    "stringstab/io/outputs.py": "output files and folders, checked first and written all-or-nothing",
+    "stringstab/derive/codegen.py": "the generator of derive/generated.py, the numeric code of every formula",
+    "stringstab/certify/robust_split.py": "the branch and bound of the split margin F − G ≥ 0 over cells",
+    "stringstab/certify/head_to_tail.py": "the head-to-tail certificate of heterogeneous strings",
+    "stringstab/hcfs/theorem.py": "the HCFS jerk theorem as a checkable statement, and its bound",
+    "stringstab/io/platoon_logs.py": "the readers of recorded platoons (OpenACC, plain CSV, NGSIM), in SI units",
+    "stringstab/certify/criteria.py": "the vectorised criteria: Hurwitz, Proposition 1 and the types I-IV",
+    "stringstab/certify/multirate.py": "the certificate of the multi-rate V2V loop",
+    "stringstab/report/render.py": "the report's model (Report, Section) and its one renderer",
+    "stringstab/traffic/metrics.py": "the IDL paper's evaluation metrics (§4.2)",
 }
 
 
