@@ -9,13 +9,14 @@ verification.  A command calls one function and writes the result::
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from ..certify.verdicts import Verdict
 from ..ranges import metric_caveat
 from .render import Report
+from .skeleton import add_figures, grid_axes
 
 __all__ = ["cars_report", "compare_report", "evaluate_report", "identify_report", "region_report",
            "scenario_report", "simulate_report", "sweep_report", "tune_report"]
@@ -33,10 +34,6 @@ METRICS: list[tuple[str, str, str]] = [
     ("min_headway", "smallest time headway", "s"),
     ("m_fss", "share of vehicle-moments whose gains are certified; higher is better", "fraction"),
 ]
-
-
-def _pngs(names: Iterable[str]) -> list[str]:
-    return [str(n) for n in names if str(n).endswith((".png", ".svg", ".jpg"))]
 
 
 def region_report(rmap: Any, files: Sequence[Any], *, command: str,
@@ -61,7 +58,7 @@ def region_report(rmap: Any, files: Sequence[Any], *, command: str,
     Report
         The report, to :meth:`~stringstab.report.Report.write`.
     """
-    axes = {n: f"[{a[0]:g}, {a[-1]:g}] in {len(a)} points" for n, a in rmap.axes.items()}
+    axes = grid_axes(rmap.axes)
     rep = Report("Map of the string-stable gains", command=command,
                  params={**axes, **{k: v for k, v in rmap.fixed.items()}, "loop": rmap.title(),
                          "methods": ", ".join(rmap.methods)},
@@ -82,9 +79,7 @@ def region_report(rmap: Any, files: Sequence[Any], *, command: str,
                 s2.verdict(f"{k} agree on every decided point", v == 0, f"{v:,} points differ")
         s2.verdict("exact certificate decided at every point", d["inconclusive"] == 0,
                    f"{d['inconclusive']:,} inconclusive points (within rounding of the boundary)")
-    figs = _pngs(Path(str(f)).name for f in files)
-    if figs:
-        rep.section("Figures").figures(figs)
+    add_figures(rep, (Path(str(f)).name for f in files))
     return rep
 
 
@@ -158,9 +153,7 @@ def simulate_report(doc: Mapping[str, Any], files: Mapping[str, str], *, command
                 columns=["follower"] + [str(i + 1) for i in range(len(doc["m_p"]))],
                 caption="m_p per follower (follower-to-predecessor acceleration energy).",
                 digits=3)
-    figs = _pngs(files.values())
-    if figs:
-        rep.section("Figures").figures(figs)
+    add_figures(rep, files.values())
     return rep
 
 
@@ -259,9 +252,7 @@ def compare_report(markdown: str, files: Sequence[str], *, command: str,
     rep = Report("Comparison of strategies on held-out episodes", command=command, started=started)
     body = "\n".join(line for line in markdown.splitlines() if not line.startswith("# "))
     rep.section("Table 4 layout").markdown(body, shift=1)
-    figs = _pngs(files)
-    if figs:
-        rep.section("Figures").figures(figs)
+    add_figures(rep, files)
     return rep
 
 
@@ -343,11 +334,7 @@ def identify_report(res: Any, files: Sequence[Any], *, command: str,
     notes += [f"skipped: {s}" for s in res.skipped]
     if notes:  # plain text: T* is a name, not emphasis
         rep.section("Notes").text("\n".join(f"- {n}".replace("*", "\\*") for n in notes))
-    figs = _pngs(Path(str(f)).name for f in files)
-    if figs:
-        sec = rep.section("Figures")
-        for f in figs:
-            sec.figure(f, _identify_caption(res, f))
+    add_figures(rep, (Path(str(f)).name for f in files), lambda f: _identify_caption(res, f))
     return rep
 
 
@@ -409,11 +396,7 @@ def cars_report(res: Any, files: Sequence[Any], *, command: str, started: float 
     notes += [f"skipped: {sk}" for sk in res.skipped]
     if notes:
         rep.section("Notes").text("\n".join(f"- {n}".replace("*", "\\*") for n in notes))
-    figs = _pngs(Path(str(f)).name for f in files)
-    if figs:
-        sec = rep.section("Figures")
-        for f in figs:
-            sec.figure(f, _cars_caption(res, f))
+    add_figures(rep, (Path(str(f)).name for f in files), lambda f: _cars_caption(res, f))
     return rep
 
 
@@ -517,9 +500,7 @@ def sweep_report(spec: Any, rows: Sequence[Mapping[str, Any]], files: Sequence[s
         if f.endswith(".md"):
             text = (Path(root) / f).read_text(encoding="utf-8")
             rep.section(f"Study: {Path(f).stem}").markdown(text)
-    figs = _pngs(files)
-    if figs:
-        rep.section("Figures").figures(figs)
+    add_figures(rep, files)
     return rep
 
 

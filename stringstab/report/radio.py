@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from .render import Report
+from .skeleton import add_figures
 
 __all__ = ["AMPLIFICATION_CAPTION", "LINKS_CAPTION", "markdown_table", "radio_report", "write_study"]
 
@@ -203,10 +204,7 @@ def radio_report(study: Any, files: Sequence[str], *, command: str,
                                        f" – {'beyond the grid' if e['loss_hi'] is None else format(e['loss_hi'], '.3g')}")})
     sec.table(table)
     rep.section("Table").markdown(markdown_table(study.rows()), shift=1)
-    figs = [f for f in files if f.endswith(".png")]
-    if figs:
-        fsec = rep.section("Figures")
-        for f in figs:
-            fsec.figure(f, AMPLIFICATION_CAPTION if f == "amplification.png" else LINKS_CAPTION)
+    add_figures(rep, (f for f in files if f.endswith(".png")),
+                lambda f: AMPLIFICATION_CAPTION if f == "amplification.png" else LINKS_CAPTION)
     rep.section("Files").text(", ".join(f"`{f}`" for f in files))
     return rep

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from .render import Report
+from .skeleton import add_figures, grid_axes
 
 __all__ = ["reaction_sweep_report"]
 
@@ -34,7 +35,7 @@ def reaction_sweep_report(sweep: Any, files: Sequence[Any], *, command: str,
         The report, to :meth:`~stringstab.report.Report.write`.
     """
     first = sweep.maps[0]
-    axes = {n: f"[{a[0]:g}, {a[-1]:g}] in {len(a)} points" for n, a in first.axes.items()}
+    axes = grid_axes(first.axes)
     th = ", ".join(f"{v:g}" for v in sweep.reaction_delays)
     rep = Report("Map of the string-stable gains per reaction delay θ_r", command=command,
                  params={**axes, **dict(first.fixed), "loop": first.title(),
@@ -50,7 +51,5 @@ def reaction_sweep_report(sweep: Any, files: Sequence[Any], *, command: str,
                 "inconclusive (%)": 100 * r["inconclusive_share"]} for r in sweep.rows()],
               caption="Share of the grid the exact certificate certifies at each θ_r.", digits=4)
     sec.code(sweep.report())
-    figs = [str(Path(str(f)).name) for f in files if str(f).endswith((".png", ".svg"))]
-    if figs:
-        rep.section("Figures").figures(figs)
+    add_figures(rep, (Path(str(f)).name for f in files))
     return rep
