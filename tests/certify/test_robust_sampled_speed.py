@@ -5,21 +5,23 @@ of ``tests/data/speed_verdicts.csv``, and the refinement's stragglers) with the 
 main at 031c8b1, before the change, over four boxes (written by
 ``PYTHONPATH=<main> python analysis/robust_sampled_verdicts.py <file>``): every verdict,
 inconclusive included, must be the same now.  The cells the search computes ahead
-(``robust_split._CellCache``) must be, bit for bit, the cells computed directly.
+(``sampled_split_cells.CellCache``) must be, bit for bit, the cells computed directly.
 """
 
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from stringstab.certify.api import certify_batch
-from stringstab.certify.sampled_split_cells import FollowerCells, PredecessorCells
-
-rsp = importlib.import_module("stringstab.certify.robust_split")
+from stringstab.certify.sampled_split_cells import (
+    CellCache,
+    FollowerCells,
+    PredecessorCells,
+    halves,
+)
 
 DATA = Path(__file__).parent / "robust_sampled_verdicts_031c8b1.npz"
 BOXES = {
@@ -37,13 +39,13 @@ def test_every_verdict_is_main_s(name, monkeypatch):
     K, base = data["K"], data[name]
     assert K.shape == (480, 3) and base.shape == (480,)
     served = [0]
-    orig = rsp._CellCache._assemble
+    orig = CellCache._assemble
 
     def count(chunks, loc):
         served[0] += len(loc)
         return orig(chunks, loc)
 
-    monkeypatch.setattr(rsp._CellCache, "_assemble", staticmethod(count))
+    monkeypatch.setattr(CellCache, "_assemble", staticmethod(count))
     now = np.asarray(certify_batch(*K.T, **BOXES[name]).verdict).astype(str)
     changed = np.flatnonzero(now != base)
     assert changed.size == 0, [(K[i].tolist(), base[i], now[i]) for i in changed[:5]]
@@ -60,7 +62,7 @@ def test_cells_computed_ahead_are_the_cells_computed_directly():
     n = 3
     kx, kv, ka = rng.uniform(-2, 2, (3, n))
     H, ends = 0.1, [(1, 0.5), (2, 0.0), (2, 0.25)]
-    cache = rsp._CellCache(kx, kv, ka, H, ends)
+    cache = CellCache(kx, kv, ka, H, ends)
     # a few cells (items 0-2): computed with their halves and quarters
     owner = np.array([0, 1, 2, 2])
     tau = np.array([[0.1, 0.15], [0.15, 0.2], [0.1, 0.125], [0.125, 0.2]])
@@ -70,10 +72,10 @@ def test_cells_computed_ahead_are_the_cells_computed_directly():
     for k, v in _fields(FollowerCells.of(owner, kx, kv, H=H, tau=tau, headway=hd)).items():
         assert np.array_equal(_fields(first)[k], v), k
     # their halves along τ, then along T* of a half: served, not computed
-    t_a, t_b = rsp._halves(tau)
+    t_a, t_b = halves(tau)
     own2 = np.concatenate([owner, owner, owner[:1]])
     t2 = np.concatenate([t_a, t_b, t_a[:1]])
-    h_a, _ = rsp._halves(hd[:1])
+    h_a, _ = halves(hd[:1])
     h2 = np.concatenate([hd, hd, h_a])
     got = cache.follower(own2, t2, h2)
     assert len(cache.f_chunks) == 1
@@ -84,7 +86,7 @@ def test_cells_computed_ahead_are_the_cells_computed_directly():
     tp = np.array([[0.1, 0.2], [0.1, 0.15], [0.15, 0.2]])
     end = np.array([0, 2, 1])
     cache.predecessor(gains + 10, gains, tp, end)
-    q_a, q_b = rsp._halves(tp)
+    q_a, q_b = halves(tp)
     g2, tp2, e2 = np.tile(gains, 2), np.concatenate([q_b, q_a]), np.tile(end, 2)
     got = cache.predecessor(g2 + 7, g2, tp2, e2)
     assert len(cache.g_chunks) == 1
