@@ -116,6 +116,13 @@ class Interval:
         if self.hi is self.lo and o.hi is o.lo:
             lo = self.lo * o.lo
             return Interval._new(lo, lo, self.mag * o.mag)
+        if o.hi is o.lo or self.hi is self.lo:
+            # one point p: the four products are two pairs of equal ones (x·p twice), so
+            # min(min(a, b), min(c, d)) is min(a, c) exactly: the same end points, two
+            # products and two comparisons fewer
+            a, c = (self.lo * o.lo, self.hi * o.lo) if o.hi is o.lo else (self.lo * o.lo,
+                                                                         self.lo * o.hi)
+            return Interval._new(np.minimum(a, c), np.maximum(a, c), self.mag * o.mag)
         a, b, c, d = self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi
         # pairwise min/max: the same end points as a reduction over the four, without
         # stacking them into one array first

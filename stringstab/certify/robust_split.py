@@ -33,7 +33,7 @@ from .sampled_split import (
     split_curvature,
     vander,
 )
-from .sampled_split_cells import FollowerCells, PredecessorCells
+from .sampled_split_cells import CellCache, FollowerCells, PredecessorCells
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED
 
 __all__ = ["screen_members", "split_search"]
@@ -101,13 +101,16 @@ class _Split:
 
 
 def _pred_of(F: FollowerCells, cells: npt.NDArray[np.intp], first: int, kx: Array, kv: Array,
-             ka: Array, H: float, ends: list[tuple[int, float]]) -> PredecessorCells:
+             ka: Array, H: float, ends: list[tuple[int, float]],
+             cache: CellCache | None = None) -> PredecessorCells:
     """τ_p = τ: the predecessor cells of the follower cells ``cells`` (numbered from ``first``)."""
     E = len(ends)
     own = np.repeat(np.arange(cells.size) + first, E)
-    return PredecessorCells.of(own, F.owner[np.repeat(cells, E)], kx, kv, ka, H=H,
-                               tau_p=np.repeat(F.tau[cells], E, axis=0),
-                               end=np.tile(np.arange(E), cells.size), ends=ends)
+    gains, tau_p = F.owner[np.repeat(cells, E)], np.repeat(F.tau[cells], E, axis=0)
+    end = np.tile(np.arange(E), cells.size)
+    if cache is not None:
+        return cache.predecessor(own, gains, tau_p, end)
+    return PredecessorCells.of(own, gains, kx, kv, ka, H=H, tau_p=tau_p, end=end, ends=ends)
 
 
 def screen_members(kx: Array, kv: Array, ka: Array, H: float, box: Box,
@@ -253,6 +256,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
     if ni == 0:
         return {"code": code, "value": best, **wit, "n_evals": n_evals}
     gx, gv, ga = kx[items], kv[items], ka[items]
+    cache = CellCache(gx, gv, ga, H, ends)
     def initial(own: npt.NDArray[np.intp], k: int) -> _Split:
         """k × k follower cells and k cells of τ_p per end of the delay, for the items ``own``."""
         nt, nh = (k if t_w > 0 else 1), (k if h_w > 0 else 1)
@@ -362,7 +366,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
             break
         cells, over = _refine(cells, act, bb, kx=gx, kv=gv, ka=ga, H=H, ends=ends,
                               heterogeneous=heterogeneous, widths=(t_w, h_w),
-                              max_cells=max_cells, e_delta=e_delta)
+                              max_cells=max_cells, e_delta=e_delta, cache=cache)
         code[items[act[over]]] = INCONCLUSIVE
         keep = np.isin(bb.pending_item, np.flatnonzero(~over))
         nxt = np.setdiff1d(pend, np.flatnonzero(over))
@@ -450,8 +454,8 @@ def _keep(cells: _Split, act: npt.NDArray[np.intp], heterogeneous: bool) -> _Spl
 
 def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv: Array,
             ka: Array, H: float, ends: list[tuple[int, float]], heterogeneous: bool,
-            widths: tuple[float, float], max_cells: int,
-            e_delta: Array) -> tuple[_Split, npt.NDArray[np.bool_]]:
+            widths: tuple[float, float], max_cells: int, e_delta: Array,
+            cache: CellCache) -> tuple[_Split, npt.NDArray[np.bool_]]:
     """Halve the cells whose bounds are in the looser half at the held intervals' midpoints.
 
     Returns the new cells and, per item of ``act``, whether it now has more than
@@ -511,10 +515,10 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
     mid_t, mid_h = F.tau[sf].mean(axis=1), F.headway[sf].mean(axis=1)
     tau_a[at, 1] = tau_b[at, 0] = mid_t[at]
     hd_a[~at, 1] = hd_b[~at, 0] = mid_h[~at]
-    kids = FollowerCells.of(np.concatenate([F.owner[sf], F.owner[sf]]), kx, kv, H=H,
-                            tau=np.concatenate([tau_a, tau_b]),
-                            headway=np.concatenate([hd_a, hd_b]))
     keep_f = np.flatnonzero(~np.isin(np.arange(len(F)), sf))
+    kids = cache.follower(np.concatenate([F.owner[sf], F.owner[sf]]),
+                          np.concatenate([tau_a, tau_b]), np.concatenate([hd_a, hd_b]),
+                          around=(F.owner[keep_f], F.tau[keep_f], F.headway[keep_f]))
     F2 = FollowerCells(*(np.concatenate([getattr(F, k)[keep_f], getattr(kids, k)])
                          for k in ("owner", "tau", "headway", "V", "a", "mag", "gmag")))
     if heterogeneous:
@@ -523,9 +527,10 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
         ta, tb = G.tau_p[sg].copy(), G.tau_p[sg].copy()
         ta[:, 1] = tb[:, 0] = mid
         own = np.concatenate([G.owner[sg], G.owner[sg]])
-        gk = PredecessorCells.of(own, own, kx, kv, ka, H=H, tau_p=np.concatenate([ta, tb]),
-                                 end=np.concatenate([G.end[sg], G.end[sg]]), ends=ends)
         keep_g = np.flatnonzero(~np.isin(np.arange(len(G)), sg))
+        gk = cache.predecessor(own, own, np.concatenate([ta, tb]),
+                               np.concatenate([G.end[sg], G.end[sg]]),
+                               around=(G.owner[keep_g], G.tau_p[keep_g], G.end[keep_g]))
         G2 = PredecessorCells(*(np.concatenate([getattr(G, k)[keep_g], getattr(gk, k)])
                                 for k in ("owner", "tau_p", "end", "m", "V", "a", "mag", "gmag")))
     else:
@@ -535,7 +540,8 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
         gk_ = np.flatnonzero(new[G.owner] >= 0)
         Gk = G.take(gk_)
         Gk.owner = new[Gk.owner]
-        Gn = _pred_of(F2, np.arange(keep_f.size, len(F2)), keep_f.size, kx, kv, ka, H, ends)
+        Gn = _pred_of(F2, np.arange(keep_f.size, len(F2)), keep_f.size, kx, kv, ka, H, ends,
+                      cache)
         Gn.owner = np.arange(keep_f.size, len(F2)).repeat(len(ends))
         G2 = PredecessorCells(*(np.concatenate([getattr(Gk, k), getattr(Gn, k)])
                                 for k in ("owner", "tau_p", "end", "m", "V", "a", "mag", "gmag")))

@@ -27,9 +27,17 @@ from .interval import IntervalAD
 from .sampled_split import follower_terms, predecessor_terms
 from .verdicts import ROUNDOFF_SLACK
 
-__all__ = ["FollowerCells", "PredecessorCells"]
+__all__ = ["CellCache", "FollowerCells", "PredecessorCells", "halves"]
 
 Array = npt.NDArray[np.float64]
+
+#: The refinement's stragglers (:class:`CellCache`): a round that needs at most this many
+#: new cells computes them with their descendants _AHEAD_DEPTH halvings deep; requests of
+#: more than _LOOKUP_LIMIT cells are not looked up (the search's first, wide rounds).
+_AHEAD_LIMIT = 48
+_AHEAD_DEPTH = 2
+_AROUND_DEPTH = 1
+_LOOKUP_LIMIT = 512
 
 
 def _stack(poly: list[IntervalAD], fields: tuple[str, ...], J: int = 3) -> Array:
@@ -352,3 +360,162 @@ class PredecessorCells:
         hw = 0.5 * (self.tau_p[cell, 1] - self.tau_p[cell, 0])
         spread = (np.maximum(np.abs(dlo), np.abs(dhi)) + Eg) * hw[:, None]
         return Gc, np.minimum(Gn, Gc + spread), E
+
+
+def halves(cells: Array) -> tuple[Array, Array]:
+    """The two halves of cells (k, 2) at their midpoints, as the split search halves them."""
+    mid = cells.mean(axis=1)
+    a, b = cells.copy(), cells.copy()
+    a[:, 1] = b[:, 0] = mid
+    return a, b
+
+
+def _descend_f(o: Any, t: Array, h: Array, depth: int,
+               own: bool) -> tuple[Any, Array, Array]:
+    """Follower cells and their halves along τ and T* (of positive width), ``depth`` deep.
+
+    The cells themselves are included when ``own``.  Rows may repeat (the caller dedupes).
+    """
+    lo, lt, lh = o, t, h
+    out_o, out_t, out_h = ([lo], [lt], [lh]) if own else ([lo[:0]], [lt[:0]], [lh[:0]])
+    for _ in range(depth):
+        st = lt[:, 1] > lt[:, 0]
+        sh = lh[:, 1] > lh[:, 0]
+        ta, tb = halves(lt[st])
+        ha, hb = halves(lh[sh])
+        lo = np.concatenate([lo[st], lo[st], lo[sh], lo[sh]])
+        lt = np.concatenate([ta, tb, lt[sh], lt[sh]])
+        lh = np.concatenate([lh[st], lh[st], ha, hb])
+        out_o.append(lo)
+        out_t.append(lt)
+        out_h.append(lh)
+    return np.concatenate(out_o), np.concatenate(out_t), np.concatenate(out_h)
+
+
+def _descend_g(g: Any, t: Array, e: Any, depth: int, own: bool) -> tuple[Any, Array, Any]:
+    """Predecessor cells and their halves along τ_p (of positive width), ``depth`` deep."""
+    lg, lt, le = g, t, e
+    out_g, out_t, out_e = ([lg], [lt], [le]) if own else ([lg[:0]], [lt[:0]], [le[:0]])
+    for _ in range(depth):
+        st = lt[:, 1] > lt[:, 0]
+        ta, tb = halves(lt[st])
+        lg = np.concatenate([lg[st], lg[st]])
+        lt = np.concatenate([ta, tb])
+        le = np.concatenate([le[st], le[st]])
+        out_g.append(lg)
+        out_t.append(lt)
+        out_e.append(le)
+    return np.concatenate(out_g), np.concatenate(out_t), np.concatenate(out_e)
+
+
+class CellCache:
+    """Cells of the few items left in the search, computed ahead (the refinement's stragglers).
+
+    Each refinement round builds its new cells in one call of :meth:`FollowerCells.of` and one
+    of :meth:`PredecessorCells.of`, whose cost is mostly fixed (a few hundred operations of
+    interval arithmetic on small arrays) when few cells are new: the last rounds, for one or
+    two triples, cost as much as the first.  When a round needs at most :data:`_AHEAD_LIMIT`
+    new cells, this cache computes them together with their halves and quarters along every
+    parameter of positive width (the cells any of the next two rounds can ask for), in the
+    same one call, and serves the later rounds' requests from them.  Each row of a cell is a
+    function of that cell's bounds and gains only (the arithmetic is elementwise), so a cell
+    served from the cache is bit for bit the cell the round would have built: the search and
+    its verdicts are unchanged.
+    """
+
+    def __init__(self, kx: Array, kv: Array, ka: Array, H: float,
+                 ends: list[tuple[int, float]]) -> None:
+        self.kx, self.kv, self.ka, self.H, self.ends = kx, kv, ka, H, ends
+        self.f_chunks: list[FollowerCells] = []
+        self.f_index: dict[tuple[float, ...], tuple[int, int]] = {}
+        self.g_chunks: list[PredecessorCells] = []
+        self.g_index: dict[tuple[float, ...], tuple[int, int]] = {}
+
+    @staticmethod
+    def _assemble(chunks: list[Any], loc: list[tuple[int, int]]) -> Any:
+        """The rows ``loc`` (chunk, row) of the chunks, in order."""
+        ch = np.array([c for c, _ in loc], dtype=np.intp)
+        rw = np.array([r for _, r in loc], dtype=np.intp)
+        used = np.unique(ch)
+        if used.size == 1:
+            return chunks[int(used[0])].take(rw)
+        parts, order = [], []
+        for c in used:
+            sel = np.flatnonzero(ch == c)
+            parts.append(chunks[int(c)].take(rw[sel]))
+            order.append(sel)
+        pos = np.empty(len(loc), dtype=np.intp)
+        pos[np.concatenate(order)] = np.arange(len(loc))
+        cat = type(parts[0])(*(np.concatenate([getattr(x, f) for x in parts])
+                               for f in parts[0].__dataclass_fields__))
+        return cat.take(pos)
+
+    def follower(self, owner: npt.NDArray[np.intp], tau: Array, headway: Array,
+                 around: tuple[Any, Array, Array] | None = None) -> FollowerCells:
+        """:meth:`FollowerCells.of` of the cells, from the cache or computed (and ahead).
+
+        ``around``: the items' cells kept this round (owner, τ, T*), whose halves and
+        quarters the next rounds may ask for: computed ahead with the new cells'.
+        """
+        if owner.size == 0:  # no new cell: nothing to compute (the arrays' shapes only)
+            return FollowerCells(owner, tau, headway, np.zeros((0, 6, 3)),
+                                 *(np.zeros((0, 3)) for _ in range(3)))
+        if owner.size > _LOOKUP_LIMIT:
+            return FollowerCells.of(owner, self.kx, self.kv, H=self.H, tau=tau, headway=headway)
+        keys = list(zip(owner.tolist(), *tau.T.tolist(), *headway.T.tolist()))
+        miss = np.array([i for i, k in enumerate(keys) if k not in self.f_index],
+                        dtype=np.intp)
+        if miss.size > _AHEAD_LIMIT:
+            return FollowerCells.of(owner, self.kx, self.kv, H=self.H, tau=tau, headway=headway)
+        if miss.size:
+            o, t, h = _descend_f(owner[miss], tau[miss], headway[miss], _AHEAD_DEPTH, True)
+            if around is not None and around[0].size <= _LOOKUP_LIMIT:
+                ao, at_, ah = _descend_f(*around, _AROUND_DEPTH, False)
+                o, t, h = np.concatenate([o, ao]), np.concatenate([t, at_]), np.concatenate([h, ah])
+            u = np.unique(np.column_stack([o, t, h]), axis=0, return_index=True)[1]
+            o, t, h = o[u], t[u], h[u]
+            new = FollowerCells.of(o, self.kx, self.kv, H=self.H, tau=t, headway=h)
+            c = len(self.f_chunks)
+            self.f_chunks.append(new)
+            for r, k in enumerate(zip(o.tolist(), *t.T.tolist(), *h.T.tolist())):
+                self.f_index.setdefault(k, (c, r))
+        return self._assemble(self.f_chunks, [self.f_index[k] for k in keys])  # type: ignore[no-any-return]
+
+    def predecessor(self, owner: npt.NDArray[np.intp], gains: npt.NDArray[np.intp],
+                    tau_p: Array, end: npt.NDArray[np.intp],
+                    around: tuple[Any, Array, Any] | None = None) -> PredecessorCells:
+        """:meth:`PredecessorCells.of` of the cells, from the cache or computed (and ahead).
+
+        ``around``: the items' cells kept this round (gains, τ_p, end), as in :meth:`follower`.
+        """
+        def compute(o: npt.NDArray[np.intp], g: npt.NDArray[np.intp], t: Array,
+                    e: npt.NDArray[np.intp]) -> PredecessorCells:
+            return PredecessorCells.of(o, g, self.kx, self.kv, self.ka, H=self.H, tau_p=t,
+                                       end=e, ends=self.ends)
+
+        if owner.size == 0:
+            return PredecessorCells(owner, tau_p, end, np.zeros(0), np.zeros((0, 14, 3)),
+                                    *(np.zeros((0, 3, 3)) for _ in range(3)))
+        if owner.size > _LOOKUP_LIMIT:
+            return compute(owner, gains, tau_p, end)
+        keys = list(zip(gains.tolist(), *tau_p.T.tolist(), end.tolist()))
+        miss = np.array([i for i, k in enumerate(keys) if k not in self.g_index],
+                        dtype=np.intp)
+        if miss.size > _AHEAD_LIMIT:
+            return compute(owner, gains, tau_p, end)
+        if miss.size:
+            g, t, e = _descend_g(gains[miss], tau_p[miss], end[miss], _AHEAD_DEPTH, True)
+            if around is not None and around[0].size <= _LOOKUP_LIMIT:
+                ag, at_, ae = _descend_g(*around, _AROUND_DEPTH, False)
+                g, t, e = np.concatenate([g, ag]), np.concatenate([t, at_]), np.concatenate([e, ae])
+            u = np.unique(np.column_stack([g, t, e]), axis=0, return_index=True)[1]
+            g, t, e = g[u], t[u], e[u]
+            new = compute(g, g, t, e)
+            c = len(self.g_chunks)
+            self.g_chunks.append(new)
+            for r, k in enumerate(zip(g.tolist(), *t.T.tolist(), e.tolist())):
+                self.g_index.setdefault(k, (c, r))
+        out: PredecessorCells = self._assemble(self.g_chunks, [self.g_index[k] for k in keys])
+        out.owner = owner.copy()
+        return out
+
