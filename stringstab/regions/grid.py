@@ -29,8 +29,9 @@ from ..errors import StringStabError
 from ..parallel import cpu_count, in_daemon
 from ..params import Box, Params, parameter_model
 from ..params import sample_time as _sample_time
+from .codes import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE
 from .pool import run_blocks
-from .result import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE, RegionMap
+from .result import RegionMap
 
 __all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
 

@@ -407,7 +407,6 @@ def test_every_subpackage_says_what_lives_there():
 #: listed here with its one job (the test fails when one is added unlisted, or shrinks).
 LONG = 600
 LONG_MODULES = {
-    "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
     "stringstab/params.py": "the model's parameters τ, δ, T*, θ_r: points, intervals, boxes, checked",
     "stringstab/parallel.py": ("the one start-method policy: pools, helpers, and the signals and "
