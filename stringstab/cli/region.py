@@ -371,13 +371,15 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
         from ..plots import trajectory_verdicts
 
         verdicts = trajectory_verdicts(rmap, gains)
+    from ..report import command_line
+    from ..report.commands import region_report
+
+    def report(written: list[Path]) -> None:  # while the helper draws (it names the figures)
+        region_report(rmap, written, command=command_line(args), started=t0).write(out)
+
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi, helper=helper)
-        from ..report import command_line
-        from ..report.commands import region_report
-
-        region_report(rmap, written, command=command_line(args), started=t0).write(out)
+                                      verdicts=verdicts, dpi=dpi, helper=helper, meanwhile=report)
     return written
 
 
