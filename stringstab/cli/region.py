@@ -43,6 +43,7 @@ examples:
   stringstab region --3d --n 81 --method exact --scheduler tcp://head:8786 --out maps3d/
   stringstab region --fix k_a=0.5 --reaction-delay 0.2 --out maps_r02/
   stringstab region --fix k_a=0.5 --reaction-delay 0:0.3:4 --n 101 --out maps_r/
+  stringstab region --fix k_a=0.5 --reaction-delay 0.2 --sample-time 0.1 --n 41 --out maps_rH/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
 in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
@@ -54,7 +55,8 @@ with --sample-time or a LO:HI interval, exact is the sampled or robust certifica
 only method; the Taylor criteria are of the continuous loop at one tau, delta, headway);
 --compare continuous adds the continuous certificate and the band where they differ.
 with --reaction-delay S > 0, exact is the certificate with the reaction delay (the only
-method); a list A,B,... or a range LO:HI:N maps each θ_r (files <prefix>_theta_r_<θ_r>.*)
+method; sampled with --sample-time, where --compare continuous adds the continuous
+certificate with the same θ_r); a list A,B,... or a range LO:HI:N maps each θ_r (files <prefix>_theta_r_<θ_r>.*)
 and writes the certified share vs θ_r: <prefix>_share_vs_theta_r.csv and its figure.
 defaults: range {DEFAULT_RANGE[0]:g},{DEFAULT_RANGE[1]:g}, n {DEFAULT_N_2D} (2-D) or {DEFAULT_N_3D} (3-D),
 tau={DEFAULT_TAU} s, delta={DEFAULT_DELTA} s, headway={DEFAULT_HEADWAY} s. See docs/regions.md.
@@ -97,9 +99,9 @@ def add_parser(sub: Any) -> None:
     # -- the reaction delay θ_r (issue 25 part 2): one value, or a list/range as a map axis
     p.add_argument("--reaction-delay", metavar="S|A,B,...|LO:HI:N",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
-                        "(τ a' = u(t − θ_r) − a), continuous time only so far (default: 0); a "
-                        "list A,B,... or a range LO:HI:N maps each θ_r and the certified share "
-                        "vs θ_r")
+                        "(τ a' = u(t − θ_r) − a), in continuous time or with --sample-time "
+                        "(default: 0); a list A,B,... or a range LO:HI:N maps each θ_r and the "
+                        "certified share vs θ_r")
     p.add_argument("--method", metavar="M[,M...]",
                    help="methods among exact, taylor, printed (default: all three; exact alone "
                         "with --sample-time or an interval)")
@@ -285,12 +287,15 @@ def run(args: argparse.Namespace) -> int:
     model, H = loop_params(args)
     N, _ = message_from_args(args, H)  # the multi-rate map (issue 26): exact is its certificate
     with_theta = thetas is not None or Box.of(model).reaction_delay != (0.0, 0.0)
-    if with_theta and H is not None and (thetas is None or max(thetas) > 0.0):
-        raise StringStabError(
-            "reaction_delay > 0 with a sample time is certified (certify, check) but not mapped "
-            f"yet; expected no --sample-time with it; got --reaction-delay "
-            f"{'a list' if thetas is not None else Box.of(model).reaction_delay[1]} "
-            f"with --sample-time {H!r}")
+    # θ_r > 0 with --sample-time (issue 25 item 3): exact is the sampled θ_r certificate
+    # (certify.sampled_reaction); what no certificate answers (θ_r over a box with a sample
+    # time, θ_r beyond the held steps the lifting takes, ...) is refused here, before any work
+    if with_theta and H is not None:
+        from ..certify.api import Loop
+        from ..params import parameter_model
+
+        Loop(model if thetas is None else parameter_model(
+            model.tau, model.delta, model.headway, float(max(thetas))), H, message_steps=N)
     methods = args.method
     if args.compare is not None:
         if H is None:
@@ -339,7 +344,8 @@ def run(args: argparse.Namespace) -> int:
                                        tau=model.tau, delta=model.delta, headway=model.headway,
                                        sample_time=H, methods=methods,
                                        workers=n_dask or workers, executor=executor,
-                                       progress=False if args.no_progress else None)
+                                       progress=False if args.no_progress else None,
+                                       message_period=None if N is None else args.message_period)
             else:
                 rmap = region_map(axes, fixed or None, tau=model.tau, delta=model.delta,
                                   headway=model.headway, sample_time=H, methods=methods,
@@ -365,13 +371,15 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
         from ..plots import trajectory_verdicts
 
         verdicts = trajectory_verdicts(rmap, gains)
+    from ..report import command_line
+    from ..report.commands import region_report
+
+    def report(written: list[Path]) -> None:  # while the helper draws (it names the figures)
+        region_report(rmap, written, command=command_line(args), started=t0).write(out)
+
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi, helper=helper)
-        from ..report import command_line
-        from ..report.commands import region_report
-
-        region_report(rmap, written, command=command_line(args), started=t0).write(out)
+                                      verdicts=verdicts, dpi=dpi, helper=helper, meanwhile=report)
     return written
 
 

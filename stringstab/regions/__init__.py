@@ -49,9 +49,11 @@ point with Λ ≤ 0.  The class map shows the types; the verdicts are in
 ``verdict``.
 
 Modules: :mod:`~stringstab.regions.grid` (the grid, its blocks, :func:`region_map`),
-:mod:`~stringstab.regions.pool` (worker processes), :mod:`~stringstab.regions.result`
-(:class:`RegionMap`: classes, shares, columns, summary), :mod:`~stringstab.regions.files`
-(NPZ and CSV), :mod:`~stringstab.regions.report` (the text report) and
+:mod:`~stringstab.regions.pool` (worker processes), :mod:`~stringstab.regions.codes` (the
+names and codes: gains, methods, verdict labels, classes), :mod:`~stringstab.regions.result`
+(:class:`RegionMap`: classes, shares, summary, slices), :mod:`~stringstab.regions.storage`
+(the map's files: metadata, columns, NPZ and CSV writers, the reader),
+:mod:`~stringstab.regions.files` (the NPZ and CSV formats), :mod:`~stringstab.regions.report` (the text report) and
 :mod:`~stringstab.regions.reaction_sweep` (:func:`reaction_sweep`: a map per reaction delay
 θ_r and the certified share vs θ_r, issue 25).
 
@@ -71,19 +73,10 @@ IDL paper, Proposition 1 (eqs 12-15), §3.3 (types I-IV), Definition 1 (eq 10).
 
 from __future__ import annotations
 
+from .codes import CONTINUOUS, EXACT_CLASSES, GAIN_NAMES, METHODS, TYPE_CLASSES, VERDICT_LABELS
 from .grid import EXACT_BLOCK, TAYLOR_BLOCK, region_map
 from .reaction_sweep import ReactionSweep, reaction_sweep
-from .result import (
-    CONTINUOUS,
-    EXACT_CLASSES,
-    GAIN_NAMES,
-    METHODS,
-    TYPE_CLASSES,
-    VERDICT_LABELS,
-    RegionMap,
-    describe_params,
-    load_npz,
-)
+from .result import RegionMap, describe_params, load_npz
 
 __all__ = [
     "CONTINUOUS",

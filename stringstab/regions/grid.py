@@ -29,8 +29,9 @@ from ..errors import StringStabError
 from ..parallel import cpu_count, in_daemon
 from ..params import Box, Params, parameter_model
 from ..params import sample_time as _sample_time
+from .codes import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE
 from .pool import run_blocks
-from .result import CONTINUOUS, GAIN_NAMES, METHODS, STABLE, UNSTABLE, RegionMap
+from .result import RegionMap
 
 __all__ = ["EXACT_BLOCK", "TAYLOR_BLOCK", "region_map"]
 
@@ -48,6 +49,9 @@ _COST = {(False, False): 1.0, (True, False): 4.0, (False, True): 3.0, (True, Tru
 #: ... times this with a reaction delay θ_r > 0 (certify_batch on a 41³ grid of [−2, 2]³ at
 #: τ = 0.1, δ = 0.2, T* = 1.1 s: 2.4e-4 s per triple at θ_r = 0.2 s vs 5.7e-5 at θ_r = 0).
 _REACTION_COST = 4.0
+#: ... and with a sample time, the sampled θ_r certificate instead (docs/sampled.md §10.4: 3.8-6.6
+#: ms per triple at H = 0.1 s; about 250 continuous triples' 2e-5 s).
+_SAMPLED_REACTION_COST = 250.0
 
 
 # --------------------------------------------------------------------------- Taylor on a grid
@@ -116,7 +120,9 @@ def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, in
     out["sup_gain"] = b.sup_gain.reshape(shape)
     out["margin"] = b.margin.reshape(shape)
     if CONTINUOUS in spec.methods:
-        c = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway)
+        # the continuous loop at the same parameters, θ_r included (issue 25 item 3)
+        c = certify_batch(*full, tau=p.tau, delta=p.delta, headway=p.headway,
+                          reaction_delay=_reaction(p))
         out["verdict_continuous"] = codes(c.verdict).reshape(shape)
         out["hurwitz_continuous"] = np.asarray(c.stable).reshape(shape)
     return out
@@ -338,9 +344,12 @@ def region_map(
         θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25): with θ_r > 0,
         ``exact`` is the continuous certificate of :mod:`stringstab.certify.reaction` (the one
         method: the Taylor criteria are of the loop without θ_r; ``hurwitz`` is the proven
-        stability of the quasi-polynomial), in continuous time at one τ, δ, T* only (with a
-        sample time or an interval, the certificate's refusal is raised before any work).
-        θ_r = 0 (the default) computes the map it always did, bit for bit.
+        stability of the quasi-polynomial); with ``sample_time``, ``exact`` is the sampled θ_r
+        certificate (:mod:`stringstab.certify.sampled_reaction`, docs/sampled.md §10) and
+        ``continuous`` the continuous one with the same θ_r; an interval is the θ_r box
+        certificate, in continuous time (with a sample time, or what else no certificate
+        answers, the certificate's refusal is raised before any work).  θ_r = 0 (the
+        default) computes the map it always did, bit for bit.
 
     Returns
     -------
@@ -390,6 +399,8 @@ def region_map(
     blocks = grid_blocks(n0, n1, n2, target)
     cost = (_COST[H is not None, box] * (30.0 if P is not None else 1.0) + (CONTINUOUS in ms)) * (
         _REACTION_COST if theta else 1.0)
+    if theta and H is not None:  # the sampled θ_r certificate (issue 25 item 3)
+        cost = _SAMPLED_REACTION_COST + (_REACTION_COST if CONTINUOUS in ms else 0.0)
     seconds = n * (_EXACT_SECONDS_PER_POINT * cost if exact else 0.0) + n * _TAYLOR_SECONDS_PER_POINT
     if workers is None:
         workers = 1 if seconds < _PARALLEL_SECONDS and executor is None else cpu_count()

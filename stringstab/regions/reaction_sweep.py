@@ -92,11 +92,13 @@ class ReactionSweep:
         Returns
         -------
         dict
-            ``params`` (τ, δ, T*), ``axes``, ``fixed``, ``rows``.
+            ``params`` (τ, δ, T*), ``sample_time`` (H, of a sampled sweep only), ``axes``,
+            ``fixed``, ``rows``.
         """
         meta = self.maps[0].metadata()
+        H = {} if "sample_time" not in meta else {"sample_time": meta["sample_time"]}
         return {"params": {k: v for k, v in meta["params"].items() if k != "reaction_delay"},
-                "axes": meta["axes"], "fixed": meta["fixed"], "rows": self.rows()}
+                **H, "axes": meta["axes"], "fixed": meta["fixed"], "rows": self.rows()}
 
     def report(self) -> str:
         """Lines for people: each map's first line, then the table of the certified share.
@@ -194,8 +196,8 @@ def reaction_sweep(
 ) -> ReactionSweep:
     """The region map of the same grid at each reaction delay θ_r, and the certified share.
 
-    Every θ_r is checked, and the loop refused (θ_r > 0 is certified in continuous time at
-    one τ, δ, T* only so far), before any map is computed.
+    Every θ_r is checked, and a loop no certificate answers refused (θ_r over a box with a
+    sample time, θ_r beyond what the sampled lifting takes), before any map is computed.
 
     Parameters
     ----------
@@ -206,8 +208,8 @@ def reaction_sweep(
     tau, delta, headway : float
         τ, δ, T* (s) of the continuous loop.
     sample_time : float, optional
-        Refused with θ_r > 0 (the certificate's refusal); accepted for θ_r = 0 only if every
-        θ_r is 0, which a strictly increasing list of 2 or more is not.
+        H (s): every map is the sampled one (at θ_r > 0 the sampled θ_r certificate,
+        :mod:`stringstab.certify.sampled_reaction`; at θ_r = 0 the sampled certificate).
     **options
         Passed on to :func:`~stringstab.regions.region_map` (``workers``, ``block``,
         ``progress``, ``executor``); ``methods`` other than ``exact`` are refused (at θ_r > 0
@@ -221,7 +223,7 @@ def reaction_sweep(
     Raises
     ------
     StringStabError
-        Bad θ_r values, a sampled or box loop, or methods other than ``exact``.
+        Bad θ_r values, a loop no certificate answers, or methods other than ``exact``.
 
     Examples
     --------

@@ -1,9 +1,11 @@
-"""The result of a region map: :class:`RegionMap`, its classes, shares, columns and files.
+"""The result of a region map: :class:`RegionMap`, its classes, shares and summary.
 
 A :class:`RegionMap` holds every per-point verdict of :func:`stringstab.regions.region_map`
-and owns what is computed from them (class maps, shares, disagreements, the per-point
-columns, the summary) and its files (:meth:`RegionMap.save_npz`, :meth:`RegionMap.save_csv`,
-:func:`load_npz`, in the formats of :mod:`stringstab.regions.files`).
+and owns what is computed from them (class maps, shares, disagreements, the summary, a
+slice).  Its files (metadata, per-point columns, :meth:`RegionMap.save_npz`,
+:meth:`RegionMap.save_csv`, :func:`load_npz`) are :mod:`stringstab.regions.storage`'s job;
+the methods here call it.  The names and codes (:data:`GAIN_NAMES`, :data:`VERDICT_LABELS`,
+the classes) are :mod:`stringstab.regions.codes`', re-exported here.
 """
 
 from __future__ import annotations
@@ -18,68 +20,22 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify.criteria import TYPE_NAMES
-from ..certify.verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, VERDICTS, Verdict
+from ..certify.verdicts import INCONCLUSIVE, Verdict
 from ..errors import StringStabError
-from ..io import atomic_write_text, dumps_json
 from ..params import Box, Params
-from .files import FORMAT, csv_text, read_npz, write_npz
+from . import storage
+from .codes import CERTIFICATE_METHODS, EXACT_CLASSES, STABLE, TYPE_CLASSES, TYPE_TO_CLASS, UNSTABLE
+from .codes import CONTINUOUS as CONTINUOUS  # kept importable from here (their home: codes)
+from .codes import GAIN_NAMES as GAIN_NAMES
+from .codes import METHODS as METHODS
+from .codes import VERDICT_LABELS as VERDICT_LABELS
 from .report import render_report
 
-__all__ = [
-    "CONTINUOUS",
-    "EXACT_CLASSES",
-    "GAIN_NAMES",
-    "METHODS",
-    "STABLE",
-    "TYPE_CLASSES",
-    "UNSTABLE",
-    "VERDICT_LABELS",
-    "RegionMap",
-    "describe_params",
-    "load_npz",
-]
+# the names and codes stay importable from here (stringstab.regions.result.VERDICT_LABELS, ...);
+# their home is stringstab.regions.codes
+__all__ = ["RegionMap", "describe_params", "load_npz"]
 
 Array = npt.NDArray[np.float64]
-
-#: The gains, in the order of K = [k_x, k_v, k_a] (IDL eq 4).
-GAIN_NAMES: tuple[str, str, str] = ("k_x", "k_v", "k_a")
-#: The methods a map of the continuous loop at one τ, δ, T* can evaluate (the default set).
-METHODS: tuple[str, str, str] = ("exact", "taylor", "printed")
-#: The comparison method of a sampled-data map: the continuous-time certificate at the same
-#: parameters (or box), beside ``exact`` (the sampled certificate).
-CONTINUOUS = "continuous"
-#: Every method's per-point codes are the verdict codes (:mod:`stringstab.certify.verdicts`):
-#: 0 says string stable, 1 says not, 2 cannot tell.
-STABLE, UNSTABLE = CERTIFIED, NOT_CERTIFIED
-#: The labels of those codes for a certificate: the verdicts themselves.
-_CERTIFICATE_LABELS: tuple[str, str, str] = (VERDICTS[0].value, VERDICTS[1].value,
-                                             VERDICTS[2].value)
-#: The labels of those codes for the Taylor methods (derived and printed Ψ, IDL Proposition 1).
-#: They say "stable" / "unstable", never "certified": a test on a Taylor approximation of the
-#: delay is not a certificate (it can call unstable gains stable), so its answer must not read
-#: as the certificate's.  Code 2 is never produced by them; its label is kept for a uniform table.
-_APPROXIMATION_LABELS: tuple[str, str, str] = ("stable", "unstable", Verdict.INCONCLUSIVE.value)
-#: Labels of the codes 0, 1, 2 per method.
-VERDICT_LABELS: dict[str, tuple[str, str, str]] = {
-    "exact": _CERTIFICATE_LABELS,
-    "taylor": _APPROXIMATION_LABELS,
-    "printed": _APPROXIMATION_LABELS,
-    CONTINUOUS: _CERTIFICATE_LABELS,
-}
-#: Methods decided by a certificate (tri-state verdicts, the classes of :data:`EXACT_CLASSES`).
-_CERTIFICATES = ("exact", CONTINUOUS)
-#: Classes of the ``taylor`` and ``printed`` class maps, by code 0-4.
-TYPE_CLASSES: tuple[str, ...] = (
-    "not internally stable", "type III", "type IV", "type I", "type II",
-)
-#: Classes of the ``exact`` class map, by code 0-3: not internally stable, then the verdicts.
-EXACT_CLASSES: tuple[str, ...] = (
-    "not internally stable", Verdict.NOT_CERTIFIED.words, Verdict.INCONCLUSIVE.words,
-    Verdict.CERTIFIED.words,
-)
-# stability_type code (1 = I, ..., 4 = IV) -> TYPE_CLASSES code
-_TYPE_TO_CLASS = np.array([0, 3, 4, 1, 2], dtype=np.int8)
 
 
 @dataclass(frozen=True, eq=False)
@@ -240,7 +196,7 @@ class RegionMap:
             If ``method`` was not evaluated in this map.
         """
         self._check_method(method)
-        return EXACT_CLASSES if method in _CERTIFICATES else TYPE_CLASSES
+        return EXACT_CLASSES if method in CERTIFICATE_METHODS else TYPE_CLASSES
 
     def classes(self, method: str) -> npt.NDArray[np.int8]:
         """Class code of every point for the class map of ``method``.
@@ -266,7 +222,7 @@ class RegionMap:
             If ``method`` was not evaluated in this map.
         """
         self._check_method(method)
-        if method in _CERTIFICATES:
+        if method in CERTIFICATE_METHODS:
             v = self.verdict[method]
             stable = self.hurwitz if method == "exact" else self.hurwitz_continuous
             assert stable is not None
@@ -277,7 +233,7 @@ class RegionMap:
             return c
         t = self.type if method == "taylor" else self.type_printed
         assert t is not None
-        c = _TYPE_TO_CLASS[t]
+        c = TYPE_TO_CLASS[t]
         return np.where(self.hurwitz, c, np.int8(0)).astype(np.int8)
 
     def class_shares(self) -> dict[str, dict[str, float]]:
@@ -303,7 +259,7 @@ class RegionMap:
         for m in self.methods:
             counts = np.bincount(self.verdict[m].ravel(), minlength=3)
             out[m] = {lab: float(c) / self.size for lab, c in zip(VERDICT_LABELS[m], counts)
-                      if m in _CERTIFICATES or lab != Verdict.INCONCLUSIVE}
+                      if m in CERTIFICATE_METHODS or lab != Verdict.INCONCLUSIVE}
         return out
 
     def disagreements(self) -> dict[str, int]:
@@ -399,42 +355,20 @@ class RegionMap:
         )
 
     # ---------------------------------------------------------------- files
+    # (stringstab.regions.storage: the map's files apart from the map)
     def metadata(self) -> dict[str, Any]:
-        """Parameters, axes, methods, code tables and the tool version (for files)."""
-        return {
-            "format": FORMAT,
-            "stringstab_version": self.version,
-            "params": self.params.as_dict(),
-            **({} if self.sample_time is None else {"sample_time": self.sample_time}),
-            **({} if self.message_period is None else {"message_period": self.message_period}),
-            **({"heterogeneous": self.heterogeneous}
-               if self.sample_time is not None and self.is_box else {}),
-            "axes": {n: {"min": float(a[0]), "max": float(a[-1]), "n": int(a.size)}
-                     for n, a in self.axes.items()},
-            "fixed": dict(self.fixed),
-            "methods": list(self.methods),
-            "verdict_labels": {m: list(VERDICT_LABELS[m]) for m in self.methods},
-            "type_names": {str(k): v for k, v in TYPE_NAMES.items()},
-        }
+        """Parameters, axes, methods, code tables and the tool version (for files).
+
+        See :func:`stringstab.regions.storage.metadata`.
+        """
+        return storage.metadata(self)
 
     def fields(self) -> dict[str, npt.NDArray[Any]]:
-        """The per-point arrays by name (``hurwitz``, ``type``, ``verdict_<method>``, ...)."""
-        f: dict[str, npt.NDArray[Any]] = {"hurwitz": self.hurwitz}
-        if self.type is not None:
-            f["type"] = self.type
-        if self.hurwitz_continuous is not None:
-            f["hurwitz_continuous"] = self.hurwitz_continuous
-        if self.type_printed is not None:
-            f["type_printed"] = self.type_printed
-        for m, code in self.verdict.items():
-            f[f"verdict_{m}"] = code
-        for m, ok in self.prop1.items():
-            f[f"prop1_{m}"] = ok
-        if self.sup_gain is not None:
-            f["sup_gain"] = self.sup_gain
-        if self.margin is not None:
-            f["margin"] = self.margin
-        return f
+        """The per-point arrays by name (``hurwitz``, ``type``, ``verdict_<method>``, ...).
+
+        See :func:`stringstab.regions.storage.fields`.
+        """
+        return storage.fields(self)
 
     _fields = fields  # the name used before RegionMap owned its columns
 
@@ -443,7 +377,8 @@ class RegionMap:
 
         ``k_x, k_v, k_a``, ``hurwitz``, ``type`` (I-IV), ``type_printed``, one verdict
         column per method (its labels, :data:`VERDICT_LABELS`), ``sup_gain`` and
-        ``margin`` (when evaluated): the columns of :meth:`save_csv`.
+        ``margin`` (when evaluated): the columns of :meth:`save_csv`
+        (:func:`stringstab.regions.storage.columns`).
 
         Examples
         --------
@@ -453,52 +388,12 @@ class RegionMap:
         >>> list(m.columns()), m.columns()["taylor"].tolist()
         (['k_x', 'k_v', 'k_a', 'hurwitz', 'type', 'taylor'], ['unstable', 'unstable', 'unstable', 'unstable'])
         """
-        cached = self.__dict__.get("_columns")
-        if cached is None:
-            cached = {k: np.asarray(v) for k, v in self._categorical_columns().items()}
-            object.__setattr__(self, "_columns", cached)  # computed once (the map is immutable)
-        return dict(cached)
+        return storage.columns(self)
 
     @property
     def n_columns(self) -> int:
         """Number of :meth:`columns` (without forming them)."""
-        return len(self._categorical_columns())
-
-    def _categorical_columns(self) -> dict[str, Any]:
-        """:meth:`columns` with the coordinates and labels as :class:`~stringstab.io.Categorical`.
-
-        Categorical columns are codes into a few distinct values: what the CSV writer formats
-        fastest.
-        """
-        cached = self.__dict__.get("_categorical")
-        if cached is not None:
-            return dict(cached)
-        from ..io import Categorical
-
-        shape = self.shape
-        cols: dict[str, Any] = {}
-        index = np.indices(shape).reshape(len(shape), -1)
-        axis_pos = {name: i for i, name in enumerate(self.axis_names)}
-        for name in GAIN_NAMES:  # the axes' values, or the fixed value, spread over the grid
-            if name in axis_pos:
-                cols[name] = Categorical(index[axis_pos[name]], np.asarray(self.axes[name], float))
-            else:
-                cols[name] = Categorical(np.zeros(self.size, dtype=np.intp),
-                                         np.asarray([self.fixed[name]], dtype=float))
-        names = np.array(["", *TYPE_NAMES.values()])
-        cols["hurwitz"] = self.hurwitz.ravel()
-        if self.type is not None:
-            cols["type"] = Categorical(self.type.ravel(), names)
-        if self.type_printed is not None:
-            cols["type_printed"] = Categorical(self.type_printed.ravel(), names)
-        for m in self.methods:
-            cols[m] = Categorical(self.verdict[m].ravel(), np.array(VERDICT_LABELS[m]))
-        if self.sup_gain is not None:
-            cols["sup_gain"] = self.sup_gain.ravel()
-        if self.margin is not None:
-            cols["margin"] = self.margin.ravel()
-        object.__setattr__(self, "_categorical", cols)  # computed once (the map is immutable)
-        return dict(cols)
+        return len(storage.categorical_columns(self))
 
     def records(self) -> list[dict[str, Any]]:
         """:meth:`columns` as one dict per grid point (small maps; use the columns for large)."""
@@ -506,63 +401,47 @@ class RegionMap:
         return [dict(zip(cols, row)) for row in zip(*(c.tolist() for c in cols.values()))]
 
     def save_npz(self, path: str | os.PathLike[str]) -> Path:
-        """Write the map to a compressed NPZ file with its metadata.
+        """Write the map to a compressed NPZ file with its metadata, atomically.
 
-        The archive holds ``axis_<gain>`` coordinates, one array per field
-        (``hurwitz``, ``type``, ``verdict_<method>``, ...) and ``metadata``, a
-        JSON string with the parameters and the tool version.  Read it back with
-        :func:`load_npz`.
+        The archive holds ``axis_<gain>`` coordinates, one array per field and ``metadata``
+        (JSON: the parameters and the tool version); :func:`load_npz` reads it back
+        (:func:`stringstab.regions.storage.save_npz`).
 
         Parameters
         ----------
         path : str or path-like
-            The file to write (atomically).
+            The file to write.
 
         Returns
         -------
         Path
             ``path``.
         """
-        return write_npz(path, self.axes, self.fields(), self.metadata())
+        return storage.save_npz(self, path)
 
     def save_csv(self, path: str | os.PathLike[str]) -> Path:
-        """Write one CSV row per grid point, after ``#`` lines with the metadata.
+        """Write one CSV row per grid point (columns :meth:`columns`), after ``#`` metadata lines.
 
-        Columns: :meth:`columns`.  The first line is ``# stringstab <version> region
-        map``, the second ``# `` followed by :meth:`metadata` as JSON; then the header
-        and the rows, written column by column (:mod:`stringstab.io`'s writer: numbers
-        in their shortest round-trip form, booleans ``True``/``False``, a non-finite
-        number, such as ``sup_gain`` where Γ is not internally stable, as an empty field).
+        See :func:`stringstab.regions.storage.save_csv` for the layout; written atomically.
 
         Parameters
         ----------
         path : str or path-like
-            The file to write (atomically).
+            The file to write.
 
         Returns
         -------
         Path
             The file written.
         """
-        return atomic_write_text(path, self.csv_text(), what="region map CSV")
+        return storage.save_csv(self, path)
 
     def csv_text(self, rows: builtins.slice | None = None, *, head: bool = True) -> str:
         """The text of :meth:`save_csv`, or of the grid points ``rows`` only (C order).
 
         ``head=False`` leaves out the ``#`` lines and the header, so that the texts of
-        consecutive row ranges concatenate to the whole file (two processes can write one).
-
-        Parameters
-        ----------
-        rows : slice, optional
-            The grid points (flattened in C order) to write; None for all.
-        head : bool
-            Start with the ``#`` lines and the header.
-
-        Returns
-        -------
-        str
-            The CSV text.
+        consecutive row ranges concatenate to the whole file
+        (:func:`stringstab.regions.storage.csv_text`).
 
         Examples
         --------
@@ -572,12 +451,7 @@ class RegionMap:
         >>> m.csv_text(slice(0, 2)) + m.csv_text(slice(2, None), head=False) == m.csv_text()
         True
         """
-        comments = [f"stringstab {self.version} region map",
-                    dumps_json(self.metadata(), indent=None).rstrip("\n")] if head else None
-        cols = self._categorical_columns()
-        if rows is not None:
-            cols = {k: v[rows] for k, v in cols.items()}
-        return csv_text(cols, comments)
+        return storage.csv_text(self, rows, head=head)
 
 
 def load_npz(path: str | os.PathLike[str]) -> RegionMap:
@@ -586,7 +460,7 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
     Parameters
     ----------
     path : str or path-like
-        The NPZ file.
+        The NPZ file (read by :func:`stringstab.regions.storage.read_map`).
 
     Returns
     -------
@@ -599,32 +473,7 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
     StringStabError
         If the file is not a stringstab region map.
     """
-    meta, data = read_npz(path)
-    need = ("methods", "params", "axes", "fixed", "stringstab_version")
-    missing = [k for k in need if k not in meta]
-    arrays = ["hurwitz", *(f"axis_{n}" for n in meta.get("axes", ())),
-              *(f"verdict_{m}" for m in meta.get("methods", ()))]
-    missing += [k for k in arrays if k not in data]
-    if missing:
-        raise StringStabError(f"{path}: expected a region map with {', '.join(missing)}; "
-                              f"found metadata keys {sorted(meta)} and arrays {sorted(data)}")
-    methods = tuple(meta["methods"])
-    p = meta["params"]
-    params: Params | Box = (Box(*(tuple(p[k]) for k in ("tau", "delta", "headway")))
-                            if isinstance(p["tau"], list) else Params(**p))
-    return RegionMap(
-        axes={n: data[f"axis_{n}"] for n in meta["axes"]},
-        fixed={k: float(v) for k, v in meta["fixed"].items()},
-        params=params, methods=methods,
-        hurwitz=data["hurwitz"], type=data.get("type"),
-        verdict={m: data[f"verdict_{m}"] for m in methods},
-        prop1={m: data[f"prop1_{m}"] for m in methods if f"prop1_{m}" in data},
-        type_printed=data.get("type_printed"), sup_gain=data.get("sup_gain"),
-        margin=data.get("margin"), version=meta["stringstab_version"],
-        sample_time=meta.get("sample_time"), heterogeneous=bool(meta.get("heterogeneous", True)),
-        hurwitz_continuous=data.get("hurwitz_continuous"),
-        message_period=meta.get("message_period"),
-    )
+    return RegionMap(**storage.read_map(path))
 
 
 def describe_params(p: Params | Box) -> str:

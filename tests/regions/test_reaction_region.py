@@ -3,7 +3,9 @@
 Independent truths: the map with ``--reaction-delay 0`` against the map of the command without
 the flag (bit for bit); the per-θ_r shares of a sweep against separate single-θ_r maps; the
 certified points of a θ_r map against a fine frequency sweep of |Γ(jω)| written here from the
-model of issue 25 (complex arithmetic, not the generated code).
+model of issue 25 (complex arithmetic, not the generated code); with ``--sample-time`` (issue 25
+item 3), the point certificates and, for θ_r and δ whole numbers of steps, a fine sweep of the
+sampled loop's H(e^{jθ}) built here from scipy's expm (the command shifted by θ_r/H steps).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import csv
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
 
 import stringstab as ss
 from stringstab.certify.verdicts import codes
@@ -138,12 +141,20 @@ def test_cli_sweep_writes_slices_table_and_figure(tmp_path, capsys):
         (["--reaction-delay", "-0.1"], "reaction delay θ_r"),
         (["--reaction-delay", "nan"], "reaction delay θ_r"),
         (["--reaction-delay", "101"], "reaction"),
-        (["--reaction-delay", "0.2", "--sample-time", "0.1"],
-         "reaction_delay > 0 with a sample time is certified"),
+        # a point θ_r with --sample-time is mapped (below); a box of θ_r with a sample time
+        # and the multi-rate loop with θ_r are refused, before any work
+        (["--reaction-delay", "0.1:0.3", "--sample-time", "0.1"],
+         "θ_r over a parameter box is certified in continuous time"),
+        (["--reaction-delay", "0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
+         "θ_r over a parameter box is certified in continuous time"),
+        (["--reaction-delay", "0,0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
+         "θ_r over a parameter box is certified in continuous time"),
+        (["--reaction-delay", "0.2", "--sample-time", "0.05", "--message-period", "0.1"],
+         "message"),
+        (["--reaction-delay", "0,0.2", "--sample-time", "0.1", "--compare", "continuous"],
+         "evaluates 'exact'"),
         # a box with θ_r (--tau 0.1:0.2 with θ_r, --reaction-delay 0.1:0.3) is mapped by the
         # θ_r box certificate: tests/certify/test_robust_reaction.py
-        (["--reaction-delay", "0,0.2", "--sample-time", "0.1"],
-         "reaction_delay > 0 with a sample time is certified"),
         (["--reaction-delay", "0,0.2", "--delta", "0.1:0.2"], "needs one τ, δ, T*"),
         (["--reaction-delay", "0,-0.2"], "reaction delay θ_r"),
         (["--reaction-delay", "0.2,0.1"], "strictly increasing"),
@@ -161,3 +172,72 @@ def test_bad_reaction_delay_exits_2_with_one_line_and_writes_nothing(tmp_path, c
     assert err.startswith("stringstab region: error:") and match in err, err
     assert err.count("\n") == 1
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- θ_r with a sample time
+def sampled_abs(theta, kx, kv, ka, *, tau, delta, headway, H, reaction_delay):
+    """|H(e^{jθ})| of the sampled loop (ZOH, period H) with θ_r = qH and δ = mH, from expm.
+
+    The command held over step k is u_{k−q}; the vehicle's P(z) over a held step is
+    (zI − Φ)⁻¹Γ, so the loop is the sampled one with P(z) z^{−q} (the shift by q steps).
+    """
+    q, m = round(reaction_delay / H), round(delta / H)
+    assert abs(q * H - reaction_delay) < 1e-12 and abs(m * H - delta) < 1e-12
+    M = np.zeros((4, 4))
+    M[0, 1] = M[1, 2] = 1.0
+    M[2, 2], M[2, 3] = -1.0 / tau, 1.0 / tau
+    E = expm(M * H)
+    Phi, G = E[:3, :3], E[:3, 3]
+    z = np.exp(1j * np.asarray(theta))
+    X = np.array([np.linalg.solve(zz * np.eye(3) - Phi, G) for zz in z]) * (z ** -q)[:, None]
+    Pp, Pv, Pa = X[:, 0], X[:, 1], X[:, 2]
+    num = kx * Pp + kv * Pv + ka * Pa * z ** (-m)
+    return np.abs(num / (1.0 + kx * (Pp + headway * Pv) + kv * Pv))
+
+
+SAMPLED = ["--range", "k_x=0.1,1.5", "--range", "k_v=0,1.5", "--n", "5", "--sample-time", "0.1"]
+
+
+def test_a_reaction_delay_with_a_sample_time_maps_the_sampled_certificate(tmp_path, capsys):
+    # issue 25 item 3: once refused, now the sampled θ_r certificate on a coarse grid
+    out = tmp_path / "m"
+    argv = [a for a in BASE if a not in ("--n", "7")]
+    assert main([*argv, *SAMPLED, "--reaction-delay", "0.2", "--compare", "continuous",
+                 "--out", str(out)]) == 0
+    head = capsys.readouterr().out.splitlines()[0]
+    assert "θ_r = 0.2 s" in head and "sampled Δt = 0.1 s" in head, head
+    m = load_npz(out / "region.npz")
+    assert m.sample_time == 0.1 and m.methods == ("exact", "continuous")
+    assert m.metadata()["params"] == {**P, "reaction_delay": 0.2}
+    kx, kv, ka = (g.ravel() for g in m.gains())
+    opts = {**P, "sample_time": 0.1, "reaction_delay": 0.2}
+    ref = ss.certify_batch(kx, kv, ka, **opts)
+    assert np.array_equal(m.verdict["exact"].ravel(), codes(ref.verdict))
+    assert np.array_equal(m.hurwitz.ravel(), np.asarray(ref.stable))
+    assert np.array_equal(m.verdict["exact"].ravel(), codes(ss.check(kx, kv, ka, **opts).verdict))
+    # the comparison is the continuous loop with the same θ_r, not the loop without it
+    cont = ss.certify_batch(kx, kv, ka, **P, reaction_delay=0.2)
+    assert np.array_equal(m.verdict["continuous"].ravel(), codes(cont.verdict))
+    assert 0 < (ref.verdict == "certified").sum() < kx.size  # the grid crosses the boundary
+    # independent: H(e^{jθ}) of the loop built here from expm, on a fine θ grid
+    th = np.linspace(1e-4, np.pi, 4001)
+    for i in range(kx.size):
+        peak = sampled_abs(th, kx[i], kv[i], ka[i], **P, H=0.1, reaction_delay=0.2).max()
+        if ref.verdict[i] == "certified":
+            assert peak <= 1.0 + 1e-9, (kx[i], kv[i], ka[i], peak)
+        elif ref.stable[i] and ref.verdict[i] == "not_certified":
+            assert peak > 1.0 - 1e-9, (kx[i], kv[i], ka[i], peak)  # its witness is real
+    assert {"region_class_exact.png", "region_compare.png", "region.csv"} <= set(_files(out))
+
+
+def test_a_sampled_sweep_over_reaction_delays_equals_its_single_maps():
+    axes = {"k_x": np.linspace(0.1, 1.5, 4), "k_v": np.linspace(0.0, 1.5, 4)}
+    s = reaction_sweep(axes, {"k_a": 0.5}, reaction_delays=[0.0, 0.2], **P, sample_time=0.1,
+                       workers=1, progress=False)
+    assert s.summary()["sample_time"] == 0.1
+    plain = region_map(axes, {"k_a": 0.5}, **P, sample_time=0.1, workers=1, progress=False)
+    assert np.array_equal(s.maps[0].verdict["exact"], plain.verdict["exact"])  # θ_r = 0: today's
+    single = region_map(axes, {"k_a": 0.5}, **P, sample_time=0.1, reaction_delay=0.2,
+                        workers=1, progress=False)
+    assert np.array_equal(s.maps[1].verdict["exact"], single.verdict["exact"])
+    assert s.maps[1].sample_time == 0.1 and s.maps[1].params.reaction_delay == 0.2

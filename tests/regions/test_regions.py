@@ -228,6 +228,23 @@ def test_npz_round_trip_keeps_fields_parameters_and_version(tmp_path, slice_map)
     assert meta["params"] == {"tau": TAU, "delta": DELTA, "headway": HEADWAY}
 
 
+def test_files_split_from_the_result_keep_every_import_path(tmp_path, slice_map):
+    # issue 32 item 5: the map's files live in regions/storage, the names in regions/codes;
+    # the methods and the old import paths give the same files and objects
+    from stringstab.regions import codes, result, storage
+
+    for name in ("CONTINUOUS", "EXACT_CLASSES", "GAIN_NAMES", "METHODS", "STABLE",
+                 "TYPE_CLASSES", "UNSTABLE", "VERDICT_LABELS"):
+        assert getattr(result, name) is getattr(codes, name)
+    assert result.load_npz is load_npz
+    a = slice_map.save_csv(tmp_path / "a.csv").read_text()
+    b = storage.save_csv(slice_map, tmp_path / "b.csv").read_text()
+    assert a == b == slice_map.csv_text()
+    assert slice_map.metadata() == storage.metadata(slice_map)
+    back = load_npz(storage.save_npz(slice_map, tmp_path / "m.npz"))
+    assert back.csv_text() == a  # the reader rebuilds the map the writer saved
+
+
 def test_load_npz_rejects_other_files(tmp_path):
     np.savez(tmp_path / "x.npz", a=np.arange(3))
     with pytest.raises(StringStabError, match="metadata"):
