@@ -18,13 +18,13 @@ lemma gives D(z) = χ_f(z; K)/χ_f(z; 0), χ_f(z; 0) = (z − 1)²(z − e^{−H
 Rosenbrock system matrix of the whole link gives
 
 .. math::
-    R(z; K) = \det\begin{bmatrix} zI - A & B\\ -C & D_0\end{bmatrix}
-            = \det(zI - A)\,H(z) = χ_o(z)\,χ_f(z; 0)\,N(z),
+    R(z; K) = \det S(z) = \det(zI - A)\,H(z) = χ_o(z)\,χ_f(z; 0)\,N(z),\qquad
+    S(z) = [zI - A,\ B;\ -C,\ D_0],
 
 χ_o(z) = det(zI − A_oo) the predecessor's and the buffer's block (independent of K).  Hence
 
 .. math::
-    g_{H,θ_r}(θ; K) = \frac{τ^2\,\bigl(|χ_f(z; K)|^2 - |R(z; K)/χ_o(z)|^2\bigr)}
+    g_{H,θ_r}(θ; K) = \frac{τ^2\,\left(|χ_f(z; K)|^2 - |R(z; K)/χ_o(z)|^2\right)}
                            {H^4\,|z - 1|^2\,(1 + τ^2 ω_H^4)},
     \qquad z = e^{jθ},\quad ω_H = |z - 1|/H,
 
