@@ -7,6 +7,10 @@ again here), how many came from the NLP or from the certified-map fallback, the 
 largest distance moved, and the median wall time per call, with the machine's load.
 
     python analysis/reaction_tune_check.py --n 40 --thetas 0.1,0.2,0.3
+    python analysis/reaction_tune_check.py --n 20 --sample-time 0.1   # the sampled loop
+
+With ``--sample-time H`` the triples are those of the lattice the sampled certificate certifies
+at θ_r = 0 and not at θ_r, repaired and re-checked for the sampled loop with θ_r.
 """
 
 from __future__ import annotations
@@ -31,9 +35,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--n", type=int, default=40, help="triples per θ_r (default 40)")
     ap.add_argument("--thetas", default="0.1,0.2,0.3", help="θ_r values, s")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--sample-time", type=float, default=None, help="H, s (the sampled loop)")
     a = ap.parse_args(argv)
     rng = np.random.default_rng(a.seed)
     base = certified_lattice(-2.0, 2.0, 21, Params(**P))
+    kw = dict(P)
+    if a.sample_time is not None:
+        kw["sample_time"] = a.sample_time
+        base = base[ss.check(*base.T, **kw).verdict == "certified"]
+        print(f"sampled loop, H = {a.sample_time:g} s")
     print(f"load {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores; {len(base)} certified "
           "lattice points at θ_r = 0 (21³ over [−2, 2]³)")
     print("| θ_r (s) | triples | certified (re-checked) | by the NLP | map fallback | "
@@ -41,15 +51,15 @@ def main(argv: list[str] | None = None) -> int:
     print("|---|---|---|---|---|---|---|")
     bad = 0
     for th in (float(v) for v in a.thetas.split(",")):
-        lost = base[ss.check(*base.T, **P, reaction_delay=th).verdict != "certified"]
+        lost = base[ss.check(*base.T, **kw, reaction_delay=th).verdict != "certified"]
         pick = lost[rng.choice(len(lost), size=min(a.n, len(lost)), replace=False)]
         ok = nlp = fb = 0
         dist, secs = [], []
         for K in pick:
             t = time.perf_counter()
-            r = project(K, **P, reaction_delay=th)
+            r = project(K, **kw, reaction_delay=th)
             secs.append(time.perf_counter() - t)
-            again = ss.certify(*r.k, **P, reaction_delay=th).verdict == "certified"
+            again = ss.certify(*r.k, **kw, reaction_delay=th).verdict == "certified"
             assert again == r.certified, (K, r)
             ok += again
             fb += bool(r.details.get("fallback"))

@@ -1,7 +1,9 @@
 """``stringstab derive``: print the derived Γ(s), Ψ1-Ψ3, Λ, gradients and Hurwitz conditions.
 
 With ``--sample-time H``: the sampled-data loop instead (H(z), the characteristic polynomial
-Δ(z) and its Schur conditions; :func:`stringstab.derive.derivation.sampled_derivation`).
+Δ(z) and its Schur conditions; :func:`stringstab.derive.derivation.sampled_derivation`); with
+a reaction delay θ_r > 0 too, the sampled link's H(z) and χ_f(z) with θ_r
+(:func:`stringstab.derive.sampled_reaction.sampled_reaction_derivation`).
 
 SymPy is imported when the command runs, not when it is registered.  ``--out`` is checked
 before anything is derived and written atomically; a bad path is one line and exit code 2.
@@ -60,8 +62,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--reaction-delay", metavar="SECONDS",
                    help="derive the loop with a reaction delay θ_r on the whole command (issue 25): "
                         "Γ(s) with its quasi-polynomial denominator, g_θ(ω), Ψ with θ_r and the "
-                        "Taylor route's (wrong) Hurwitz tests; the same as --substitute "
-                        "reaction_delay=SECONDS")
+                        "Taylor route's (wrong) Hurwitz tests; with --sample-time the sampled "
+                        "link's H(z) and characteristic polynomial with θ_r; the same as "
+                        "--substitute reaction_delay=SECONDS")
     p.add_argument("--sample-time", metavar="H",
                    help="derive the sampled-data loop with period H s instead (H(z), Δ(z), Schur "
                         "conditions); --substitute may also set tau_prev")
@@ -112,6 +115,29 @@ def _check_substitutions(args: argparse.Namespace) -> None:
         warn_beyond_sensible(args, [(kind, x, f"--substitute {name.strip()}")])
 
 
+def _substituted_reaction_delay(text: str | None) -> float:
+    """θ_r of ``--substitute reaction_delay=S`` (or ``--reaction-delay``), 0 when absent.
+
+    Checked by the one check of θ_r (:func:`stringstab.params.check_reaction_delay`): a value
+    that is not a finite number ≥ 0 is one line, exit 2.
+    """
+    from ..params import check_reaction_delay
+
+    theta = 0.0
+    for item in (text or "").split(","):
+        name, sep, value = item.partition("=")
+        if sep and name.strip() == "reaction_delay":
+            theta = check_reaction_delay(value.strip(), "--substitute reaction_delay")
+    return theta
+
+
+def _without_reaction_delay(text: str | None) -> str | None:
+    """``--substitute`` without ``reaction_delay=0`` (θ_r = 0 is the sampled loop of today)."""
+    if not text:
+        return text
+    return ",".join(x for x in text.split(",") if x.partition("=")[0].strip() != "reaction_delay")
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``derive``; ``--out`` is checked before any derivation.
 
@@ -136,11 +162,7 @@ def run(args: argparse.Namespace) -> int:
     if theta is not None:  # θ_r (issue 25): checked as certify checks it, then substituted
         from ..params import check_reaction_delay
 
-        check_reaction_delay(theta, "--reaction-delay (reaction delay θ_r)")
-        if args.sample_time is not None:
-            raise StringStabError(
-                "reaction_delay > 0 is derived in continuous time only so far; expected no "
-                f"--sample-time with --reaction-delay; got --sample-time {args.sample_time}")
+        theta = check_reaction_delay(theta, "--reaction-delay (reaction delay θ_r)")
         args.substitute = ",".join(x for x in (args.substitute, f"reaction_delay={theta}") if x)
     H = None
     if args.sample_time is not None:
@@ -159,8 +181,17 @@ def run(args: argparse.Namespace) -> int:
 
     args.format = resolve_format(args.format, args.out, ("text", "latex", "json"), default="text")
     out = check_output_file(args.out, what="--out") if args.out else None
-    d = (sampled_derivation(H, args.substitute) if H is not None
-         else derivation(delay_order, args.substitute, args.errata))
+    theta_r = _substituted_reaction_delay(args.substitute)
+    if H is not None and theta_r:  # θ_r with a sample time (issue 25): its own derivation
+        from ..certify.lifting_reaction import check_reaction_sampled
+        from ..derive.sampled_reaction import sampled_reaction_derivation
+
+        check_reaction_sampled(theta_r, H)  # the certificate's limit (q ≤ 2000), one line
+        d = sampled_reaction_derivation(H, theta_r, args.substitute)
+    elif H is not None:
+        d = sampled_derivation(H, _without_reaction_delay(args.substitute))
+    else:
+        d = derivation(delay_order, args.substitute, args.errata)
     text = {"json": d.json, "text": d.text, "latex": d.latex}[args.format]()
     if out is not None:
         atomic_write_text(out, text, what="--out")

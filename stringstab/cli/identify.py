@@ -91,8 +91,8 @@ def add_parser(sub: Any) -> None:
                         "distance setting, all its logs fitted jointly (cars.json)")
     p.add_argument("--fit-delay", action=argparse.BooleanOptionalAction, default=None,
                    help="fit the reaction delay θ_r on the whole law beside the lag τ and certify "
-                        "with it (default: on, except with --sample-time, which has no θ_r "
-                        "certificate yet)")
+                        "with it (default: on; with --sample-time the sampled certificate with θ_r, "
+                        "slower at small H)")
     p.add_argument("--baselines", action="store_true",
                    help="also calibrate IDM and OVRV on the same segments and judge their "
                         "linearisations (slower: the IDM is simulated step by step)")
@@ -158,10 +158,8 @@ def run(args: argparse.Namespace) -> int:
             for lg in read_logs(path, min_duration=min_seg)]
     warn_beyond_sensible(args, [("sample_time", H, "--sample-time"), ("refits", B, "--bootstrap"),
                                 ("starts", starts, "--starts")])
-    if args.fit_delay and H is not None:
-        raise StringStabError("--fit-delay certifies θ_r in continuous time only so far; expected it "
-                              f"without --sample-time (got --sample-time {H:g})")
-    fit_delay = H is None if args.fit_delay is None else bool(args.fit_delay)
+    # θ_r fitted by default, with a sample time too (the sampled certificate with θ_r, issue 25)
+    fit_delay = True if args.fit_delay is None else bool(args.fit_delay)
     opts = dict(sample_time=H, bootstrap=B, block=block, n_starts=starts, seed=seed, min_duration=min_seg,
                 progress=not args.no_progress, baselines=args.baselines, screen=not args.no_screen,
                 fit_delay=fit_delay)

@@ -42,6 +42,7 @@ examples:
   stringstab tune 0.9,-0.5,1.1 --sample-time 0.1      # certified for the loop sampled at 10 Hz
   stringstab tune 0.9,-0.5,1.1 --tau 0.1:0.2 --delta 0.15:0.25   # for every τ, δ in the box
   stringstab tune 1.2,0.5,0.6 --reaction-delay 0.2    # certified with the command 0.2 s late
+  stringstab tune 0.5,0.4,0 --tau 0.5 --delta 0.1 --headway 1.5 --sample-time 0.1 --reaction-delay 0.2
 
 input files: as for `stringstab certify` (CSV with a header k_x,k_v,k_a and
 optional t, vehicle; JSON; NPZ).
@@ -49,7 +50,8 @@ optional t, vehicle; JSON; NPZ).
 with --sample-time or a LO:HI interval the projection repairs to gains certified for
 that loop (sampled, or every member of the box); region growing (a continuous-time
 Taylor test at one tau, delta, headway) takes neither. With --reaction-delay S > 0 the
-projection repairs to gains certified with the reaction delay (continuous time only so far).
+projection repairs to gains certified with the reaction delay, continuous or sampled (at one
+tau, delta, headway: a box with a reaction delay is refused).
 
 output: per input and method, the input gains (k_x_in, ...), the output gains,
 whether the output is certified by the exact certificate, the status
@@ -93,7 +95,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--reaction-delay", metavar="SECONDS",
                    help="reaction (actuation) delay θ_r in s, >= 0, on the whole command "
                         "(τ a' = u(t − θ_r) − a): the projection repairs to gains certified with "
-                        "it; continuous time only so far (default: 0)")
+                        "it, continuous or with --sample-time (default: 0)")
     p.add_argument("--bounds", default="-2,2", metavar="LO,HI",
                    help="bounds on every gain (default: -2,2, IDL Table 2)")
     p.add_argument("--weights", default="1,1,1", metavar="WX,WV,WA",

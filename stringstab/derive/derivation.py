@@ -223,7 +223,12 @@ def _impact(impact: dict[str, Any]) -> str:
 
 
 def _text(exprs: dict[str, Any], doc: dict[str, Any], labels: dict[str, tuple[str, str]]) -> str:
-    if "sample_time" in doc:
+    if "sample_time" in doc and "reaction_delay" in doc:
+        lines = [f"# stringstab derive --sample-time {doc['sample_time']} --reaction-delay "
+                 f"{doc['reaction_delay']}: the sampled-data loop with a reaction delay "
+                 "(zero-order hold, exact lag, delay and reaction delay), derived from the IDL "
+                 "model (eqs 3-9)", f"# delay: {doc['delay']}", f"# reaction: {doc['reaction']}"]
+    elif "sample_time" in doc:
         lines = [f"# stringstab derive --sample-time {doc['sample_time']}: the sampled-data loop "
                  "(zero-order hold, exact lag and delay), derived from the IDL model (eqs 3-9)",
                  f"# delay: {doc['delay']}"]

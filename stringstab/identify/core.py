@@ -99,8 +99,7 @@ def check_settings(s: Settings) -> None:
     Raises
     ------
     StringStabError
-        An unknown model, a negative bootstrap count, a block that is not a positive number,
-        θ_r fitted for the sampled certificate (which has no θ_r yet).
+        An unknown model, a negative bootstrap count, a block that is not a positive number.
     """
     if s.model not in PARAMETERS:
         raise StringStabError(f"model must be 'acc' or 'cacc'; got {show(s.model)}")
@@ -108,9 +107,6 @@ def check_settings(s: Settings) -> None:
         raise StringStabError(f"bootstrap must be an integer >= 0; got {show(s.bootstrap)}")
     if not (math.isfinite(s.block) and s.block > 0):
         raise StringStabError(f"block must be a number of seconds > 0; got {show(s.block)}")
-    if s.fit_delay and s.sample_time is not None:
-        raise StringStabError("fit_delay certifies θ_r in continuous time only so far; expected it "
-                              f"without a sample time (got {show(s.sample_time)})")
 
 
 def identify(log: PlatoonLog | Sequence[PlatoonLog], model: str = "acc", *,

@@ -11,6 +11,9 @@ constraint of the NLP is a *quadratic form in the gains*:
   a is affine, b, c_x, c_v are quadratic;
 * the sampled margin g_H(θ; K) (:func:`stringstab.certify.sampled_frequency.sampled_margin`) is one too: every
   w-coefficient of Δ(w) and n(w) is affine in K, and g_H is a sum of products of two of them;
+* with a reaction delay θ_r > 0, sampled, the margin g_{H,θ_r}(θ; K) of
+  :mod:`stringstab.tuning.sampled_reaction_margin` (|χ_f|² − |N χ_f(·; 0)|², the follower's
+  characteristic polynomial and the link's numerator, both affine in K) is one too;
 * so are the internal-stability conditions: the Hurwitz conditions (linear,
   :func:`stringstab.certify.criteria.hurwitz_conditions`) and the normalised Schur conditions of the
   sampled loop (:func:`stringstab.certify.schur.schur_margins`).
@@ -165,22 +168,19 @@ class LoopConstraints:
         self.heterogeneous = bool(heterogeneous)
         self.box = Box.of(params)
         lo, hi = self.box.reaction_delay
-        if hi and (not isinstance(params, Params) or sample_time is not None):
-            # θ_r > 0 beyond the continuous point loop: the certificate's own refusal line
+        if hi:
+            # θ_r > 0: the certificate's own refusal line first (a message period, q > 2000, ...)
             from ..certify.api import Loop
 
             Loop(params, sample_time)
             if not isinstance(params, Params):
-                # a box with θ_r is certified (continuous time) but its constraints are not written
+                # a box with θ_r is certified but its constraints are not written
                 raise StringStabError(
-                    "tuning takes θ_r at a point in continuous time (the box certificate with θ_r "
-                    "is certify's); expected a point τ, δ, T* with reaction_delay, got "
+                    "tuning takes θ_r at a point (the box certificate with θ_r is certify's); "
+                    "expected a point τ, δ, T* with reaction_delay, got "
                     f"reaction_delay={lo:g}" + (f":{hi:g}" if hi != lo else "") + " with a box")
-            raise StringStabError(  # a sampled point loop: certified, not tuned yet
-                "reaction_delay > 0 with a sample time is certified (certify, check) but not "
-                "tuned yet; expected reaction_delay=0 with a sample time; got "
-                f"reaction_delay={hi:g} with sample_time={sample_time!r}")
-        #: The reaction delay θ_r (s) of the continuous point loop (issue 25); 0 otherwise.
+        #: The reaction delay θ_r (s) of the point loop, continuous or sampled (issue 25); 0
+        #: otherwise.
         self.reaction_delay = float(lo)
 
     @property
@@ -246,7 +246,10 @@ class LoopConstraints:
         """The margin g (or g_H, sampled) at ``member`` on frequencies ``freq`` for the gains K.
 
         Taken from the one home of each margin (:func:`stringstab.certify.margin.g`,
-        :func:`stringstab.certify.sampled_frequency.sampled_margin`).
+        :func:`stringstab.certify.sampled_frequency.sampled_margin`; with θ_r > 0
+        :func:`stringstab.certify.margin_reaction.g` and, sampled,
+        :func:`stringstab.tuning.sampled_reaction_margin.sampled_reaction_margin`: the
+        certificate's own link model, its margin a positive multiple of 1 − |H(e^{jθ})|²).
 
         Parameters
         ----------
@@ -263,6 +266,8 @@ class LoopConstraints:
             g(ω) = (|D(jω)|² − |N(jω)|²)/ω² (≥ 0 iff |Γ(jω)| ≤ 1), or the normalised sampled
             margin g_H(θ), at each frequency.
         """
+        if self.reaction_delay and self.sampled:  # θ_r > 0 sampled: g_{H,θ_r}, quadratic in K
+            return self._sampled_reaction(member, freq, K)
         if self.reaction_delay:  # θ_r > 0: g_θ of its one home (issue 25)
             return _margin_reaction.g(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                                       headway=member.headway, reaction_delay=self.reaction_delay)
@@ -274,6 +279,23 @@ class LoopConstraints:
         return sampled_margin(freq, K[0], K[1], K[2], tau=member.tau, delta=member.delta,
                               headway=member.headway, sample_time=self.H,
                               tau_prev=member.tau_prev)
+
+    def _sampled_reaction(self, member: Member, freq: Array, K: Array) -> Array:
+        """g_{H,θ_r} (:mod:`stringstab.tuning.sampled_reaction_margin`) shaped as ``freq``.
+
+        ``K`` holds three floats (the result has the shape of ``freq``) or three arrays of
+        one shape (one frequency: the result has the arrays' shape).
+        """
+        from .sampled_reaction_margin import sampled_reaction_margin
+
+        p = Params(member.tau, member.delta, member.headway, self.reaction_delay)
+        kx, kv, ka = (np.asarray(k, dtype=float) for k in K)
+        f = np.asarray(freq, dtype=float)
+        g = sampled_reaction_margin(f.ravel(), kx.ravel(), kv.ravel(), ka.ravel(), p, self.H,
+                                    tau_prev=member.tau_prev)
+        if kx.ndim == 0:
+            return np.asarray(g[0].reshape(f.shape))
+        return np.asarray(g[:, 0].reshape(kx.shape))
 
     def margin_slot(self, member: Member, freq: float) -> Slot:
         """The constraint g(freq; K) ≥ ε at ``member``, as a quadratic form in K.
@@ -312,6 +334,9 @@ class LoopConstraints:
         function D(s) = τs³ + s² + e^{−θ_r s}((k_v + T*k_x)s + k_x) is real on the real axis,
         D(0) = k_x and D(σ) → +∞, so k_x ≤ 0 puts a root on [0, ∞) (necessary, not
         sufficient: internal stability is the certificate's, which decides every output).
+        Sampled with θ_r > 0: the two normalised necessary Schur conditions of the follower
+        block's characteristic polynomial χ_f(z; K), at z = 1 (k_x) and z = −1
+        (:func:`stringstab.tuning.sampled_reaction_margin.stability_conditions`).
 
         Parameters
         ----------
@@ -326,6 +351,13 @@ class LoopConstraints:
             (:func:`stringstab.certify.schur.schur_margins`), ``index`` 0, 1, …; with θ_r > 0,
             k_x alone (index 0).
         """
+        if self.reaction_delay and self.sampled:  # two necessary Schur conditions of χ_f
+            from .sampled_reaction_margin import stability_conditions
+
+            p = Params(member.tau, member.delta, member.headway, self.reaction_delay)
+            both = np.array([quadratic_form(lambda x, v, a: stability_conditions(x, v, a, p, self.H)[0]),
+                             quadratic_form(lambda x, v, a: stability_conditions(x, v, a, p, self.H)[1])])
+            return [Slot("stability", member, math.nan, i, f) for i, f in enumerate(both)]
         if self.reaction_delay:
             return [Slot("stability", member, math.nan, 0, quadratic_form(lambda x, v, a: x))]
         def conditions(x: Array, v: Array, a: Array) -> Array:
@@ -386,7 +418,9 @@ class LoopConstraints:
             The minimisers: ω (rad/s) or θ (rad/sample), at most 12.
         """
         top = math.pi
-        if self.reaction_delay:  # θ_r > 0: the scan below on [0, Ω], g_θ > 0 beyond Ω (proven)
+        if self.reaction_delay and self.sampled:  # θ_r > 0 sampled: the scan below on [0, π]
+            pass
+        elif self.reaction_delay:  # θ_r > 0: the scan below on [0, Ω], g_θ > 0 beyond Ω (proven)
             Q = _margin_reaction.coefficient_table(
                 np.array([K[0]]), np.array([K[1]]), np.array([K[2]]), member.tau, member.delta,
                 member.headway, self.reaction_delay)

@@ -160,10 +160,13 @@ def project(
     predictor : bool
         Try the Newton predictor before IPOPT (default); False: IPOPT only.
     reaction_delay : float
-        θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25; continuous loop at
-        one τ, δ, T* only so far): the margin is g_θ (:mod:`stringstab.certify.margin_reaction`),
-        taken as quadratic forms in K as for the sampled loop, with k_x ≥ ``hurwitz_margin``;
-        the certificate with θ_r (:mod:`stringstab.certify.reaction`) decides every output.
+        θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25; at one τ, δ, T*,
+        continuous or with ``sample_time``): the margin is g_θ
+        (:mod:`stringstab.certify.margin_reaction`) or, sampled, g_{H,θ_r}
+        (:mod:`stringstab.tuning.sampled_reaction_margin`), taken as quadratic forms in K as
+        for the sampled loop, with k_x ≥ ``hurwitz_margin``; the certificate with θ_r
+        (:mod:`stringstab.certify.reaction`, :mod:`stringstab.certify.sampled_reaction`)
+        decides every output.
 
     Returns
     -------

@@ -148,10 +148,11 @@ class Projector:
         Try the Newton predictor before IPOPT (see :func:`project`).
     reaction_delay : float
         θ_r ≥ 0 (s), the reaction delay on the whole command (issue 25): with θ_r > 0 the
-        gains are certified by :mod:`stringstab.certify.reaction` (continuous point loop only
-        so far; otherwise that certificate's refusal is raised).  The exchange then runs on
-        the quadratic forms of g_θ(ω_j; K) (:mod:`stringstab.tuning.constraints`) under
-        k_x ≥ ``hurwitz_margin``, without the predictor.
+        gains are certified by :mod:`stringstab.certify.reaction` or, with ``sample_time``, by
+        :mod:`stringstab.certify.sampled_reaction` (a point loop only; a box is refused).
+        The exchange then runs on the quadratic forms of g_θ(ω_j; K) or g_{H,θ_r}(θ_j; K)
+        (:mod:`stringstab.tuning.constraints`) under k_x ≥ ``hurwitz_margin`` (and, sampled,
+        the condition of χ_f at z = −1), without the predictor.
     warm_from_previous : bool
         Start IPOPT from the previous output when it is nearer to K0 than the
         nearest map point.  Off by default: on a 2,000-step random walk it made
@@ -213,7 +214,9 @@ class Projector:
         if self.loop is not None:
             # a sampled box's certificate is the slow one: an 11³ map (72 points at
             # Δt = 0.1 s, τ ∈ [0.1, 0.2], δ ∈ [0.15, 0.25] s: 3.5 s) instead of 21³ (33.6 s)
-            n = 11 if self.loop.sampled and isinstance(self.params, Box) else 21
+            # (and with θ_r > 0 sampled: its lifted certificate is slower still)
+            n = 11 if self.loop.sampled and (isinstance(self.params, Box)
+                                             or self.loop.reaction_delay) else 21
             return _loop_map(self.loop.box, self.sample_time, self.loop.heterogeneous,
                              *self.bounds, self.hurwitz_margin, n)
         p = self._point

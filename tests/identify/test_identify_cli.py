@@ -132,7 +132,6 @@ def _dropouts(h, c):
     (None, ["--model", "cacc"], "needs the predecessor's acceleration"),
     (None, ["--bootstrap", "-1"], "--bootstrap must be an integer >= 0"),
     (None, ["--sample-time", "0"], "--sample-time must be a number of seconds > 0"),
-    (None, ["--sample-time", "0.1", "--fit-delay"], "--fit-delay certifies θ_r in continuous time only"),
 ])
 def test_identify_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str], mutate, args, message) -> None:
     log = _csv(tmp_path / "log.csv", duration=60.0, mutate=mutate)
@@ -188,3 +187,47 @@ def test_identify_fit_delay_cli(tmp_path: Path, capsys: pytest.CaptureFixture[st
     sim = json.loads((tmp_path / "sim" / "metrics.json").read_text(encoding="utf-8"))
     assert sim["run"]["reaction_delay"] == r["reaction_delay"]  # the fitted θ_r, simulated
     assert sim["certificate"]["reaction_delay"] == r["reaction_delay"]
+
+
+def test_identify_fit_delay_with_a_sample_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--sample-time with θ_r fitted (the default, issue 25): the verdict and sup|Γ| are the sampled
+    certificate's with θ_r at the fitted parameters, sup|Γ| agrees with a fine sweep of the
+    certificate's link |H(e^{jθ})| (an independent resolvent, no branch and bound), and
+    ``certify --from --sample-time`` re-certifies the same; ``--no-fit-delay`` keeps θ_r = 0."""
+    import stringstab as ss
+    from stringstab.certify.lifting import lifted_response
+    from stringstab.certify.lifting_reaction import lift_reaction
+    from stringstab.identify import FollowerModel
+    from stringstab.params import Params
+    from tests.identify_sim import car_log
+
+    lg = car_log(FollowerModel(0.2, 0.5, 0.0, 0.3, 0.0, 1.2, 4.0, 0.4), (12, 20, 9, 16), ramp=4.0, seed=3)
+    t = lg.t
+    path = tmp_path / "delayed.csv"
+    rows = ["t,v_lead,v,gap"] + [f"{t[k]:.1f},{lg.speed[0, k]:.5f},{lg.speed[1, k]:.5f},{lg.gap[1][k]:.4f}"
+                                 for k in range(t.size)]
+    path.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "run"
+    assert main(["identify", str(path), "--sample-time", "0.1", "--bootstrap", "2", "--starts", "1",
+                 "--no-figures", "--no-progress", "--out", str(out)]) == 0
+    capsys.readouterr()
+    doc = json.loads((out / "identify.json").read_text())
+    [r] = doc["vehicles"]
+    assert abs(r["reaction_delay"] - 0.4) < 0.1
+    H, theta = 0.1, r["reaction_delay"]
+    c = ss.certify(r["k_x"], r["k_v"], r["k_a"], tau=r["tau"], delta=r["delta"], headway=r["headway"],
+                   reaction_delay=theta, sample_time=H)
+    assert c.verdict == r["verdict"] and float(c.sup_gain) == pytest.approx(r["sup_gain"], rel=1e-12)
+    link = lift_reaction(np.array([r["k_x"]]), np.array([r["k_v"]]), np.array([r["k_a"]]),
+                         Params(r["tau"], r["delta"], r["headway"], reaction_delay=theta), H, 1)
+    sweep = np.abs(lifted_response(link, np.linspace(1e-4, np.pi, 20_001))[0, :, 0, 0]).max()
+    assert sweep == pytest.approx(r["sup_gain"], rel=1e-4)
+    assert (r["verdict"] == "not_certified") == (sweep > 1 + 1e-6)
+    main(["certify", "--from", str(out / "identify.json"), "--sample-time", "0.1", "--format", "json"])
+    [cr] = json.loads(capsys.readouterr().out)["results"]
+    assert cr["verdict"] == r["verdict"] and cr["sup_gain"] == pytest.approx(r["sup_gain"], rel=1e-9)
+    out2 = tmp_path / "run2"
+    assert main(["identify", str(path), "--sample-time", "0.1", "--no-fit-delay", "--bootstrap", "0",
+                 "--starts", "1", "--no-figures", "--no-progress", "--out", str(out2)]) == 0
+    [r2] = json.loads((out2 / "identify.json").read_text())["vehicles"]
+    assert r2.get("reaction_delay", 0.0) == 0.0

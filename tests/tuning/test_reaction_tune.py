@@ -64,9 +64,9 @@ def test_projection_certifies_with_the_reaction_delay():
 
 
 def test_the_refusals_pass_through():
-    with pytest.raises(ss.StringStabError, match=r"with a sample time is certified .* not tuned yet"):
-        Projector(**P, sample_time=0.1, reaction_delay=0.2)
-    with pytest.raises(ss.StringStabError, match="tuning takes θ_r at a point in continuous time"):
+    with pytest.raises(ss.StringStabError, match="at most 2000 whole samples"):
+        Projector(**P, sample_time=0.001, reaction_delay=3.0)  # the certificate's own refusal
+    with pytest.raises(ss.StringStabError, match="tuning takes θ_r at a point"):
         project(K0, tau=(0.1, 0.2), delta=0.2, headway=1.1, reaction_delay=0.2)
     with pytest.raises(ss.StringStabError, match="region growing"):
         tune(K0, "region-growing", **P, reaction_delay=0.2)
@@ -110,10 +110,11 @@ def test_cli_tune_reaction_delay_zero_is_unchanged(capsys):
         (["--reaction-delay", "-0.1"], "reaction delay θ_r"),
         (["--reaction-delay", "nan"], "reaction delay θ_r"),
         (["--reaction-delay", "101"], "reaction"),
-        (["--reaction-delay", "0.2", "--sample-time", "0.1"],
-         "reaction_delay > 0 with a sample time is certified"),
-        (["--reaction-delay", "0.2", "--tau", "0.1:0.2"],
-         "tuning takes θ_r at a point in continuous time"),
+        (["--reaction-delay", "0.2", "--tau", "0.1:0.2"], "tuning takes θ_r at a point"),
+        (["--reaction-delay", "0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
+         "θ_r over a parameter box"),  # the certificate's own refusal
+        (["--reaction-delay", "0.2", "--sample-time", "0.1", "--method", "region-growing"],
+         "region growing"),
         (["--reaction-delay", "0.2", "--method", "both"], "region growing"),
     ],
 )
@@ -123,3 +124,12 @@ def test_cli_tune_bad_reaction_delay_exit_2(capsys, args, match):
     assert captured.out == ""
     assert captured.err.startswith("stringstab tune: error:") and match in captured.err, captured.err
     assert captured.err.count("\n") == 1
+
+
+def test_cli_tune_sampled_reaction_delay_beyond_the_certificate_exit_2(capsys):
+    """q = θ_r/H > 2000: the sampled certificate's refusal (after the sensible-range warning)."""
+    assert main(["tune", "1.2,0.5,0.6", "--reaction-delay", "1.5", "--sample-time", "0.0005"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    last = captured.err.splitlines()[-1]
+    assert last.startswith("stringstab tune: error:") and "at most 2000 whole samples" in last
