@@ -363,7 +363,18 @@ class PredecessorCells:
 
 
 def halves(cells: Array) -> tuple[Array, Array]:
-    """The two halves of cells (k, 2) at their midpoints, as the split search halves them."""
+    """The two halves of cells (k, 2) at their midpoints, as the split search halves them.
+
+    Parameters
+    ----------
+    cells : ndarray, shape (k, 2)
+        Intervals [lo, hi] along one parameter.
+
+    Returns
+    -------
+    tuple of ndarray
+        ([lo, mid], [mid, hi]) per row, the midpoint computed as the split search does.
+    """
     mid = cells.mean(axis=1)
     a, b = cells.copy(), cells.copy()
     a[:, 1] = b[:, 0] = mid
