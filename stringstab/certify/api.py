@@ -142,7 +142,7 @@ class Loop:
         if theta and H is not None:
             from .lifting_reaction import check_reaction_sampled
 
-            check_reaction_sampled(theta, H, self.message_steps)
+            check_reaction_sampled(theta, H)
         if theta and self.method == "pade":
             raise StringStabError(
                 "method='pade' (python-control's cross-check) has no reaction delay; expected "
@@ -397,7 +397,7 @@ def check(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -489,7 +489,7 @@ def certify_batch(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -591,7 +591,7 @@ def certify(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 
