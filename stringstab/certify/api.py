@@ -174,7 +174,7 @@ class Loop:
             The method of :func:`certify_batch`.
         reaction_delay : float
             θ_r ≥ 0 (s), the delay on the whole command (issue 25): certified in continuous
-            time and with ``sample_time`` (not with a box or a message period yet).
+            time and with ``sample_time`` (with a message period too; not with a box and a sample time).
         message_period, message_phase, fallback_gains : optional
             The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 

@@ -555,15 +555,30 @@ def certify_kernel(
     fx = kx if fallback is None else np.full(n, float(fallback[0]))
     fv = kv if fallback is None else np.full(n, float(fallback[1]))
     if p.reaction_delay:  # the fallback loop has the same θ_r (docs/sampled.md §10.5)
-        from .sampled_reaction import certify_kernel as reaction_kernel
-
-        fb = reaction_kernel(fx, fv, np.zeros(n), p, H, p.tau, chunk=4096)
+        fb_verdict, fb_sup = _reaction_fallback(fx, fv, p, H)
     else:
         fb = sampled_kernel(fx, fv, np.zeros(n), p, H, p.tau, chunk=4096)
+        fb_verdict, fb_sup = fb.verdict, fb.sup_gain
     return MultirateCertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, sample_time=H, message_period=N * H,
         message_steps=N, message_phase=phase, schur=sure, spectral_radius=rad,
         verdict=names(verdict), sup_gain=np.where(sure, sup, np.inf), linf_gain=sup,
         peak_theta=peak, peak_omega=peak / (N * H), margin=margin, n_evals=n_evals,
-        fallback_k_x=fx, fallback_k_v=fv, fallback_verdict=fb.verdict,
-        fallback_sup_gain=fb.sup_gain)
+        fallback_k_x=fx, fallback_k_v=fv, fallback_verdict=fb_verdict,
+        fallback_sup_gain=fb_sup)
+
+
+def _reaction_fallback(fx: Array, fv: Array, p: Params, H: float,
+                       ) -> tuple[npt.NDArray[np.str_], Array]:
+    """The fallback (ACC) loop with θ_r > 0: the sampled θ_r certificate's decision.
+
+    :func:`decide` at N = 1 with the grid of :data:`stringstab.certify.sampled_reaction.GRID`
+    (32) is that certificate's decision operation for operation; the peak (reporting) is
+    located by :func:`stringstab.certify.lifted_peak.lifted_peak`.
+    """
+    d = decide(fx, fv, np.zeros(fx.size), p, H, 1, n_grid=32)
+    sup = np.ones(fx.size)
+    need = np.flatnonzero((d.verdict != CERTIFIED) & d.sure)
+    if need.size:
+        sup[need] = lifted_peak(d.link.take(need), d.grid[need], d.argmin[need])[0]
+    return names(d.verdict), np.where(d.sure, sup, np.inf)

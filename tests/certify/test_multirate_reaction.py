@@ -175,8 +175,10 @@ def test_the_fallback_loop_has_the_reaction_delay():
     P = {"tau": 0.5, "delta": 0.1, "headway": 1.5, "sample_time": 0.1, "reaction_delay": 0.15}
     b = ss.certify_batch(*K, message_period=0.3, **P)
     acc = ss.certify_batch([0.5], [0.8], [0.0], **P)
-    assert b.fallback_verdict[0] == acc.verdict[0]
-    assert b.fallback_sup_gain[0] == acc.sup_gain[0]
+    assert b.fallback_verdict[0] == acc.verdict[0] == "not_certified"
+    assert b.fallback_sup_gain[0] == pytest.approx(acc.sup_gain[0], rel=1e-6)
+    ok = ss.certify_batch([0.2], [0.6], [0.0], message_period=0.3, **P)
+    assert ok.fallback_verdict[0] == "certified" and ok.fallback_sup_gain[0] == 1.0
 
 
 def test_the_largest_message_period_with_theta_r(tmp_path, capsys):
