@@ -130,6 +130,10 @@ class RegionMap:
     message_period : float or None
         The V2V message period N·H (s) of a multi-rate map (``exact`` is then the multi-rate
         certificate); None otherwise.
+    stability_undecided : ndarray of bool or None
+        θ_r box maps: internal stability over the box neither proven nor disproven within the
+        budget (``stability == "undecided"`` of the robust θ_r certificate); such points are
+        never drawn as "not internally stable".  None: no such point can occur.
     """
 
     axes: dict[str, Array]
@@ -148,6 +152,7 @@ class RegionMap:
     heterogeneous: bool = True
     hurwitz_continuous: npt.NDArray[np.bool_] | None = None
     message_period: float | None = None
+    stability_undecided: npt.NDArray[np.bool_] | None = None
 
     @property
     def is_box(self) -> bool:
@@ -273,6 +278,8 @@ class RegionMap:
             c = np.full(self.shape, 3, dtype=np.int8)
             c[v == UNSTABLE] = 1
             c[(v == UNSTABLE) & ~stable] = 0
+            if method == "exact" and self.stability_undecided is not None:  # not proven unstable
+                c[(v == UNSTABLE) & self.stability_undecided] = 1
             c[v == INCONCLUSIVE] = 2
             return c
         t = self.type if method == "taylor" else self.type_printed
@@ -395,7 +402,7 @@ class RegionMap:
             type_printed=take(self.type_printed), sup_gain=take(self.sup_gain),
             margin=take(self.margin), version=self.version, sample_time=self.sample_time,
             heterogeneous=self.heterogeneous, hurwitz_continuous=take(self.hurwitz_continuous),
-            message_period=self.message_period,
+            message_period=self.message_period, stability_undecided=take(self.stability_undecided),
         )
 
     # ---------------------------------------------------------------- files
@@ -424,6 +431,8 @@ class RegionMap:
             f["type"] = self.type
         if self.hurwitz_continuous is not None:
             f["hurwitz_continuous"] = self.hurwitz_continuous
+        if self.stability_undecided is not None:
+            f["stability_undecided"] = self.stability_undecided
         if self.type_printed is not None:
             f["type_printed"] = self.type_printed
         for m, code in self.verdict.items():
@@ -624,6 +633,7 @@ def load_npz(path: str | os.PathLike[str]) -> RegionMap:
         sample_time=meta.get("sample_time"), heterogeneous=bool(meta.get("heterogeneous", True)),
         hurwitz_continuous=data.get("hurwitz_continuous"),
         message_period=meta.get("message_period"),
+        stability_undecided=data.get("stability_undecided"),
     )
 
 
