@@ -133,11 +133,9 @@ class Loop:
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
         # -- the reaction delay θ_r (issue 25): over a box, in continuous time (item 4)
         if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0) and H is not None:
-            lo, hi = self.model.reaction_delay
-            raise StringStabError(
-                "θ_r over a parameter box is certified in continuous time; with sample_time="
-                f"{H!r} certify points of θ_r; got reaction_delay={lo:g}"
-                + (f":{hi:g}" if hi != lo else "") + " with a parameter box")
+            from .robust_reaction import sampled_box_refusal
+
+            raise StringStabError(sampled_box_refusal(self.model, H))
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
             from .lifting_reaction import check_reaction_sampled

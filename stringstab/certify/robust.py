@@ -366,9 +366,9 @@ def certify_kernel(
     reacting = box.reaction_delay != (0.0, 0.0)
     if reacting:
         if H is not None:
-            raise StringStabError(
-                "θ_r over a parameter box is certified in continuous time; with sample_time="
-                f"{H!r} certify points of θ_r; got reaction_delay={box.reaction_delay}")
+            from .robust_reaction import sampled_box_refusal
+
+            raise StringStabError(sampled_box_refusal(box, H))
         keys += ("reaction_delay", "stability")
     acc: dict[str, list[Array]] = {k: [] for k in keys}
     if H is not None:

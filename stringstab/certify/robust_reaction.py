@@ -58,7 +58,8 @@ from .branch_bound import PENDING, branch_and_bound
 from .quasipolynomial import count_unstable_roots
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, Check, Verdict
 
-__all__ = ["STABILITY", "box_margin_tail", "cell_cost", "certify_box_reaction", "stability_words"]
+__all__ = ["STABILITY", "box_margin_tail", "cell_cost", "certify_box_reaction", "sampled_box_refusal",
+           "stability_words"]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
@@ -323,6 +324,38 @@ def _own_evidence(kx: Array, kv: Array, ka: Array, box: Box,
 #: :func:`stringstab.certify.box_axis.axis_free` ran out) — never drawn as "not internally
 #: stable".
 STABILITY = ("stable", "unstable", "undecided")
+
+
+def sampled_box_refusal(box: Box, H: float) -> str:
+    """The one line refusing a box with θ_r > 0 and a sample time (no sound certificate yet).
+
+    Parameters
+    ----------
+    box : Box
+        The box (θ_r not (0, 0)).
+    H : float
+        The sample time, s.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from stringstab.params import check_box
+    >>> print(sampled_box_refusal(check_box("0.1:0.2", 0.2, 1.1, 0.2), 0.1))
+    θ_r > 0 over a parameter box is certified in continuous time only (the sampled-data loop has no sound θ_r box certificate yet); expected point values of tau, delta, headway and reaction_delay with sample_time=0.1 (each member certified on its own), or the box without sample_time; got tau=0.1:0.2, reaction_delay=0.2 with sample_time=0.1
+    """
+    def show(lo: float, hi: float) -> str:
+        return f"{lo:g}" if lo == hi else f"{lo:g}:{hi:g}"
+
+    parts = [f"{k}={show(*getattr(box, k))}" for k in ("tau", "delta", "headway")
+             if getattr(box, k)[0] != getattr(box, k)[1]]
+    parts.append(f"reaction_delay={show(*box.reaction_delay)}")
+    return ("θ_r > 0 over a parameter box is certified in continuous time only (the sampled-data "
+            "loop has no sound θ_r box certificate yet); expected point values of tau, delta, "
+            f"headway and reaction_delay with sample_time={H!r} (each member certified on its "
+            f"own), or the box without sample_time; got {', '.join(parts)} with sample_time={H!r}")
 
 
 def stability_words(stable: npt.NDArray[np.bool_],
