@@ -133,16 +133,14 @@ class Loop:
                 f"τ, δ, T*; got {'sample_time=' + repr(H) if H is not None else 'a parameter box'}")
         # -- the reaction delay θ_r (issue 25): over a box, in continuous time (item 4)
         if isinstance(self.model, Box) and self.model.reaction_delay != (0.0, 0.0) and H is not None:
-            lo, hi = self.model.reaction_delay
-            raise StringStabError(
-                "θ_r over a parameter box is certified in continuous time; with sample_time="
-                f"{H!r} certify points of θ_r; got reaction_delay={lo:g}"
-                + (f":{hi:g}" if hi != lo else "") + " with a parameter box")
+            from .robust_reaction import sampled_box_refusal
+
+            raise StringStabError(sampled_box_refusal(self.model, H))
         theta = Box.of(self.model).reaction_delay[1]
         if theta and H is not None:
             from .lifting_reaction import check_reaction_sampled
 
-            check_reaction_sampled(theta, H, self.message_steps)
+            check_reaction_sampled(theta, H)
         if theta and self.method == "pade":
             raise StringStabError(
                 "method='pade' (python-control's cross-check) has no reaction delay; expected "
@@ -174,7 +172,7 @@ class Loop:
             The method of :func:`certify_batch`.
         reaction_delay : float
             θ_r ≥ 0 (s), the delay on the whole command (issue 25): certified in continuous
-            time and with ``sample_time`` (not with a box or a message period yet).
+            time and with ``sample_time`` (with a message period too; not with a box and a sample time).
         message_period, message_phase, fallback_gains : optional
             The multi-rate loop, checked by :func:`stringstab.certify.message.message_schedule`.
 
@@ -397,7 +395,7 @@ def check(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     n_grid, max_rounds, max_intervals : int
         As for :func:`certify_batch`.
     message_period, message_phase
@@ -489,7 +487,7 @@ def certify_batch(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     method : {"exact", "pade"}
         ``"pade"`` additionally runs the python-control cross-check
         (:func:`stringstab.certify.pade.certify_pade`) per triple and warns where it disagrees; the
@@ -591,7 +589,7 @@ def certify(
         point of τ, δ, T*, with a sample time (:mod:`stringstab.certify.sampled_reaction`); an
         interval ``(lo, hi)`` or ``"LO:HI"``, or a point θ_r with intervals of τ, δ, T*, is the
         box certificate (:mod:`stringstab.certify.robust_reaction`), in continuous time only;
-        with a message period: refused.
+        with a message period too (:mod:`stringstab.certify.multirate`, docs/sampled.md §10.5).
     method, pade_order, message_period, message_phase, fallback_gains
         As for :func:`certify_batch`.
 

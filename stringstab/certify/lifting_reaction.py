@@ -94,20 +94,19 @@ def held_steps(theta_r: float, H: float) -> tuple[int, float, int]:
     return q, f, q + (1 if f > 0.0 else 0)
 
 
-def check_reaction_sampled(theta_r: float, H: float, message_steps: int | None = None) -> None:
-    """Refuse, in one line, a sampled loop with θ_r > 0 that no certificate answers.
+def check_reaction_sampled(theta_r: float, H: float) -> None:
+    """Refuse, in one line, a sampled loop with θ_r > 0 too long to build.
 
     Parameters
     ----------
     theta_r, H : float
-        θ_r > 0 and H > 0, s (each checked already).
-    message_steps : int, optional
-        N of a multi-rate loop (≥ 2 is refused: the multi-rate certificate has θ_r = 0 only).
+        θ_r > 0 and H > 0, s (each checked already).  A message period is lifted as well
+        (:func:`lift_reaction` with N ≥ 2; docs/sampled.md §10.5).
 
     Raises
     ------
     StringStabError
-        With a message period, or with q = ⌊θ_r/H⌋ > :data:`MAX_HELD_STEPS`.
+        With q = ⌊θ_r/H⌋ > :data:`MAX_HELD_STEPS`.
 
     Examples
     --------
@@ -117,11 +116,6 @@ def check_reaction_sampled(theta_r: float, H: float, message_steps: int | None =
     ...
     stringstab.errors.StringStabError: reaction_delay / sample_time must be at most 2000 whole samples (each adds two held-input states to the sampled loop); got reaction_delay=30 with sample_time=0.001: 30000 samples
     """
-    if message_steps is not None and message_steps >= 2:
-        raise StringStabError(
-            "reaction_delay > 0 is certified with a sample time but not with a message period "
-            f"yet; expected reaction_delay=0 or no message period; got reaction_delay={theta_r:g} "
-            f"with sample_time={H!r} and a message every {message_steps} steps")
     q, _, _ = held_steps(theta_r, H)
     if q > MAX_HELD_STEPS:
         raise StringStabError(

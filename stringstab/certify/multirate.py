@@ -143,7 +143,10 @@ class Decision:
     link : LiftedLink
         The lifted link of every row.
     delta : list of ndarray
-        δ0, δ1, δ2 of Δ(w) (spectral radius, reporting).
+        δ0, δ1, δ2 of Δ(w) (spectral radius, reporting); empty with θ_r > 0.
+    rho : ndarray or None
+        With θ_r > 0: the spectral radius of the computed one-step follower block
+        (reporting); None otherwise (computed from ``delta``).
     """
 
     verdict: npt.NDArray[np.int8]
@@ -155,6 +158,7 @@ class Decision:
     grid: Array
     link: LiftedLink
     delta: list[Array]
+    rho: Array | None = None
 
 
 def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
@@ -180,6 +184,9 @@ def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
     -------
     Decision
     """
+    if p.reaction_delay:
+        return _decide_reaction(kx, kv, ka, p, H, N, n_grid=n_grid, max_rounds=max_rounds,
+                                max_intervals=max_intervals)
     co, _ = point_coefficients(kx, kv, ka, p, H, p.tau)
     sure, fail = schur_bands(co.delta)
     link = lift(kx, kv, ka, p, H, N)
@@ -188,6 +195,35 @@ def decide(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
         max_intervals=max_intervals)
     return Decision(verdict, sure, fail, margin, argmin, n_evals, grid, link,
                     [d.lo for d in co.delta])
+
+
+def _decide_reaction(kx: Array, kv: Array, ka: Array, p: Params, H: float, N: int, *,
+                     n_grid: int | None, max_rounds: int, max_intervals: int) -> Decision:
+    """:func:`decide` with θ_r > 0: the held-input lift (docs/sampled.md §10.5).
+
+    Internal stability is decided on the one-step follower block A_f (3 + L states) by the
+    Stein inertia theorem, as the sampled θ_r certificate does: the lifted state matrix is
+    block triangular and its follower block is A_f^N (the message's hold enters through the
+    predecessor's states only), so it is Schur iff A_f is.  The frequency half is
+    :func:`decide_lifted` on the N-step lift.  At N = 1 this is
+    :func:`stringstab.certify.sampled_reaction.decide`, operation for operation (with its
+    grid).
+    """
+    from .lifting_reaction import follower_block, held_steps, lift_reaction
+    from .stein import stein_schur
+
+    _, _, L = held_steps(p.reaction_delay, H)
+    one = lift_reaction(kx, kv, ka, p, H, 1)
+    Af = follower_block(one, L)
+    sure, fail = stein_schur(Af)
+    link = one if N == 1 else lift_reaction(kx, kv, ka, p, H, N)
+    verdict, margin, argmin, n_evals, grid = decide_lifted(
+        link, sure, fail, n_grid=n_grid or _default_grid(N), max_rounds=max_rounds,
+        max_intervals=max_intervals)
+    with np.errstate(invalid="ignore"):
+        rho = np.array([np.abs(np.linalg.eigvals(a)).max() if np.all(np.isfinite(a)) else np.nan
+                        for a in Af.mid])
+    return Decision(verdict, sure, fail, margin, argmin, n_evals, grid, link, [], rho)
 
 
 def decide_lifted(link: LiftedLink, sure: npt.NDArray[np.bool_], fail: npt.NDArray[np.bool_], *,
@@ -511,18 +547,38 @@ def certify_kernel(
         d = decide(kx[sl], kv[sl], ka[sl], p, H, N, n_grid=n_grid, max_rounds=max_rounds,
                    max_intervals=max_intervals)
         verdict[sl], margin[sl], n_evals[sl], sure[sl] = d.verdict, d.margin, d.n_evals, d.sure
-        rad[sl] = spectral_radius_of(d.delta)
+        rad[sl] = spectral_radius_of(d.delta) if d.rho is None else d.rho
         need = np.flatnonzero(d.verdict != CERTIFIED)
         if need.size:
             s_, w_ = lifted_peak(d.link.take(need), d.grid[need], d.argmin[need])
             sup[sl][need], peak[sl][need] = s_, w_
     fx = kx if fallback is None else np.full(n, float(fallback[0]))
     fv = kv if fallback is None else np.full(n, float(fallback[1]))
-    fb = sampled_kernel(fx, fv, np.zeros(n), p, H, p.tau, chunk=4096)
+    if p.reaction_delay:  # the fallback loop has the same θ_r (docs/sampled.md §10.5)
+        fb_verdict, fb_sup = _reaction_fallback(fx, fv, p, H)
+    else:
+        fb = sampled_kernel(fx, fv, np.zeros(n), p, H, p.tau, chunk=4096)
+        fb_verdict, fb_sup = fb.verdict, fb.sup_gain
     return MultirateCertificateBatch(
         k_x=kx, k_v=kv, k_a=ka, params=p, sample_time=H, message_period=N * H,
         message_steps=N, message_phase=phase, schur=sure, spectral_radius=rad,
         verdict=names(verdict), sup_gain=np.where(sure, sup, np.inf), linf_gain=sup,
         peak_theta=peak, peak_omega=peak / (N * H), margin=margin, n_evals=n_evals,
-        fallback_k_x=fx, fallback_k_v=fv, fallback_verdict=fb.verdict,
-        fallback_sup_gain=fb.sup_gain)
+        fallback_k_x=fx, fallback_k_v=fv, fallback_verdict=fb_verdict,
+        fallback_sup_gain=fb_sup)
+
+
+def _reaction_fallback(fx: Array, fv: Array, p: Params, H: float,
+                       ) -> tuple[npt.NDArray[np.str_], Array]:
+    """The fallback (ACC) loop with θ_r > 0: the sampled θ_r certificate's decision.
+
+    :func:`decide` at N = 1 with the grid of :data:`stringstab.certify.sampled_reaction.GRID`
+    (32) is that certificate's decision operation for operation; the peak (reporting) is
+    located by :func:`stringstab.certify.lifted_peak.lifted_peak`.
+    """
+    d = decide(fx, fv, np.zeros(fx.size), p, H, 1, n_grid=32)
+    sup = np.ones(fx.size)
+    need = np.flatnonzero((d.verdict != CERTIFIED) & d.sure)
+    if need.size:
+        sup[need] = lifted_peak(d.link.take(need), d.grid[need], d.argmin[need])[0]
+    return names(d.verdict), np.where(d.sure, sup, np.inf)

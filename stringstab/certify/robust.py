@@ -225,14 +225,20 @@ class RobustReactionCertificate(RobustCertificate):
     ----------
     witness_reaction_delay : float
         θ_r of the witness member, s.
+    stability : str
+        Internal stability over the box in three states: ``"stable"`` (proven: ``stable``),
+        ``"unstable"`` (a member proven not) or ``"undecided"`` (the budget ran out)
+        (:data:`stringstab.certify.robust_reaction.STABILITY`).
     """
 
     witness_reaction_delay: float = 0.0
+    stability: str = "undecided"
 
 
 #: The robust table with the witness member's θ_r.
 REACTION_TABLE_COLUMNS: list[TableColumn] = [
-    *TABLE_COLUMNS[:-1], TableColumn("θ_r", "witness.reaction_delay", "%.4g"), TABLE_COLUMNS[-1],
+    *(TableColumn("stability", "stability") if c.key == "stable" else c for c in TABLE_COLUMNS[:-1]),
+    TableColumn("θ_r", "witness.reaction_delay", "%.4g"), TABLE_COLUMNS[-1],
 ]
 
 
@@ -244,6 +250,7 @@ class RobustReactionCertificateBatch(RobustCertificateBatch):
     TABLE: ClassVar[Sequence[TableColumn]] = REACTION_TABLE_COLUMNS
 
     witness_reaction_delay: Array = dataclasses.field(default_factory=lambda: np.zeros(0))
+    stability: npt.NDArray[np.str_] = dataclasses.field(default_factory=lambda: np.zeros(0, str))
 
     def __getitem__(self, i: int) -> RobustReactionCertificate:
         return super().__getitem__(i)  # type: ignore[return-value]
@@ -258,6 +265,7 @@ class RobustReactionCertificateBatch(RobustCertificateBatch):
         """
         cols = super().columns()
         cols["witness"]["reaction_delay"] = self.witness_reaction_delay
+        cols["stability"] = self.stability
         return cols
 
 
@@ -308,10 +316,10 @@ def certify_kernel(
     reacting = box.reaction_delay != (0.0, 0.0)
     if reacting:
         if H is not None:
-            raise StringStabError(
-                "θ_r over a parameter box is certified in continuous time; with sample_time="
-                f"{H!r} certify points of θ_r; got reaction_delay={box.reaction_delay}")
-        keys += ("reaction_delay",)
+            from .robust_reaction import sampled_box_refusal
+
+            raise StringStabError(sampled_box_refusal(box, H))
+        keys += ("reaction_delay", "stability")
     acc: dict[str, list[Array]] = {k: [] for k in keys}
     if H is not None:
         # the sampled loop's arithmetic is imported only when a sample time is given
@@ -348,7 +356,8 @@ def certify_kernel(
     )
     if reacting:
         return RobustReactionCertificateBatch(**fields,
-                                              witness_reaction_delay=cat("reaction_delay"))
+                                              witness_reaction_delay=cat("reaction_delay"),
+                                              stability=cat("stability", str))
     return RobustCertificateBatch(**fields)
 
 

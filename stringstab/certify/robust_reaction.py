@@ -58,7 +58,8 @@ from .branch_bound import PENDING, branch_and_bound
 from .quasipolynomial import count_unstable_roots
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, Check, Verdict
 
-__all__ = ["box_margin_tail", "cell_cost", "certify_box_reaction"]
+__all__ = ["STABILITY", "box_margin_tail", "cell_cost", "certify_box_reaction", "sampled_box_refusal",
+           "stability_words"]
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
@@ -317,6 +318,68 @@ def _own_evidence(kx: Array, kv: Array, ka: Array, box: Box,
             "margin": margin[i, j], "unstable": unstable}
 
 
+#: Internal stability over the box, three states (``stability``): every member proven stable;
+#: a member proven not (k_x ≤ 0, or roots in Re s ≥ 0 counted at the box's centre); neither
+#: proven within the budget (the centre's count or the axis bisection of
+#: :func:`stringstab.certify.box_axis.axis_free` ran out) — never drawn as "not internally
+#: stable".
+STABILITY = ("stable", "unstable", "undecided")
+
+
+def sampled_box_refusal(box: Box, H: float) -> str:
+    """The one line refusing a box with θ_r > 0 and a sample time (no sound certificate yet).
+
+    Parameters
+    ----------
+    box : Box
+        The box (θ_r not (0, 0)).
+    H : float
+        The sample time, s.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from stringstab.params import check_box
+    >>> print(sampled_box_refusal(check_box("0.1:0.2", 0.2, 1.1, 0.2), 0.1))
+    θ_r > 0 over a parameter box is certified in continuous time only (the sampled-data loop has no sound θ_r box certificate yet); expected point values of tau, delta, headway and reaction_delay with sample_time=0.1 (each member certified on its own), or the box without sample_time; got tau=0.1:0.2, reaction_delay=0.2 with sample_time=0.1
+    """
+    def show(lo: float, hi: float) -> str:
+        return f"{lo:g}" if lo == hi else f"{lo:g}:{hi:g}"
+
+    parts = [f"{k}={show(*getattr(box, k))}" for k in ("tau", "delta", "headway")
+             if getattr(box, k)[0] != getattr(box, k)[1]]
+    parts.append(f"reaction_delay={show(*box.reaction_delay)}")
+    return ("θ_r > 0 over a parameter box is certified in continuous time only (the sampled-data "
+            "loop has no sound θ_r box certificate yet); expected point values of tau, delta, "
+            f"headway and reaction_delay with sample_time={H!r} (each member certified on its "
+            f"own), or the box without sample_time; got {', '.join(parts)} with sample_time={H!r}")
+
+
+def stability_words(stable: npt.NDArray[np.bool_],
+                    unstable: npt.NDArray[np.bool_]) -> npt.NDArray[np.str_]:
+    """The three-state internal stability of :data:`STABILITY`, per triple.
+
+    Parameters
+    ----------
+    stable, unstable : ndarray of bool
+        Every member proven internally stable; a member proven not (never both).
+
+    Returns
+    -------
+    ndarray of str
+
+    Examples
+    --------
+    >>> stability_words(np.array([True, False, False]), np.array([False, True, False])).tolist()
+    ['stable', 'unstable', 'undecided']
+    """
+    assert not np.any(stable & unstable), "a box both proven stable and proven not"
+    return np.where(stable, STABILITY[0], np.where(unstable, STABILITY[1], STABILITY[2]))
+
+
 def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: int,
                          max_rounds: int, max_intervals: int, max_splits: int,
                          max_cells: int) -> dict[str, Array]:
@@ -344,7 +407,8 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
     -------
     dict of str to ndarray
         As :func:`stringstab.certify.robust_continuous.certify_box_continuous`, plus
-        ``reaction_delay``: the witness member's θ_r.
+        ``reaction_delay``: the witness member's θ_r, and ``stability``: the three-state
+        internal stability of :data:`STABILITY` (``stable`` is its first state only).
 
     Examples
     --------
@@ -411,7 +475,8 @@ def certify_box_reaction(kx: Array, kv: Array, ka: Array, box: Box, *, n_grid: i
             if e2[j] > 0:  # the frequency where |Γ| > 1 is seen (also when ω_w = 0)
                 w[i] = W[j]
     return {
-        "verdict": v, "stable": stable, "margin": margin, "omega": w, "theta": np.full(n, np.nan),
+        "verdict": v, "stable": stable, "stability": stability_words(stable, unstable),
+        "margin": margin, "omega": w, "theta": np.full(n, np.nan),
         "tau": member[:, 0], "tau_prev": member[:, 0].copy(), "delta": member[:, 1],
         "headway": member[:, 2], "reaction_delay": member[:, 3], "n_evals": n_evals,
         "sup_gain": sup, "sup_gain_excess": excess,

@@ -273,8 +273,8 @@ def check_vehicles(vehicles: Any, *, sample_time: Any = None,
     StringStabError
         One line saying which vehicle and what was expected: fewer than 2 or more than
         :data:`~stringstab.certify.head_to_tail.MAX_VEHICLES` vehicles, a missing, non-finite
-        or out-of-range value, a bad sample time, a reaction delay with a sample time (the
-        sampled loop has none yet).
+        or out-of-range value, a bad sample time, reaction delays that differ between the
+        vehicles of a sampled string (:mod:`stringstab.certify.head_to_tail_reaction`).
 
     Examples
     --------
@@ -293,13 +293,10 @@ def check_vehicles(vehicles: Any, *, sample_time: Any = None,
         raise StringStabError(f"a string has at most {MAX_VEHICLES} vehicles; got {len(vs)}")
     out = tuple(_vehicle(i, v) for i, v in enumerate(vs, start=1))
     H = None if sample_time is None else checked_sample_time(sample_time)
-    if H is not None:
-        late = [f"{i} ({v.name})" if v.name else str(i) for i, v in enumerate(out, start=1)
-                if v.reaction_delay > 0]
-        if late:
-            raise StringStabError(
-                f"vehicle {', '.join(late)} has a reaction delay θ_r > 0: the sampled-data loop "
-                "is certified with θ_r = 0 only so far (issue 25 part 3); drop --sample-time")
+    if H is not None:  # θ_r common to a sampled string (head_to_tail_reaction)
+        from .head_to_tail_reaction import check_common_reaction_delay
+
+        check_common_reaction_delay(out)
     if leader_tau is not None and H is None:
         raise StringStabError("leader_tau (the leader's lag) is for the sampled loop; got it "
                               "without sample_time")
@@ -334,10 +331,11 @@ def _vehicle_certificates(vehicles: Sequence[Vehicle], sample_time: float | None
         elif sample_time is None:
             out.append(continuous.certify_kernel(kx, kv, ka, p)[0])
         else:
-            from . import sampled
+            from . import sampled, sampled_reaction
 
             tp = float(leader_tau if i == 0 else vehicles[i - 1].params.tau)  # type: ignore[arg-type]
-            out.append(sampled.certify_kernel(kx, kv, ka, p, sample_time, tp)[0])
+            kern = sampled_reaction.certify_kernel if p.reaction_delay > 0 else sampled.certify_kernel
+            out.append(kern(kx, kv, ka, p, sample_time, tp)[0])
     return tuple(out)
 
 
@@ -411,9 +409,17 @@ def certify_string_kernel(
     lengths = range(2, N + 1) if substrings else (N,)
     for ell in lengths:
         starts = list(range(0, N - ell + 1)) if substrings else [0]
-        loop = _loop([vehicles[s:s + ell] for s in starts], H, [pred_tau(s) for s in starts])
-        dec = decide(loop, n_grid=n_grid or default_grid(ell), max_rounds=max_rounds,
-                     max_intervals=max_intervals)
+        if H is not None and vehicles[0].reaction_delay > 0:  # θ_r > 0: the cascade
+            from .head_to_tail_reaction import decide_strings
+
+            dec = decide_strings([vehicles[s:s + ell] for s in starts], H,
+                                 [pred_tau(s) for s in starts],
+                                 n_grid=n_grid or default_grid(ell), max_rounds=max_rounds,
+                                 max_intervals=max_intervals)
+        else:
+            loop = _loop([vehicles[s:s + ell] for s in starts], H, [pred_tau(s) for s in starts])
+            dec = decide(loop, n_grid=n_grid or default_grid(ell), max_rounds=max_rounds,
+                         max_intervals=max_intervals)
         for j, s in enumerate(starts):
             runs.append(Substring(s + 1, s + ell, VERDICTS[int(dec.verdict[j])].value,
                                   float(dec.sup_gain[j]), float(dec.peak[j]) / x_to_omega))

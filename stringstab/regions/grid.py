@@ -116,6 +116,8 @@ def _eval_certificates(spec: _Spec, full: list[Array], shape: tuple[int, int, in
                       reaction_delay=_reaction(p),
                       message_period=spec.message_period)
     out["hurwitz"] = np.asarray(b.stable).reshape(shape)
+    if hasattr(b, "stability"):  # a θ_r box: stability has a third state, undecided
+        out["stability_undecided"] = (np.asarray(b.stability) == "undecided").reshape(shape)
     out["verdict_exact"] = codes(b.verdict).reshape(shape)
     out["sup_gain"] = b.sup_gain.reshape(shape)
     out["margin"] = b.margin.reshape(shape)
@@ -437,6 +439,8 @@ def region_map(
             contextlib.closing(blocks_done):
         for (i0, i1, j0, j1), out in blocks_done:
             for k, v in out.items():
+                if k not in res:  # stability_undecided: θ_r box maps only
+                    res[k] = np.zeros(shape3, dtype=np.asarray(v).dtype)
                 res[k][i0:i1, j0:j1] = v
             bar.update((i1 - i0) * (j1 - j0) * n2)
 
@@ -453,6 +457,7 @@ def region_map(
         type_printed=get("type_printed"), sup_gain=get("sup_gain"), margin=get("margin"),
         version=__version__, sample_time=H, heterogeneous=bool(heterogeneous),
         hurwitz_continuous=get("hurwitz_continuous"), message_period=P,
+        stability_undecided=get("stability_undecided"),
     )
 
 

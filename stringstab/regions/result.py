@@ -86,6 +86,10 @@ class RegionMap:
     message_period : float or None
         The V2V message period N·H (s) of a multi-rate map (``exact`` is then the multi-rate
         certificate); None otherwise.
+    stability_undecided : ndarray of bool or None
+        θ_r box maps: internal stability over the box neither proven nor disproven within the
+        budget (``stability == "undecided"`` of the robust θ_r certificate); such points are
+        never drawn as "not internally stable".  None: no such point can occur.
     """
 
     axes: dict[str, Array]
@@ -104,6 +108,7 @@ class RegionMap:
     heterogeneous: bool = True
     hurwitz_continuous: npt.NDArray[np.bool_] | None = None
     message_period: float | None = None
+    stability_undecided: npt.NDArray[np.bool_] | None = None
 
     @property
     def is_box(self) -> bool:
@@ -229,6 +234,8 @@ class RegionMap:
             c = np.full(self.shape, 3, dtype=np.int8)
             c[v == UNSTABLE] = 1
             c[(v == UNSTABLE) & ~stable] = 0
+            if method == "exact" and self.stability_undecided is not None:  # not proven unstable
+                c[(v == UNSTABLE) & self.stability_undecided] = 1
             c[v == INCONCLUSIVE] = 2
             return c
         t = self.type if method == "taylor" else self.type_printed
@@ -351,7 +358,7 @@ class RegionMap:
             type_printed=take(self.type_printed), sup_gain=take(self.sup_gain),
             margin=take(self.margin), version=self.version, sample_time=self.sample_time,
             heterogeneous=self.heterogeneous, hurwitz_continuous=take(self.hurwitz_continuous),
-            message_period=self.message_period,
+            message_period=self.message_period, stability_undecided=take(self.stability_undecided),
         )
 
     # ---------------------------------------------------------------- files

@@ -88,6 +88,8 @@ def fields(rmap: RegionMap) -> dict[str, npt.NDArray[Any]]:
         f["type"] = rmap.type
     if rmap.hurwitz_continuous is not None:
         f["hurwitz_continuous"] = rmap.hurwitz_continuous
+    if rmap.stability_undecided is not None:
+        f["stability_undecided"] = rmap.stability_undecided
     if rmap.type_printed is not None:
         f["type_printed"] = rmap.type_printed
     for m, code in rmap.verdict.items():
@@ -290,4 +292,5 @@ def read_map(path: str | os.PathLike[str]) -> dict[str, Any]:
         sample_time=meta.get("sample_time"), heterogeneous=bool(meta.get("heterogeneous", True)),
         hurwitz_continuous=data.get("hurwitz_continuous"),
         message_period=meta.get("message_period"),
+        stability_undecided=data.get("stability_undecided"),
     )

@@ -92,8 +92,6 @@ def test_the_batch_carries_the_schedule_the_fallback_and_the_scope():
     ({"sample_time": 0.01, "message_period": 0.1, "tau_prev": 0.2}, r"homogeneous platoon"),
     ({"sample_time": 0.01, "message_period": 0.1, "fallback_gains": (1.0,)}, r"two numbers"),
     ({"sample_time": 0.01, "fallback_gains": (1.0, 1.0)}, r"fallback gains are for the multi-rate"),
-    ({"sample_time": 0.01, "message_period": 0.1, "reaction_delay": 0.1},
-     r"not with a message period yet; .* got reaction_delay=0.1 with sample_time=0.01 and a message every 10"),
 ])
 def test_bad_schedules_are_refused_with_what_was_expected(kw, match):
     with pytest.raises(StringStabError, match=match):
@@ -110,10 +108,6 @@ def test_bad_schedules_are_refused_with_what_was_expected(kw, match):
     (["--sample-time", "0.01", "--fallback-gains", "1,1"], "expected --message-period"),
     (["--sample-time", "0.01", "--max-message-period", "0.001"], ">= --sample-time 0.01"),
     (["--max-message-period"], "expected --sample-time H"),
-    (["--sample-time", "0.01", "--message-period", "0.1", "--reaction-delay", "0.1"],
-     "not with a message period yet"),
-    (["--sample-time", "0.01", "--max-message-period", "--reaction-delay", "0.1"],
-     "not with a message period yet"),
 ])
 def test_bad_command_lines_are_one_line_exit_2_and_no_file(tmp_path, capsys, flags, says):
     out = tmp_path / "o.json"

@@ -140,7 +140,6 @@ def test_certify_and_check_agree_and_report_the_sampled_rows():
     ({"reaction_delay": float("nan")}, "reaction_delay"),
     ({"reaction_delay": 150.0}, "reaction_delay"),
     ({"reaction_delay": 25.0, "sample_time": 0.01}, "at most 2000 whole samples"),
-    ({"reaction_delay": 0.1, "message_period": 0.05}, "not with a message period yet"),
 ])
 def test_bad_theta_with_a_sample_time_is_one_line(kw, says):
     args = {"tau": 0.1, "delta": 0.2, "headway": 1.1, "sample_time": 0.01, **kw}
