@@ -12,11 +12,12 @@ as balls.  The string's transfer u_0 → u_n is their series connection
 G = G_n ⋯ G_1, built exactly in ball arithmetic:
 
 .. math::
-    A = \begin{bmatrix} A_1 & 0 \\ B_2 C_1 & A_2 \end{bmatrix},\quad
-    B = \begin{bmatrix} B_1 \\ 0 \end{bmatrix},\quad
-    C = \begin{bmatrix} 0 & C_2 \end{bmatrix},\quad D = 0
+    x = (x_1, x_2),\quad x_1^{+} = A_1 x_1 + B_1 u,\quad x_2^{+} = A_2 x_2 + B_2 C_1 x_1,\quad
+    y = C_2 x_2
 
-(repeated for every vehicle; D_i = 0: no feed-through within a step), so
+(x⁺ the next step's state; the series connection: A is block lower triangular with A_1, A_2 on its diagonal and
+B_2 C_1 below it, B = (B_1, 0), C = (0, C_2), D = 0;
+repeated for every vehicle; D_i = 0: no feed-through within a step), so
 G(e^{jθ}) = ∏_i H_i(e^{jθ}) and |G| = ∏_i |H_i| — the head-to-tail product of
 :mod:`stringstab.certify.head_to_tail_sampled`.
 

@@ -141,16 +141,14 @@ def test_cli_sweep_writes_slices_table_and_figure(tmp_path, capsys):
         (["--reaction-delay", "-0.1"], "reaction delay θ_r"),
         (["--reaction-delay", "nan"], "reaction delay θ_r"),
         (["--reaction-delay", "101"], "reaction"),
-        # a point θ_r with --sample-time is mapped (below); a box of θ_r with a sample time
-        # and the multi-rate loop with θ_r are refused, before any work
+        # a point θ_r with --sample-time (and --message-period) is mapped (below); a box of
+        # θ_r with a sample time is refused, before any work
         (["--reaction-delay", "0.1:0.3", "--sample-time", "0.1"],
-         "θ_r over a parameter box is certified in continuous time"),
+         "over a parameter box is certified in continuous time only"),
         (["--reaction-delay", "0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
-         "θ_r over a parameter box is certified in continuous time"),
+         "over a parameter box is certified in continuous time only"),
         (["--reaction-delay", "0,0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
-         "θ_r over a parameter box is certified in continuous time"),
-        (["--reaction-delay", "0.2", "--sample-time", "0.05", "--message-period", "0.1"],
-         "message"),
+         "over a parameter box is certified in continuous time only"),
         (["--reaction-delay", "0,0.2", "--sample-time", "0.1", "--compare", "continuous"],
          "evaluates 'exact'"),
         # a box with θ_r (--tau 0.1:0.2 with θ_r, --reaction-delay 0.1:0.3) is mapped by the
@@ -241,3 +239,14 @@ def test_a_sampled_sweep_over_reaction_delays_equals_its_single_maps():
                         workers=1, progress=False)
     assert np.array_equal(s.maps[1].verdict["exact"], single.verdict["exact"])
     assert s.maps[1].sample_time == 0.1 and s.maps[1].params.reaction_delay == 0.2
+
+
+def test_a_reaction_delay_with_a_message_period_maps_the_multirate_certificate():
+    # θ_r with the radio's message period (issue 25): the map is the point certificate's
+    axes = {"k_x": np.linspace(0.1, 1.5, 3), "k_v": np.linspace(0.2, 1.5, 3)}
+    opts = {**P, "sample_time": 0.05, "message_period": 0.1, "reaction_delay": 0.2}
+    m = region_map(axes, {"k_a": 0.5}, **opts, workers=1, progress=False)
+    kx, kv, ka = (g.ravel() for g in m.gains())
+    ref = ss.certify_batch(kx, kv, ka, **opts)
+    assert np.array_equal(m.verdict["exact"].ravel(), codes(ref.verdict))
+    assert m.message_period == 0.1 and m.params.reaction_delay == 0.2

@@ -112,7 +112,7 @@ def test_cli_tune_reaction_delay_zero_is_unchanged(capsys):
         (["--reaction-delay", "101"], "reaction"),
         (["--reaction-delay", "0.2", "--tau", "0.1:0.2"], "tuning takes θ_r at a point"),
         (["--reaction-delay", "0.2", "--tau", "0.1:0.2", "--sample-time", "0.1"],
-         "θ_r over a parameter box"),  # the certificate's own refusal
+         "over a parameter box"),  # the certificate's own refusal
         (["--reaction-delay", "0.2", "--sample-time", "0.1", "--method", "region-growing"],
          "region growing"),
         (["--reaction-delay", "0.2", "--method", "both"], "region growing"),
