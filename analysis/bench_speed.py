@@ -260,7 +260,7 @@ def work_verdicts(inp: dict, out: dict) -> None:
 
 def work_train(inp: dict, out: dict) -> None:
     from stringstab.rl import config_for, train
-    from stringstab.rl import repair as rp
+    from stringstab.tuning import repair as rp
 
     rp.GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
     steps = inp["train_steps"]
@@ -311,7 +311,7 @@ def work_train(inp: dict, out: dict) -> None:
 def work_env(inp: dict, out: dict) -> None:
     from stringstab.rl import config_for
     from stringstab.rl.envs import make_env
-    from stringstab.rl.repair import GainRepair
+    from stringstab.tuning.repair import GainRepair
 
     A = np.load(inp["inputs"])["proposals"][-inp["env_steps"]:].astype(np.float32)
     GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
@@ -364,7 +364,7 @@ def run_worker(side: str, base_dir: str, spec: dict) -> dict:
 def record_proposals(steps: int) -> np.ndarray:
     """Proposals of an IDL training run of this checkout (what the repair is given), flat."""
     from stringstab.rl import config_for, train
-    from stringstab.rl import repair as rp
+    from stringstab.tuning import repair as rp
 
     rows: list[np.ndarray] = []
     orig = rp.GainRepair.__call__

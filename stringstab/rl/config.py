@@ -30,6 +30,7 @@ from .. import constants
 from ..errors import StringStabError, show
 from ..traffic.radio import Radio
 from ..traffic.sensors import SensorNoise
+from ..tuning.repair import REPAIR_METHODS
 
 __all__ = [
     "ALGOS",
@@ -47,8 +48,9 @@ __all__ = [
 
 #: Agent names of the command line.
 ALGOS: tuple[str, str, str] = ("idl", "td3", "ddpg")
-#: Repair methods of the IDL action (``"off"``: the ablation without repair).
-REPAIRS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
+#: Repair methods of the IDL action (``"off"``: the ablation without repair):
+#: :data:`stringstab.tuning.repair.REPAIR_METHODS`.
+REPAIRS: tuple[str, ...] = REPAIR_METHODS
 
 Action = Literal["gains", "accel"]
 #: The fields of the loop as it runs (issues 25 and 26), left out of :meth:`TD3Config.as_dict`

@@ -75,7 +75,7 @@ class TrainResult:
         Seconds in the environment (repair included), in the repair, in gradient updates, and
         environment steps per second.
     repair : dict or None
-        The repair's statistics (``GainRepair.stats``) for an IDL run.
+        The repair's statistics (:attr:`stringstab.tuning.repair.GainRepair.stats`) for an IDL run.
     out : Path or None
         The run folder.
     """

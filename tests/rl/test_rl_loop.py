@@ -32,7 +32,7 @@ pytest.importorskip("safetensors")
 
 from stringstab.rl import config_for, train  # noqa: E402
 from stringstab.rl.evaluate import evaluate, fss  # noqa: E402
-from stringstab.rl.repair import GainRepair  # noqa: E402
+from stringstab.tuning.repair import GainRepair  # noqa: E402
 
 pytestmark = pytest.mark.torch
 

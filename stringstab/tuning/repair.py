@@ -1,0 +1,307 @@
+"""The IDL repair step (§3.3) for a training loop: every executed gain triple is certified.
+
+The agent proposes K = (k_x, k_v, k_a) for every environment at every step; before the eq-4 law
+acts, :class:`GainRepair` replaces each K that the exact certificate
+(:func:`stringstab.certify.api.check`) does not certify by a nearby certified triple.  The
+library's repairs (:func:`stringstab.tuning.project`, :func:`stringstab.tuning.region_growing`)
+take milliseconds per triple, and at the start of training about 90 % of the gain box is not
+certified (at τ = 0.1 s, δ = 0.2 s, T* = 1.1 s, 9 % of a 0.05-spaced lattice over [−2, 2]³ is),
+so calling them per environment step would dominate training.  The default method is therefore a
+*certified lookup*:
+
+``"projection"`` (default)
+    1. a proposal inside a *proven cell* of the lattice below — a cell on which both
+       certificates hold for every gain (:mod:`stringstab.certify.gain_cells`, proven by blocks
+       the first time a proposal comes near: :func:`certified_cells`) — is executed unchanged,
+       without a certificate call;
+    2. for the others, cheap screens drop triples that surely fail
+       (:func:`stringstab.certify.screen.surely_uncertifiable`: not internally stable, or g(ω)
+       below its round-off threshold at one of 48 fixed frequencies, where g is the margin of
+       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there; with a sample time, the sampled
+       loop's :class:`~stringstab.certify.screen.SampledScreen`), and the rest are checked by
+       the exact certificates in one vectorised call each; certified triples are executed
+       unchanged;
+    3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
+       points of a grid of spacing ``resolution`` over the gain box that the exact certificates
+       certify (built once per process and parameter set, one vectorised call);
+    4. ``refine`` bisection steps along the segment from that point towards the proposed K keep
+       the farthest point in a proven cell (no certificate call).
+
+    The result is within about one lattice spacing of the true projection (the nearest certified
+    triple); ``analysis/bench_train.py`` measures the difference against
+    :func:`stringstab.tuning.project`.
+``"projection-exact"``
+    :class:`stringstab.tuning.Projector` (IPOPT, with its cache) per uncertified triple.
+``"region-growing"``
+    the paper's search, :func:`stringstab.tuning.region_growing`, per uncertified triple; its
+    candidate test is the Taylor Proposition 1, so where its output is not certified by the
+    exact certificate the ``"projection"`` result is executed instead (counted in
+    ``stats["fallbacks"]``).
+``"off"``
+    no repair: the ablation (executed gains may be uncertified).
+
+Whatever the method, a triple is executed only if it is certified (``"off"`` excepted): by
+:func:`~stringstab.certify.api.check` for exactly that triple, or by the proof of a proven cell
+that contains it — and, with ``sample_time`` H, also by the sampled-data certificate
+(:func:`stringstab.certify.sampled.check_sampled` at H, or the cell's proof): the loop the
+simulator runs holds u over each control step, and gains on the continuous certificate's
+boundary need not be string stable in that sampled loop.
+
+With a reaction delay θ_r > 0 (issue 25, ``reaction_delay``) the judge is the continuous
+certificate with θ_r (:func:`~stringstab.certify.api.check` with ``reaction_delay``, exact in
+θ_r).  The proven cells and the cheap screens are objects of the loop without θ_r and are not
+used: every proposal is checked at θ_r; the certified lattice is the points of the θ_r = 0
+lattice that the certificate at θ_r certifies (a subset of the θ_r lattice, so every point is
+certified; points certified only with θ_r are left out, which is conservative, never unsound);
+the ``refine`` steps move towards the proposal by exact checks at θ_r.  The sampled-data
+certificate has no θ_r: ``sample_time`` with θ_r > 0 is refused (one line).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..certify import grid
+from ..certify.gain_cells import CertifiedCells
+from ..certify.screen import surely_uncertifiable
+from ..constants import GAIN_BOUNDS
+from ..errors import StringStabError
+from ..params import Params, positive
+from .lattice import certified_cells, certified_lattice
+
+__all__ = ["REPAIR_METHODS", "GainRepair"]
+
+Array = npt.NDArray[np.float64]
+
+#: Repair methods of the IDL action (``"off"``: the ablation without repair).
+REPAIR_METHODS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
+
+
+class GainRepair:
+    """Map proposed gains ``(n, 3)`` to executed gains ``(n, 3)``, each certified (see module).
+
+    Parameters
+    ----------
+    method : {"projection", "projection-exact", "region-growing", "off"}
+        The repair (module docstring).
+    tau, delta, headway : float
+        Model parameters, s.
+    bounds : (float, float)
+        Gain box (Table 2: [−2, 2]).
+    resolution : float
+        Lattice spacing of the lookup.
+    refine : int
+        Bisection steps after the lookup.
+    sample_time : float, optional
+        Also require the sampled-data certificate of the zero-order-hold loop at this step
+        (:func:`stringstab.certify.sampled.check_sampled`) for every executed triple.
+    reaction_delay : float
+        θ_r, s (issue 25): certify with the continuous certificate at θ_r (module docstring);
+        refused with ``sample_time``.
+
+    Attributes
+    ----------
+    stats : dict
+        ``calls``, ``rows``, ``unchanged`` (certified as proposed), ``repaired``, ``fallbacks``,
+        ``seconds`` (time spent in the repair).
+
+    Examples
+    --------
+    >>> rep = GainRepair(tau=0.1, delta=0.2, headway=1.1, resolution=0.25)
+    >>> K = rep([[1.2, 0.5, 0.6], [0.9, -0.5, 1.1]])
+    >>> K[0].tolist(), bool((K[1] != [0.9, -0.5, 1.1]).any())
+    ([1.2, 0.5, 0.6], True)
+    >>> from stringstab.certify.api import check
+    >>> check(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1).verdict.tolist()
+    ['certified', 'certified']
+    """
+
+    def __init__(self, method: str = "projection", *, tau: float, delta: float, headway: float,
+                 bounds: tuple[float, float] = GAIN_BOUNDS, resolution: float = 0.05,
+                 refine: int = 4, sample_time: float | None = None,
+                 reaction_delay: float = 0.0) -> None:
+        if method not in REPAIR_METHODS:
+            raise StringStabError(f"repair method must be one of {list(REPAIR_METHODS)}; got {method!r}")
+        self.method = method
+        self.params = Params(tau, delta, headway, reaction_delay=reaction_delay)
+        #: θ_r, s (0: the loop without reaction delay).
+        self.reaction_delay = self.params.reaction_delay
+        lo, hi = (float(b) for b in bounds)
+        if not lo < hi:
+            raise StringStabError(f"bounds must be (low, high) with low < high; got {bounds!r}")
+        self.bounds = (lo, hi)
+        self.resolution = positive("repair resolution", resolution)
+        if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 0:
+            raise StringStabError(f"repair refine must be an integer >= 0; got {refine!r}")
+        self.refine = int(refine)
+        self.sample_time = None if sample_time is None else positive("repair sample_time",
+                                                                      sample_time, unit=" s")
+        if self.reaction_delay and self.sample_time is not None:
+            raise StringStabError(
+                f"repair with reaction_delay={self.reaction_delay:g} s and sample_time="
+                f"{self.sample_time:g} s: the sampled-data certificate has no reaction delay θ_r; "
+                "expected no sample_time (the continuous certificate at θ_r certifies)")
+        self._tree: Any = None
+        self._projector: Any = None
+        self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
+                                        "fallbacks": 0, "seconds": 0.0}
+
+    def describe(self) -> dict[str, Any]:
+        """The settings, for logs and JSON (``reaction_delay`` only when θ_r > 0)."""
+        return {"method": self.method, **self.params.as_dict(), "bounds": list(self.bounds),
+                "resolution": self.resolution, "refine": self.refine,
+                "sample_time": self.sample_time}
+
+    # -- the lookup -------------------------------------------------------------------------
+    def lattice(self) -> Array:
+        """The certified lattice of this repair (built on first use)."""
+        p = self.params
+        return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                                 self.sample_time, self.reaction_delay)
+
+    def cells(self) -> CertifiedCells:
+        """The proven cells of this repair's lattice (:func:`certified_cells`, shared)."""
+        p = self.params
+        return certified_cells(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                               self.sample_time)
+
+    def _kdtree(self) -> Any:
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.lattice())
+        return self._tree
+
+    def _in_cells(self, K: Array) -> npt.NDArray[np.bool_]:
+        """Rows of K in a proven cell; none with θ_r > 0 (the cells are of the loop without it)."""
+        if self.reaction_delay:
+            return np.zeros(K.shape[0], dtype=bool)
+        return self.cells().contains(K)
+
+    def _nearest(self, K0: Array) -> Array:
+        """The lattice points nearest K0, moved towards K0 by bisection within proven cells.
+
+        Each step keeps the farther point of the segment from the lattice point to K0 that
+        lies in a proven cell of :meth:`cells`: every point returned is a certified lattice
+        point or in a proven cell, so certified by both certificates.  With θ_r > 0 a point
+        is kept when the certificate at θ_r certifies it (one vectorised check per step).
+        """
+        _, idx = self._kdtree().query(K0)
+        P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
+        if self.refine:
+            lo = np.zeros(K0.shape[0])
+            hi = np.ones(K0.shape[0])
+            best = P.copy()
+            for _ in range(self.refine):  # bisection within the proven cells
+                mid = 0.5 * (lo + hi)
+                C = P + mid[:, None] * (K0 - P)
+                ok = (grid.certified(C, self.params) if self.reaction_delay
+                      else self.cells().contains(C))
+                best[ok] = C[ok]
+                lo = np.where(ok, mid, lo)
+                hi = np.where(ok, hi, mid)
+            P = best
+        return P
+
+    def _exact(self, K0: Array) -> Array:
+        from .projector import Projector
+        from .region_growing import region_growing
+
+        out = np.empty_like(K0)
+        p = self.params
+        for i, k in enumerate(K0):
+            if self.method == "projection-exact":
+                if self._projector is None:
+                    self._projector = Projector(tau=p.tau, delta=p.delta, headway=p.headway,
+                                                bounds=self.bounds)
+                r = self._projector(k)
+            else:
+                r = region_growing(k, tau=p.tau, delta=p.delta, headway=p.headway,
+                                   bounds=self.bounds)
+            # a solver may return a point a rounding error outside its bounds: the env would
+            # clip it before executing it, so the point certified is the clipped one
+            kr = np.clip(np.asarray(r.k, dtype=np.float64), *self.bounds)
+            if r.certified and grid.certified(kr[None], p)[0]:
+                out[i] = kr
+            else:
+                out[i] = self._nearest(k[None])[0]
+                self.stats["fallbacks"] += 1
+        return out
+
+    def approximate(self, K: npt.ArrayLike) -> Array:
+        """A cheap, *uncertified* stand-in for the repair, for training signals only.
+
+        Rows that pass the cheap screen (module docstring, step 1) are returned unchanged, the
+        others are replaced by their nearest certified lattice point, without the exact check
+        or the refinement.  Used by the actor's proposal penalty
+        (``TD3Config.proposal_penalty``); never executed.
+
+        Parameters
+        ----------
+        K : array_like (..., 3)
+            Proposed gains (k_x, k_v, k_a); clipped to the bounds first.
+
+        Returns
+        -------
+        ndarray (n, 3)
+            The approximate repaired gains (not certified); the clipped input if the repair is
+            ``"off"``.
+        """
+        K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
+        if self.method == "off":
+            return K0
+        p = self.params
+        out = K0.copy()
+        # the screen of the loop without θ_r (an approximation either way: never executed)
+        bad = np.flatnonzero(surely_uncertifiable(K0, Params(p.tau, p.delta, p.headway)))
+        if bad.size:
+            _, idx = self._kdtree().query(K0[bad])
+            out[bad] = self.lattice()[np.asarray(idx)]
+        return out
+
+    # -- the call -----------------------------------------------------------------------------
+    def __call__(self, K: npt.ArrayLike) -> Array:
+        """Executed gains for proposed gains ``K`` (shape ``(n, 3)``; clipped to the bounds)."""
+        t0 = time.perf_counter()
+        K0 = np.clip(np.asarray(K, dtype=np.float64).reshape(-1, 3), *self.bounds)
+        if not np.isfinite(K0).all():
+            raise StringStabError("proposed gains must be finite; found NaN or inf")
+        out = K0.copy()
+        if self.method != "off":
+            p = self.params
+            # a gain in a proven cell is certified by both certificates (the cell's proof);
+            # the others go to the continuous-time certificate (``check``, at θ_r if > 0)
+            in_cell = self._in_cells(K0)
+            ok = in_cell.copy()
+            rest = np.flatnonzero(~in_cell)
+            if rest.size:
+                ok[rest] = grid.certified(K0[rest], p)
+            bad = np.flatnonzero(~ok)
+            pending = ok & ~in_cell  # rows whose executed gains still need the sampled check
+            if bad.size:
+                if self.method == "projection":
+                    # lattice points and points in proven cells: certified both ways
+                    out[bad] = self._nearest(K0[bad])
+                    pending[bad] = False
+                else:
+                    out[bad] = self._exact(K0[bad])
+                    pending[bad] = ~self._in_cells(out[bad])
+            if self.sample_time is not None and pending.any():
+                # one sampled-data call per step; where it fails, the nearest lattice point
+                j = np.flatnonzero(pending)
+                keep = grid.certified(out[j], p, sample_time=self.sample_time)
+                if (~keep).any():
+                    jj = j[~keep]
+                    out[jj] = self._nearest(K0[jj])
+                    bad = np.union1d(bad, jj)
+                    self.stats["fallbacks"] += int(jj.size)
+            self.stats["unchanged"] += int(K0.shape[0] - bad.size)
+            self.stats["repaired"] += int(bad.size)
+        self.stats["calls"] += 1
+        self.stats["rows"] += K0.shape[0]
+        self.stats["seconds"] += time.perf_counter() - t0
+        return out
