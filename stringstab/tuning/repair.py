@@ -14,13 +14,16 @@ so calling them per environment step would dominate training.  The default metho
        certificates hold for every gain (:mod:`stringstab.certify.gain_cells`, proven by blocks
        the first time a proposal comes near: :func:`certified_cells`) — is executed unchanged,
        without a certificate call;
-    2. for the others, cheap screens drop triples that surely fail
-       (:func:`stringstab.certify.screen.surely_uncertifiable`: not internally stable, or g(ω)
-       below its round-off threshold at one of 48 fixed frequencies, where g is the margin of
-       :func:`stringstab.certify.margin.g`: |Γ(jω)| > 1 there; with a sample time, the sampled
-       loop's :class:`~stringstab.certify.screen.SampledScreen`), and the rest are checked by
-       the exact certificates in one vectorised call each; certified triples are executed
-       unchanged;
+    2. the others are checked point by point by the exact certificates
+       (:meth:`GainRepair.certified`): with a sample time H the sampled-data certificate at H
+       first (one vectorised :meth:`stringstab.certify.api.Loop.check` call for the step's
+       rows), then the continuous one on the rows it certifies — except rows inside a proven
+       cell of the continuous certificate alone (the cells of :func:`certified_cells` without
+       H, whose 8 corners the continuous certificate certifies: near the sampled loop's
+       boundary the continuous region is wider, so most such rows are); every verdict is kept
+       by the triple's exact bits and reused when the same floats come again (a rate-limited
+       training walks on a ±r lattice from each start and revisits its points); triples
+       certified both ways are executed unchanged;
     3. every other triple goes to the nearest point (Euclidean) of a *certified lattice*: the
        points of a grid of spacing ``resolution`` over the gain box that the exact certificates
        certify (built once per process and parameter set, one vectorised call);
@@ -43,7 +46,7 @@ so calling them per environment step would dominate training.  The default metho
 Whatever the method, a triple is executed only if it is certified (``"off"`` excepted): by
 :func:`~stringstab.certify.api.check` for exactly that triple, or by the proof of a proven cell
 that contains it — and, with ``sample_time`` H, also by the sampled-data certificate
-(:func:`stringstab.certify.sampled.check_sampled` at H, or the cell's proof): the loop the
+(:meth:`~stringstab.certify.api.Loop.check` of the loop at H, or the cell's proof): the loop the
 simulator runs holds u over each control step, and gains on the continuous certificate's
 boundary need not be string stable in that sampled loop.
 
@@ -65,9 +68,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify import grid
 from ..certify.gain_cells import CertifiedCells
 from ..certify.screen import surely_uncertifiable
+from ..certify.verdicts import Verdict
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
 from ..params import Params, positive
@@ -76,6 +79,10 @@ from .lattice import certified_cells, certified_lattice
 __all__ = ["REPAIR_METHODS", "GainRepair"]
 
 Array = npt.NDArray[np.float64]
+
+#: The most triples whose verdicts a :class:`GainRepair` keeps (:meth:`GainRepair.certified`;
+#: about 150 bytes each).
+VERDICT_CACHE = 200_000
 
 #: Repair methods of the IDL action (``"off"``: the ablation without repair).
 REPAIR_METHODS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
@@ -98,7 +105,7 @@ class GainRepair:
         Bisection steps after the lookup.
     sample_time : float, optional
         Also require the sampled-data certificate of the zero-order-hold loop at this step
-        (:func:`stringstab.certify.sampled.check_sampled`) for every executed triple.
+        (:meth:`stringstab.certify.api.Loop.check` at H) for every executed triple.
     reaction_delay : float
         θ_r, s (issue 25): certify with the continuous certificate at θ_r (module docstring);
         refused with ``sample_time``.
@@ -106,8 +113,11 @@ class GainRepair:
     Attributes
     ----------
     stats : dict
-        ``calls``, ``rows``, ``unchanged`` (certified as proposed), ``repaired``, ``fallbacks``,
-        ``seconds`` (time spent in the repair).
+        ``calls``, ``rows``, ``unchanged`` (certified as proposed), ``repaired``, ``fallbacks``
+        (``"projection-exact"``/``"region-growing"`` outputs not certified, replaced by the
+        lookup's), ``seconds`` (time spent in the repair), ``checked`` (rows asked of the point
+        certificates), ``reused`` (of them, answered by a kept verdict) and
+        ``certificate_calls`` (vectorised point-certificate calls).
 
     Examples
     --------
@@ -147,8 +157,12 @@ class GainRepair:
                 "expected no sample_time (the continuous certificate at θ_r certifies)")
         self._tree: Any = None
         self._projector: Any = None
+        self._loops: tuple[Any, Any] | None = None
+        #: Verdicts of both certificates by exact gains (row bytes → certified), bounded.
+        self._verdicts: dict[bytes, bool] = {}
         self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
-                                        "fallbacks": 0, "seconds": 0.0}
+                                        "fallbacks": 0, "seconds": 0.0, "checked": 0,
+                                        "reused": 0, "certificate_calls": 0}
 
     def describe(self) -> dict[str, Any]:
         """The settings, for logs and JSON (``reaction_delay`` only when θ_r > 0)."""
@@ -169,12 +183,87 @@ class GainRepair:
         return certified_cells(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
                                self.sample_time)
 
+    def continuous_cells(self) -> CertifiedCells:
+        """The proven cells of the continuous certificate alone (:func:`certified_cells` without H)."""
+        p = self.params
+        return certified_cells(p.tau, p.delta, p.headway, *self.bounds, self.resolution, None)
+
     def _kdtree(self) -> Any:
         if self._tree is None:
             from scipy.spatial import cKDTree
 
             self._tree = cKDTree(self.lattice())
         return self._tree
+
+    def _certificate_loops(self) -> tuple[Any, Any]:
+        """The continuous loop and (with ``sample_time``) the sampled loop, checked once."""
+        if self._loops is None:
+            from ..certify.api import Loop
+
+            self._loops = (Loop(self.params),
+                           None if self.sample_time is None else Loop(self.params, self.sample_time))
+        return self._loops
+
+    def _judge(self, loop: Any, K: Array) -> npt.NDArray[np.bool_]:
+        """Rows of K that ``loop``'s exact certificate certifies (one vectorised call)."""
+        self.stats["certificate_calls"] += 1
+        c = loop.check(K[:, 0], K[:, 1], K[:, 2])
+        return np.asarray(c.verdict == Verdict.CERTIFIED.value)
+
+    def certified(self, K: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Which rows of K this repair's certificates all certify, point by point (cached).
+
+        A row is certified when :meth:`stringstab.certify.api.Loop.check` of the continuous
+        loop (at θ_r if > 0) and, with ``sample_time``, of the sampled-data loop at H both say
+        ``"certified"`` for exactly that triple.  The sampled check runs first (one vectorised
+        call on the rows not yet known), the continuous one on the rows it certifies (a row the
+        sampled certificate does not certify is not certified, whatever the other says).
+        Each answer is kept, keyed by the triple's exact bits (a verdict of a certificate is a
+        property of the triple: asking again gives it again), and reused when the same
+        triple comes again — under a gain rate limit a training proposes the same floats
+        often (``stats["reused"]``); at most :data:`VERDICT_CACHE` triples are kept (the
+        oldest dropped first).
+
+        Parameters
+        ----------
+        K : array_like (n, 3)
+            Gain triples (k_x, k_v, k_a) of eq 4.
+
+        Returns
+        -------
+        ndarray of bool (n,)
+        """
+        K = np.ascontiguousarray(np.asarray(K, dtype=np.float64).reshape(-1, 3))
+        out = np.zeros(K.shape[0], dtype=bool)
+        cache = self._verdicts
+        keys = [row.tobytes() for row in K]
+        miss: list[int] = []
+        for i, key in enumerate(keys):
+            v = cache.get(key)
+            if v is None:
+                miss.append(i)
+            else:
+                out[i] = v
+        self.stats["checked"] += K.shape[0]
+        self.stats["reused"] += K.shape[0] - len(miss)
+        if miss:
+            idx = np.array(miss)
+            cont, samp = self._certificate_loops()
+            ok = np.ones(idx.size, dtype=bool)
+            if samp is not None:
+                ok = self._judge(samp, K[idx])
+            j = np.flatnonzero(ok)
+            if j.size and samp is not None and not self.reaction_delay:
+                # a row in a proven cell of the continuous certificate needs no point check
+                j = j[~self.continuous_cells().contains(K[idx[j]])]
+            if j.size:
+                ok[j] = self._judge(cont, K[idx[j]])
+            out[idx] = ok
+            for i, v in zip(miss, ok.tolist()):
+                cache[keys[i]] = v
+            while len(cache) > VERDICT_CACHE:
+                del cache[next(iter(cache))]
+        return out
 
     def _in_cells(self, K: Array) -> npt.NDArray[np.bool_]:
         """Rows of K in a proven cell; none with θ_r > 0 (the cells are of the loop without it)."""
@@ -199,8 +288,7 @@ class GainRepair:
             for _ in range(self.refine):  # bisection within the proven cells
                 mid = 0.5 * (lo + hi)
                 C = P + mid[:, None] * (K0 - P)
-                ok = (grid.certified(C, self.params) if self.reaction_delay
-                      else self.cells().contains(C))
+                ok = self.certified(C) if self.reaction_delay else self.cells().contains(C)
                 best[ok] = C[ok]
                 lo = np.where(ok, mid, lo)
                 hi = np.where(ok, hi, mid)
@@ -225,7 +313,7 @@ class GainRepair:
             # a solver may return a point a rounding error outside its bounds: the env would
             # clip it before executing it, so the point certified is the clipped one
             kr = np.clip(np.asarray(r.k, dtype=np.float64), *self.bounds)
-            if r.certified and grid.certified(kr[None], p)[0]:
+            if r.certified and self.certified(kr[None])[0]:
                 out[i] = kr
             else:
                 out[i] = self._nearest(k[None])[0]
@@ -272,33 +360,21 @@ class GainRepair:
             raise StringStabError("proposed gains must be finite; found NaN or inf")
         out = K0.copy()
         if self.method != "off":
-            p = self.params
             # a gain in a proven cell is certified by both certificates (the cell's proof);
-            # the others go to the continuous-time certificate (``check``, at θ_r if > 0)
+            # the others by the point certificates (:meth:`certified`: sampled at H, then
+            # continuous, at θ_r if > 0; answers reused by exact gains)
             in_cell = self._in_cells(K0)
             ok = in_cell.copy()
             rest = np.flatnonzero(~in_cell)
             if rest.size:
-                ok[rest] = grid.certified(K0[rest], p)
+                ok[rest] = self.certified(K0[rest])
             bad = np.flatnonzero(~ok)
-            pending = ok & ~in_cell  # rows whose executed gains still need the sampled check
             if bad.size:
                 if self.method == "projection":
                     # lattice points and points in proven cells: certified both ways
                     out[bad] = self._nearest(K0[bad])
-                    pending[bad] = False
-                else:
+                else:  # an output the point certificates certify, else the lookup's
                     out[bad] = self._exact(K0[bad])
-                    pending[bad] = ~self._in_cells(out[bad])
-            if self.sample_time is not None and pending.any():
-                # one sampled-data call per step; where it fails, the nearest lattice point
-                j = np.flatnonzero(pending)
-                keep = grid.certified(out[j], p, sample_time=self.sample_time)
-                if (~keep).any():
-                    jj = j[~keep]
-                    out[jj] = self._nearest(K0[jj])
-                    bad = np.union1d(bad, jj)
-                    self.stats["fallbacks"] += int(jj.size)
             self.stats["unchanged"] += int(K0.shape[0] - bad.size)
             self.stats["repaired"] += int(bad.size)
         self.stats["calls"] += 1

@@ -1,0 +1,125 @@
+"""The training repair (:class:`stringstab.tuning.repair.GainRepair`): every executed gain certified.
+
+Independent truths: each executed triple is checked afresh by both certificates
+(:func:`stringstab.check`, continuous and sampled at H, no cache), and by a fine sweep of the
+sampled loop's |H(e^{jθ})| and its poles built from ``scipy.linalg.expm``
+(``tests/_sampled_truth.py``, not the package's sampled code) and of the continuous |Γ(jω)|
+written out here; the repair with its verdict cache against the same repair asked with an empty
+cache at every call (the same outputs, bit for bit).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import stringstab as ss
+from stringstab.tuning.repair import GainRepair
+from tests._sampled_truth import pair_response, pair_roots
+
+TAU, DELTA, HEADWAY, H = 0.1, 0.2, 1.1, 0.1
+
+
+def continuous_peak(k) -> float:
+    """sup |Γ(jω)| on a fine sweep, Γ of IDL eq 11 written out (the derived form)."""
+    kx, kv, ka = k
+    w = np.concatenate([np.linspace(1e-4, 5.0, 20_000), np.geomspace(5.0, 1e3, 4000)])
+    s = 1j * w
+    num = kx + kv * s + ka * s * s * np.exp(-DELTA * s)
+    den = TAU * s**3 + s**2 + (kv + kx * HEADWAY) * s + kx
+    return float(np.max(np.abs(num / den)))
+
+
+def sampled_truth(k) -> tuple[float, float]:
+    """(spectral radius of the follower's sampled loop, sup |H(e^{jθ})| on a fine θ sweep)."""
+    kx, kv, ka = k
+    rho = float(np.max(np.abs(pair_roots(kx, kv, TAU, HEADWAY, H))))
+    theta = np.linspace(1e-4, np.pi, 3000)
+    peak = np.max(np.abs(pair_response(theta, kx, kv, ka, TAU, DELTA, HEADWAY, H)))
+    return rho, float(peak)
+
+
+def walk(n_steps=60, n_envs=6, rate=0.02, seed=3):
+    """Proposals the way training makes them: random ±rate steps from certified starts.
+
+    Starting points near the certified region's edge (k_a large), so that many proposals leave
+    the proven cells and some leave the certified region; the step after a repair starts from
+    the executed gains, as the rate limit does.
+    """
+    rng = np.random.default_rng(seed)
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                     sample_time=H)
+    E = np.array([[1.2, 0.5, 0.6], [0.8, 0.9, 0.7], [1.0, 0.6, 0.75], [0.6, 0.6, 0.3],
+                  [1.4, 1.0, 0.8], [0.9, 0.7, 0.65]])[:n_envs]
+    proposals, executed = [], []
+    for _ in range(n_steps):
+        P = np.clip(E + rate * rng.choice([-1.0, 1.0], size=E.shape), -2, 2)
+        E = rep(P)
+        proposals.append(P)
+        executed.append(E)
+    return rep, np.stack(proposals), np.stack(executed)
+
+
+@pytest.fixture(scope="module")
+def walked():
+    return walk()
+
+
+def test_every_executed_gain_is_certified_by_both_certificates(walked):
+    rep, _, executed = walked
+    K = np.unique(executed.reshape(-1, 3), axis=0)
+    cont = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY)
+    samp = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=H)
+    assert (cont.verdict == "certified").all(), K[cont.verdict != "certified"]
+    assert (samp.verdict == "certified").all(), K[samp.verdict != "certified"]
+    # the walk used the cache and the continuous cells, and repaired some proposals
+    assert rep.stats["reused"] > 0 and rep.stats["repaired"] > 0
+    # independent truth on a sample of them: |Γ| ≤ 1 on a fine sweep, the sampled loop's
+    # poles inside the unit circle and |H| ≤ 1 on a fine θ sweep (tolerances: sweep round-off)
+    for k in K[np.random.default_rng(0).choice(len(K), 6, replace=False)]:
+        assert continuous_peak(k) <= 1.0 + 1e-9, k
+        rho, peak = sampled_truth(k)
+        assert rho < 1.0 and peak <= 1.0 + 1e-9, (k, rho, peak)
+
+
+def test_a_proposal_certified_by_both_is_executed_unchanged_and_others_are_moved(walked):
+    _, proposals, executed = walked
+    P, E = proposals.reshape(-1, 3), executed.reshape(-1, 3)
+    moved = (P != E).any(axis=1)
+    cont = ss.check(*P.T, tau=TAU, delta=DELTA, headway=HEADWAY).verdict == "certified"
+    samp = ss.check(*P.T, tau=TAU, delta=DELTA, headway=HEADWAY,
+                    sample_time=H).verdict == "certified"
+    both = cont & samp
+    assert moved.any() and (~moved).any()
+    assert not moved[both].any()  # certified both ways as proposed: executed as proposed
+    assert moved[~both].all()  # not certified both ways: never executed as proposed
+
+
+def test_the_verdict_cache_changes_no_output(walked):
+    _, proposals, executed = walked
+    fresh = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                       sample_time=H)
+    out = []
+    for P in proposals:
+        fresh._verdicts.clear()  # no verdict kept from one call to the next
+        out.append(fresh(P))
+    np.testing.assert_array_equal(np.stack(out), executed)
+    assert fresh.stats["reused"] < fresh.stats["checked"]
+
+
+def test_verdicts_are_reused_for_the_same_triple_and_bounded(monkeypatch):
+    from stringstab.tuning import repair as rp
+
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, sample_time=H)
+    K = np.array([[1.05, 0.55, 0.62], [0.9, -0.5, 1.1], [1.3, 0.41, 0.33]])
+    first = rep.certified(K)
+    calls = rep.stats["certificate_calls"]
+    np.testing.assert_array_equal(rep.certified(K[::-1]), first[::-1])
+    assert rep.stats["certificate_calls"] == calls and rep.stats["reused"] == 3
+    truth = ((ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY).verdict == "certified")
+             & (ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY,
+                         sample_time=H).verdict == "certified"))
+    np.testing.assert_array_equal(first, truth)
+    monkeypatch.setattr(rp, "VERDICT_CACHE", 2)
+    rep.certified(K + 0.01)
+    assert len(rep._verdicts) == 2
