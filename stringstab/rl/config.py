@@ -189,8 +189,8 @@ class TD3Config:
     #: Reaction (actuation) delay θ_r of the follower, s (issue 25; not in the paper): the
     #: vehicle applies its command θ_r late, τ ȧ = u(t − θ_r) − a, integrated exactly
     #: (:mod:`stringstab.traffic.dynamics`); the repair certifies with it (the continuous
-    #: certificate with ``reaction_delay``).  θ_r > 0 needs ``repair_sampled=False``: the
-    #: sampled-data certificate has no θ_r.  0 (default) changes nothing, bit for bit.
+    #: certificate with ``reaction_delay`` and, with ``repair_sampled``, the sampled-data one
+    #: with θ_r at ``dt``).  0 (default) changes nothing, bit for bit.
     reaction_delay: float = 0.0
     #: The follower's V2V radio (issue 26; :class:`stringstab.traffic.Radio`: message period,
     #: loss, staleness and fallback); None (default): the predecessor's acceleration every step.
@@ -379,10 +379,9 @@ def _check_loop(c: TD3Config) -> None:
 
         message_steps(c.radio.message_period, c.dt)  # a whole multiple of the step, or one line
     if theta > 0 and c.action == "gains" and c.repair != "off" and c.repair_sampled:
-        raise StringStabError(
-            f"config field reaction_delay={theta:g} s with repair_sampled: the sampled-data "
-            "certificate has no reaction delay θ_r; expected repair_sampled=False (the repair "
-            "then certifies with the continuous certificate at θ_r, exact)")
+        from ..certify.lifting_reaction import check_reaction_sampled
+
+        check_reaction_sampled(theta, c.dt)  # at most 2,000 steps of dt, or one line
 
 
 def loop_info(config: TD3Config) -> dict[str, Any]:

@@ -61,8 +61,12 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
         Also require the sampled-data certificate of the zero-order-hold loop at this
         period H, s.
     reaction_delay : float
-        θ_r, s (issue 25): with θ_r > 0, the points of the θ_r = 0 lattice that the
-        continuous certificate at θ_r certifies (module docstring); no ``sample_time`` then.
+        θ_r, s (issue 25): with θ_r > 0, the points of the θ_r = 0 continuous lattice that the
+        continuous certificate at θ_r certifies, and with ``sample_time`` of those the points
+        the sampled-data certificate with θ_r at H certifies too
+        (:class:`stringstab.certify.api.Loop` with ``reaction_delay`` and ``sample_time``,
+        docs/sampled.md §10).  Every point is certified; a point certified only with θ_r is
+        left out (conservative, never unsound).
 
     Returns
     -------
@@ -82,11 +86,13 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     """
     n = round((hi - lo) / resolution) + 1
     if reaction_delay:
-        if sample_time is not None:
-            raise StringStabError(f"reaction_delay={reaction_delay:g} s with sample_time={sample_time:g} s: "
-                                  "the sampled-data certificate has no reaction delay θ_r")
-        base = certified_lattice(tau, delta, headway, lo, hi, resolution)
-        keep = grid.certified(base, Params(tau, delta, headway, reaction_delay=reaction_delay))
+        theta = Params(tau, delta, headway, reaction_delay=reaction_delay)
+        if sample_time is not None:  # the continuous lattice at θ_r, then the sampled check
+            base = certified_lattice(tau, delta, headway, lo, hi, resolution, None, reaction_delay)
+            keep = grid.certified(base, theta, sample_time=sample_time)
+        else:
+            base = certified_lattice(tau, delta, headway, lo, hi, resolution)
+            keep = grid.certified(base, theta)
         pts = np.array(base[keep])
         pts.flags.writeable = False
     else:

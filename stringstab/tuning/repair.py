@@ -50,14 +50,17 @@ that contains it — and, with ``sample_time`` H, also by the sampled-data certi
 simulator runs holds u over each control step, and gains on the continuous certificate's
 boundary need not be string stable in that sampled loop.
 
-With a reaction delay θ_r > 0 (issue 25, ``reaction_delay``) the judge is the continuous
+With a reaction delay θ_r > 0 (issue 25, ``reaction_delay``) the judges are the continuous
 certificate with θ_r (:func:`~stringstab.certify.api.check` with ``reaction_delay``, exact in
-θ_r).  The proven cells and the cheap screens are objects of the loop without θ_r and are not
-used: every proposal is checked at θ_r; the certified lattice is the points of the θ_r = 0
-lattice that the certificate at θ_r certifies (a subset of the θ_r lattice, so every point is
-certified; points certified only with θ_r are left out, which is conservative, never unsound);
-the ``refine`` steps move towards the proposal by exact checks at θ_r.  The sampled-data
-certificate has no θ_r: ``sample_time`` with θ_r > 0 is refused (one line).
+θ_r) and, with ``sample_time`` H, the sampled-data certificate with θ_r at H (the loop
+:class:`~stringstab.certify.api.Loop` with ``reaction_delay`` and ``sample_time``: θ_r = qH + a
+fraction, exact discretisation, docs/sampled.md §10).  The proven cells are objects of the loop
+without θ_r and are not used: every proposal is checked at θ_r (verdicts kept, as above); the
+certified lattice is the points of the θ_r = 0 lattice that the certificates at θ_r certify
+(:func:`~stringstab.tuning.lattice.certified_lattice`: every point certified; points certified
+only with θ_r are left out, which is conservative, never unsound); the ``refine`` steps move
+towards the proposal by exact checks at θ_r.  A θ_r of more than 2,000 samples of H is refused
+(one line, as by the certificate).
 """
 
 from __future__ import annotations
@@ -107,8 +110,8 @@ class GainRepair:
         Also require the sampled-data certificate of the zero-order-hold loop at this step
         (:meth:`stringstab.certify.api.Loop.check` at H) for every executed triple.
     reaction_delay : float
-        θ_r, s (issue 25): certify with the continuous certificate at θ_r (module docstring);
-        refused with ``sample_time``.
+        θ_r, s (issue 25): certify with the certificates at θ_r (continuous, and sampled at
+        ``sample_time``; module docstring).
 
     Attributes
     ----------
@@ -151,10 +154,9 @@ class GainRepair:
         self.sample_time = None if sample_time is None else positive("repair sample_time",
                                                                       sample_time, unit=" s")
         if self.reaction_delay and self.sample_time is not None:
-            raise StringStabError(
-                f"repair with reaction_delay={self.reaction_delay:g} s and sample_time="
-                f"{self.sample_time:g} s: the sampled-data certificate has no reaction delay θ_r; "
-                "expected no sample_time (the continuous certificate at θ_r certifies)")
+            from ..certify.lifting_reaction import check_reaction_sampled
+
+            check_reaction_sampled(self.reaction_delay, self.sample_time)
         self._tree: Any = None
         self._projector: Any = None
         self._loops: tuple[Any, Any] | None = None
@@ -177,6 +179,26 @@ class GainRepair:
         return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
                                  self.sample_time, self.reaction_delay)
 
+    def _lazy(self) -> bool:
+        """Whether lattice points are checked when first needed (θ_r > 0 with a sample time).
+
+        The sampled certificate with θ_r checks a lattice point when a repair first needs it
+        (:meth:`_nearest`), not all points at the start.
+        """
+        return bool(self.reaction_delay) and self.sample_time is not None
+
+    def _candidates(self) -> Array:
+        """The points the lookup searches.
+
+        :meth:`lattice`, or with θ_r > 0 and a sample time the continuous lattice at θ_r (each
+        point also checked by the sampled certificate with θ_r before it is executed).
+        """
+        if not self._lazy():
+            return self.lattice()
+        p = self.params
+        return certified_lattice(p.tau, p.delta, p.headway, *self.bounds, self.resolution,
+                                 None, self.reaction_delay)
+
     def cells(self) -> CertifiedCells:
         """The proven cells of this repair's lattice (:func:`certified_cells`, shared)."""
         p = self.params
@@ -192,7 +214,7 @@ class GainRepair:
         if self._tree is None:
             from scipy.spatial import cKDTree
 
-            self._tree = cKDTree(self.lattice())
+            self._tree = cKDTree(self._candidates())
         return self._tree
 
     def _certificate_loops(self) -> tuple[Any, Any]:
@@ -279,8 +301,8 @@ class GainRepair:
         point or in a proven cell, so certified by both certificates.  With θ_r > 0 a point
         is kept when the certificate at θ_r certifies it (one vectorised check per step).
         """
-        _, idx = self._kdtree().query(K0)
-        P = np.array(self.lattice()[np.asarray(idx)], dtype=np.float64)
+        P = self._nearest_certified(K0) if self._lazy() else \
+            np.array(self.lattice()[np.asarray(self._kdtree().query(K0)[1])], dtype=np.float64)
         if self.refine:
             lo = np.zeros(K0.shape[0])
             hi = np.ones(K0.shape[0])
@@ -294,6 +316,38 @@ class GainRepair:
                 hi = np.where(ok, hi, mid)
             P = best
         return P
+
+    def _nearest_certified(self, K0: Array) -> Array:
+        """The nearest points of :meth:`_candidates` that :meth:`certified` certifies (lazy).
+
+        The k nearest candidates of each row, in order of distance, are checked (one call for
+        all rows, verdicts kept); the first certified one is the nearest certified point of the
+        eager lattice (:func:`~stringstab.tuning.lattice.certified_lattice` with θ_r and H).
+        Rows with none among them look further (k × 8), up to every candidate.
+        """
+        C = self._candidates()
+        out = np.empty_like(K0)
+        todo = np.arange(K0.shape[0])
+        k = 8
+        while todo.size:
+            k = min(k, C.shape[0])
+            _, idx = self._kdtree().query(K0[todo], k=k)
+            idx = np.asarray(idx).reshape(todo.size, k)
+            uniq, inv = np.unique(idx, return_inverse=True)
+            ok = self.certified(C[uniq])[inv.reshape(idx.shape)]
+            found = ok.any(axis=1)
+            first = np.argmax(ok, axis=1)
+            rows = np.flatnonzero(found)
+            out[todo[rows]] = C[idx[rows, first[rows]]]
+            todo = todo[~found]
+            if todo.size and k == C.shape[0]:
+                p = self.params
+                raise StringStabError(
+                    f"no certified gains on the lattice at tau={p.tau}, delta={p.delta}, "
+                    f"headway={p.headway}, reaction_delay={p.reaction_delay:g}, sample_time="
+                    f"{self.sample_time:g}; expected parameters with a certified region")
+            k *= 8
+        return out
 
     def _exact(self, K0: Array) -> Array:
         from .projector import Projector
@@ -348,7 +402,7 @@ class GainRepair:
         bad = np.flatnonzero(surely_uncertifiable(K0, Params(p.tau, p.delta, p.headway)))
         if bad.size:
             _, idx = self._kdtree().query(K0[bad])
-            out[bad] = self.lattice()[np.asarray(idx)]
+            out[bad] = self._candidates()[np.asarray(idx)]
         return out
 
     # -- the call -----------------------------------------------------------------------------

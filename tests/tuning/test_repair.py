@@ -123,3 +123,63 @@ def test_verdicts_are_reused_for_the_same_triple_and_bounded(monkeypatch):
     monkeypatch.setattr(rp, "VERDICT_CACHE", 2)
     rep.certified(K + 0.01)
     assert len(rep._verdicts) == 2
+
+
+# -- θ_r > 0 with the sampled certificate (issue 25) ------------------------------------------
+THETA = 0.2  # θ_r = qH with q = 2 (and δ = mH, m = 2): the truth below shifts by whole steps
+
+
+def shifted_response(k, theta):
+    """H(e^{jθ}) of the sampled loop whose command acts q = θ_r/H steps late, δ = mH.
+
+    Built from ``scipy.linalg.expm`` of one vehicle over a held step (not the certificate's
+    lifting): P(z) = (zI − Φ)⁻¹Γ delayed by z^{−q}, the predecessor's acceleration by z^{−m}.
+    """
+    from scipy.linalg import expm
+
+    q, m = round(THETA / H), round(DELTA / H)
+    M = np.zeros((4, 4))
+    M[0, 1] = M[1, 2] = 1.0
+    M[2, 2], M[2, 3] = -1.0 / TAU, 1.0 / TAU
+    E = expm(M * H)
+    Phi, G = E[:3, :3], E[:3, 3]
+    z = np.exp(1j * theta)
+    X = np.array([np.linalg.solve(zz * np.eye(3) - Phi, G) for zz in z])
+    d = z ** (-q)
+    Pp, Pv, Pa = X[:, 0] * d, X[:, 1] * d, X[:, 2] * d
+    num = k[0] * Pp + k[1] * Pv + k[2] * Pa * z ** (-m)
+    return num / (1.0 + k[0] * (Pp + HEADWAY * Pv) + k[1] * Pv)
+
+
+def test_the_sampled_repair_with_theta_certifies_every_executed_gain_both_ways():
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=2,
+                     sample_time=H, reaction_delay=THETA)
+    P = np.array([[1.2, 0.5, 0.6], [0.6, 0.6, 0.3], [0.9, -0.5, 1.1], [0.3, 0.8, 0.1],
+                  [1.5, 1.2, 0.9], [0.4, 0.7, 0.2]])
+    K = rep(P)
+    c = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA)
+    s = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA,
+                 sample_time=H)
+    assert (c.verdict == "certified").all() and (s.verdict == "certified").all(), K
+    both = ((ss.check(*P.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA)
+             .verdict == "certified")
+            & (ss.check(*P.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA,
+                        sample_time=H).verdict == "certified"))
+    np.testing.assert_array_equal((K == P).all(axis=1), both)  # unchanged iff certified
+    assert (~both).any()
+    th = np.linspace(1e-4, np.pi, 2000)
+    for k in K:  # the independent truth: |H| ≤ 1 on a fine θ sweep
+        assert np.max(np.abs(shifted_response(k, th))) <= 1.0 + 1e-9, k
+    # the lattice: every point certified both ways at θ_r (a sample, afresh)
+    L = rep.lattice()
+    pick = L[np.random.default_rng(1).choice(len(L), min(20, len(L)), replace=False)]
+    v = ss.check(*pick.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA,
+                 sample_time=H).verdict
+    assert (v == "certified").all()
+
+
+def test_theta_of_too_many_steps_is_refused_in_one_line():
+    from stringstab.errors import StringStabError
+
+    with pytest.raises(StringStabError, match="at most 2000 whole samples"):
+        GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=0.001, reaction_delay=30.0)
