@@ -172,6 +172,76 @@ class GainRepair:
                 "resolution": self.resolution, "refine": self.refine,
                 "sample_time": self.sample_time}
 
+    # -- the state a resumed training needs ---------------------------------------------------
+    def state(self) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
+        """The repair's decision-affecting state: the kept verdicts, in their insertion order.
+
+        Everything else the repair builds lazily is a function of its settings alone: the
+        certified lattices (one vectorised call over the whole grid), the proven cells (each
+        block of :class:`~stringstab.certify.gain_cells.CertifiedCells` proven in a call of its
+        own) and the k-d tree.  The kept verdicts are not: a verdict of
+        :meth:`stringstab.certify.api.Loop.check` is computed with the other rows of its call
+        (the branch and bound sizes its splits over the batch; only an inconclusive-versus-
+        decided outcome could differ, and none was found in ``analysis/repair_batch_dependence.py``),
+        and which rows shared a call depends on the run's history.  A training checkpoint saves
+        them (:func:`stringstab.rl.train.train`), so a resumed run repairs as the uninterrupted
+        one by design.  With θ_r > 0 and a sample time the lazily checked lattice points are
+        among these verdicts.
+
+        Returns
+        -------
+        meta : dict
+            JSON-ready: ``settings`` (:meth:`describe`) and ``verdicts`` (how many are kept).
+        arrays : dict of str to ndarray
+            ``gains`` (m, 3) float64, the triples' exact bits, oldest first; ``certified`` (m,)
+            uint8, 1 where both certificates certify the triple.
+        """
+        m = len(self._verdicts)
+        gains = np.frombuffer(b"".join(self._verdicts), dtype=np.float64).reshape(m, 3).copy()
+        certified = np.fromiter(self._verdicts.values(), dtype=np.uint8, count=m)
+        return {"settings": self.describe(), "verdicts": m}, {"gains": gains,
+                                                              "certified": certified}
+
+    def load_state(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
+        """Restore :meth:`state` output: the kept verdicts, in the same order (replaces them).
+
+        Parameters
+        ----------
+        meta : dict
+            :meth:`state`'s ``meta``; its ``settings`` must be this repair's (:meth:`describe`).
+        arrays : dict
+            :meth:`state`'s ``arrays``: ``gains`` (m, 3) and ``certified`` (m,) of 0/1.
+
+        Raises
+        ------
+        StringStabError
+            If the settings differ, or the arrays are missing, mis-shaped, not finite or hold
+            more than :data:`VERDICT_CACHE` rows.
+        """
+        where = "repair state"
+        if not isinstance(meta, dict) or meta.get("settings") != self.describe():
+            found = meta.get("settings") if isinstance(meta, dict) else meta
+            raise StringStabError(f"{where}: expected the settings {self.describe()}; "
+                                  f"found {found}")
+        if set(arrays) != {"gains", "certified"}:
+            raise StringStabError(f"{where}: expected the arrays ['certified', 'gains']; "
+                                  f"found {sorted(arrays)}")
+        gains = np.ascontiguousarray(arrays["gains"], dtype=np.float64)
+        cert = np.asarray(arrays["certified"])
+        m = cert.shape[0] if cert.ndim == 1 else -1
+        if (gains.ndim != 2 or gains.shape[1:] != (3,) or gains.shape[0] != m
+                or meta.get("verdicts") != m or m > VERDICT_CACHE
+                or not np.isin(cert, (0, 1)).all() or not np.isfinite(gains).all()):
+            raise StringStabError(
+                f"{where}: expected {meta.get('verdicts')!r} (at most {VERDICT_CACHE}) finite "
+                f"gain triples (m, 3) with a 0/1 verdict each; found gains of shape "
+                f"{gains.shape} and verdicts of shape {cert.shape}")
+        kept = {row.tobytes(): bool(v) for row, v in zip(gains, cert.tolist())}
+        if len(kept) != m:
+            raise StringStabError(f"{where}: expected {m} distinct gain triples; found "
+                                  f"{m - len(kept)} repeated")
+        self._verdicts = kept
+
     # -- the lookup -------------------------------------------------------------------------
     def lattice(self) -> Array:
         """The certified lattice of this repair (built on first use)."""

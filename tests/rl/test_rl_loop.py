@@ -245,6 +245,53 @@ def test_training_with_theta_and_radio_executes_certified_gains_and_resumes_bit_
     assert ev.summary["m_fss_sampled"] == pytest.approx(float(share_s), abs=1e-12)
 
 
+def test_resume_restores_the_repairs_kept_verdicts_bit_for_bit(tmp_path):
+    """The default repair (both certificates, θ_r = 0): interrupted + resumed = uninterrupted.
+
+    The truth: the uninterrupted run's kept verdicts (their bits and order) equal the resumed
+    run's at the end, which holds only if the checkpoint's verdicts were restored (a resumed
+    run starting with none would keep only its second half's, in another order).
+    """
+    from stringstab.rl.checkpoint import CHECKPOINT_FORMAT, latest_checkpoint, read_json, sha256
+
+    cfg = tiny(total_steps=90, learning_starts=30, checkpoint_every=45)
+    assert cfg.repair == "projection" and cfg.repair_sampled
+    full = train(cfg, leaders=short_leaders(), out=tmp_path / "full", progress=False)
+    train(cfg.replace(total_steps=45), leaders=short_leaders(), out=tmp_path / "half",
+          progress=False)
+    sh, th = latest_checkpoint(tmp_path / "half" / "checkpoint")
+    assert sh["step"] == 45 and sh["repair"]["verdicts"] > 0  # the cache is not empty there
+    assert sh["repair"]["settings"]["sample_time"] == cfg.dt
+    resumed = train(cfg, leaders=short_leaders(), out=tmp_path / "half", resume=True,
+                    progress=False)
+    assert full.repair["repaired"] > 0
+    assert full.episodes == resumed.episodes
+    s1, t1 = latest_checkpoint(tmp_path / "full" / "checkpoint")
+    s2, t2 = latest_checkpoint(tmp_path / "half" / "checkpoint")
+    assert s1["repair"] == s2["repair"] and s1["step"] == s2["step"] == 90
+    for stem in ("repair", "buffer", "agent"):
+        assert t1[stem].keys() == t2[stem].keys()
+        for k in t1[stem]:
+            np.testing.assert_array_equal(t1[stem][k], t2[stem][k], err_msg=f"{stem}.{k}")
+    assert t1["repair"]["gains"].shape[0] > th["repair"]["gains"].shape[0]
+    np.testing.assert_array_equal(  # the resumed run kept the first half's verdicts first
+        t2["repair"]["gains"][: th["repair"]["gains"].shape[0]], th["repair"]["gains"])
+    # a checkpoint written before the verdicts were saved (no repair file) still resumes,
+    # with none kept (docs/training.md, "Resuming")
+    train(cfg.replace(total_steps=45), leaders=short_leaders(), out=tmp_path / "old",
+          progress=False)
+    d = tmp_path / "old" / "checkpoint" / "ckpt-0000000045"
+    doc = read_json(d / "state.json", fmt=CHECKPOINT_FORMAT, what="test")
+    del doc["repair"], doc["files"]["repair.safetensors"]
+    (d / "repair.safetensors").unlink()
+    (d / "state.json").write_text(json.dumps(doc))
+    assert all(sha256(d / f) == h for f, h in doc["files"].items())
+    old = train(cfg, leaders=short_leaders(), out=tmp_path / "old", resume=True, progress=False)
+    assert old.steps == 90
+    t3 = latest_checkpoint(tmp_path / "old" / "checkpoint")[1]
+    assert 0 < t3["repair"]["gains"].shape[0] < t1["repair"]["gains"].shape[0]
+
+
 def test_resume_refuses_a_changed_loop(tmp_path):
     cfg = tiny(total_steps=40, learning_starts=16, reaction_delay=0.1, repair_sampled=False)
     train(cfg, leaders=short_leaders(), out=tmp_path / "r", progress=False)

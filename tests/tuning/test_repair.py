@@ -125,6 +125,76 @@ def test_verdicts_are_reused_for_the_same_triple_and_bounded(monkeypatch):
     assert len(rep._verdicts) == 2
 
 
+def _kept(rep):
+    """The kept verdicts as (gains, certified) arrays, oldest first (:meth:`GainRepair.state`)."""
+    meta, arrays = rep.state()
+    assert meta["verdicts"] == arrays["gains"].shape[0] == arrays["certified"].shape[0]
+    return arrays["gains"], arrays["certified"]
+
+
+def test_state_load_state_round_trips_the_kept_verdicts_in_order(walked, monkeypatch):
+    from stringstab.errors import StringStabError
+    from stringstab.tuning import repair as rp
+
+    rep = walked[0]
+    meta, arrays = rep.state()
+    assert meta["verdicts"] > 0 and arrays["certified"].any() and not arrays["certified"].all()
+    # the arrays are the kept verdicts, in their insertion order
+    keys = list(rep._verdicts)
+    np.testing.assert_array_equal(arrays["gains"],
+                                  np.array([np.frombuffer(k) for k in keys]))
+    np.testing.assert_array_equal(arrays["certified"], [int(v) for v in rep._verdicts.values()])
+    back = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                      sample_time=H)
+    back.load_state(json_round_trip(meta), {k: v.copy() for k, v in arrays.items()})
+    assert list(back._verdicts.items()) == list(rep._verdicts.items())  # bits and order
+    # the restored verdicts answer without a certificate call, as the saved ones did
+    K = arrays["gains"][:50]
+    np.testing.assert_array_equal(back.certified(K), arrays["certified"][:50].astype(bool))
+    assert back.stats["certificate_calls"] == 0 and back.stats["reused"] == 50
+    # and they are dropped in the same order when the bound is reached
+    monkeypatch.setattr(rp, "VERDICT_CACHE", meta["verdicts"])
+    a = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, refine=3,
+                   sample_time=H)
+    a.load_state(meta, arrays)
+    new = np.array([[1.01, 0.51, 0.61], [0.91, 0.71, 0.66], [1.31, 0.42, 0.34]])
+    for r in (a, back):
+        r.certified(new)
+    ga, ca = _kept(a)
+    gb, cb = _kept(back)
+    np.testing.assert_array_equal(ga, gb)
+    np.testing.assert_array_equal(ca, cb)
+    np.testing.assert_array_equal(ga[:-3], arrays["gains"][3:])  # the three oldest dropped
+    np.testing.assert_array_equal(ga[-3:], new)
+    # an empty repair round-trips to empty; other settings or bad arrays are refused
+    empty = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, sample_time=H)
+    m0, a0 = empty.state()
+    assert m0["verdicts"] == 0 and a0["gains"].shape == (0, 3)
+    empty.load_state(m0, a0)
+    other = GainRepair(tau=TAU, delta=DELTA, headway=1.2, resolution=0.25, refine=3,
+                       sample_time=H)
+    with pytest.raises(StringStabError, match="expected the settings"):
+        other.load_state(meta, arrays)
+    bad = [{"gains": arrays["gains"][:, :2], "certified": arrays["certified"]},
+           {"gains": arrays["gains"], "certified": arrays["certified"][:-1]},
+           {"gains": arrays["gains"], "certified": arrays["certified"] + 2},
+           {"gains": np.vstack([arrays["gains"][:-1], arrays["gains"][:1]]),
+            "certified": arrays["certified"]},
+           {"gains": arrays["gains"]}]
+    before = list(back._verdicts.items())
+    for arrs in bad:
+        with pytest.raises(StringStabError, match="repair state: expected"):
+            back.load_state(meta, arrs)
+    assert list(back._verdicts.items()) == before  # unchanged by a refusal
+
+
+def json_round_trip(doc):
+    """``doc`` as a checkpoint's state.json gives it back."""
+    import json
+
+    return json.loads(json.dumps(doc))
+
+
 # -- θ_r > 0 with the sampled certificate (issue 25) ------------------------------------------
 THETA = 0.2  # θ_r = qH with q = 2 (and δ = mH, m = 2): the truth below shifts by whole steps
 
