@@ -186,7 +186,9 @@ class GainRepair:
         and which rows shared a call depends on the run's history.  A training checkpoint saves
         them (:func:`stringstab.rl.train.train`), so a resumed run repairs as the uninterrupted
         one by design.  With θ_r > 0 and a sample time the lazily checked lattice points are
-        among these verdicts.
+        among these verdicts.  With ``"projection-exact"`` the state of its
+        :class:`~stringstab.tuning.Projector` (its cache of solutions by rounded K0, which
+        answers a nearby K0 with an earlier solution) is part of it too.
 
         Returns
         -------
@@ -194,13 +196,17 @@ class GainRepair:
             JSON-ready: ``settings`` (:meth:`describe`) and ``verdicts`` (how many are kept).
         arrays : dict of str to ndarray
             ``gains`` (m, 3) float64, the triples' exact bits, oldest first; ``certified`` (m,)
-            uint8, 1 where both certificates certify the triple.
+            uint8, 1 where both certificates certify the triple; with ``"projection-exact"``
+            also ``projector.keys``, ``projector.gains`` and ``projector.last``
+            (:meth:`stringstab.tuning.Projector.state`).
         """
         m = len(self._verdicts)
         gains = np.frombuffer(b"".join(self._verdicts), dtype=np.float64).reshape(m, 3).copy()
         certified = np.fromiter(self._verdicts.values(), dtype=np.uint8, count=m)
-        return {"settings": self.describe(), "verdicts": m}, {"gains": gains,
-                                                              "certified": certified}
+        arrays: dict[str, npt.NDArray[Any]] = {"gains": gains, "certified": certified}
+        if self.method == "projection-exact":
+            arrays.update({f"projector.{k}": v for k, v in self._exact_projector().state().items()})
+        return {"settings": self.describe(), "verdicts": m}, arrays
 
     def load_state(self, meta: dict[str, Any], arrays: dict[str, npt.NDArray[Any]]) -> None:
         """Restore :meth:`state` output: the kept verdicts, in the same order (replaces them).
@@ -210,7 +216,8 @@ class GainRepair:
         meta : dict
             :meth:`state`'s ``meta``; its ``settings`` must be this repair's (:meth:`describe`).
         arrays : dict
-            :meth:`state`'s ``arrays``: ``gains`` (m, 3) and ``certified`` (m,) of 0/1.
+            :meth:`state`'s ``arrays``: ``gains`` (m, 3) and ``certified`` (m,) of 0/1 (and
+            the projector's arrays with ``"projection-exact"``).
 
         Raises
         ------
@@ -223,8 +230,11 @@ class GainRepair:
             found = meta.get("settings") if isinstance(meta, dict) else meta
             raise StringStabError(f"{where}: expected the settings {self.describe()}; "
                                   f"found {found}")
-        if set(arrays) != {"gains", "certified"}:
-            raise StringStabError(f"{where}: expected the arrays ['certified', 'gains']; "
+        names = {"gains", "certified"}
+        if self.method == "projection-exact":
+            names |= {"projector.keys", "projector.gains", "projector.last"}
+        if set(arrays) != names:
+            raise StringStabError(f"{where}: expected the arrays {sorted(names)}; "
                                   f"found {sorted(arrays)}")
         gains = np.ascontiguousarray(arrays["gains"], dtype=np.float64)
         cert = np.asarray(arrays["certified"])
@@ -240,6 +250,9 @@ class GainRepair:
         if len(kept) != m:
             raise StringStabError(f"{where}: expected {m} distinct gain triples; found "
                                   f"{m - len(kept)} repeated")
+        if self.method == "projection-exact":
+            self._exact_projector().load_state(
+                {k[len("projector."):]: v for k, v in arrays.items() if k.startswith("projector.")})
         self._verdicts = kept
 
     # -- the lookup -------------------------------------------------------------------------
@@ -419,18 +432,24 @@ class GainRepair:
             k *= 8
         return out
 
+    def _exact_projector(self) -> Any:
+        """The :class:`~stringstab.tuning.Projector` of ``"projection-exact"`` (built on first use)."""
+        if self._projector is None:
+            from .projector import Projector
+
+            p = self.params
+            self._projector = Projector(tau=p.tau, delta=p.delta, headway=p.headway,
+                                        bounds=self.bounds)
+        return self._projector
+
     def _exact(self, K0: Array) -> Array:
-        from .projector import Projector
         from .region_growing import region_growing
 
         out = np.empty_like(K0)
         p = self.params
         for i, k in enumerate(K0):
             if self.method == "projection-exact":
-                if self._projector is None:
-                    self._projector = Projector(tau=p.tau, delta=p.delta, headway=p.headway,
-                                                bounds=self.bounds)
-                r = self._projector(k)
+                r = self._exact_projector()(k)
             else:
                 r = region_growing(k, tau=p.tau, delta=p.delta, headway=p.headway,
                                    bounds=self.bounds)

@@ -188,6 +188,34 @@ def test_state_load_state_round_trips_the_kept_verdicts_in_order(walked, monkeyp
     assert list(back._verdicts.items()) == before  # unchanged by a refusal
 
 
+def test_projection_exact_state_includes_the_projectors_cache():
+    """``"projection-exact"``: the Projector's cache (by rounded K0) is saved and restored."""
+    pytest.importorskip("casadi")
+    kw = dict(tau=TAU, delta=DELTA, headway=HEADWAY, resolution=0.25, sample_time=H)
+    rep = GainRepair("projection-exact", **kw)
+    P = np.array([[0.9, -0.5, 1.1], [1.5, 0.2, 1.4], [0.3, 1.8, 1.2]])
+    out = rep(P)
+    meta, arrays = rep.state()
+    assert arrays["projector.keys"].shape[0] > 0
+    back = GainRepair("projection-exact", **kw)
+    back.load_state(json_round_trip(meta), arrays)
+    for k, v in back.state()[1].items():
+        np.testing.assert_array_equal(v, arrays[k], err_msg=k)
+    # a proposal a rounding step away is answered from the restored cache, as by the original
+    near = P + 1e-9
+    np.testing.assert_array_equal(back(near), rep(near))
+    assert back._projector.stats["cache_hits"] > 0
+    # the executed gains are certified by both certificates (independent of the cache)
+    for K in (out, back(near)):
+        assert (ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY).verdict == "certified").all()
+        assert (ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY,
+                         sample_time=H).verdict == "certified").all()
+    from stringstab.errors import StringStabError
+
+    with pytest.raises(StringStabError, match="expected the arrays"):
+        back.load_state(meta, {"gains": arrays["gains"], "certified": arrays["certified"]})
+
+
 def json_round_trip(doc):
     """``doc`` as a checkpoint's state.json gives it back."""
     import json
