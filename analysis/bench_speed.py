@@ -258,9 +258,22 @@ def work_verdicts(inp: dict, out: dict) -> None:
     out["load"] = list(os.getloadavg())
 
 
+def repair_module():
+    """The module of ``GainRepair``: ``stringstab.tuning.repair`` (since issue 32 item 3), or
+    ``stringstab.rl.repair`` in a base commit before the move."""
+    try:
+        from stringstab.tuning import repair as rp
+        from stringstab.tuning.lattice import certified_cells
+        rp.certified_cells = certified_cells  # type: ignore[attr-defined]
+    except ImportError:
+        from stringstab.rl import repair as rp  # type: ignore[no-redef]
+    return rp
+
+
 def work_train(inp: dict, out: dict) -> None:
     from stringstab.rl import config_for, train
-    from stringstab.rl import repair as rp
+
+    rp = repair_module()
 
     rp.GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
     steps = inp["train_steps"]
@@ -311,7 +324,7 @@ def work_train(inp: dict, out: dict) -> None:
 def work_env(inp: dict, out: dict) -> None:
     from stringstab.rl import config_for
     from stringstab.rl.envs import make_env
-    from stringstab.rl.repair import GainRepair
+    GainRepair = repair_module().GainRepair
 
     A = np.load(inp["inputs"])["proposals"][-inp["env_steps"]:].astype(np.float32)
     GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice()
@@ -364,8 +377,8 @@ def run_worker(side: str, base_dir: str, spec: dict) -> dict:
 def record_proposals(steps: int) -> np.ndarray:
     """Proposals of an IDL training run of this checkout (what the repair is given), flat."""
     from stringstab.rl import config_for, train
-    from stringstab.rl import repair as rp
 
+    rp = repair_module()
     rows: list[np.ndarray] = []
     orig = rp.GainRepair.__call__
 

@@ -34,8 +34,8 @@ import numpy as np
 from stringstab.certify import zoh
 from stringstab.certify.api import check
 from stringstab.rl import config_for, train
-from stringstab.rl.repair import GainRepair
 from stringstab.tuning import project
+from stringstab.tuning.repair import GainRepair
 
 
 def arm(name: str, steps: int, **kw: object) -> dict[str, float]:
@@ -96,7 +96,7 @@ def main() -> None:
           f"(load {os.getloadavg()[0]:.2f})")
     # the certified lattice is built once per process (lru_cache) by the first arm that repairs;
     # build it here, timed before and after, so that no arm pays for it
-    from stringstab.rl.repair import certified_lattice
+    from stringstab.tuning.lattice import certified_lattice
 
     for label, ctx in (("before", sampled_before), ("after", contextlib.nullcontext)):
         certified_lattice.cache_clear()

@@ -1,6 +1,6 @@
 r"""Certificates over cells of gains: every K of a box [k_x] × [k_v] × [k_a] at once.
 
-The gain repair of training (:mod:`stringstab.rl.repair`) asks at every control step whether
+The gain repair of training (:mod:`stringstab.tuning.repair`) asks at every control step whether
 the proposed gains are certified, by the continuous certificate and the sampled-data one.  A
 cell of its lattice proven here needs no certificate call for any gain inside it: a lookup
 answers.  :func:`certified_cells` proves cells of the lattice of

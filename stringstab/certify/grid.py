@@ -1,7 +1,7 @@
 """The certified points of a grid of gains: one helper for every caller.
 
 Gain repairs start from, and fall back to, the points of a lattice over the gain box that the
-certificate of their loop certifies (:mod:`stringstab.rl.repair`'s lookup,
+certificate of their loop certifies (:mod:`stringstab.tuning.repair`'s lookup,
 :mod:`stringstab.tuning.projection`'s certified maps, :mod:`stringstab.tuning.constraints`).
 :func:`certified` decides which rows of an array of gains are certified for a loop — the
 continuous loop at one τ, δ, T*, the sampled-data loop (``sample_time``) or every member of a

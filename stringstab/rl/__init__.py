@@ -3,8 +3,9 @@
 * :mod:`~stringstab.rl.config` — :class:`TD3Config`, :class:`DDPGConfig` (IDL Table 1 defaults),
   :func:`config_for` ("idl", "td3", "ddpg");
 * :mod:`~stringstab.rl.episodes` — training and test leaders;
-* :mod:`~stringstab.rl.repair` — the §3.3 repair for a training loop (certified lookup) and
-  :func:`~stringstab.rl.repair.repair_for`, the one way to rebuild it from a config or policy;
+* :mod:`~stringstab.rl.repair` — :func:`~stringstab.rl.repair.repair_for`, the one way to rebuild
+  the §3.3 repair (:class:`stringstab.tuning.repair.GainRepair`, the certified lookup, which lives
+  in :mod:`stringstab.tuning`) from a config or policy;
 * :mod:`~stringstab.rl.envs` — :func:`~stringstab.rl.envs.make_env` (the training environments
   of a config) and :class:`~stringstab.rl.envs.RepairedGains`, the action wrapper that rate
   limits and repairs the proposed gains;

@@ -10,7 +10,8 @@ naming the file, what was expected and what was found.
 A training checkpoint is a folder ``checkpoint/ckpt-<step>/`` holding ``state.json`` (config,
 counters, RNG states of NumPy and the environment, optimiser hyper-parameters, the episode log)
 and ``agent.safetensors`` (networks, targets, Adam moments, torch's RNG state) and
-``buffer.safetensors`` (the replay memory and the environments' arrays).  It is written into a
+``buffer.safetensors`` (the replay memory and the environments' arrays) and, for gain actions,
+``repair.safetensors`` (the repair's kept verdicts, :meth:`stringstab.tuning.repair.GainRepair.state`).  It is written into a
 staging folder, renamed into place, and only then named by ``checkpoint/latest.json`` (written
 atomically), so an interrupted write never replaces a good checkpoint.
 """
@@ -232,7 +233,7 @@ def latest_checkpoint(folder: str | os.PathLike[str]) -> tuple[dict[str, Any],
     state : dict
         The checkpoint's ``state.json`` (config, counters, RNG states, episode log, ``files``).
     tensors : dict of str to dict of str to ndarray
-        The arrays of each tensor file, by file stem (``"agent"``, ``"buffer"``), each file's
+        The arrays of each tensor file, by file stem (``"agent"``, ``"buffer"``, ``"repair"``), each file's
         SHA-256 checked against ``state.json`` before it is parsed.
 
     Raises

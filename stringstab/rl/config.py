@@ -30,6 +30,7 @@ from .. import constants
 from ..errors import StringStabError, show
 from ..traffic.radio import Radio
 from ..traffic.sensors import SensorNoise
+from ..tuning.repair import REPAIR_METHODS
 
 __all__ = [
     "ALGOS",
@@ -47,8 +48,9 @@ __all__ = [
 
 #: Agent names of the command line.
 ALGOS: tuple[str, str, str] = ("idl", "td3", "ddpg")
-#: Repair methods of the IDL action (``"off"``: the ablation without repair).
-REPAIRS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
+#: Repair methods of the IDL action (``"off"``: the ablation without repair):
+#: :data:`stringstab.tuning.repair.REPAIR_METHODS`.
+REPAIRS: tuple[str, ...] = REPAIR_METHODS
 
 Action = Literal["gains", "accel"]
 #: The fields of the loop as it runs (issues 25 and 26), left out of :meth:`TD3Config.as_dict`
@@ -187,8 +189,8 @@ class TD3Config:
     #: Reaction (actuation) delay θ_r of the follower, s (issue 25; not in the paper): the
     #: vehicle applies its command θ_r late, τ ȧ = u(t − θ_r) − a, integrated exactly
     #: (:mod:`stringstab.traffic.dynamics`); the repair certifies with it (the continuous
-    #: certificate with ``reaction_delay``).  θ_r > 0 needs ``repair_sampled=False``: the
-    #: sampled-data certificate has no θ_r.  0 (default) changes nothing, bit for bit.
+    #: certificate with ``reaction_delay`` and, with ``repair_sampled``, the sampled-data one
+    #: with θ_r at ``dt``).  0 (default) changes nothing, bit for bit.
     reaction_delay: float = 0.0
     #: The follower's V2V radio (issue 26; :class:`stringstab.traffic.Radio`: message period,
     #: loss, staleness and fallback); None (default): the predecessor's acceleration every step.
@@ -377,10 +379,9 @@ def _check_loop(c: TD3Config) -> None:
 
         message_steps(c.radio.message_period, c.dt)  # a whole multiple of the step, or one line
     if theta > 0 and c.action == "gains" and c.repair != "off" and c.repair_sampled:
-        raise StringStabError(
-            f"config field reaction_delay={theta:g} s with repair_sampled: the sampled-data "
-            "certificate has no reaction delay θ_r; expected repair_sampled=False (the repair "
-            "then certifies with the continuous certificate at θ_r, exact)")
+        from ..certify.lifting_reaction import check_reaction_sampled
+
+        check_reaction_sampled(theta, c.dt)  # at most 2,000 steps of dt, or one line
 
 
 def loop_info(config: TD3Config) -> dict[str, Any]:

@@ -9,7 +9,7 @@ that turns the policy's *proposed* gains into the gains the vehicle *executes*:
 2. with ``gain_rate`` r > 0 (not in the paper), clip each gain to within r of the gain executed
    at the previous step (:func:`~stringstab.traffic.rate.limit_rate`; an episode's first step
    is not limited);
-3. repair (§3.3, :class:`~stringstab.rl.repair.GainRepair`), so every executed triple is
+3. repair (§3.3, :class:`~stringstab.tuning.repair.GainRepair`), so every executed triple is
    certified.
 
 The order matters: the rate limit keeps the gains near the previous (certified) triple, and the
@@ -32,8 +32,9 @@ from gymnasium.vector import VectorActionWrapper, VectorEnv, VectorWrapper
 from ..errors import StringStabError, show
 from ..traffic.env import BatchedCarFollowingEnv
 from ..traffic.rate import limit_rate
+from ..tuning.repair import GainRepair
 from .config import TD3Config
-from .repair import GainRepair, repair_for
+from .repair import repair_for
 
 __all__ = ["RepairedGains", "executed_gains", "make_env", "repair_of"]
 

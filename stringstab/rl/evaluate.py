@@ -61,8 +61,9 @@ PAPER_MP_100_MAX = 0.989
 BASELINES = ("cacc", "idm")
 
 
-#: What the reports say for m_fss_sampled with θ_r > 0.
-SAMPLED_NOT_AVAILABLE = "not available: the sampled certificate has no θ_r"
+#: What the reports say for m_fss_sampled with θ_r > 0 when the sampled certificate with θ_r
+#: refuses the loop (θ_r of more than 2,000 steps: :func:`fss`).
+SAMPLED_NOT_AVAILABLE = "not available: the sampled certificate refuses this θ_r at this step"
 
 
 def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
@@ -88,8 +89,11 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
         Control step, s: the sampling period H of the sampled-data certificate; one per triple
         when the triples ran at different steps (episodes of leaders sampled differently).
     reaction_delay : float
-        θ_r, s (issue 25): m_fss by the continuous certificate at θ_r; with θ_r > 0
-        ``"m_fss_sampled"`` is None (:data:`SAMPLED_NOT_AVAILABLE`).
+        θ_r, s (issue 25): m_fss by the continuous certificate at θ_r, m_fss_sampled by the
+        sampled-data certificate with θ_r at each step (:class:`stringstab.certify.api.Loop`
+        with ``reaction_delay`` and ``sample_time``; docs/sampled.md §10); None where that
+        certificate refuses the loop (:data:`SAMPLED_NOT_AVAILABLE`: θ_r of more than 2,000
+        steps).
 
     Returns
     -------
@@ -117,12 +121,29 @@ def fss(gains: npt.ArrayLike, *, tau: float, delta: float, headway: float,
                               f"found {step.size}")
     steps = np.broadcast_to(step.reshape(-1) if step.ndim else step, K.shape[:1])
     hs = sorted(float(h) for h in np.unique(steps))
-    if reaction_delay:
+    if reaction_delay:  # both certificates with θ_r (issue 25), through certify.api
+        from ..certify.api import Loop
+
+        m_s: float | None = None
+        sampled = f"sampled-data {SAMPLED_NOT_AVAILABLE}"
+        try:
+            ok_r = np.zeros(K.shape[0], dtype=bool)
+            for h in np.unique(steps):  # each triple at the step it ran at
+                rows = np.flatnonzero(steps == h)
+                uniq, inverse = np.unique(K[rows], axis=0, return_inverse=True)
+                loop = Loop.of(tau, delta, headway, sample_time=float(h),
+                               reaction_delay=reaction_delay)
+                cr = loop.check(uniq[:, 0], uniq[:, 1], uniq[:, 2])
+                ok_r[rows] = np.asarray(cr.verdict == Verdict.CERTIFIED)[np.ravel(inverse)]
+            m_s = float(ok_r.mean())
+            sampled = "sampled-data (ZOH) at dt with θ_r beside it"
+        except StringStabError as e:  # θ_r too many steps of dt for the sampled certificate
+            sampled += f" ({e})"
         return {"m_fss": fss_ratio(K[:, 0], K[:, 1], K[:, 2], tau=tau, delta=delta, headway=headway,
                                    reaction_delay=reaction_delay),
-                "m_fss_sampled": None, "n": int(K.shape[0]),
+                "m_fss_sampled": m_s, "n": int(K.shape[0]),
                 "certificate": f"exact (continuous time) with reaction delay θ_r = {reaction_delay:g} s; "
-                               f"sampled-data {SAMPLED_NOT_AVAILABLE}",
+                               + sampled,
                 "dt": hs[0] if len(hs) == 1 else hs}
     ok_s = np.zeros(K.shape[0], dtype=bool)
     for h in np.unique(steps):  # each triple at the step it ran at

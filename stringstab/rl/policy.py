@@ -3,7 +3,7 @@
 ``policy(obs)`` is the actor's action μ(s) in environment units (no exploration noise): the
 proposed gains K for an IDL policy, the acceleration for a pure-RL one.  For an IDL policy,
 :meth:`Policy.gains` is what the vehicle *executes*: μ(s) after the repair step
-(:class:`~stringstab.rl.repair.GainRepair`), each triple certified by the exact certificate.
+(:class:`~stringstab.tuning.repair.GainRepair`), each triple certified by the exact certificate.
 
 :meth:`Policy.save` writes ``policy.safetensors`` (the actor's weights) and ``policy.json``
 (sizes, bounds, settings and the weights file's SHA-256); :func:`load_policy` refuses a missing,
@@ -22,8 +22,9 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..io import atomic_write_text, check_output_dir, dumps_json
+from ..tuning.repair import GainRepair
 from .checkpoint import read_json, read_tensors, write_tensors
-from .repair import GainRepair, repair_for
+from .repair import repair_for
 
 __all__ = ["POLICY_FORMAT", "POLICY_KEYS", "Policy", "load_policy"]
 

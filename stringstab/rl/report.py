@@ -141,7 +141,9 @@ def evaluation_markdown(ev: Evaluation, platoons: Sequence[Mapping[str, Any]],
         lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
                      "certified by the exact, delay-aware certificate (continuous time, frozen "
                      f"gains) with the reaction delay θ_r = {run['reaction_delay']:g} s; "
-                     f"m_fss_sampled: {SAMPLED_NOT_AVAILABLE}.\n\n")
+                     "m_fss_sampled: by the sampled-data certificate with θ_r of the "
+                     f"zero-order-hold loop at the control step dt = {run.get('dt')} s "
+                     f"({SAMPLED_NOT_AVAILABLE} when it refuses θ_r).\n\n")
     else:
         lines.append("\nm_fss: share (a fraction in [0, 1]) of executed (episode, moment) gains "
                      "certified by the exact, delay-aware certificate (continuous time, frozen gains); "

@@ -20,8 +20,8 @@ also writes the log and the summary (``stopped_by: "checkpoint"`` until the run 
 whole while Ctrl-C is held: whenever a run is stopped (a second Ctrl-C raises at once), it leaves
 no folder or a resumable one with its log and summary.  ``resume=True`` continues the newest checkpoint: networks, optimisers,
 the replay memory, the RNG states of NumPy, torch and the environments, the environments' state
-and every counter are restored, so an interrupted run ends bit for bit where an uninterrupted one
-would.
+every counter and the repair's kept verdicts (:meth:`~stringstab.tuning.repair.GainRepair.state`)
+are restored, so an interrupted run ends bit for bit where an uninterrupted one would.
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ class TrainResult:
         Seconds in the environment (repair included), in the repair, in gradient updates, and
         environment steps per second.
     repair : dict or None
-        The repair's statistics (``GainRepair.stats``) for an IDL run.
+        The repair's statistics (:attr:`stringstab.tuning.repair.GainRepair.stats`) for an IDL run.
     out : Path or None
         The run folder.
     """
@@ -344,6 +344,10 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         ep_ret, ep_len = np.array(tensors["buffer"]["ep_ret"]), np.array(tensors["buffer"]["ep_len"])
         episodes = list(state["episodes"])
         returns = [float(r["return"]) for r in episodes]
+        if repair is not None and "repair" in tensors:
+            # the repair's kept verdicts, in order (a checkpoint without them, written before
+            # they were saved, resumes with none kept: docs/training.md "Resuming")
+            repair.load_state(state.get("repair", {}), tensors["repair"])
 
     def result_now(stopped_by: str) -> TrainResult:
         seconds = time.perf_counter() - t_start
@@ -388,7 +392,10 @@ def _train(config: TD3Config, *, envs: Any, out: str | os.PathLike[str] | None, 
         st = {"config": config.as_dict(), "agent": agent_meta, "buffer": buffer.state(),
               "env": env_meta, "rng": rng.bit_generator.state,
               "counters": {"step": step, "clean_ends": clean_ends}, "episodes": episodes}
-        write_checkpoint(out_path / "checkpoint", step, st, {"agent": arrs, "buffer": barr})
+        files = {"agent": arrs, "buffer": barr}
+        if repair is not None:  # its kept verdicts: the resumed run repairs as this one would
+            st["repair"], files["repair"] = repair.state()
+        write_checkpoint(out_path / "checkpoint", step, st, files)
         Policy(agent.actor, info_fn).save(out_path)
         _write_outputs(final or result_now("checkpoint"), figure=final is not None)
         if log is not None:

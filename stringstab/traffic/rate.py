@@ -1,7 +1,7 @@
 """The gain rate limit (not in the paper): :func:`limit_rate`.
 
 Each executed gain stays within r of the previous step's, so a policy cannot jump between
-distant certified triples; the repair (:mod:`stringstab.rl.repair`) still certifies the
+distant certified triples; the repair (:mod:`stringstab.tuning.repair`) still certifies the
 result.  Applied by the action wrapper :class:`stringstab.rl.envs.RepairedGains` in training,
 and identically in evaluation.
 """

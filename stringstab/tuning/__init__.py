@@ -22,7 +22,14 @@ Taylor formula alone.
     (usually one constraint) answers without IPOPT when the exact
     certificate certifies its point.
 
-Both return a :class:`TuneResult` (:class:`TuneResults` for many, owning their
+:class:`GainRepair` (:mod:`~stringstab.tuning.repair`)
+    The repair of a training loop (IDL §3.3 at every control step): a certified lookup on a
+    lattice of certified gains and its proven cells (:mod:`~stringstab.tuning.lattice`), or one
+    of the two methods above per uncertified triple; every executed triple is certified by the
+    exact certificates.  :func:`stringstab.rl.repair.repair_for` rebuilds it from a training
+    config or a saved policy.
+
+:func:`project` and :func:`region_growing` return a :class:`TuneResult` (:class:`TuneResults` for many, owning their
 records, columns and summary).  Gains that the exact certificate already
 certifies are returned unchanged, without any search or solve.
 
@@ -31,7 +38,10 @@ Modules: :mod:`~stringstab.tuning.result` (the result types),
 :mod:`~stringstab.tuning.region_growing`, :mod:`~stringstab.tuning.projection`
 (:func:`project`), :mod:`~stringstab.tuning.projector` (the :class:`Projector`),
 :mod:`~stringstab.tuning.nlp` (the CasADi/IPOPT problems), :mod:`~stringstab.tuning.exchange`
-(the exchange method), :mod:`~stringstab.tuning.predictor` (the Newton predictor) and :mod:`~stringstab.tuning.methods` (:func:`tune`); the figure
+(the exchange method), :mod:`~stringstab.tuning.predictor` (the Newton predictor),
+:mod:`~stringstab.tuning.margin_terms` (the margin's gradient, Newton terms and CasADi form),
+:mod:`~stringstab.tuning.methods` (:func:`tune`), :mod:`~stringstab.tuning.repair` and
+:mod:`~stringstab.tuning.lattice` (the repair of training); the figure
 :func:`~stringstab.plots.plot_moves` lives in :mod:`stringstab.plots.tuning` (the
 plots import the tuning, never the reverse).
 
@@ -49,10 +59,13 @@ from .methods import METHODS, tune
 from .projection import project
 from .projector import Projector
 from .region_growing import region_growing
+from .repair import REPAIR_METHODS, GainRepair
 from .result import TuneResult, TuneResults
 
 __all__ = [
     "METHODS",
+    "REPAIR_METHODS",
+    "GainRepair",
     "Projector",
     "TuneResult",
     "TuneResults",

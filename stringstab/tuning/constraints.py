@@ -2,7 +2,7 @@
 
 The gain repair (:mod:`stringstab.tuning.projection`) asks for gains certified for the loop a
 controller runs: the continuous loop at one τ, δ, T* (its own NLP, built on
-:func:`stringstab.certify.margin.casadi_g`), the sampled-data loop (``sample_time``) or every member of
+:func:`stringstab.tuning.margin_terms.casadi_g`), the sampled-data loop (``sample_time``) or every member of
 a box of τ, δ, T* (the robust certificate), sampled or not.  For the last three, every
 constraint of the NLP is a *quadratic form in the gains*:
 

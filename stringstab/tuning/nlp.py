@@ -6,7 +6,7 @@ Two NLPs in the decision K = (k_x, k_v, k_a), both minimising the weighted dista
 :func:`projection_nlp`
     the continuous loop at one τ, δ, T*: the internal-stability conditions
     (:func:`stringstab.certify.criteria.hurwitz_conditions`, ≥ a margin) and the exact frequency
-    condition g(ω_j; K) ≥ ε (:func:`stringstab.certify.margin.casadi_g`) on ``n`` frequency slots;
+    condition g(ω_j; K) ≥ ε (:func:`stringstab.tuning.margin_terms.casadi_g`) on ``n`` frequency slots;
 :func:`quadratic_nlp`
     the sampled and robust loops: ``n`` quadratic forms q_j(K) = c + bᵀK + KᵀAK ≥ a bound
     (:mod:`stringstab.tuning.constraints`).
@@ -27,10 +27,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..certify import margin as _margin
 from ..certify.criteria import hurwitz_conditions
 from ..errors import StringStabError
 from ..params import Params
+from . import margin_terms
 from .constraints import FORM_SIZE, Slot
 
 __all__ = [
@@ -97,7 +97,7 @@ def projection_nlp(n_slots: int) -> Any:
     K0, w = par[0:3], par[3:6]
     tau, delta, T = par[6], par[7], par[8]
     kx, kv, ka = x[0], x[1], x[2]
-    gs = _margin.casadi_g([par[9 + j] for j in range(n_slots)], kx, kv, ka, tau, delta, T)
+    gs = margin_terms.casadi_g([par[9 + j] for j in range(n_slots)], kx, kv, ka, tau, delta, T)
     f = ca.sum1(w * (x - K0) ** 2)
     g = ca.vertcat(*hurwitz_conditions(kx, kv, ka, tau=tau, headway=T), *gs)
     return ca.nlpsol(f"stringstab_projection_{n_slots}", "ipopt",

@@ -21,6 +21,7 @@ from ..certify import margin as _margin
 from ..certify.criteria import HURWITZ_LABELS, hurwitz_gradients
 from ..certify.verdicts import Verdict
 from ..params import Params
+from . import margin_terms
 from .inputs import GAIN_NAMES
 
 __all__ = ["predict", "predict_dips", "violating_dips"]
@@ -53,8 +54,8 @@ def violating_dips(K: Array, p: Params, threshold: float) -> tuple[float, list[f
 
 
 def _g_and_grad(om: Array, K: Array, p: Params) -> tuple[Array, Array]:
-    """g(ω; K) and ∇_K g (rows: frequencies): :func:`stringstab.certify.margin.gradient`."""
-    return _margin.gradient(om, K, tau=p.tau, delta=p.delta, headway=p.headway)
+    """g(ω; K) and ∇_K g (rows: frequencies): :func:`stringstab.tuning.margin_terms.gradient`."""
+    return margin_terms.gradient(om, K, tau=p.tau, delta=p.delta, headway=p.headway)
 
 
 def predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
@@ -114,11 +115,11 @@ def predict_dips(K0: Array, dips: list[float], p: Params, w: Array, eps: float,
 def _g_full(om: float, K: Array, p: Params) -> tuple[float, Array, float, Array, float, Array]:
     """g(ω; K) with the derivatives the KKT Newton step needs, in scalar arithmetic.
 
-    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g): :func:`stringstab.certify.margin.newton_terms`
+    Returns (g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g): :func:`stringstab.tuning.margin_terms.newton_terms`
     (the generated derivatives in ``math``-module arithmetic; the vectorised form costs
     ~0.5 ms of median repair latency).
     """
-    return _margin.newton_terms(om, float(K[0]), float(K[1]), float(K[2]), p.tau, p.delta,
+    return margin_terms.newton_terms(om, float(K[0]), float(K[1]), float(K[2]), p.tau, p.delta,
                                 p.headway)
 
 

@@ -6,7 +6,7 @@ frequency condition g(ω_j; K) ≥ ε on a finite set of frequencies, refined by
 the exact certificate (:func:`stringstab.certify.api.check`) certifies; first, the Newton
 predictor of :mod:`stringstab.tuning.predictor` answers without IPOPT when it can.  The NLP's
 constraints are the generated Hurwitz conditions (:func:`stringstab.certify.criteria.hurwitz_conditions`)
-and g (:func:`stringstab.certify.margin.casadi_g`).
+and g (:func:`stringstab.tuning.margin_terms.casadi_g`).
 
 For the sampled-data loop (``sample_time``) and for a box of parameters (intervals: every
 member certified) the same exchange runs on the NLP of

@@ -227,6 +227,52 @@ class Projector:
         self._cache.clear()
         self._last = None
 
+    def state(self) -> dict[str, npt.NDArray[np.float64]]:
+        """The state kept between calls, as arrays (a training checkpoint saves it).
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``keys`` (m, 3): the cache's rounded K0, least recently used first; ``gains``
+            (m, 3): the certified gains kept for each; ``last`` (3,): the previous solution
+            (NaN when there is none).
+        """
+        m = len(self._cache)
+        keys = np.array(list(self._cache), dtype=np.float64).reshape(m, 3)
+        gains = np.array([k for k, _ in self._cache.values()], dtype=np.float64).reshape(m, 3)
+        last = np.full(3, np.nan) if self._last is None else np.array(self._last, dtype=np.float64)
+        return {"keys": keys, "gains": gains, "last": last}
+
+    def load_state(self, arrays: dict[str, npt.NDArray[np.float64]]) -> None:
+        """Restore :meth:`state` output (replaces the cache and the previous solution).
+
+        Every kept gain was certified by the exact certificate when it was kept (the cache
+        holds only such gains); the arrays are checked for shape and finiteness only.
+
+        Raises
+        ------
+        StringStabError
+            If an array is missing, mis-shaped or not finite, or there are more rows than
+            ``cache_size``.
+        """
+        try:
+            keys = np.asarray(arrays["keys"], dtype=np.float64)
+            gains = np.asarray(arrays["gains"], dtype=np.float64)
+            last = np.asarray(arrays["last"], dtype=np.float64)
+        except (KeyError, TypeError, ValueError) as e:
+            raise StringStabError(f"projector state: expected arrays keys, gains, last; "
+                                  f"found {sorted(arrays)}") from e
+        if (keys.ndim != 2 or keys.shape[1:] != (3,) or gains.shape != keys.shape
+                or last.shape != (3,) or keys.shape[0] > self.cache_size
+                or not (np.isfinite(keys).all() and np.isfinite(gains).all())):
+            raise StringStabError(
+                f"projector state: expected keys and gains of one shape (m, 3), m <= "
+                f"{self.cache_size}, finite, and last (3,); found {keys.shape}, {gains.shape}, "
+                f"{last.shape}")
+        self._cache = OrderedDict((tuple(k.tolist()), (g.copy(), CERTIFIED_BY_CHECK))
+                                  for k, g in zip(keys, gains))
+        self._last = None if np.isnan(last).all() else last.copy()
+
     # -- one NLP solve ------------------------------------------------------------------
     def _solve(self, K0: Array, x0: Array, omegas: list[float]) -> tuple[Array, str, int]:
         return solve_projection(K0, x0, omegas, params=self._point, weights=self.weights,

@@ -144,7 +144,7 @@ def _repair_certified(K, p, sample_time=None):
 
 @pytest.mark.parametrize("sample_time", [None, 0.1])
 def test_same_points_as_the_rl_repair_lattice(sample_time):
-    from stringstab.rl.repair import certified_lattice as repair_lattice
+    from stringstab.tuning.lattice import certified_lattice as repair_lattice
 
     K = lattice(-2.0, 2.0, 9)
     new = certified_lattice(-2.0, 2.0, 9, P, sample_time=sample_time, also_continuous=True)

@@ -13,7 +13,7 @@ from stringstab.certify.gain_cells import CertifiedCells, continuous_cells, samp
 from stringstab.certify.sampled import check_members
 from stringstab.certify.screen import SampledScreen
 from stringstab.params import Params
-from stringstab.rl.repair import GainRepair
+from stringstab.tuning.repair import GainRepair
 from tests._sampled_truth import pair_response
 
 P = Params(0.1, 0.2, 1.1)

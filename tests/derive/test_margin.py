@@ -23,6 +23,7 @@ from stringstab.derive import codegen
 from stringstab.derive import generated as gen
 from stringstab.derive import symbolic as S
 from stringstab.derive.printed import printed_psi
+from stringstab.tuning import margin_terms
 
 G, P, W = S.GAINS, S.PARAMS, S.omega
 ARGS = [*G, *P]
@@ -116,7 +117,7 @@ def test_casadi_form_of_g():
     casadi = pytest.importorskip("casadi")
     K = casadi.SX.sym("K", 3)
     x = casadi.SX.sym("x", 4)  # ω, τ, δ, T*
-    (e,) = margin.casadi_g([x[0]], K[0], K[1], K[2], x[1], x[2], x[3])
+    (e,) = margin_terms.casadi_g([x[0]], K[0], K[1], K[2], x[1], x[2], x[3])
     f = casadi.Function("g", [K, x], [e])
     vals = [float(f([KX[i], KV[i], KA[i]], [OMEGA[i], TAU[i], DELTA[i], HEADWAY[i]]))
             for i in range(N)]
@@ -131,14 +132,14 @@ def test_gradient_and_newton_terms_are_sympys_derivatives():
     close(gen.margin_gradient(OMEGA, *POINT), expect[:4])
     close(gen.margin_newton(OMEGA, *POINT), expect)
     for i in range(0, N, 7):  # the scalar wrappers of margin.py
-        gv, gk, gwv, gwk, gww, gkk = margin.newton_terms(
+        gv, gk, gwv, gwk, gww, gkk = margin_terms.newton_terms(
             float(OMEGA[i]), float(KX[i]), float(KV[i]), float(KA[i]),
             float(TAU[i]), float(DELTA[i]), float(HEADWAY[i]))
         flat = np.array([gv, *gk, gwv, *gwk, gww, *gkk[np.triu_indices(3)]])
         want = np.array([e[i] for e in expect])
         assert_allclose(flat, want, rtol=1e-10, atol=1e-10 * (1 + np.max(np.abs(want))))
         assert_allclose(gkk, gkk.T, rtol=0, atol=0)
-        _, grad = margin.gradient(OMEGA[i:i + 3], [KX[i], KV[i], KA[i]],
+        _, grad = margin_terms.gradient(OMEGA[i:i + 3], [KX[i], KV[i], KA[i]],
                                   tau=TAU[i], delta=DELTA[i], headway=HEADWAY[i])
         assert grad.shape == (min(3, N - i), 3)
         assert_allclose(grad[0], want[1:4], rtol=1e-10, atol=1e-10 * (1 + np.max(np.abs(want))))

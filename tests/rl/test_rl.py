@@ -30,7 +30,8 @@ pytest.importorskip("safetensors")
 
 from stringstab.rl import config_for, load_policy, train  # noqa: E402
 from stringstab.rl.envs import RepairedGains, make_env, repair_of  # noqa: E402
-from stringstab.rl.repair import GainRepair, repair_for  # noqa: E402
+from stringstab.rl.repair import repair_for  # noqa: E402
+from stringstab.tuning.repair import GainRepair  # noqa: E402
 
 pytestmark = pytest.mark.torch
 

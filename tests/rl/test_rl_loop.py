@@ -32,7 +32,7 @@ pytest.importorskip("safetensors")
 
 from stringstab.rl import config_for, train  # noqa: E402
 from stringstab.rl.evaluate import evaluate, fss  # noqa: E402
-from stringstab.rl.repair import GainRepair  # noqa: E402
+from stringstab.tuning.repair import GainRepair  # noqa: E402
 
 pytestmark = pytest.mark.torch
 
@@ -164,30 +164,39 @@ def test_repair_output_is_certified_at_theta():
     np.testing.assert_array_equal(rep(ok), ok)
 
 
-def test_repair_and_config_refuse_theta_with_the_sampled_certificate():
-    with pytest.raises(StringStabError, match="sampled-data certificate has no reaction delay"):
-        GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=0.1, reaction_delay=THETA)
-    with pytest.raises(StringStabError, match=r"reaction_delay=0\.2 s with repair_sampled"):
-        config_for("idl", reaction_delay=THETA)
+def test_repair_and_config_with_theta_and_the_sampled_certificate():
+    rep = GainRepair(tau=TAU, delta=DELTA, headway=HEADWAY, sample_time=0.1, reaction_delay=THETA,
+                     resolution=0.25)
+    assert rep.describe()["sample_time"] == 0.1 and rep.describe()["reaction_delay"] == THETA
+    from stringstab.rl.repair import repair_for
+
+    both = repair_for(config_for("idl", reaction_delay=THETA))  # repair_sampled by default
+    assert both is not None and both.sample_time == 0.1 and both.reaction_delay == THETA
+    with pytest.raises(StringStabError, match="at most 2000 whole samples"):
+        config_for("idl", reaction_delay=30.0, dt=0.01)
     with pytest.raises(StringStabError, match="reaction_delay"):
         config_for("idl", reaction_delay=-0.1, repair_sampled=False)
     with pytest.raises(StringStabError, match="message period must be a whole multiple"):
         config_for("td3", radio=Radio(message_period=0.15))
     cfg = config_for("idl", reaction_delay=THETA, repair_sampled=False)
-    from stringstab.rl.repair import repair_for
-
     rep = repair_for(cfg)
     assert rep is not None and rep.sample_time is None and rep.reaction_delay == THETA
 
 
-def test_fss_at_theta_and_sampled_not_available():
-    K = np.array([[1.2, 0.5, 0.6], [0.6, 0.6, 0.3]])
+def test_fss_at_theta_with_the_sampled_certificate():
+    K = np.array([[1.2, 0.5, 0.6], [0.6, 0.6, 0.3], [0.6, 0.6, 0.3], [0.9, 0.9, 0.7]])
     f0 = fss(K, tau=TAU, delta=DELTA, headway=HEADWAY, dt=0.1)
     ft = fss(K, tau=TAU, delta=DELTA, headway=HEADWAY, dt=0.1, reaction_delay=THETA)
     truth = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA)
     assert ft["m_fss"] == pytest.approx(float(np.mean(truth.verdict == "certified")), abs=0)
-    assert ft["m_fss_sampled"] is None and "no θ_r" in ft["certificate"]
-    assert f0["m_fss"] == 1.0 and f0["m_fss_sampled"] is not None
+    st = ss.check(*K.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA,
+                  sample_time=0.1)
+    assert ft["m_fss_sampled"] == pytest.approx(float(np.mean(st.verdict == "certified")), abs=0)
+    assert "with θ_r" in ft["certificate"]
+    assert f0["m_fss_sampled"] is not None
+    # refused by the sampled certificate (θ_r of more than 2,000 steps): None, and said
+    fr = fss(K, tau=TAU, delta=DELTA, headway=HEADWAY, dt=0.001, reaction_delay=30.0)
+    assert fr["m_fss_sampled"] is None and "refuses" in fr["certificate"]
 
 
 # ------------------------------------------------------------------ training and resuming
@@ -228,7 +237,59 @@ def test_training_with_theta_and_radio_executes_certified_gains_and_resumes_bit_
     assert (v[u[:, 2] != 0] == "certified").all()
     share = np.mean([v[np.flatnonzero((u == k).all(axis=1))[0]] == "certified" for k in ev.gains[:, 2:]])
     assert ev.summary["m_fss"] == pytest.approx(float(share), abs=1e-12)
-    assert ev.summary["m_fss_sampled"] is None
+    vs = ss.check(*u.T, tau=TAU, delta=DELTA, headway=HEADWAY, reaction_delay=THETA,
+                  sample_time=cfg.dt).verdict
+    # m_fss_sampled: the sampled certificate with θ_r at dt (issue 25), on the same gains
+    share_s = np.mean([vs[np.flatnonzero((u == k).all(axis=1))[0]] == "certified"
+                       for k in ev.gains[:, 2:]])
+    assert ev.summary["m_fss_sampled"] == pytest.approx(float(share_s), abs=1e-12)
+
+
+def test_resume_restores_the_repairs_kept_verdicts_bit_for_bit(tmp_path):
+    """The default repair (both certificates, θ_r = 0): interrupted + resumed = uninterrupted.
+
+    The truth: the uninterrupted run's kept verdicts (their bits and order) equal the resumed
+    run's at the end, which holds only if the checkpoint's verdicts were restored (a resumed
+    run starting with none would keep only its second half's, in another order).
+    """
+    from stringstab.rl.checkpoint import CHECKPOINT_FORMAT, latest_checkpoint, read_json, sha256
+
+    cfg = tiny(total_steps=90, learning_starts=30, checkpoint_every=45)
+    assert cfg.repair == "projection" and cfg.repair_sampled
+    full = train(cfg, leaders=short_leaders(), out=tmp_path / "full", progress=False)
+    train(cfg.replace(total_steps=45), leaders=short_leaders(), out=tmp_path / "half",
+          progress=False)
+    sh, th = latest_checkpoint(tmp_path / "half" / "checkpoint")
+    assert sh["step"] == 45 and sh["repair"]["verdicts"] > 0  # the cache is not empty there
+    assert sh["repair"]["settings"]["sample_time"] == cfg.dt
+    resumed = train(cfg, leaders=short_leaders(), out=tmp_path / "half", resume=True,
+                    progress=False)
+    assert full.repair["repaired"] > 0
+    assert full.episodes == resumed.episodes
+    s1, t1 = latest_checkpoint(tmp_path / "full" / "checkpoint")
+    s2, t2 = latest_checkpoint(tmp_path / "half" / "checkpoint")
+    assert s1["repair"] == s2["repair"] and s1["step"] == s2["step"] == 90
+    for stem in ("repair", "buffer", "agent"):
+        assert t1[stem].keys() == t2[stem].keys()
+        for k in t1[stem]:
+            np.testing.assert_array_equal(t1[stem][k], t2[stem][k], err_msg=f"{stem}.{k}")
+    assert t1["repair"]["gains"].shape[0] > th["repair"]["gains"].shape[0]
+    np.testing.assert_array_equal(  # the resumed run kept the first half's verdicts first
+        t2["repair"]["gains"][: th["repair"]["gains"].shape[0]], th["repair"]["gains"])
+    # a checkpoint written before the verdicts were saved (no repair file) still resumes,
+    # with none kept (docs/training.md, "Resuming")
+    train(cfg.replace(total_steps=45), leaders=short_leaders(), out=tmp_path / "old",
+          progress=False)
+    d = tmp_path / "old" / "checkpoint" / "ckpt-0000000045"
+    doc = read_json(d / "state.json", fmt=CHECKPOINT_FORMAT, what="test")
+    del doc["repair"], doc["files"]["repair.safetensors"]
+    (d / "repair.safetensors").unlink()
+    (d / "state.json").write_text(json.dumps(doc))
+    assert all(sha256(d / f) == h for f, h in doc["files"].items())
+    old = train(cfg, leaders=short_leaders(), out=tmp_path / "old", resume=True, progress=False)
+    assert old.steps == 90
+    t3 = latest_checkpoint(tmp_path / "old" / "checkpoint")[1]
+    assert 0 < t3["repair"]["gains"].shape[0] < t1["repair"]["gains"].shape[0]
 
 
 def test_resume_refuses_a_changed_loop(tmp_path):
@@ -298,8 +359,8 @@ def test_cli_train_evaluate_compare_with_theta_and_radio(tmp_path, capsys):
     out = capsys.readouterr().out
     doc = json.loads((run / "evaluation" / "evaluation.json").read_text())
     assert doc["run"]["reaction_delay"] == 0.2 and doc["run"]["radio"]["message_period"] == 0.2
-    assert doc["summary"]["m_fss"] == 1.0 and doc["summary"]["m_fss_sampled"] is None
-    assert "not available: the sampled certificate has no θ_r" in out
+    assert doc["summary"]["m_fss"] == 1.0 and doc["summary"]["m_fss_sampled"] is not None
+    assert "sampled-data at dt=" in out
     assert code == (0 if doc["summary"]["collisions"] == 0 else 1)
     # evaluated in another loop on request: θ_r = 0.3, no radio
     assert main(["evaluate", str(run), "--leaders", str(lead), "--platoon", "none", "--no-progress",
@@ -316,7 +377,7 @@ def test_cli_train_evaluate_compare_with_theta_and_radio(tmp_path, capsys):
     assert main(["compare", str(run), "--baselines", "cacc", "--leaders", str(lead), "--out",
                  str(cmp), "--no-progress"]) == 0
     table = (cmp / "table.md").read_text()
-    assert "reaction delay θ_r = 0.2 s" in table and "not available" in table
+    assert "reaction delay θ_r = 0.2 s" in table and "not available" not in table  # m_fss_sampled at θ_r
     assert not (cmp / "gains_region.png").exists() and "region map has no reaction delay" in table
     assert json.loads((cmp / "comparison.json").read_text())["loop"]["reaction_delay"] == 0.2
     import matplotlib.pyplot as plt

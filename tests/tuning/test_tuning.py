@@ -381,13 +381,13 @@ def test_plot_moves():
 
 
 def test_hand_derivatives_of_g_match_sympy():
-    """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g (stringstab.certify.margin.newton_terms
-    and its vectorised twin margin.gradient) equal SymPy's derivatives of the derived margin
+    """The predictor's g, ∇_K g, g_ω, ∇_K g_ω, g_ωω, ∇²_KK g (stringstab.tuning.margin_terms.newton_terms
+    and its vectorised twin margin_terms.gradient) equal SymPy's derivatives of the derived margin
     (|D|² − |N|²)/ω² (stringstab.derive.symbolic)."""
     import sympy as sp
 
-    from stringstab.certify import margin
     from stringstab.derive import symbolic as S
+    from stringstab.tuning import margin_terms
 
     g = S.margin_exact() / S.omega**2
     K = list(S.GAINS)
@@ -401,9 +401,9 @@ def test_hand_derivatives_of_g_match_sympy():
         tau, delta, headway = rng.uniform(0.05, 0.6), rng.uniform(0, 0.5), rng.uniform(0.3, 2)
         om = rng.uniform(0.05, 8)
         ref = np.array(f(*k, tau, delta, headway, om), dtype=float)
-        val, gk, gw, gwk, gww, gkk = margin.newton_terms(om, *k, tau, delta, headway)
+        val, gk, gw, gwk, gww, gkk = margin_terms.newton_terms(om, *k, tau, delta, headway)
         ours = np.concatenate([[val], gk, [gw], gwk, [gww], np.asarray(gkk).ravel()])
         assert_allclose(ours, ref, rtol=1e-9, atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
-        gv, gk2 = margin.gradient(np.array([om]), k, tau=tau, delta=delta, headway=headway)  # vectorised twin
+        gv, gk2 = margin_terms.gradient(np.array([om]), k, tau=tau, delta=delta, headway=headway)  # vectorised twin
         assert_allclose(np.concatenate([gv, gk2[0]]), ref[:4], rtol=1e-9,
                         atol=1e-9 * (1 + float(np.max(np.abs(ref)))))
