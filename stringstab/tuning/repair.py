@@ -323,11 +323,13 @@ class GainRepair:
         ``"certified"`` for exactly that triple.  The sampled check runs first (one vectorised
         call on the rows not yet known), the continuous one on the rows it certifies (a row the
         sampled certificate does not certify is not certified, whatever the other says).
-        Each answer is kept, keyed by the triple's exact bits (a verdict of a certificate is a
-        property of the triple: asking again gives it again), and reused when the same
+        Each answer is kept, keyed by the triple's exact bits, and reused when the same
         triple comes again — under a gain rate limit a training proposes the same floats
         often (``stats["reused"]``); at most :data:`VERDICT_CACHE` triples are kept (the
-        oldest dropped first).
+        oldest dropped first).  A verdict is computed with the other rows of its call, so
+        an inconclusive-versus-decided outcome could depend on them (none did in
+        ``analysis/repair_batch_dependence.py``); a training checkpoint saves the kept
+        answers (:meth:`state`), so a resumed run does not rely on that.
 
         Parameters
         ----------

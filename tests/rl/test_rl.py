@@ -230,7 +230,7 @@ def test_resume_is_bit_for_bit(tmp_path):
     s1, t1 = latest_checkpoint(tmp_path / "full" / "checkpoint")
     s2, t2 = latest_checkpoint(tmp_path / "half" / "checkpoint")
     assert s1["rng"] == s2["rng"] and s1["env"] == s2["env"] and s1["buffer"] == s2["buffer"]
-    for f in ("agent", "buffer"):
+    for f in ("agent", "buffer", "repair"):  # the repair's kept verdicts too
         assert t1[f].keys() == t2[f].keys()
         for k in t1[f]:
             np.testing.assert_array_equal(t1[f][k], t2[f][k], err_msg=k)
