@@ -334,7 +334,7 @@ def run(args: argparse.Namespace) -> int:
     # plotting code while the map is computed in the worker pool
     from ..plots import start_output_helper
 
-    with start_output_helper() as helper:
+    with start_output_helper(dpi) as helper:
         # region_map validates the methods before computing anything
         with _executor(args.scheduler, workers) as (executor, n_dask):
             if thetas is not None:  # -- one map per θ_r (issue 25 part 2)

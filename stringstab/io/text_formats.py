@@ -11,7 +11,7 @@ from __future__ import annotations
 import io
 import json
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 import numpy.typing as npt
@@ -21,7 +21,7 @@ from .columns import Columns, Leaf, Normalised, flat_leaves, n_rows, normalise_c
 from .plain import to_plain
 from .table import human_value
 
-__all__ = ["render_csv", "render_json", "warm_up"]
+__all__ = ["render_csv", "render_json", "warm_up", "write_csv"]
 
 
 def _pa() -> tuple[Any, Any]:
@@ -53,6 +53,34 @@ def _mapped(values: npt.NDArray[Any], fn: Callable[[Any], str]) -> Any:
     )
 
 
+def _float_cells(v: npt.NDArray[Any], mask: npt.NDArray[np.bool_] | None) -> Any:
+    """Float cells: the shortest round-trip digits, ``.0`` on integral values, null where missing.
+
+    A non-finite number is missing too.  The missing cells are nulls from the start (only the
+    present numbers are formatted), and only the integral values are formatted a second time.
+    """
+    pa, pc = _pa()
+    bad = ~np.isfinite(v)
+    if bad.any():
+        mask = bad if mask is None else (mask | bad)
+    if mask is not None and not mask.any():
+        mask = None
+    s = pc.cast(pa.array(v, type=pa.float64(), mask=mask), pa.string())  # shortest round-trip
+    # integral values keep a '.0', as Python writes them (1.0, not 1)
+    whole = (np.abs(v) < 1e15) & (np.trunc(v) == v)
+    if mask is not None:
+        whole &= ~mask
+    if whole.any():  # those cells only, formatted as integers, replace theirs
+        w = np.asarray(v, dtype=np.float64)[whole]
+        as_int = pc.binary_join_element_wise(
+            pc.cast(pa.array(w.astype(np.int64)), pa.string()), ".0", "")
+        negative_zero = (w == 0.0) & np.signbit(w)
+        if negative_zero.any():
+            as_int = pc.if_else(pa.array(negative_zero), pa.scalar("-0.0", pa.string()), as_int)
+        s = pc.replace_with_mask(s, pa.array(whole), as_int)
+    return s
+
+
 def _cells(leaf: Leaf, style: str) -> Any:
     """The column as a pyarrow string array of CSV or JSON cells (null where missing)."""
     pa, pc = _pa()
@@ -62,23 +90,12 @@ def _cells(leaf: Leaf, style: str) -> Any:
     mask = leaf.mask
     k = leaf.kind
     if k == "f":
-        bad = ~np.isfinite(v)
-        if bad.any():
-            mask = bad if mask is None else (mask | bad)
-        s = pc.cast(pa.array(v, type=pa.float64()), pa.string())  # shortest round-trip digits
-        # integral values keep a '.0', as Python writes them (1.0, not 1)
-        whole = (np.abs(v) < 1e15) & (np.trunc(v) == v)
-        if whole.any():
-            as_int = pc.cast(pa.array(np.where(whole, v, 0.0).astype(np.int64)), pa.string())
-            s = pc.if_else(pa.array(whole), pc.binary_join_element_wise(as_int, ".0", ""), s)
-            negative_zero = whole & (v == 0.0) & np.signbit(v)
-            if negative_zero.any():
-                s = pc.if_else(pa.array(negative_zero), pa.scalar("-0.0", pa.string()), s)
-    elif k == "i":
+        return _float_cells(v, mask)
+    if k == "i":
         s = pc.cast(pa.array(v, type=pa.int64()), pa.string())
-    elif k == "b":
+    elif k == "b":  # the two words, spread by the values (no string per row formed here)
         t, f = ("true", "false") if style == "json" else ("True", "False")
-        s = pa.array(np.where(v, t, f), type=pa.string())
+        s = pa.array([f, t], type=pa.string()).take(pa.array(np.asarray(v, dtype=np.int8)))
     else:
         if style == "json":
             s = _mapped(v, lambda x: json.dumps(x, ensure_ascii=False))
@@ -132,11 +149,49 @@ def _params_flat(params: Mapping[str, Any] | None) -> dict[str, Any]:
     return out
 
 
+def _csv_cells(columns: Columns, params: Mapping[str, Any] | None) -> tuple[str, list[Any], bool]:
+    """(header, the cells column by column as pyarrow arrays, whether some carry quotes)."""
+    cols = normalise_columns(columns)
+    pa, pc = _pa()
+    flat = flat_leaves(cols)
+    n = n_rows(cols)
+    extra = {k: v for k, v in _params_flat(params).items() if k not in flat}
+    header = ",".join(_csv_quote(h) for h in [*flat, *extra])
+    if n == 0:
+        return header, [], False
+    pieces = [_filled(_cells(leaf, "csv"), "") for leaf in flat.values()]
+    extra_cells = [_csv_cell(v) for v in extra.values()]
+    pieces += [pa.repeat(pa.scalar(c, pa.string()), n) for c in extra_cells]
+    # only text can carry quotes (numbers and booleans never do); a categorical's labels suffice
+    quoted = any(c.startswith('"') for c in extra_cells) or any(
+        any(_csv_quote(str(x)) != str(x) for x in leaf.base.tolist()) if leaf.codes is not None
+        else pc.any(pc.starts_with(cells, '"')).as_py()
+        for leaf, cells in zip(flat.values(), pieces) if leaf.kind not in "bif")
+    return header, pieces, quoted
+
+
+def _write_rows(pieces: list[Any], quoted: bool, sink: Any) -> None:
+    """The rows of :func:`_csv_cells`' cells, each newline-terminated, as UTF-8 into ``sink``."""
+    pa, pc = _pa()
+    if not quoted:
+        # Arrow's CSV writer lays the (already formatted) cells out in C++, 3x faster than
+        # joining them here; "none" because every cell is final text needing no quotes.
+        import pyarrow.csv as pa_csv
+
+        table = pa.table({str(i): p for i, p in enumerate(pieces)})
+        pa_csv.write_csv(table, sink, pa_csv.WriteOptions(include_header=False,
+                                                          quoting_style="none"))
+        return
+    rows = pc.binary_join_element_wise(*pieces, ",")  # some cells carry their own quotes
+    sink.write(_join_rows(rows, "\n").encode("utf-8") + b"\n")
+
+
 def render_csv(columns: Columns, params: Mapping[str, Any] | None = None) -> str:
     """The ``csv`` text of result columns: one row per result, groups flattened with ``_``.
 
     The scalar parameters are repeated as trailing columns (lists joined with ``,``); numbers
     are written in their shortest round-trip form, a non-finite number as an empty field.
+    :func:`write_csv` writes the same text, UTF-8 encoded, to a binary file.
 
     Parameters
     ----------
@@ -155,34 +210,47 @@ def render_csv(columns: Columns, params: Mapping[str, Any] | None = None) -> str
     StringStabError
         On ragged or malformed columns.
     """
-    cols = normalise_columns(columns)
-    pa, pc = _pa()
-    flat = flat_leaves(cols)
-    n = n_rows(cols)
-    extra = {k: v for k, v in _params_flat(params).items() if k not in flat}
-    header = ",".join(_csv_quote(h) for h in [*flat, *extra])
-    if n == 0:
+    header, pieces, quoted = _csv_cells(columns, params)
+    if not pieces:
         return header + "\n"
-    pieces = [_filled(_cells(leaf, "csv"), "") for leaf in flat.values()]
-    extra_cells = [_csv_cell(v) for v in extra.values()]
-    pieces += [pa.repeat(pa.scalar(c, pa.string()), n) for c in extra_cells]
-    # only text can carry quotes (numbers and booleans never do); a categorical's labels suffice
-    quoted = any(c.startswith('"') for c in extra_cells) or any(
-        any(_csv_quote(str(x)) != str(x) for x in leaf.base.tolist()) if leaf.codes is not None
-        else pc.any(pc.starts_with(cells, '"')).as_py()
-        for leaf, cells in zip(flat.values(), pieces) if leaf.kind not in "bif")
-    if not quoted:
-        # Arrow's CSV writer lays the (already formatted) cells out in C++, 3x faster than
-        # joining them here; "none" because every cell is final text needing no quotes.
-        import pyarrow.csv as pa_csv
+    buf = io.BytesIO()
+    _write_rows(pieces, quoted, buf)
+    return header + "\n" + buf.getvalue().decode("utf-8")
 
-        buf = io.BytesIO()
-        table = pa.table({str(i): p for i, p in enumerate(pieces)})
-        pa_csv.write_csv(table, buf, pa_csv.WriteOptions(include_header=False,
-                                                         quoting_style="none"))
-        return header + "\n" + buf.getvalue().decode("utf-8")
-    rows = pc.binary_join_element_wise(*pieces, ",")  # some cells carry their own quotes
-    return header + "\n" + _join_rows(rows, "\n") + "\n"
+
+def write_csv(columns: Columns, sink: BinaryIO, params: Mapping[str, Any] | None = None) -> None:
+    """Write the text of :func:`render_csv`, UTF-8 encoded, to the binary file ``sink``.
+
+    The same bytes as ``render_csv(columns, params).encode("utf-8")``, without forming the
+    text: the rows go from Arrow's buffers to the file (a region map of 641,601 rows is a
+    60 MB text, decoded, joined and encoded again otherwise).
+
+    Parameters
+    ----------
+    columns : mapping
+        Ordered columns ``name → 1-D array`` (or ``name → {name → array}``), one length.
+    sink : binary file
+        Open for writing (e.g. ``open(path, "wb")``); written from its position, not closed.
+    params : mapping, optional
+        Settings of the run.
+
+    Raises
+    ------
+    StringStabError
+        On ragged or malformed columns (nothing is written then).
+
+    Examples
+    --------
+    >>> buf = io.BytesIO()
+    >>> write_csv({"k_x": [1.0, 0.25], "ok": [True, False]}, buf, params={"tau": 0.1})
+    >>> buf.getvalue() == render_csv({"k_x": [1.0, 0.25], "ok": [True, False]},
+    ...                              {"tau": 0.1}).encode("utf-8")
+    True
+    """
+    header, pieces, quoted = _csv_cells(columns, params)
+    sink.write(header.encode("utf-8") + b"\n")
+    if pieces:
+        _write_rows(pieces, quoted, sink)
 
 
 def _csv_cell(v: Any) -> str:

@@ -44,7 +44,14 @@ matplotlib is imported on first use.
 from __future__ import annotations
 
 from ..io.figures import FIGURE_FORMATS
-from ._common import CLASS_COLORS, GAIN_LABELS, OKABE_ITO, PlotResult, warm_up
+from ._common import (
+    CLASS_COLORS,
+    GAIN_LABELS,
+    OKABE_ITO,
+    PlotResult,
+    share_mathtext_parser,
+    warm_up,
+)
 from .mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
 from .outputs import (
     draw_figure,
@@ -90,6 +97,7 @@ __all__ = [
     "save_figures",
     "save_reaction_sweep_outputs",
     "save_region_outputs",
+    "share_mathtext_parser",
     "start_output_helper",
     "trajectory_verdicts",
     "warm_up",

@@ -136,9 +136,13 @@ def draw_field(ax: Any, rmap: RegionMap, values: np.ndarray, **kw: Any) -> Any:
     x, y = rmap.axes.values()
     if _uniform(x) and _uniform(y):
         dx, dy = (x[1] - x[0]) / 2, (y[1] - y[0]) / 2
+        # nearest-neighbour resampling of the values, then the colours of the screen pixels
+        # only: with "nearest", picking then colouring is the same picture as colouring then
+        # picking (matplotlib's choice when a large map is shrunk to fewer pixels), pixel for
+        # pixel, without colouring every grid point as an RGBA float image first
         return ax.imshow(
             np.asarray(values).T, origin="lower", extent=(x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy),
-            aspect="auto", interpolation="nearest", **kw,
+            aspect="auto", interpolation="nearest", interpolation_stage="data", **kw,
         )
     return ax.pcolormesh(x, y, np.asarray(values).T, shading="nearest", **kw)
 

@@ -30,7 +30,7 @@ from ..errors import StringStabError
 from ..io.figures import check_figure_formats, figure_metadata, save_figure
 from ..parallel import Helper, cpu_count, map_processes, start_helper
 from ..regions import RegionMap
-from ._common import pyplot
+from ._common import pyplot, share_mathtext_parser
 from .map_axes import method_title
 from .projection import plot_projected_region, projected_region
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
@@ -215,10 +215,11 @@ def _need_verdicts(gains: Any, verdicts: Any) -> None:
                               "stringstab.plots.trajectory_verdicts(rmap, gains)); got none")
 
 
-def _warm_up_outputs() -> None:
+def _warm_up_outputs(dpi: int = 150) -> None:
     """Import and warm up what drawing a map's figures needs: pyplot (Agg), a first figure.
 
-    Run in the helper of :func:`start_output_helper` while the map is computed.
+    Run in the helper of :func:`start_output_helper` while the map is computed; the gain
+    labels are parsed at ``dpi`` once for every figure (:func:`~stringstab.plots.warm_up`).
     """
     import matplotlib
 
@@ -226,15 +227,20 @@ def _warm_up_outputs() -> None:
         matplotlib.use("Agg")
     from ._common import warm_up
 
-    warm_up()
+    warm_up(dpi)
 
 
-def start_output_helper() -> Helper:
+def start_output_helper(dpi: int = 150) -> Helper:
     """Start the helper process of :func:`save_region_outputs`, warming up now.
 
     Start it before the map's worker pool (both are then started from a single-threaded
     process, :mod:`stringstab.parallel`): it imports the plotting code and draws once while
     the map is computed, so that the figures it draws afterwards do not wait for that.
+
+    Parameters
+    ----------
+    dpi : int, default 150
+        The resolution the figures will be saved at (warmed up for it).
 
     Returns
     -------
@@ -242,7 +248,7 @@ def start_output_helper() -> Helper:
         To pass to :func:`save_region_outputs` (``helper=``); use it as a context manager
         (leaving by an error stops it).
     """
-    return start_helper(_warm_up_outputs, preload=("stringstab.plots.outputs",))
+    return start_helper(_warm_up_outputs, int(dpi), preload=("stringstab.plots.outputs",))
 
 
 #: Drawing cost of a figure relative to a class map (measured on an 801² map: the sup|Γ| heat
@@ -261,6 +267,7 @@ def _draw_all(rmap: RegionMap, folder: Path, prefix: str, formats: Sequence[str]
 
     if "matplotlib.pyplot" not in sys.modules:
         matplotlib.use("Agg")
+    share_mathtext_parser()  # the drawers forked below inherit it (and what it has parsed)
     order = sorted(stems, key=lambda s: -_FIGURE_COST.get(s, 1.0))
     save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
                  dpi=dpi, stems=order, workers=drawers)

@@ -26,8 +26,9 @@ import numpy.typing as npt
 
 from ..errors import StringStabError
 from ..io import atomic_path, format_results
+from ..io.text_formats import write_csv as write_csv_rows
 
-__all__ = ["FORMAT", "csv_text", "read_npz", "write_npz"]
+__all__ = ["FORMAT", "csv_text", "read_npz", "write_csv", "write_npz"]
 
 #: The ``format`` entry of a region map's metadata.
 FORMAT = "stringstab-region-map/1"
@@ -133,3 +134,31 @@ def csv_text(columns: Mapping[str, npt.NDArray[Any]], comments: Sequence[str] | 
     if comments is None:
         return text[text.index("\n") + 1:]
     return "".join(f"# {c}\n" for c in comments) + text
+
+
+def write_csv(path: str | os.PathLike[str], columns: Mapping[str, npt.NDArray[Any]],
+              comments: Sequence[str]) -> Path:
+    """Write :func:`csv_text` ``(columns, comments)`` to ``path`` as UTF-8, atomically.
+
+    The same bytes as ``csv_text(columns, comments).encode("utf-8")``, streamed to the file
+    (:func:`stringstab.io.text_formats.write_csv`) without forming the text.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The CSV file to write.
+    columns : mapping of str to ndarray
+        The table, column by column; every column has one element per row.
+    comments : sequence of str
+        Lines written first, each as ``# <line>``, before the header.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    head = "".join(f"# {c}\n" for c in comments).encode("utf-8")
+    with atomic_path(path, what="region map CSV") as tmp, open(tmp, "wb") as fh:
+        fh.write(head)
+        write_csv_rows(columns, fh)
+    return Path(path)

@@ -27,10 +27,10 @@ import numpy.typing as npt
 
 from ..certify.criteria import TYPE_NAMES
 from ..errors import StringStabError
-from ..io import atomic_write_text, dumps_json
+from ..io import dumps_json
 from ..params import Box, Params
 from .codes import GAIN_NAMES, VERDICT_LABELS
-from .files import FORMAT, read_npz, write_npz
+from .files import FORMAT, read_npz, write_csv, write_npz
 from .files import csv_text as format_csv
 
 if TYPE_CHECKING:  # type hints only: RegionMap's module imports this one
@@ -215,12 +215,17 @@ def csv_text(rmap: RegionMap, rows: builtins.slice | None = None, *, head: bool 
     str
         The CSV text.
     """
-    comments = [f"stringstab {rmap.version} region map",
-                dumps_json(metadata(rmap), indent=None).rstrip("\n")] if head else None
+    comments = _comments(rmap) if head else None
     cols = categorical_columns(rmap)
     if rows is not None:
         cols = {k: v[rows] for k, v in cols.items()}
     return format_csv(cols, comments)
+
+
+def _comments(rmap: RegionMap) -> list[str]:
+    """The ``#`` lines of the CSV: the tool and the map's metadata as JSON."""
+    return [f"stringstab {rmap.version} region map",
+            dumps_json(metadata(rmap), indent=None).rstrip("\n")]
 
 
 def save_csv(rmap: RegionMap, path: str | os.PathLike[str]) -> Path:
@@ -244,7 +249,7 @@ def save_csv(rmap: RegionMap, path: str | os.PathLike[str]) -> Path:
     Path
         The file written.
     """
-    return atomic_write_text(path, csv_text(rmap), what="region map CSV")
+    return write_csv(path, categorical_columns(rmap), _comments(rmap))
 
 
 def read_map(path: str | os.PathLike[str]) -> dict[str, Any]:
