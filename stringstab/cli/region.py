@@ -374,12 +374,12 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
     from ..report import command_line
     from ..report.commands import region_report
 
-    def report(written: list[Path]) -> None:  # while the helper draws (it names the figures)
-        region_report(rmap, written, command=command_line(args), started=t0).write(out)
-
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi, helper=helper, meanwhile=report)
+                                      verdicts=verdicts, dpi=dpi, helper=helper)
+        # after the figures: the HTML report embeds them (written while they were drawn, it
+        # embedded empty images)
+        region_report(rmap, written, command=command_line(args), started=t0).write(out)
     return written
 
 
