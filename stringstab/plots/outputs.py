@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -293,7 +293,7 @@ def _final(out: Any, name: str) -> Path:
 def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
-    helper: Helper | None = None, meanwhile: Callable[[list[Path]], Any] | None = None,
+    helper: Helper | None = None,
 ) -> list[Path]:
     """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps) and the standard figures.
 
@@ -313,10 +313,6 @@ def save_region_outputs(
     helper : stringstab.parallel.Helper, optional
         A helper started earlier by :func:`start_output_helper` (warm); it draws the figures
         (whatever ``processes``), and is done with when this returns.
-    meanwhile : callable, optional
-        ``meanwhile(paths)`` with the files' final paths (those returned), called here after
-        the data files while the figures are being drawn (e.g. a report that names the
-        figures without reading them); its files must be staged in ``out`` too.
 
     Returns
     -------
@@ -351,15 +347,11 @@ def save_region_outputs(
     if helper is None and (int(processes) <= 1 or not stems):
         _write_data(rmap, folder, prefix)
         _draw_all(*figures, 1)
-        if meanwhile is not None:
-            meanwhile(final)
         return final
     if helper is None:
         helper = start_helper()
     with helper:  # the figures there (in its forked drawers), the data files here
         helper.submit(_draw_all, *figures, min(max(2, cpu_count() - 1), len(stems)))
         _write_data(rmap, folder, prefix)
-        if meanwhile is not None:  # off the critical path: the drawers are still busy
-            meanwhile(final)
         helper.result()
     return final
