@@ -8,6 +8,7 @@ inherited a lock held by a thread hung for ever: 3 hangs in 20 runs at 801²).
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import functools
 import json
 import os
@@ -180,11 +181,42 @@ def test_leaving_a_pool_by_an_exception_kills_its_workers_at_once():
     t0 = time.perf_counter()
     pids = []
     with pytest.raises(KeyboardInterrupt), process_pool(2, method="fork") as ex:
-        pids = [p.pid for p in parallel.multiprocessing.active_children()]
+        pids = [p.pid for p in __import__("multiprocessing").active_children()]
         ex.submit(time.sleep, 30)
         raise KeyboardInterrupt
     assert time.perf_counter() - t0 < 10  # not the 30 s the worker was asked to sleep
     assert pids and not any(_exists(p) for p in pids)
+
+
+def _half_a_reply_then_die() -> None:
+    """In a worker: write the start of a reply (a length and 4 of its bytes) on every pipe this
+    process may write to, then die: a worker killed half-way through sending its result."""
+    import gc
+    import struct
+    from multiprocessing.connection import Connection
+
+    for c in gc.get_objects():
+        if isinstance(c, Connection) and not c.closed and c.writable:
+            os.write(c.fileno(), struct.pack("!i", 1 << 20) + b"half")
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+@_fresh
+def test_a_worker_dying_half_way_through_its_reply_breaks_the_pool_and_never_hangs():
+    # ProcessPoolExecutor's shared result pipe waited for the rest of such a reply for ever,
+    # and the interpreter's exit waited for it (an interrupted region command that never
+    # ended: CI, 2026-11-28); each worker's own pipe ends with it instead
+    for method in ("fork", "forkserver"):
+        t0 = time.perf_counter()
+        with pytest.raises(StringStabError, match=r"^a worker process ended unexpectedly"), \
+                process_pool(2, method=method) as ex:
+            assert ex.submit(_square, 5).result(timeout=60) == 25
+            ex.submit(_half_a_reply_then_die).result(timeout=60)
+        with pytest.raises(KeyboardInterrupt), process_pool(2, method=method) as ex:
+            fut = ex.submit(_half_a_reply_then_die)
+            cf.wait([fut], timeout=60)
+            raise KeyboardInterrupt
+        assert time.perf_counter() - t0 < 60
 
 
 # --------------------------------------------------------------------------- from outside

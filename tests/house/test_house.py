@@ -390,7 +390,7 @@ def test_the_continuous_certificate_loads_neither_the_sampled_nor_the_robust_one
 #: The package root: the façade and the shared basics; every other module lives in a
 #: subpackage whose ``__init__`` says what is there.
 ROOT_MODULES = {"__init__.py", "__main__.py", "_version.py", "ranges.py",
-                "constants.py", "errors.py", "progress.py", "memory.py", "parallel.py"}
+                "constants.py", "errors.py", "progress.py", "memory.py"}
 
 
 def test_the_root_holds_the_facade_and_the_shared_basics_only():
@@ -416,8 +416,6 @@ LONG_MODULES = {
                                   "(certify, certify_batch, check, certify_string), mostly docstrings"),
     "stringstab/regions/result.py": "RegionMap, the result of a region map, with its files",
     "stringstab/derive/symbolic.py": "the symbolic derivation of Γ(s), Ψ1–Ψ3 and Λ",
-    "stringstab/parallel.py": ("the one start-method policy: pools, helpers, and the signals and "
-                               "lifetime of every child process"),
     "stringstab/identify/estimate.py": "one follower's estimate: fit, certificate, bootstrap, profiles",
     "stringstab/cli/platoon.py": "the `stringstab platoon` command: head-to-tail verdicts of recorded strings",
     "stringstab/certify/continuous.py": "the exact continuous-time certificate: its results and kernels",
