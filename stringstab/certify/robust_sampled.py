@@ -38,7 +38,7 @@ import numpy.typing as npt
 
 from ..params import Box
 from .excess import EXCESS_SEARCH, searched_excess
-from .interval import IntervalAD
+from .interval_stack import StackedAD, phi_stacked, ratio_stacked
 from .robust_split import split_search
 from .sampled import check_members
 from .sampled_excess import peak_gain, violation_peak
@@ -46,7 +46,7 @@ from .sampled_frequency import margin_bound
 from .sampled_split import delay_ends
 from .schur import SCHUR_RTOL, schur_terms
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
-from .zoh import Coefficients, coefficients, phi_ad, ratio_ad, split_delay
+from .zoh import Coefficients, coefficients, split_delay
 
 __all__ = ["certify_box_sampled"]
 
@@ -69,7 +69,7 @@ def _delay_pieces(d_lo: float, d_hi: float, H: float) -> list[tuple[int, float, 
     return out
 
 
-def _delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) -> list[IntervalAD]:
+def _delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) -> list[StackedAD]:
     """δ0, δ1, δ2 of Δ(w) with derivative enclosures over cells of (τ, T*) alone.
 
     The characteristic polynomial depends on τ and T* only (not on δ, k_a or the
@@ -89,14 +89,15 @@ def _delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) 
 
     Returns
     -------
-    list of IntervalAD
-        [δ0, δ1, δ2], derivatives in the order (τ, T*).
+    list of StackedAD
+        [δ0, δ1, δ2], derivatives in the order (τ, T*) (the numbers of IntervalAD, in the
+        stacked arrays of :mod:`stringstab.certify.interval_stack`).
     """
-    T = IntervalAD.variable(tau[:, 0], tau[:, 1], 0, 2)
-    Th = IntervalAD.variable(headway[:, 0], headway[:, 1], 1, 2)
+    T = StackedAD.variable(tau[:, 0], tau[:, 1], 0, 2)
+    Th = StackedAD.variable(headway[:, 0], headway[:, 1], 1, 2)
     K_x, K_v = T.const(kx), T.const(kv)
     Cc = K_v + Th * K_x
-    f1, p2, p3 = phi_ad(ratio_ad(T, H))
+    f1, p2, p3 = phi_stacked(ratio_stacked(T, H))[0]
     Hs = float(H)
     d0 = K_x * (Hs * Hs) * f1
     d1 = Hs * (Cc * f1 + K_x * (T * p2 + (0.5 * Hs) * f1))

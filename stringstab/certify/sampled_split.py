@@ -51,6 +51,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .interval import IntervalAD, poly_add, poly_scale
+from .interval_stack import StackedAD, exp_neg_stacked, phi_stacked, ratio_stacked
 from .sampled_frequency import curvature_bound
 from .verdicts import ROUNDOFF_SLACK
 from .zoh import (
@@ -64,14 +65,16 @@ from .zoh import (
 )
 
 __all__ = [
-        "delay_ends",
+    "delay_ends",
     "follower_margins",
     "follower_of",
     "follower_points",
+    "follower_stacked",
     "follower_terms",
     "predecessor_margins",
     "predecessor_of",
     "predecessor_points",
+    "predecessor_stacked",
     "predecessor_terms",
     "split_curvature",
     "vander",
@@ -207,6 +210,65 @@ def predecessor_terms(kx: Array, kv: Array, ka: Array, *, H: float, tau_p: Array
         "K_x": Tp.const(kx), "K_v": Tp.const(kv), "K_a": Tp.const(ka), "Tp": Tp, "f1p": f1p,
         "p2p": p2p, "p3p": p3p, "ell1": phi_ad(y)[0],  # 1 − C
         "cm": exp_neg_ad(y) * phi_ad(E * xp)[0],  # C − E_p = C(1 − e^{−εH/τ_p}) ≥ 0
+    }, H)
+
+
+def follower_stacked(kx: Array, kv: Array, *, H: float, tau: Array,
+                     headway: Array) -> list[StackedAD]:
+    """:func:`follower_terms` in stacked arrays (:class:`StackedAD`): the same numbers, bit for bit.
+
+    Parameters
+    ----------
+    kx, kv : ndarray
+        The gains, one per cell.
+    H : float
+        Sample time, s.
+    tau, headway : ndarray, shape (n, 2)
+        The cells' bounds of τ and T*.
+
+    Returns
+    -------
+    list of StackedAD
+        The three coefficients of F in ρ (:func:`follower_of`); derivatives along (τ, T*).
+    """
+    T = StackedAD.variable(tau[:, 0], tau[:, 1], 0, 2)
+    Th = StackedAD.variable(headway[:, 0], headway[:, 1], 1, 2)
+    K_x, K_v = T.const(kx), T.const(kv)
+    f1, p2, p3 = phi_stacked(ratio_stacked(T, H))[0]
+    return follower_of({"K_x": K_x, "Cc": K_v + Th * K_x, "T": T, "f1": f1, "p2": p2,
+                        "p3": p3}, H)
+
+
+def predecessor_stacked(kx: Array, kv: Array, ka: Array, *, H: float, tau_p: Array,
+                        eps: Array) -> tuple[list[StackedAD], list[StackedAD], list[StackedAD]]:
+    """:func:`predecessor_terms` in stacked arrays (:class:`StackedAD`), bit for bit.
+
+    Parameters
+    ----------
+    kx, kv, ka : ndarray
+        The gains, one per cell.
+    H : float
+        Sample time, s.
+    tau_p : ndarray, shape (n, 2)
+        The cells' bounds of τ_p.
+    eps : ndarray, shape (n,)
+        The fractional delay ε ∈ [0, 1] of each cell.
+
+    Returns
+    -------
+    (list, list, list) of StackedAD
+        The coefficients of P_G, Y_r and Y_i in ρ (:func:`predecessor_of`); along τ_p.
+    """
+    Tp = StackedAD.variable(tau_p[:, 0], tau_p[:, 1], 0, 1)
+    xp = ratio_stacked(Tp, H)
+    E = Tp.const(eps)
+    y = (1.0 - E) * xp
+    # φ of x_p, y and εx_p in one call (elementwise: the numbers of three calls)
+    (f1p, p2p, p3p), (ell1, _, _), (phe, _, _) = phi_stacked(xp, y, E * xp)
+    return predecessor_of({
+        "K_x": Tp.const(kx), "K_v": Tp.const(kv), "K_a": Tp.const(ka), "Tp": Tp, "f1p": f1p,
+        "p2p": p2p, "p3p": p3p, "ell1": ell1,  # 1 − C
+        "cm": exp_neg_stacked(y) * phe,  # C − E_p
     }, H)
 
 

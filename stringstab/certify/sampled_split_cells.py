@@ -4,7 +4,8 @@ The split form of :mod:`stringstab.certify.sampled_split` compares the follower'
 minimised over (τ, T*), with the predecessor's G, maximised over τ_p and the ends of the
 delay's pieces.  :class:`FollowerCells` and :class:`PredecessorCells` hold, one row per cell,
 their coefficients in ρ with derivative enclosures over the cell
-(:class:`~stringstab.certify.interval.IntervalAD`) as arrays, and bound F and G over each
+(:class:`~stringstab.certify.interval.IntervalAD`, computed in the stacked arrays of
+:class:`~stringstab.certify.interval_stack.StackedAD`) as arrays, and bound F and G over each
 cell at any frequencies by the better of the interval extension and the mean-value form,
 with the round-off slack of :data:`~stringstab.certify.verdicts.ROUNDOFF_SLACK` times the
 magnitudes.  The search over such cells is :mod:`stringstab.certify.robust_split`.
@@ -23,8 +24,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from .interval import IntervalAD
-from .sampled_split import follower_terms, predecessor_terms
+from .interval_stack import StackedAD
+from .sampled_split import follower_stacked, predecessor_stacked
 from .verdicts import ROUNDOFF_SLACK
 
 __all__ = ["CellCache", "FollowerCells", "PredecessorCells", "halves"]
@@ -40,42 +41,28 @@ _AROUND_DEPTH = 1
 _LOOKUP_LIMIT = 512
 
 
-def _stack(poly: list[IntervalAD], fields: tuple[str, ...], J: int = 3) -> Array:
-    """The coefficients' ``fields`` as an array (rows, len(fields), J), zero-padded to J."""
-    d = len(poly[0].g)
-    getters: dict[str, Any] = {
-        "c": lambda v: v.c.lo, "lo": lambda v: v.r.lo, "hi": lambda v: v.r.hi,
-        **{f"glo{i}": (lambda v, i=i: v.g[i].lo) for i in range(d)},
-        **{f"ghi{i}": (lambda v, i=i: v.g[i].hi) for i in range(d)},
-    }
-    n = np.shape(poly[0].c.lo)[0]
-    out = np.zeros((n, len(fields), J))
-    for j, v in enumerate(poly):
-        for k, f in enumerate(fields):
-            out[:, k, j] = getters[f](v)
-    return out
+def _stacked(polys: list[list[StackedAD]], J: int = 3) -> Array:
+    """Polynomials' coefficients as one array (polynomial, J, 3, 2 + d, n), zero-padded to J.
 
-
-def _magnitudes(poly: list[IntervalAD], J: int = 3) -> tuple[Array, Array, Array]:
-    """Per cell: |coefficient| bounds, value magnitudes and gradient magnitudes, (n, J) each.
-
-    max(|lo|, |hi|) + ROUNDOFF_SLACK·mag of the enclosure (the curvature bound's input), the
-    magnitude companion of the value (the larger of the centre's and the enclosure's) and the
-    gradients' magnitudes summed over the parameters (the round-off slacks' input),
-    zero-padded to J.
+    Axis 2 is (lower end, upper end, magnitude), axis 3 the centre, the enclosure and the
+    derivatives (:class:`~stringstab.certify.interval_stack.StackedAD`).
     """
-    n = np.shape(poly[0].c.lo)[0]
-    a, mag, gmag = (np.zeros((n, J)) for _ in range(3))
-    for j, v in enumerate(poly):
-        a[:, j] = np.maximum(np.abs(v.r.lo), np.abs(v.r.hi)) + ROUNDOFF_SLACK * v.r.mag
-        mag[:, j] = np.maximum(v.c.mag, v.r.mag)
-        gmag[:, j] = np.broadcast_to(np.asarray(sum(g.mag for g in v.g)), (n,))
+    v0 = polys[0][0]
+    S = np.zeros((len(polys), J, 3, 2 + v0.d, v0.X.shape[2]))
+    for i, poly in enumerate(polys):
+        for j, v in enumerate(poly):
+            S[i, j] = v.full()
+    return S
+
+
+def _stacked_magnitudes(S: Array) -> tuple[Array, Array, Array]:
+    """:func:`_magnitudes` of :func:`_stacked` polynomials, each (polynomial, J, n)."""
+    a = np.maximum(np.abs(S[:, :, 0, 1]), np.abs(S[:, :, 1, 1])) + ROUNDOFF_SLACK * S[:, :, 2, 1]
+    mag = np.maximum(S[:, :, 2, 0], S[:, :, 2, 1])
+    gmag = S[:, :, 2, 2]
+    for i in range(3, S.shape[3]):  # Σ over the parameters, in order
+        gmag = gmag + S[:, :, 2, i]
     return a, mag, gmag
-
-
-_F_FIELDS = ("c", "lo", "glo0", "ghi0", "glo1", "ghi1")
-_P_FIELDS = ("c", "hi", "glo0", "ghi0")
-_Y_FIELDS = ("c", "lo", "hi", "glo0", "ghi0")
 
 
 @dataclass
@@ -124,8 +111,10 @@ class FollowerCells:
         -------
         FollowerCells
         """
-        Fp = follower_terms(kx[owner], kv[owner], H=H, tau=tau, headway=headway)
-        return cls(owner, tau, headway, _stack(Fp, _F_FIELDS), *_magnitudes(Fp))
+        S = _stacked([follower_stacked(kx[owner], kv[owner], H=H, tau=tau, headway=headway)])
+        V = S[0][:, [0, 0, 0, 1, 0, 1], [0, 1, 2, 2, 3, 3]]  # c, lo, glo0, ghi0, glo1, ghi1: (J, 6, n)
+        return cls(owner, tau, headway, np.ascontiguousarray(V.transpose(2, 1, 0)),
+                   *(np.ascontiguousarray(x[0].T) for x in _stacked_magnitudes(S)))
 
     def __len__(self) -> int:
         return int(self.owner.size)
@@ -267,15 +256,15 @@ class PredecessorCells:
         -------
         PredecessorCells
         """
-        m = np.array([ends[e][0] for e in end], dtype=float)
-        eps = np.array([ends[e][1] for e in end], dtype=float)
-        P, Yr, Yi = predecessor_terms(kx[gains], kv[gains], ka[gains], H=H, tau_p=tau_p,
-                                      eps=eps)
-        V = np.concatenate([_stack(P, _P_FIELDS), _stack(Yr, _Y_FIELDS), _stack(Yi, _Y_FIELDS)],
-                           axis=1)
-        mags = [_magnitudes(p) for p in (P, Yr, Yi)]
-        return cls(owner, tau_p, end, m, V, *(np.stack([x[i] for x in mags], axis=1)
-                                              for i in range(3)))
+        me = np.array(ends, dtype=float).reshape(-1, 2)[end]  # (m, ε) of each cell
+        m, eps = me[:, 0], me[:, 1]
+        S = _stacked(list(predecessor_stacked(kx[gains], kv[gains], ka[gains], H=H,
+                                              tau_p=tau_p, eps=eps)))
+        # P_G's c, hi, glo, ghi; Y_r's and Y_i's c, lo, hi, glo, ghi: (14, J, n)
+        V = S[[0] * 4 + [1] * 5 + [2] * 5, :, [0, 1, 0, 1] + [0, 0, 1, 0, 1] * 2,
+              [0, 1, 2, 2] + [0, 1, 1, 2, 2] * 2]
+        return cls(owner, tau_p, end, m, np.ascontiguousarray(V.transpose(2, 0, 1)),
+                   *(np.ascontiguousarray(x.transpose(2, 0, 1)) for x in _stacked_magnitudes(S)))
 
     def __len__(self) -> int:
         return int(self.owner.size)
