@@ -7,9 +7,10 @@ delays over several pieces, a delay box alone) with the base commit (unpacked wi
 ``git archive``) and with this checkout, each in its own process, and compares every field
 of the :class:`~stringstab.certify.robust.RobustCertificateBatch` byte for byte (floats by
 their bits: NaN patterns and signs of zero included).  The triples: ``--n`` random ones in
-[−2, 2]³ (seed 33) and every adversarial row of the robust sampled kinds in
-``tests/data/speed_verdicts.csv`` (near Schur, near |H| = 1 over the box, boxes straddling
-the boundary).  Prints the counts per box and field; exits 1 when any field differs::
+[−2, 2]³ (seed 33, mostly not certified), ``--n-near`` in k_x ∈ [0, 1], k_v ∈ [0, 2],
+k_a ∈ [−0.5, 0.5] (seed 34, about half certified: the searches that run to the end) and
+every adversarial row of the robust sampled kinds in ``tests/data/speed_verdicts.csv``
+(near Schur, near |H| = 1 over the box, boxes straddling the boundary).  Prints the counts per box and field; exits 1 when any field differs::
 
     python analysis/robust_sampled_fields.py --base 8043ba3            # ~1 min
 """
@@ -32,15 +33,16 @@ sys.path.insert(0, str(HERE / "analysis"))
 from robust_sampled_verdicts import BOXES  # noqa: E402
 
 
-def inputs(n: int) -> np.ndarray:
-    """The gain triples (rows, 3): ``n`` random ones and the adversarial rows."""
+def inputs(n: int, n_near: int) -> np.ndarray:
+    """The gain triples (rows, 3): random ones, random ones near certified, adversarial."""
     rand = np.random.default_rng(33).uniform(-2, 2, (n, 3))
+    near = np.random.default_rng(34).uniform([0.0, 0.0, -0.5], [1.0, 2.0, 0.5], (n_near, 3))
     data = HERE / "tests" / "data" / "speed_verdicts.csv"
     with data.open(encoding="utf-8") as f:
         adv = np.array([[float(r["k_x"]), float(r["k_v"]), float(r["k_a"])]
                         for r in csv.DictReader(f)
                         if r["set"] in ("sampled_adversarial", "sampledhom_adversarial")])
-    return np.concatenate([rand, adv])
+    return np.concatenate([rand, near, adv])
 
 
 def worker(inp: str, out: str) -> None:
@@ -87,6 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--base", default="8043ba3", help="the base commit (default 8043ba3)")
     ap.add_argument("--n", type=int, default=3000, help="random triples (default 3000)")
+    ap.add_argument("--n-near", type=int, default=1500,
+                    help="random triples near the certified region (default 1500)")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
@@ -97,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(base)
     subprocess.run(f"git -C {HERE} archive {args.base} stringstab | tar -x -C {base}",
                    shell=True, check=True)
-    K = inputs(args.n)
+    K = inputs(args.n, args.n_near)
     inp = os.path.join(tmp, "inputs.npz")
     np.savez(inp, K=K)
     res = {}
@@ -113,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{K.shape[0] * len(BOXES)} verdicts, {nf} fields compared")
     for name in BOXES:
         v = res["after"][f"{name}/verdict"]
-        counts = dict(zip(*np.unique(v, return_counts=True)))
+        counts = {str(a): int(b) for a, b in zip(*np.unique(v, return_counts=True))}
         bad = {k.split("/", 1)[1]: d for k, d in diff.items() if k.startswith(name + "/") and d}
         print(f"{name}: verdicts {counts}; rows with a field different: "
               f"{bad if bad else 0}")

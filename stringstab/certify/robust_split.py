@@ -167,7 +167,10 @@ def screen_members(kx: Array, kv: Array, ka: Array, H: float, box: Box,
     k = X.size
     viol = np.zeros(n, dtype=bool)
     val, wrow = np.full(n, np.inf), np.zeros((n, 5))
-    step = max(1, 100_000 // ((nf + ng) * k))
+    # triples per chunk: one chunk for a few hundred (each chunk's point arithmetic is a few
+    # hundred small-array operations whatever its size; the values are the same in any
+    # chunking: elementwise, and one product per triple and member)
+    step = max(1, 250_000 // ((nf + ng) * k))
     for s in range(0, n, step):
         q = np.arange(s, min(s + step, n))
         r = q.size

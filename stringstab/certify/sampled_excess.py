@@ -58,13 +58,16 @@ def peak_gain(co: Coefficients, m: int, ka: Array, W: Array, worst: Array) -> tu
     rows = np.arange(n)
     Wall = np.concatenate([W, worst[:, None]], axis=1)
 
+    # the coefficients as columns, once (every call of absH reads the same ones)
+    cols = Coefficients(
+        [Interval(d.lo[:, None]) for d in co.delta],
+        [Interval(d.lo[:, None]) for d in co.nu],
+        [Interval(d.lo[:, None]) for d in co.ell], Interval(co.phi1.lo[:, None]),
+        Interval(co.phi1p.lo[:, None]), co.P, co.Yr, co.Yi)
+    kac = ka[:, None]
+
     def absH(th: Array) -> Array:
-        cols = Coefficients(
-            [Interval(d.lo[:, None]) for d in co.delta],
-            [Interval(d.lo[:, None]) for d in co.nu],
-            [Interval(d.lo[:, None]) for d in co.ell], Interval(co.phi1.lo[:, None]),
-            Interval(co.phi1p.lo[:, None]), co.P, co.Yr, co.Yi)
-        a = np.abs(response(th, cols, m, ka[:, None]))
+        a = np.abs(response(th, cols, m, kac))
         return np.where(np.isnan(a), np.inf, a)
 
     A = absH(Wall)

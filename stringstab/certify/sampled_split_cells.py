@@ -472,12 +472,15 @@ class CellCache:
             if around is not None and around[0].size <= _LOOKUP_LIMIT:
                 ao, at_, ah = _descend_f(*around, _AROUND_DEPTH, False)
                 o, t, h = np.concatenate([o, ao]), np.concatenate([t, at_]), np.concatenate([h, ah])
-            u = np.unique(np.column_stack([o, t, h]), axis=0, return_index=True)[1]
-            o, t, h = o[u], t[u], h[u]
-            new = FollowerCells.of(o, self.kx, self.kv, H=self.H, tau=t, headway=h)
+            # each cell once, in the order first seen (a cell's row depends on it alone)
+            first: dict[tuple[float, ...], int] = {}
+            for i, k in enumerate(zip(o.tolist(), *t.T.tolist(), *h.T.tolist())):
+                first.setdefault(k, i)
+            u = np.fromiter(first.values(), dtype=np.intp, count=len(first))
+            new = FollowerCells.of(o[u], self.kx, self.kv, H=self.H, tau=t[u], headway=h[u])
             c = len(self.f_chunks)
             self.f_chunks.append(new)
-            for r, k in enumerate(zip(o.tolist(), *t.T.tolist(), *h.T.tolist())):
+            for r, k in enumerate(first):
                 self.f_index.setdefault(k, (c, r))
         return self._assemble(self.f_chunks, [self.f_index[k] for k in keys])  # type: ignore[no-any-return]
 
@@ -508,12 +511,14 @@ class CellCache:
             if around is not None and around[0].size <= _LOOKUP_LIMIT:
                 ag, at_, ae = _descend_g(*around, _AROUND_DEPTH, False)
                 g, t, e = np.concatenate([g, ag]), np.concatenate([t, at_]), np.concatenate([e, ae])
-            u = np.unique(np.column_stack([g, t, e]), axis=0, return_index=True)[1]
-            g, t, e = g[u], t[u], e[u]
-            new = compute(g, g, t, e)
+            first_g: dict[tuple[float, ...], int] = {}
+            for i, k in enumerate(zip(g.tolist(), *t.T.tolist(), e.tolist())):
+                first_g.setdefault(k, i)
+            u = np.fromiter(first_g.values(), dtype=np.intp, count=len(first_g))
+            new = compute(g[u], g[u], t[u], e[u])
             c = len(self.g_chunks)
             self.g_chunks.append(new)
-            for r, k in enumerate(zip(g.tolist(), *t.T.tolist(), e.tolist())):
+            for r, k in enumerate(first_g):
                 self.g_index.setdefault(k, (c, r))
         out: PredecessorCells = self._assemble(self.g_chunks, [self.g_index[k] for k in keys])
         out.owner = owner.copy()
