@@ -80,6 +80,14 @@ def _first_min(v: Array, vmin: Array, pr: npt.NDArray[np.intp],
     return np.asarray(np.minimum.reduceat(at, off))
 
 
+def _among(values: npt.NDArray[np.intp], members: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
+    """``np.isin(values, members)`` for indices ≥ 0, by a table (no sort)."""
+    size = 1 + max(int(values.max(initial=-1)), int(members.max(initial=-1)))
+    table = np.zeros(size, dtype=bool)
+    table[members] = True
+    return table[values]
+
+
 @dataclass
 class _Split:
     """The cells of the split search: follower cells by item, predecessor cells by owner."""
@@ -371,7 +379,7 @@ def split_search(kx: Array, kv: Array, ka: Array, box: Box, H: float,
                               heterogeneous=heterogeneous, widths=(t_w, h_w),
                               max_cells=max_cells, e_delta=e_delta, cache=cache)
         code[items[act[over]]] = INCONCLUSIVE
-        keep = np.isin(bb.pending_item, np.flatnonzero(~over))
+        keep = ~over[bb.pending_item]
         nxt = np.setdiff1d(pend, np.flatnonzero(over))
         intervals = (np.searchsorted(nxt, bb.pending_item[keep]).astype(np.intp),
                      bb.pending_lo[keep], bb.pending_hi[keep])
@@ -443,10 +451,10 @@ def _evaluate_rows(it: npt.NDArray[np.intp], X: Array, F: FollowerCells, G: Pred
 
 def _keep(cells: _Split, act: npt.NDArray[np.intp], heterogeneous: bool) -> _Split:
     """Only the cells of the items ``act`` (sorted by owner)."""
-    fk = np.flatnonzero(np.isin(cells.F.owner, act))
+    fk = np.flatnonzero(_among(cells.F.owner, act))
     F = cells.F.take(fk)
     if heterogeneous:
-        return _Split(F, cells.G.take(np.flatnonzero(np.isin(cells.G.owner, act))))
+        return _Split(F, cells.G.take(np.flatnonzero(_among(cells.G.owner, act))))
     new = np.full(len(cells.F), -1, dtype=np.intp)
     new[fk] = np.arange(fk.size)
     gk = np.flatnonzero(new[cells.G.owner] >= 0)
@@ -518,7 +526,7 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
     mid_t, mid_h = F.tau[sf].mean(axis=1), F.headway[sf].mean(axis=1)
     tau_a[at, 1] = tau_b[at, 0] = mid_t[at]
     hd_a[~at, 1] = hd_b[~at, 0] = mid_h[~at]
-    keep_f = np.flatnonzero(~np.isin(np.arange(len(F)), sf))
+    keep_f = np.flatnonzero(~_among(np.arange(len(F)), sf))
     kids = cache.follower(np.concatenate([F.owner[sf], F.owner[sf]]),
                           np.concatenate([tau_a, tau_b]), np.concatenate([hd_a, hd_b]),
                           around=(F.owner[keep_f], F.tau[keep_f], F.headway[keep_f]))
@@ -530,7 +538,7 @@ def _refine(cells: _Split, act: npt.NDArray[np.intp], bb: Any, *, kx: Array, kv:
         ta, tb = G.tau_p[sg].copy(), G.tau_p[sg].copy()
         ta[:, 1] = tb[:, 0] = mid
         own = np.concatenate([G.owner[sg], G.owner[sg]])
-        keep_g = np.flatnonzero(~np.isin(np.arange(len(G)), sg))
+        keep_g = np.flatnonzero(~_among(np.arange(len(G)), sg))
         gk = cache.predecessor(own, own, np.concatenate([ta, tb]),
                                np.concatenate([G.end[sg], G.end[sg]]),
                                around=(G.owner[keep_g], G.tau_p[keep_g], G.end[keep_g]))

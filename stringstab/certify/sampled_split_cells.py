@@ -460,7 +460,8 @@ class CellCache:
         if owner.size == 0:  # no new cell: nothing to compute (the arrays' shapes only)
             return FollowerCells(owner, tau, headway, np.zeros((0, 6, 3)),
                                  *(np.zeros((0, 3)) for _ in range(3)))
-        if owner.size > _LOOKUP_LIMIT:
+        if owner.size > _LOOKUP_LIMIT or (owner.size > _AHEAD_LIMIT and not self.f_index):
+            # too many to look up, or more than _AHEAD_LIMIT and none computed yet (all new)
             return FollowerCells.of(owner, self.kx, self.kv, H=self.H, tau=tau, headway=headway)
         keys = list(zip(owner.tolist(), *tau.T.tolist(), *headway.T.tolist()))
         miss = np.array([i for i, k in enumerate(keys) if k not in self.f_index],
@@ -499,7 +500,7 @@ class CellCache:
         if owner.size == 0:
             return PredecessorCells(owner, tau_p, end, np.zeros(0), np.zeros((0, 14, 3)),
                                     *(np.zeros((0, 3, 3)) for _ in range(3)))
-        if owner.size > _LOOKUP_LIMIT:
+        if owner.size > _LOOKUP_LIMIT or (owner.size > _AHEAD_LIMIT and not self.g_index):
             return compute(owner, gains, tau_p, end)
         keys = list(zip(gains.tolist(), *tau_p.T.tolist(), end.tolist()))
         miss = np.array([i for i, k in enumerate(keys) if k not in self.g_index],
