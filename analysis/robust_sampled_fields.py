@@ -113,8 +113,8 @@ def main(argv: list[str] | None = None) -> int:
         with np.load(out) as z:
             res[side] = {k: z[k] for k in z.files}
     diff, rows, nf = compare(res["before"], res["after"])
-    print(f"# base {args.base} vs {HERE}: {K.shape[0]} triples × {len(BOXES)} boxes = "
-          f"{K.shape[0] * len(BOXES)} verdicts, {nf} fields compared")
+    print(f"# base {args.base} vs {HERE}: {rows} triples × {len(BOXES)} boxes = "
+          f"{rows * len(BOXES)} verdicts, {nf} fields compared")
     for name in BOXES:
         v = res["after"][f"{name}/verdict"]
         counts = {str(a): int(b) for a, b in zip(*np.unique(v, return_counts=True))}
