@@ -278,11 +278,17 @@ def certify_box_sampled(kx: Array, kv: Array, ka: Array, box: Box, H: float, *,
     m_w = np.array([s[0] for s in split], dtype=float)
     e_w = np.array([s[1] for s in split])
     coeffs: dict[float, tuple[npt.NDArray[np.intp], Coefficients]] = {}
+    # the witnesses' point coefficients in one call (elementwise: each row's numbers are the
+    # ones a call on its own group of m computes), then taken per m
+    every = np.flatnonzero(member)
+    e_a, c_a = e_w[every], kv[every] + h_w[every] * kx[every]
+    co_all = coefficients(kx[every], kv[every], ka[every], H=H,
+                          tau=(tau_w[every], tau_w[every]),
+                          tau_p=(taup_w[every], taup_w[every]), eps=(e_a, e_a), c=(c_a, c_a))
     for mm in np.unique(m_w[member]):
-        idx = np.flatnonzero(member & (m_w == mm))
-        e_i, cc = e_w[idx], kv[idx] + h_w[idx] * kx[idx]
-        co = coefficients(kx[idx], kv[idx], ka[idx], H=H, tau=(tau_w[idx], tau_w[idx]),
-                          tau_p=(taup_w[idx], taup_w[idx]), eps=(e_i, e_i), c=(cc, cc))
+        at = np.flatnonzero(m_w[every] == mm)
+        idx = every[at]
+        co = co_all.take(at)
         coeffs[float(mm)] = (idx, co)
         fresh = ~np.isfinite(margin[idx])  # g_H at the witness (the evidence rows have it)
         g_w = margin_bound(theta[idx][:, None], co, np.full(idx.size, float(mm)))[0][:, 0]
