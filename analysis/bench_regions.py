@@ -11,8 +11,8 @@ once after a warm-up (SymPy lambdify caches built):
 Targets on 2 cores: Taylor 201³ < 1 s, exact 801² < 10 s, exact 101³ < 60 s.
 
 ``--only cli`` (issues 9 and 31): the 801² slice through the command line with its
-**default outputs** (every method, the NPZ, the CSV, the figures in the default formats, the
-report): ``stringstab region --fix k_a=0.5 --n 801 --workers 2``, a fresh process, against
+**default outputs** (every method, the NPZ, the CSV, the default figures in the default
+formats, the report): ``stringstab region --fix k_a=0.5 --n 801 --workers 2``, a fresh process, against
 :func:`region_map` alone on the same grid with the same methods and workers (timed in a fresh
 process too, after a warm-up), ``--reps`` times, every variant alternated within a rep, with
 the load beside each: wall and CPU time (all processes), and the median ratios CLI / map
@@ -20,7 +20,9 @@ the load beside each: wall and CPU time (all processes), and the median ratios C
 ``--base`` (default f6db69e, exported with ``git archive`` into a temporary folder, run on this
 interpreter), *after* this checkout; *after, forkserver* this checkout with
 ``STRINGSTAB_START_METHOD=forkserver`` (the other start method of the policy, measured for the
-choice); *after, png,pdf* this checkout with the figure formats of the base.
+choice); *after, png,pdf* this checkout with the figure formats of the base; *after, figures
+all* this checkout with every method's class map (``--figures all``: the figures of the base
+before the fifth pass of issue 31).
 For the exact maps it also times :func:`stringstab.certify.api.certify_batch`
 alone, in this process, on a 20 000-point sample of the same grid: the
 certificate's own cost per point, which bounds what the map can reach.
@@ -175,6 +177,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
         "after": (here, [], "after"),
         "after, forkserver": ({**here, "STRINGSTAB_START_METHOD": "forkserver"}, [], "after"),
         "after, png,pdf": (here, ["--format", "png,pdf"], "after"),
+        "after, figures all": (here, ["--figures", "all"], "after"),
     }
     print(f"region CLI target (issue 31): {n}x{n} slice, default outputs: stringstab region "
           f"{' '.join(cli[4:])} --out DIR; before = {base} ({base_dir}), after = this checkout")
@@ -205,7 +208,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
                 finally:
                     shutil.rmtree(work, ignore_errors=True)
                 rows[name].append((wall, cpu))
-                print(f"  rep {r + 1}: CLI {name:<14} {wall:6.2f} s wall {cpu:6.2f} s CPU "
+                print(f"  rep {r + 1}: CLI {name:<18} {wall:6.2f} s wall {cpu:6.2f} s CPU "
                       f"({_load()})", flush=True)
     finally:
         shutil.rmtree(base_dir, ignore_errors=True)
@@ -215,11 +218,11 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
     print(f"  medians over {reps} reps ({_load()}):")
     for label in ("map before", "map after"):
         wall, cpu = (float(np.median([x[k] for x in rows[label]])) for k in (0, 1))
-        print(f"    region_map alone, {label[4:]:<17} {wall:6.2f} s wall {cpu:6.2f} s CPU")
+        print(f"    region_map alone, {label[4:]:<18} {wall:6.2f} s wall {cpu:6.2f} s CPU")
     for name, (_, _, against) in variants.items():
         ratio = [a[0] / b[0] for a, b in zip(rows[name], rows[f"map {against}"])]
         cpu_ratio = [a[1] / b[1] for a, b in zip(rows[name], rows[f"map {against}"])]
-        print(f"    CLI / region_map, {name:<17} {np.median(ratio):5.2f} wall "
+        print(f"    CLI / region_map, {name:<18} {np.median(ratio):5.2f} wall "
               f"(min {min(ratio):.2f}, max {max(ratio):.2f}), {np.median(cpu_ratio):5.2f} CPU"
               f"{'   (target <= 1.5)' if name == 'after' else ''}")
 

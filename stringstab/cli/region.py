@@ -30,6 +30,9 @@ __all__ = ["add_parser", "run"]
 DEFAULT_RANGE = GAIN_BOUNDS
 DEFAULT_N_2D = 201
 DEFAULT_N_3D = 61
+#: ``--figures``: as :data:`stringstab.plots.outputs.FIGURE_SETS` (not imported: the parser
+#: stays free of the plotting code; a test compares the two).
+FIGURE_SETS = ("default", "all")
 
 _EPILOG = f"""\
 examples:
@@ -46,9 +49,10 @@ examples:
   stringstab region --fix k_a=0.5 --reaction-delay 0.2 --sample-time 0.1 --n 41 --out maps_rH/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
-in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>,
-<prefix>_compare, <prefix>_sup_gain, <prefix>_overlay (2-D) or
-<prefix>_slices_<method>, <prefix>_3d_<method> (3-D).
+in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>
+(the first method's; every method's with --figures all), <prefix>_compare,
+<prefix>_sup_gain, <prefix>_overlay (2-D) or <prefix>_slices_<method>,
+<prefix>_3d_<method> (3-D); report.md and report.html.
 classes: exact = not internally stable / not certified / inconclusive / certified;
 taylor, printed = not internally stable / type III / type IV / type I / type II.
 with --sample-time or a LO:HI interval, exact is the sampled or robust certificate (the
@@ -115,6 +119,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--format", default="png", metavar="F[,F...]",
                    help="figure formats among png, pdf, svg (default: png; e.g. png,pdf for "
                         "print-ready copies too)")
+    p.add_argument("--figures", choices=FIGURE_SETS, default="default", metavar="default|all",
+                   help="the class maps of a 2-D map with two or more methods: the first "
+                        "method's beside the comparison and sup|Γ| maps (default), or every "
+                        "method's (all); the data files hold every method's either way")
     p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
     p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
     p.add_argument("--scheduler", metavar="ADDRESS|local",
@@ -376,7 +384,8 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
 
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
-                                      verdicts=verdicts, dpi=dpi, helper=helper)
+                                      verdicts=verdicts, dpi=dpi, helper=helper,
+                                      figures=args.figures)
         # after the figures: the HTML report embeds them (written while they were drawn, it
         # embedded empty images)
         region_report(rmap, written, command=command_line(args), started=t0).write(out)
@@ -392,7 +401,7 @@ def _write_sweep(sweep: Any, out: Any, args: argparse.Namespace, formats: list[s
 
     with out:
         written = save_reaction_sweep_outputs(sweep, out, prefix=args.prefix, formats=formats,
-                                              dpi=dpi)
+                                              dpi=dpi, figures=args.figures)
         reaction_sweep_report(sweep, written, command=command_line(args), started=t0).write(out)
     print(sweep.report())
     print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))

@@ -49,11 +49,13 @@ from ._common import (
     GAIN_LABELS,
     OKABE_ITO,
     PlotResult,
+    dry_runs_without_images,
     share_mathtext_parser,
     warm_up,
 )
 from .mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
 from .outputs import (
+    FIGURE_SETS,
     draw_figure,
     figure_stems,
     save_figures,
@@ -71,10 +73,12 @@ from .tuning import moves_projection, moves_region, plot_moves
 __all__ = [
     "CLASS_COLORS",
     "FIGURE_FORMATS",
+    "FIGURE_SETS",
     "GAIN_LABELS",
     "OKABE_ITO",
     "PlotResult",
     "draw_figure",
+    "dry_runs_without_images",
     "figure_stems",
     "moves_projection",
     "moves_region",

@@ -15,6 +15,7 @@ https://jfly.uni-koeln.de/color/.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,6 +30,7 @@ __all__ = [
     "OKABE_ITO",
     "PlotResult",
     "categorical",
+    "dry_runs_without_images",
     "legend_below",
     "log_colorbar_ticks",
     "new_ax",
@@ -288,22 +290,80 @@ def share_mathtext_parser() -> None:
     figure, about 12 % of its drawing time.  The parse is a pure function of the expression,
     the dpi and the font, so one parser serves all renderers with the same pictures (pixel for
     pixel).  Idempotent; affects this process only.
+
+    A process forked from this one starts with a parser of its own (``os.register_at_fork``):
+    a parse holds the fonts it was made with, and Agg loads their glyphs again when it draws,
+    reading the font file through a file offset that a fork shares with the parent and every
+    sibling; two drawers forked from one warm process drawing at once then read each other's
+    bytes (FreeType's "invalid outline", "too many hints", or a wrong glyph).  Matplotlib
+    drops its own font cache at a fork for the same reason; the parses made before it must
+    not outlive it either.
     """
+    import os
+
     from matplotlib.backends.backend_agg import RendererAgg
     from matplotlib.mathtext import MathTextParser
 
     if getattr(RendererAgg, "_stringstab_shared_mathtext", None) is not None:
         return
-    shared = MathTextParser("path")  # what RendererAgg.__init__ makes for itself
+    shared: list[MathTextParser] = []  # the one parser of this process
     init = RendererAgg.__init__
 
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
         init(self, *args, **kwargs)
         if isinstance(getattr(self, "mathtext_parser", None), MathTextParser):
-            self.mathtext_parser = shared
+            self.mathtext_parser = shared[0]
 
+    def new_parser() -> None:  # what RendererAgg.__init__ makes for itself
+        shared[:] = [MathTextParser("path")]
+
+    new_parser()
     RendererAgg.__init__ = __init__  # type: ignore[method-assign]
     RendererAgg._stringstab_shared_mathtext = shared  # type: ignore[attr-defined]
+    if hasattr(os, "register_at_fork"):
+        os.register_at_fork(after_in_child=new_parser)
+
+
+@contextlib.contextmanager
+def dry_runs_without_images() -> Iterator[None]:
+    """Within: the dry run of a tight-box save leaves images out (made once per save, not twice).
+
+    ``savefig(bbox_inches="tight")`` draws a figure twice: a dry run, with the renderer's
+    ``draw_*`` methods patched to no-ops (``RendererBase._draw_disabled``), to lay it out and
+    measure its tight bounding box, then the real draw.  An image's part of the box is its
+    extent (:meth:`~matplotlib.image.AxesImage.get_window_extent`, from the data limits), not
+    its pixels, yet the dry run still resamples and colours it (``make_image``) only to hand
+    the result to a no-op.  Within this context an :class:`~matplotlib.image.AxesImage` drawn
+    on such a renderer returns at once; every other draw is unchanged, so the files are the
+    same bytes.  The class is patched for the duration (this process, not thread-safe: the
+    figure processes are single-threaded) and restored on leaving.
+
+    Yields
+    ------
+    None
+    """
+    from matplotlib.backend_bases import RendererBase
+    from matplotlib.image import AxesImage
+
+    own = AxesImage.__dict__.get("draw")  # None: inherited (from matplotlib's image base)
+    draw = AxesImage.draw
+
+    def skipping(self: Any, renderer: Any, *args: Any, **kwargs: Any) -> Any:
+        # the dry run's no-op draw_image wraps RendererBase.draw_image (functools.update_wrapper)
+        no_op = getattr(getattr(renderer, "draw_image", None), "__wrapped__", None)
+        if no_op is RendererBase.draw_image:
+            self.stale = False
+            return None
+        return draw(self, renderer, *args, **kwargs)
+
+    AxesImage.draw = skipping  # type: ignore[method-assign]
+    try:
+        yield
+    finally:
+        if own is None:
+            del AxesImage.draw
+        else:
+            AxesImage.draw = own  # type: ignore[method-assign]
 
 
 def warm_up(dpi: int = 150) -> None:
@@ -314,7 +374,8 @@ def warm_up(dpi: int = 150) -> None:
     pay it earlier, e.g. in a thread while its map is computed in worker processes (processes
     forked later inherit the warm state).  The Agg renderers share one mathtext parser
     (:func:`share_mathtext_parser`), so the gain labels parsed here at ``dpi`` are not parsed
-    again by the figures saved at that resolution.
+    again by the figures this process saves at that resolution (a process forked from it
+    parses them once more, with fonts of its own).
 
     Parameters
     ----------

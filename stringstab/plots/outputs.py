@@ -30,23 +30,29 @@ from ..errors import StringStabError
 from ..io.figures import check_figure_formats, figure_metadata, save_figure
 from ..parallel import Helper, cpu_count, map_processes, start_helper
 from ..regions import RegionMap
-from ._common import pyplot, share_mathtext_parser
+from ._common import dry_runs_without_images, pyplot, share_mathtext_parser
 from .map_axes import method_title
 from .projection import plot_projected_region, projected_region
 from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
 from .trajectory import gain_rows, plot_trajectory
 
-__all__ = ["draw_figure", "figure_stems", "save_figures", "save_region_outputs",
+__all__ = ["FIGURE_SETS", "draw_figure", "figure_stems", "save_figures", "save_region_outputs",
            "start_output_helper"]
 
 
-def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
+#: The figure sets of a 2-D map (issue 31): ``default`` draws the class map of the first method
+#: only (with :func:`figure_stems`' comparison and sup|Γ| maps), ``all`` every method's.
+FIGURE_SETS = ("default", "all")
+
+
+def figure_stems(rmap: RegionMap, overlay: bool = False, figures: str = "default") -> list[str]:
     """The names (without prefix and format) of the standard figures of ``rmap``.
 
-    2-D map: ``class_<method>`` for each method, ``compare`` (two or more methods),
-    ``sup_gain`` (``exact``) and, with ``overlay``, ``overlay``.  3-D map:
-    ``slices_<method>`` and ``3d_<method>`` for each method.
+    2-D map: ``class_<method>`` for the first method (for each method with ``figures="all"``,
+    or when there is one), ``compare`` (two or more methods, which draws where they
+    disagree), ``sup_gain`` (``exact``) and, with ``overlay``, ``overlay``.  3-D map:
+    ``slices_<method>`` and ``3d_<method>`` for each method, whatever ``figures``.
 
     Parameters
     ----------
@@ -54,14 +60,34 @@ def figure_stems(rmap: RegionMap, overlay: bool = False) -> list[str]:
         The computed map.
     overlay : bool, default False
         Include the ``overlay`` figure (2-D maps only; it needs gains to draw).
+    figures : {"default", "all"}, default "default"
+        Which class maps of a 2-D map with two or more methods: the first method's only, or
+        every method's (:data:`FIGURE_SETS`).
 
     Returns
     -------
     list of str
         The stems, in drawing order.
+
+    Raises
+    ------
+    StringStabError
+        On a ``figures`` not in :data:`FIGURE_SETS`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stringstab.regions import region_map
+    >>> m = region_map({"k_x": np.linspace(-2, 2, 3), "k_v": np.linspace(-2, 2, 3)},
+    ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods="taylor,printed")
+    >>> figure_stems(m), figure_stems(m, figures="all")
+    (['class_taylor', 'compare'], ['class_taylor', 'class_printed', 'compare'])
     """
+    if figures not in FIGURE_SETS:
+        raise StringStabError(f"figures must be one of {', '.join(FIGURE_SETS)}; got {figures!r}")
     if rmap.ndim == 2:
-        stems = [f"class_{m}" for m in rmap.methods]
+        classes = rmap.methods if figures == "all" else rmap.methods[:1]
+        stems = [f"class_{m}" for m in classes]
         if len(rmap.methods) >= 2:
             stems.append("compare")
         if "exact" in rmap.methods:
@@ -80,7 +106,7 @@ def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = N
     rmap : RegionMap
         The computed map.
     stem : str
-        One of :func:`figure_stems` ``(rmap, True)``.
+        One of :func:`figure_stems` ``(rmap, True, "all")``.
     gains : GainTable or array_like of shape (n, 3), optional
         The gain trajectory; required for ``overlay`` (drawn over the exact region projected
         over the points' own values of the map's fixed gain, computed here).
@@ -128,13 +154,14 @@ def draw_figure(rmap: RegionMap, stem: str, gains: Any = None, verdicts: Any = N
         return plot_slices(rmap, stem[len("slices_"):]).figure
     if stem.startswith("3d_"):
         return plot_region_3d(rmap, stem[len("3d_"):]).figure
-    raise StringStabError(f"unknown figure {stem!r}; expected one of {figure_stems(rmap, True)}")
+    raise StringStabError(f"unknown figure {stem!r}; expected one of {figure_stems(rmap, True, 'all')}")
 
 
 def save_figures(
     rmap: RegionMap, out: Any, *, prefix: str = "region",
     formats: Sequence[str] = ("png", "pdf"), gains: Any = None, verdicts: Any = None,
     dpi: int = 150, workers: int = 1, stems: Sequence[str] | None = None,
+    figures: str = "default",
 ) -> list[Path]:
     """Draw the standard figures of a map and save each in every format.
 
@@ -165,7 +192,11 @@ def save_figures(
         Processes drawing the figures (:func:`stringstab.parallel.map_processes`; 1 draws
         them here, one after another).
     stems : sequence of str, optional
-        Draw only these of :func:`figure_stems`.
+        Draw these of :func:`figure_stems` ``(rmap, overlay, "all")`` (default: those of
+        ``figures``).
+    figures : {"default", "all"}, default "default"
+        Without ``stems``: the first method's class map only, or every method's
+        (:func:`figure_stems`).
 
     Returns
     -------
@@ -175,15 +206,16 @@ def save_figures(
     Raises
     ------
     StringStabError
-        On an unknown format, ``gains`` with a 3-D map, or ``gains`` without ``verdicts``.
+        On an unknown format or figure set, ``gains`` with a 3-D map, or ``gains`` without
+        ``verdicts``.
     """
     formats = check_figure_formats(formats)
     if gains is not None and rmap.ndim != 2:
         raise StringStabError(f"a gain trajectory can be overlaid on a 2-D map only; got a {rmap.ndim}-D map")
     _need_verdicts(gains, verdicts)
-    every = figure_stems(rmap, gains is not None)
+    every = figure_stems(rmap, gains is not None, "all")
     if stems is None:
-        stems = every
+        stems = figure_stems(rmap, gains is not None, figures)
     elif any(s not in every for s in stems):
         raise StringStabError(f"figures must be among {every}; got {list(stems)}")
     jobs = [(stem, [(f, _stage(out, f"{prefix}_{stem}.{f}")) for f in formats]) for stem in stems]
@@ -202,8 +234,9 @@ class _FigureJob:
     def __call__(self, job: tuple[str, list[tuple[str, Path]]]) -> None:
         stem, targets = job
         fig = draw_figure(self.rmap, stem, self.gains, self.verdicts)
-        try:
-            save_figure(fig, targets, metadata=self.metadata, dpi=self.dpi)
+        try:  # the tight box's dry run without the images: the same bytes, each image made once
+            with dry_runs_without_images():
+                save_figure(fig, targets, metadata=self.metadata, dpi=self.dpi)
         finally:
             pyplot().close(fig)
 
@@ -260,14 +293,17 @@ def _draw_all(rmap: RegionMap, folder: Path, prefix: str, formats: Sequence[str]
               stems: Sequence[str], gains: Any, verdicts: Any, dpi: int, drawers: int) -> None:
     """The figures (in the helper): shared by ``drawers`` processes forked from it, warm.
 
-    The costliest first (the longest-processing-time rule), so that no drawer is left with a
-    long figure at the end while the others wait.
+    The drawers share one mathtext parser (:func:`share_mathtext_parser`).  The costliest
+    first (the longest-processing-time rule), so that no drawer is left with a long figure at
+    the end while the others wait.
     """
     import matplotlib
 
     if "matplotlib.pyplot" not in sys.modules:
         matplotlib.use("Agg")
-    share_mathtext_parser()  # the drawers forked below inherit it (and what it has parsed)
+    # each drawer forked below shares one parser among its renderers (a parser of its own: the
+    # parses made here hold fonts whose file offset the drawers would share)
+    share_mathtext_parser()
     order = sorted(stems, key=lambda s: -_FIGURE_COST.get(s, 1.0))
     save_figures(rmap, folder, prefix=prefix, formats=formats, gains=gains, verdicts=verdicts,
                  dpi=dpi, stems=order, workers=drawers)
@@ -293,9 +329,13 @@ def _final(out: Any, name: str) -> Path:
 def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
-    helper: Helper | None = None,
+    helper: Helper | None = None, figures: str = "default",
 ) -> list[Path]:
     """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps) and the standard figures.
+
+    The data files hold every method's fields; the figures are :func:`figure_stems`
+    ``(rmap, gains is not None, figures)``: on a 2-D map with two or more methods, by default
+    the first method's class map, the comparison and the sup|Γ| map (issue 31).
 
     Parameters
     ----------
@@ -313,6 +353,9 @@ def save_region_outputs(
     helper : stringstab.parallel.Helper, optional
         A helper started earlier by :func:`start_output_helper` (warm); it draws the figures
         (whatever ``processes``), and is done with when this returns.
+    figures : {"default", "all"}, default "default"
+        The class maps of a 2-D map with two or more methods: the first method's only, or
+        every method's (:func:`figure_stems`).
 
     Returns
     -------
@@ -322,8 +365,8 @@ def save_region_outputs(
     Raises
     ------
     StringStabError
-        On a bad format, ``gains`` without ``verdicts``, or when a file cannot be written (in
-        either process).
+        On a bad format or figure set, ``gains`` without ``verdicts``, or when a file cannot be
+        written (in either process).
 
     Examples
     --------
@@ -336,22 +379,22 @@ def save_region_outputs(
     """
     formats = check_figure_formats(formats)
     _need_verdicts(gains, verdicts)
-    stems = figure_stems(rmap, gains is not None)
+    stems = figure_stems(rmap, gains is not None, figures)
     names = [f"{prefix}.npz", *([f"{prefix}.csv"] if rmap.ndim == 2 else []),
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]
     folder = Path()
     for name in names:  # register every output here, whichever process writes it
         folder = _stage(out, name).parent
-    figures = (rmap, folder, prefix, formats, stems, gains, verdicts, dpi)
+    drawing = (rmap, folder, prefix, formats, stems, gains, verdicts, dpi)
     final = [_final(out, n) for n in names]
     if helper is None and (int(processes) <= 1 or not stems):
         _write_data(rmap, folder, prefix)
-        _draw_all(*figures, 1)
+        _draw_all(*drawing, 1)
         return final
     if helper is None:
         helper = start_helper()
     with helper:  # the figures there (in its forked drawers), the data files here
-        helper.submit(_draw_all, *figures, min(max(2, cpu_count() - 1), len(stems)))
+        helper.submit(_draw_all, *drawing, min(max(2, cpu_count() - 1), len(stems)))
         _write_data(rmap, folder, prefix)
         helper.result()
     return final

@@ -95,7 +95,7 @@ def _table(sweep: ReactionSweep) -> str:
 
 def save_reaction_sweep_outputs(
     sweep: ReactionSweep, out: Any, *, prefix: str = "region",
-    formats: Sequence[str] = ("png", "pdf"), dpi: int = 150,
+    formats: Sequence[str] = ("png", "pdf"), dpi: int = 150, figures: str = "default",
 ) -> list[Path]:
     """Write every θ_r's map files, the share table and the share-vs-θ_r figure.
 
@@ -111,6 +111,9 @@ def save_reaction_sweep_outputs(
         Figure formats (``png``, ``pdf``, ``svg``).
     dpi : int
         Resolution of PNG figures.
+    figures : {"default", "all"}, default "default"
+        Each map's class maps: the first method's only, or every method's
+        (:func:`~stringstab.plots.figure_stems`).
 
     Returns
     -------
@@ -138,5 +141,5 @@ def save_reaction_sweep_outputs(
     written = [final(table), *(final(f"{stem}.{f}") for f in formats)]
     for th, m in zip(sweep.reaction_delays, sweep.maps):
         written += save_region_outputs(m, out, prefix=sweep_prefix(prefix, float(th)),
-                                       formats=formats, dpi=dpi)
+                                       formats=formats, dpi=dpi, figures=figures)
     return written

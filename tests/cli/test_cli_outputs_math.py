@@ -132,8 +132,16 @@ def test_region_outputs_shared_by_two_processes_equal_one(tmp_path, processes):
     g = np.linspace(-2, 2, 23)
     m = region_map({"k_x": g, "k_v": g}, {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1)
     written = save_region_outputs(m, tmp_path, formats=("png",), dpi=20, processes=processes)
-    assert [p.name for p in written][:2] == ["region.npz", "region.csv"]
+    assert [p.name for p in written] == ["region.npz", "region.csv", "region_class_exact.png",
+                                         "region_compare.png", "region_sup_gain.png"]
     assert all(p.is_file() and p.stat().st_size > 0 for p in written)
     assert (tmp_path / "region.csv").read_text(encoding="utf-8") == m.csv_text()
     assert (load_npz(tmp_path / "region.npz").verdict["exact"] == m.verdict["exact"]).all()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in written)
+    every = tmp_path / "all"  # figures="all": every method's class map as well
+    every.mkdir()
+    names = [p.name for p in save_region_outputs(m, every, formats=("png",), dpi=20,
+                                                 processes=processes, figures="all")]
+    assert names == ["region.npz", "region.csv", "region_class_exact.png", "region_class_taylor.png",
+                     "region_class_printed.png", "region_compare.png", "region_sup_gain.png"]
+    assert sorted(p.name for p in every.iterdir()) == sorted(names)

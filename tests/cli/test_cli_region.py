@@ -1,6 +1,7 @@
 """`stringstab region` end to end: files, printed shares, and exit 2 with nothing written on bad input."""
 
 import csv
+import re
 from pathlib import Path
 
 import numpy as np
@@ -22,8 +23,10 @@ def test_slice_writes_data_and_figures(tmp_path, capsys):
                "--out", str(out), "--format", "png,pdf", "--overlay", str(ROLLOUT), "--dpi", "40"])
     assert rc == 0
     names = {p.name for p in out.iterdir()}
-    for stem in ("class_exact", "class_taylor", "class_printed", "compare", "sup_gain", "overlay"):
+    # the default figures (issue 31): the first method's class map, the comparison, sup|Γ|
+    for stem in ("class_exact", "compare", "sup_gain", "overlay"):
         assert {f"region_{stem}.png", f"region_{stem}.pdf"} <= names
+    assert not any("class_taylor" in n or "class_printed" in n for n in names)
     assert {"region.npz", "region.csv"} <= names
     m = load_npz(out / "region.npz")
     assert m.version == stringstab.__version__ and m.fixed == {"k_a": 0.5} and m.shape == (15, 15)
@@ -83,6 +86,46 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, argv, match):
     assert err.startswith("stringstab region: error:") and match in err
     assert err.count("\n") == 1
     assert not out.exists()
+
+
+def test_an_unknown_figure_set_exits_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "maps"
+    with pytest.raises(SystemExit) as e:  # refused by the parser, before any work
+        main(["region", "--fix", "k_a=1", "--n", "5", "--figures", "some", "--out", str(out)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stringstab region: error: argument --figures: invalid choice: 'some'")
+    assert err.count("\n") == 1 and "default" in err and "all" in err
+    assert not out.exists()
+
+
+def test_figures_all_draws_every_class_map_and_the_data_is_the_same(tmp_path, capsys):
+    from stringstab.cli import build_parser
+    from stringstab.plots import FIGURE_SETS
+
+    base = ["region", "--fix", "k_a=0.5", "--n", "7", "--dpi", "30", "--no-progress"]
+    assert main([*base, "--out", str(tmp_path / "d")]) == 0
+    assert main([*base, "--figures", "all", "--out", str(tmp_path / "a")]) == 0
+    stdout = capsys.readouterr().out
+    figures = {d: sorted(p.name for p in (tmp_path / d).glob("*.png")) for d in ("d", "a")}
+    assert figures["d"] == ["region_class_exact.png", "region_compare.png", "region_sup_gain.png"]
+    assert figures["a"] == sorted([*figures["d"], "region_class_taylor.png",
+                                   "region_class_printed.png"])
+    assert "wrote 7 files" in stdout and "wrote 5 files" in stdout
+    # every method's data either way: the same CSV, the same verdicts in the NPZ
+    assert (tmp_path / "d" / "region.csv").read_bytes() == (tmp_path / "a" / "region.csv").read_bytes()
+    d, a = load_npz(tmp_path / "d" / "region.npz"), load_npz(tmp_path / "a" / "region.npz")
+    assert d.methods == a.methods == ("exact", "taylor", "printed")
+    assert all((d.verdict[k] == a.verdict[k]).all() for k in d.methods)
+    # the report shows the figures drawn, and only those
+    for folder, pngs in figures.items():
+        md = (tmp_path / folder / "report.md").read_text(encoding="utf-8")
+        shown = set(re.findall(r"\]\((region_\w+\.png)\)", md))
+        assert shown == set(pngs), (folder, shown)
+    # the parser's choices are the plotting code's figure sets (the parser does not import it)
+    sub = next(a for a in build_parser("region")._actions if a.__class__.__name__ == "_SubParsersAction")
+    flag = next(a for a in sub.choices["region"]._actions if "--figures" in a.option_strings)
+    assert tuple(flag.choices) == FIGURE_SETS and flag.default == "default"
 
 
 def test_out_must_not_be_a_file(tmp_path, capsys):

@@ -177,7 +177,7 @@ def test_region_figures(tmp_path, captured):
 
     rollout = read_gains("stringstab/data/examples/gain_rollout.csv")
     save_figures(m2, tmp_path, formats=("png",), dpi=40, gains=rollout,
-                 verdicts=trajectory_verdicts(m2, rollout))
+                 verdicts=trajectory_verdicts(m2, rollout), figures="all")
     m3 = region_map({"k_x": g[::2], "k_v": g[::2], "k_a": np.linspace(-1, 1, 3)}, tau=0.1,
                     delta=0.2, headway=1.1, methods="exact", progress=False, workers=1)
     save_figures(m3, tmp_path, prefix="r3", formats=("png",), dpi=40)

@@ -144,8 +144,9 @@ def test_facets_and_boundaries_over_tau():
 def test_save_figures_writes_each_format(tmp_path, m2):
     written = plots.save_figures(m2, tmp_path, formats=("png", "svg"), dpi=40)
     names = sorted(p.name for p in written)
-    assert "region_compare.svg" in names and "region_sup_gain.png" in names
-    assert len(names) == 2 * (3 + 2)
+    # the default figures (issue 31): the first method's class map, the comparison and sup|Γ|
+    assert names == sorted(f"region_{s}.{f}" for s in ("class_exact", "compare", "sup_gain")
+                           for f in ("png", "svg"))
     assert all(p.stat().st_size > 0 for p in written)
     from PIL import Image
 
@@ -156,6 +157,8 @@ def test_save_figures_writes_each_format(tmp_path, m2):
     assert m2.version in (tmp_path / "region_sup_gain.svg").read_text()
     with pytest.raises(StringStabError, match="formats"):
         plots.save_figures(m2, tmp_path, formats=("gif",))
+    with pytest.raises(StringStabError, match="figures must be one of default, all"):
+        plots.save_figures(m2, tmp_path, formats=("png",), figures="every")
     with pytest.raises(StringStabError, match="verdicts"):  # gains come with their verdicts
         plots.save_figures(m2, tmp_path, formats=("png",), gains=[[0.9, 0.5, 0.3]])
     # each file was written atomically: no temporary file is left beside them

@@ -160,6 +160,9 @@ def test_region_command_report(tmp_path, capsys):
     md = (out / "report.md").read_text(encoding="utf-8")
     pngs = sorted(p.name for p in out.glob("*.png"))
     assert pngs and all(f"]({p})" in md for p in pngs)
+    # and no other: the figures not drawn by default (issue 31) are not referenced
+    assert "class_taylor" not in md and "class_printed" not in md
+    assert md.count(".png)") == len(pngs)
     html = (out / "report.html").read_text(encoding="utf-8")
     data, other = _embedded(html)
     assert other == [] and sorted(data) == sorted((out / p).read_bytes() for p in pngs)
