@@ -51,7 +51,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .interval import IntervalAD, poly_add, poly_scale
-from .sampled_frequency import curvature_bound
+from .sampled_curvature import curvature_bound
 from .verdicts import ROUNDOFF_SLACK
 from .zoh import (
     abs2_over_rho,
@@ -399,7 +399,7 @@ def split_curvature(aF: Array, aG: Array, m: Array, L: Array, R: Array) -> Array
     Returns
     -------
     ndarray, shape (r, k)
-        |F''| + |G''| bounded by :func:`stringstab.certify.sampled_frequency.curvature_bound`
+        |F''| + |G''| bounded by :func:`stringstab.certify.sampled_curvature.curvature_bound`
         (F has no oscillating terms).
     """
     J = aF.shape[1]
