@@ -32,12 +32,20 @@ load (``os.getloadavg()``), and the table keeps, per side, the round whose figur
    proposals recorded from a training run of this checkout (past its random first 2,000
    steps; the same proposals before and after), per
    CPU second of the process (the wall figure is printed too), and the env without the repair;
-6. the verdict sets: robust sampled (both lags), robust continuous and ``check`` before and
+6. the verdict sets: robust sampled (both lags), robust continuous, ``check`` and the sampled
+   point ``check`` at H = 0.1 (``checksampled``, the repair's) before and
    after on ``--n-verdicts`` random triples and on adversarial sets (points near the
    Hurwitz/Schur boundary, near |Γ| = 1 and |H| = 1 over the box, boxes straddling the
    boundary: :func:`adversarial`); a change is counted when a decided verdict
    (certified / not_certified) changes, and reported apart when a verdict that was
    inconclusive is now decided.
+
+7. part ``replay``: ``--replay-steps`` proposals recorded from an IDL training run of this
+   checkout (seed 1, as part 5) replayed through ``GainRepair`` (defaults, both checks; 8
+   rows per call as training's 8 envs; the first half warms the cells and kept verdicts):
+   the repair's CPU time on the second half, the sampled point check's share of it, the
+   sampled ``Loop.check`` one triple per call on the rows the repair gave it, and whether
+   the executed gains are the same bit for bit before and after.
 
 Prints the table (before, after, ratio after/before, target) and the loads; asserts nothing
 about time.  ``--write-fixture PATH`` writes a sample of the inputs with the base verdicts
@@ -247,6 +255,8 @@ def work_verdicts(inp: dict, out: dict) -> None:
         kx, kv, ka = (np.ascontiguousarray(K[:, i]) for i in range(3))
         if kind == "check":
             v = check(kx, kv, ka, **POINT).verdict
+        elif kind == "checksampled":  # the sampled point check (the repair's), H = 0.1
+            v = check(kx, kv, ka, **POINT, sample_time=H).verdict
         elif kind == "robust":
             v = certify_batch(kx, kv, ka, **BOX).verdict
         elif kind == "sampled":
@@ -348,8 +358,59 @@ def work_env(inp: dict, out: dict) -> None:
                load=[load0, os.getloadavg()])
 
 
+def work_replay(inp: dict, out: dict) -> None:
+    """The repair on recorded proposals (8 rows per call, as training's 8 envs): its CPU time.
+
+    The first half warms the proven cells and the kept verdicts, the second half is timed
+    (CPU of the process); the sampled point check (``Loop.check`` at H) is timed inside it
+    (calls, rows, CPU), and afterwards one triple per call on the first ``n_single`` rows it
+    was given (best of ``repeat``).  The executed gains of the whole replay are saved
+    (``executed_out``) for the bit-for-bit comparison of the two sides.
+    """
+    from stringstab.certify.api import Loop
+
+    GainRepair = repair_module().GainRepair
+    P = np.load(inp["inputs"])["replay"]
+    rep = GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1)
+    rep.lattice()
+    rep.cells()
+    rep.continuous_cells()
+    sampled = {"seconds": 0.0, "calls": 0, "rows": []}
+    orig = Loop.check
+
+    def chk(self, kx, kv, ka, **kw):
+        if self.sample_time is None:
+            return orig(self, kx, kv, ka, **kw)
+        c = time.process_time()
+        try:
+            return orig(self, kx, kv, ka, **kw)
+        finally:
+            sampled["seconds"] += time.process_time() - c
+            sampled["calls"] += 1
+            sampled["rows"].append(np.stack([np.asarray(kx), np.asarray(kv), np.asarray(ka)], 1))
+
+    Loop.check = chk  # type: ignore[method-assign]
+    half = (len(P) // 16) * 8
+    executed = [rep(P[i:i + 8]) for i in range(0, half, 8)]
+    sampled.update(seconds=0.0, calls=0, rows=[])
+    load0 = os.getloadavg()
+    c0 = time.process_time()
+    executed += [rep(P[i:i + 8]) for i in range(half, len(P), 8)]
+    c_rep = time.process_time() - c0
+    Loop.check = orig  # type: ignore[method-assign]
+    np.save(inp["executed_out"], np.concatenate(executed))
+    rows = np.concatenate(sampled["rows"]) if sampled["rows"] else np.zeros((0, 3))
+    loop = Loop.of(0.1, 0.2, 1.1, sample_time=0.1)
+    one = [(k[0:1].copy(), k[1:2].copy(), k[2:3].copy()) for k in rows[:inp.get("n_single", 1500)]]
+    t1 = _best(lambda: [loop.check(*k) for k in one], inp["repeat"])
+    out.update(repair_cpu=c_rep, rows=len(P) - half, sampled_cpu=sampled["seconds"],
+               sampled_calls=sampled["calls"], sampled_rows=len(rows),
+               single_sampled=t1 / max(len(one), 1), n_single=len(one),
+               load=[load0, os.getloadavg()])
+
+
 WORKERS = {"certify": work_certify, "verdicts": work_verdicts, "train": work_train,
-           "env": work_env}
+           "env": work_env, "replay": work_replay}
 
 
 def worker_main(spec: str) -> None:
@@ -414,7 +475,8 @@ def main(argv=None):
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--base", default="f6db69e", help="the base commit (default f6db69e)")
     ap.add_argument("--parts", default="certify,env,train,trainfull,verdicts",
-                    help="certify, env, train (--train-steps), trainfull (the default "
+                    help="certify, env, replay (the repair on recorded proposals: "
+                         "--replay-steps), train (--train-steps), trainfull (the default "
                          "training, about 211,000 steps each side), verdicts")
     ap.add_argument("--n-time", type=int, default=5000, help="triples timed (default 5000)")
     ap.add_argument("--n-rs", type=int, default=None,
@@ -427,6 +489,10 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=2, help="alternations of before/after")
     ap.add_argument("--train-steps", type=int, default=20_000)
     ap.add_argument("--env-steps", type=int, default=4000)
+    ap.add_argument("--replay-steps", type=int, default=40_000,
+                    help="part replay: proposals recorded from a training run of this "
+                         "checkout (seed 1), replayed through GainRepair before and after "
+                         "(default 40000: the first half warms, the second is timed)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--write-fixture", help="write inputs and base verdicts (a sample) here")
     args = ap.parse_args(argv)
@@ -445,14 +511,20 @@ def main(argv=None):
     inputs = {"time": rng.uniform(-2, 2, (args.n_time, 3))}
     if "verdicts" in parts or args.write_fixture:
         Kv = rng.uniform(-2, 2, (args.n_verdicts, 3))
-        for kind in ("check", "robust", "sampled", "sampledhom"):
+        for kind in ("check", "robust", "sampled", "sampledhom", "checksampled"):
             inputs[f"v_{kind}_random"] = Kv
             inputs[f"v_{kind}_adversarial"] = adversarial(
-                kind if kind != "sampledhom" else "sampled", args.n_adversarial, args.seed + 1)
+                kind if kind in ("check", "robust") else "sampled", args.n_adversarial,
+                args.seed + 1)
     if "env" in parts:
         t0 = time.perf_counter()
         inputs["proposals"] = record_proposals(args.env_steps + 4000)
         print(f"# recorded {len(inputs['proposals'])} proposals in "
+              f"{time.perf_counter() - t0:.0f} s")
+    if "replay" in parts:
+        t0 = time.perf_counter()
+        inputs["replay"] = record_proposals(args.replay_steps)
+        print(f"# recorded {len(inputs['replay'])} proposals for the replay in "
               f"{time.perf_counter() - t0:.0f} s")
     path = os.path.join(tmp, "inputs.npz")
     np.savez(path, **inputs)
@@ -460,15 +532,18 @@ def main(argv=None):
              "env_steps": args.env_steps,
              "n_rs": args.n_time if args.n_rs is None else args.n_rs}
     res: dict[str, dict[str, list[dict]]] = {"before": {}, "after": {}}
-    for part in ("certify", "env", "train", "trainfull"):
+    for part in ("certify", "env", "replay", "train", "trainfull"):
         if part not in parts:
             continue
         spec = {**spec0, "part": part}
+        if part == "replay":
+            spec["executed_out"] = os.path.join(tmp, "executed_{side}.npy")
         if part == "trainfull":  # the default training, its own length
             spec.update(part="train", train_steps=0)
         for _ in range(args.rounds if not part.startswith("train") else 1):
             for side in ("before", "after"):
-                r = run_worker(side, base_dir, spec)
+                r = run_worker(side, base_dir, {**spec, "executed_out": spec.get(
+                    "executed_out", "").format(side=side)})
                 res[side].setdefault(part, []).append(r)
                 print(f"# {part} {side}: {json.dumps(r)}", flush=True)
     rows = []
@@ -531,6 +606,32 @@ def main(argv=None):
                     f"{b['steps_per_second']:.0f} ({b['cpu_seconds']:.0f} s) | "
                     f"{a['steps_per_second']:.0f} ({a['cpu_seconds']:.0f} s) | "
                     f"{a['steps_per_second'] / b['steps_per_second']:.2f} | (reported) |")
+    if "replay" in parts:
+        b = min(res["before"]["replay"], key=lambda r: r["repair_cpu"])
+        a = min(res["after"]["replay"], key=lambda r: r["repair_cpu"])
+        rows.append(f"| repair CPU on the replay of {b['rows']} recorded proposals (8 per call) | "
+                    f"{b['repair_cpu']:.2f} s (load {b['load'][0][0]:.1f}) | "
+                    f"{a['repair_cpu']:.2f} s (load {a['load'][0][0]:.1f}) | "
+                    f"{a['repair_cpu'] / b['repair_cpu']:.3f} | ≤ 0.6 |")
+        rows.append(f"| of which the sampled point check ({b['sampled_calls']} calls, "
+                    f"{b['sampled_rows']} rows) | {b['sampled_cpu']:.2f} s "
+                    f"({1e3 * b['sampled_cpu'] / max(b['sampled_calls'], 1):.3f} ms/call) | "
+                    f"{a['sampled_cpu']:.2f} s "
+                    f"({1e3 * a['sampled_cpu'] / max(a['sampled_calls'], 1):.3f} ms/call) | "
+                    f"{a['sampled_cpu'] / b['sampled_cpu']:.3f} | |")
+        b = min(res["before"]["replay"], key=lambda r: r["single_sampled"])
+        a = min(res["after"]["replay"], key=lambda r: r["single_sampled"])
+        rows.append(f"| sampled `Loop.check`, one triple per call ({a['n_single']} of the "
+                    f"replay's rows) | {1e3 * b['single_sampled']:.3f} ms (load "
+                    f"{b['load'][1][0]:.1f}) | {1e3 * a['single_sampled']:.3f} ms (load "
+                    f"{a['load'][1][0]:.1f}) | {a['single_sampled'] / b['single_sampled']:.3f} "
+                    f"| ≤ 0.4 |")
+        ex = {side: np.load(os.path.join(tmp, f"executed_{side}.npy"))
+              for side in ("before", "after")}
+        same = ex["before"].shape == ex["after"].shape and np.array_equal(
+            ex["before"].view(np.uint64), ex["after"].view(np.uint64))
+        print(f"# replay: executed gains of {len(ex['after'])} proposals bit for bit the same "
+              f"before and after: {same}")
     if "env" in parts:
         b = max(res["before"]["env"], key=lambda r: r["steps_per_second"])
         a = max(res["after"]["env"], key=lambda r: r["steps_per_second"])
@@ -590,6 +691,9 @@ def verify_new_decisions(inputs: dict, before: dict, after: dict) -> str:
         kind = name.split("_")[1]
         idx = np.flatnonzero((b == "inconclusive") & (after[name] != "inconclusive"))
         if not idx.size:
+            continue
+        if kind == "checksampled":  # the sampled point check is meant to be unchanged
+            bad += idx.size
             continue
         if kind == "check":
             K = inputs[name][idx]

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import numpy.typing as npt
@@ -129,6 +130,14 @@ def verdict_codes(status: npt.NDArray[np.int8]) -> npt.NDArray[np.int8]:
     return v
 
 
+@lru_cache(maxsize=64)
+def _unit_grid(k: int) -> Array:
+    """``np.linspace(0, 1, k + 1)``, kept (read-only): the same points at every call."""
+    u = np.linspace(0.0, 1.0, k + 1)
+    u.setflags(write=False)
+    return u
+
+
 def _lower(Glow: Array, E: Array, M: Array, X: Array) -> tuple[Array, Array, Array]:
     """(lower bound, end value − slack, M h²/8) on every interval; a row's grid is uniform."""
     h = X[:, 1:2] - X[:, :1]
@@ -179,7 +188,7 @@ def branch_and_bound(
     if intervals is None:
         if right is None:
             raise ValueError("branch_and_bound needs right or intervals")
-        u = np.linspace(0.0, 1.0, n_grid + 1)
+        u = _unit_grid(n_grid)
         X = np.asarray(right, dtype=float)[:, None] * u[None, :]
         idx = np.arange(n)
     else:
@@ -251,7 +260,7 @@ def branch_and_bound(
         split = int(min(max(4, 2 ** math.ceil(math.log2(max(float(np.max(need)), 1.0)))), 64))
         while split > 4 and it.size * split > 2_000_000:
             split //= 2
-        v = np.linspace(0.0, 1.0, split + 1)
+        v = _unit_grid(split)
         new_points = split - 1
         first = False
         idx = it

@@ -45,11 +45,11 @@ from . import margin as _margin
 from .branch_bound import branch_and_bound
 from .criteria import hurwitz_bands_kernel
 from .interval import Interval, IntervalAD
-from .sampled_frequency import curvature_bound
+from .sampled_curvature import curvature_bound
 from .sampled_split import vander
-from .schur import SCHUR_RTOL, schur_terms
+from .schur import SCHUR_RTOL
 from .verdicts import CERTIFIED, ROUNDOFF_SLACK
-from .zoh import build, primitives, split_delay
+from .zoh import build, primitives, schur_terms, split_delay
 
 __all__ = ["CertifiedCells", "certified_cells", "continuous_cells", "sampled_cells"]
 
@@ -431,6 +431,8 @@ class CertifiedCells:
         flat = (ijk[:, 0] * m + ijk[:, 1]) * m + ijk[:, 2]
         bl = ijk // BLOCK_SIDE
         block = (bl[:, 0] * b + bl[:, 1]) * b + bl[:, 2]
-        for blk in np.unique(block[inside & ~self.done[block] & self.candidates[flat]]):
-            self._prove_block(int(blk))
+        todo = inside & ~self.done[block] & self.candidates[flat]
+        if todo.any():  # (most calls: every block near the rows already done)
+            for blk in np.unique(block[todo]):
+                self._prove_block(int(blk))
         return np.asarray(inside & self.proven_cells[flat])

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Interval", "IntervalAD", "interval", "poly_add", "poly_scale"]
+__all__ = ["Interval", "IntervalAD", "Point", "interval", "poly_add", "poly_scale"]
 
 Array = npt.NDArray[np.float64]
 
@@ -157,6 +157,130 @@ class Interval:
         lo = self.lo[idx]
         return Interval(lo, None, self.mag[idx]) if self.point else Interval(lo, self.hi[idx],
                                                                             self.mag[idx])
+
+
+#: The factors of a negation, rows (value, magnitude): −lo, and ``mag`` unchanged.
+_NEG = np.array([[-1.0], [1.0]])
+#: (c, |c|) of the numbers met, by value (read-only).
+_PAIRS: dict[float, Array] = {}
+
+
+def _pair(v: Any) -> Array:
+    """A number or array as the rows (v, |v|) of a point: its value and magnitude.
+
+    A number gives shape (2, 1) (broadcast against points of one-dimensional rows).
+    """
+    if type(v) is float:
+        pair = _PAIRS.get(v)
+        if pair is None:
+            pair = np.array([[v], [abs(v)]])
+            pair.setflags(write=False)
+            if len(_PAIRS) < 4096:  # the constants of the loop's formulas, and H's powers
+                _PAIRS[v] = pair
+        return pair
+    lo = np.asarray(v, dtype=float)
+    if lo.ndim == 0:
+        return np.array([[float(lo)], [abs(float(lo))]])
+    return np.stack((lo, np.abs(lo)))
+
+
+class Point(Interval):
+    """A point :class:`Interval` whose ``lo`` and ``mag`` are the two rows of one array ``s``.
+
+    Each operation of two points is one array operation on the stacked rows (value,
+    magnitude) instead of two, and computes the same numbers as :class:`Interval`'s point
+    path element by element: a product is lo·lo and mag·mag, a sum lo + lo and mag + mag, a
+    negation −lo (as lo·(−1), exact) with ``mag`` unchanged, and a number c multiplies the
+    rows by (c, |c|).  Operations with any other :class:`Interval` take
+    :class:`Interval`'s own paths (IEEE + and × commute, so the operands' order does not
+    matter).  :func:`stringstab.certify.zoh.point_coefficients` computes in it (the
+    sampled point certificate's fixed cost per call: Moore et al. §2, Higham §3.1 as in
+    the module docstring).
+
+    Parameters
+    ----------
+    s : ndarray, shape (2, n) or (2, 1)
+        The values (row 0) and their magnitude companions (row 1), one-dimensional rows.
+    """
+
+    __slots__ = ("_lo", "_mag", "s")
+
+    def __init__(self, s: Array) -> None:
+        self.s = s
+        self._lo = self._mag = None
+
+    # the rows as views, made when first read (the build reads none of them)
+    @property
+    def lo(self) -> Array:  # type: ignore[override]
+        """The values (row 0 of ``s``)."""
+        v = self._lo
+        if v is None:
+            v = self._lo = self.s[0]
+        return v
+
+    @property
+    def hi(self) -> Array:  # type: ignore[override]
+        """The values again (a point: ``hi is lo``)."""
+        return self.lo
+
+    @property
+    def mag(self) -> Array:  # type: ignore[override]
+        """The magnitude companions (row 1 of ``s``)."""
+        v = self._mag
+        if v is None:
+            v = self._mag = self.s[1]
+        return v
+
+    @property
+    def point(self) -> bool:
+        """True (a point)."""
+        return True
+
+    @staticmethod
+    def of(v: Any) -> Point:  # type: ignore[override]
+        """The point of an :class:`Interval` point, or of a number or array (``mag`` = |v|)."""
+        if isinstance(v, Point):
+            return v
+        if isinstance(v, Interval):
+            lo, mag = np.broadcast_arrays(v.lo, v.mag)
+            return Point(np.stack((lo, mag)))
+        return Point(_pair(v))
+
+    def __add__(self, o: Any) -> Interval:
+        if type(o) is Point:
+            return Point(self.s + o.s)
+        if isinstance(o, Interval):
+            return Interval.__add__(self, o)
+        return Point(self.s + _pair(o))
+
+    __radd__ = __add__
+
+    def __neg__(self) -> Point:
+        return Point(self.s * _NEG)
+
+    def __sub__(self, o: Any) -> Interval:
+        return self + (-o if isinstance(o, Interval) else -Point(_pair(o)))
+
+    def __rsub__(self, o: Any) -> Interval:
+        return (o if isinstance(o, Interval) else Point(_pair(o))) + (-self)
+
+    def __mul__(self, o: Any) -> Interval:
+        if type(o) is Point:
+            return Point(self.s * o.s)
+        if isinstance(o, Interval):
+            return Interval.__mul__(self, o)
+        return Point(self.s * _pair(o))
+
+    __rmul__ = __mul__
+
+    def const(self, v: Any) -> Point:
+        """A point constant of this item's shape (``mag`` = |v|, as :meth:`Interval.const`)."""
+        lo = np.zeros_like(self.lo) + v
+        return Point(np.stack((lo, np.abs(lo))))
+
+    def take(self, idx: npt.NDArray[np.intp]) -> Point:
+        """The rows ``idx``."""
+        return Point(self.s[:, idx])
 
 
 class IntervalAD:

@@ -16,7 +16,7 @@ largest), so a violation comes with its witness.  The delay enters as z^{−(m+1
 m = ⌊δ/H⌋: the δ interval is split at the multiples of H into pieces of fractional delay
 ε ∈ [ε_lo, ε_hi] ⊂ [0, 1] (continuous at the joins: ε = 1 at m equals ε = 0 at m + 1).  Schur
 stability over (τ, T*) is decided by a two-dimensional bisection on the interval-evaluated Schur
-conditions (:func:`stringstab.certify.schur.schur_terms` of
+conditions (:func:`stringstab.certify.zoh.schur_terms` of
 :func:`_delta_cells`).  A box left inconclusive is not certified when one
 of its members — a corner, or the member where the search came closest — is not certified by
 its own point certificate (:func:`stringstab.certify.sampled.check_members`): that member is
@@ -44,9 +44,9 @@ from .sampled import check_members
 from .sampled_excess import peak_gain, violation_peak
 from .sampled_frequency import margin_bound
 from .sampled_split import delay_ends
-from .schur import SCHUR_RTOL, schur_terms
+from .schur import SCHUR_RTOL
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
-from .zoh import Coefficients, coefficients, split_delay
+from .zoh import Coefficients, coefficients, schur_terms, split_delay
 
 __all__ = ["certify_box_sampled"]
 

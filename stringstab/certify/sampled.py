@@ -21,7 +21,7 @@ H → 0.
 **The decision** of max_{θ∈[0,π]} |H(e^{jθ})| ≤ 1 is a branch and bound
 (:mod:`stringstab.certify.branch_bound`) on g_H over the compact [0, π] (no tail): on
 [l, r] of width h, g_H ≥ min(g_H(l), g_H(r)) − M h²/8 with an explicit bound M ≥ |g_H''|
-on [l, r] (:func:`~stringstab.certify.sampled_frequency.margin_curvature`).  Every
+on [l, r] (:func:`~stringstab.certify.sampled_curvature.margin_curvature`).  Every
 coefficient is computed together with a magnitude companion (the same arithmetic on
 absolute values), and every comparison carries a slack of 10⁻¹³ (1 + m) times the
 magnitude — hundreds of ulps, covering the round-off of the coefficients and of the
@@ -49,6 +49,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, ClassVar
 
 import numpy as np
@@ -58,8 +59,9 @@ from ..io import TableColumn
 from ..params import Box, Params
 from .branch_bound import BranchAndBound, Evaluate, branch_and_bound, verdict_codes
 from .excess import EXCESS_SEARCH, searched_excess
+from .sampled_curvature import interval_terms, margin_curvature, point_curvature, point_stack
 from .sampled_excess import peak_gain, violation_peak
-from .sampled_frequency import margin_bound, margin_curvature
+from .sampled_frequency import circle_terms, margin_bound, point_margin
 from .schur import schur_bands, spectral_radius_of
 from .verdicts import (
     CERTIFIED,
@@ -85,19 +87,49 @@ __all__ = [
 ]
 
 Array = npt.NDArray[np.float64]
+Circle = tuple[Array, Array, Array, Array]
 
 
 # ---------------------------------------------------------------------------
 # The branch and bound of g_H ≥ 0 on [0, π]
 # ---------------------------------------------------------------------------
-def _point_evaluator(co: Coefficients, m: int) -> Evaluate:
-    """The :data:`~stringstab.certify.branch_bound.Evaluate` of g_H for point coefficients."""
-    mm = np.full(co.P[0].lo.size, float(m))
+@lru_cache(maxsize=32)
+def _initial_grid(m: int, n_grid: int) -> tuple[Array, Circle, tuple[Array, Array]]:
+    """The engine's initial grid on [0, π] (one row) and its terms (each row's), once per loop."""
+    X = np.array([np.pi])[:, None] * np.linspace(0.0, 1.0, n_grid + 1)[None, :]
+    circle = circle_terms(X, float(m))
+    ends = interval_terms(X[:, :-1], X[:, 1:])
+    for a in (X, *circle, *ends):
+        a.setflags(write=False)
+    return X, circle, ends
+
+
+def _point_evaluator(co: Coefficients, m: int, n_grid: int) -> Evaluate:
+    """The :data:`~stringstab.certify.branch_bound.Evaluate` of g_H for point coefficients.
+
+    From one stack of :class:`~stringstab.certify.interval.Point` coefficients (a later round
+    takes its rows), on the initial grid with :func:`_initial_grid`'s terms: the same numbers.
+    """
+    n = co.P[0].lo.size
+    mm = np.full(n, float(m))
+    every = np.arange(n)
+    grid, circle, ends = _initial_grid(m, n_grid)
+    S = point_stack(co)
+    mcol = mm[:, None]
 
     def evaluate(idx: npt.NDArray[np.intp], X: Array) -> tuple[Array, Array, Array, Array]:
-        sub = co.take(idx)
-        G, E = margin_bound(X, sub, mm[idx])
-        return G, G, E, margin_curvature(sub, mm[idx], X[:, :-1], X[:, 1:])
+        full = idx.size == n and bool((idx == every).all())
+        if S is None:
+            sub = co if full else co.take(idx)
+            G, E = margin_bound(X, sub, mm[idx])
+            return G, G, E, margin_curvature(sub, mm[idx], X[:, :-1], X[:, 1:])
+        L, R = X[:, :-1], X[:, 1:]
+        if full and X.shape == (n, grid.shape[1]) and bool((X == grid).all()):
+            G, E = point_margin(S, circle, mcol)
+            return G, G, E, point_curvature(S, mm, L, R, ends)
+        Si = S if full else S[..., idx]
+        G, E = point_margin(Si, circle_terms(X, mm[idx]), mcol[idx])
+        return G, G, E, point_curvature(Si, mm[idx], L, R)
 
     return evaluate
 
@@ -108,7 +140,7 @@ def _bnb_points(
 ) -> BranchAndBound:
     """Branch and bound of g_H ≥ 0 on [0, π] for point coefficients (one item per triple)."""
     n = co.P[0].lo.size
-    return branch_and_bound(n, _point_evaluator(co, m), right=np.full(n, np.pi), n_grid=n_grid,
+    return branch_and_bound(n, _point_evaluator(co, m, n_grid), right=np.full(n, np.pi), n_grid=n_grid,
                             max_rounds=max_rounds, max_intervals=max_intervals, refine=refine)
 
 
@@ -178,7 +210,7 @@ def check_kernel(
     SampledCheck
     """
     co, m = point_coefficients(kx, kv, ka, p, H, tp)
-    sure, fail = schur_bands(co.delta)
+    sure, fail = schur_bands(co.delta, co.schur)
     bb = _bnb_points(co, m, n_grid=n_grid or _default_grid(m), max_rounds=max_rounds,
                      max_intervals=max_intervals, refine=~fail)
     v = verdict_codes(bb.status)

@@ -37,15 +37,16 @@ import numpy.typing as npt
 
 from ..params import as_gains
 from .interval import Interval
+from .sampled_curvature import point_stack
 from .verdicts import ROUNDOFF_SLACK
 from .zoh import Coefficients, loop_parameters, point_coefficients
 
 __all__ = [
-    "curvature_bound",
+    "circle_terms",
     "margin_bound",
-    "margin_curvature",
     "margin_over_cells",
     "margin_spread",
+    "point_margin",
     "response",
     "sampled_margin",
     "sampled_response",
@@ -55,11 +56,15 @@ Array = npt.NDArray[np.float64]
 
 
 def _polyval(coefs: list[Array], rho: Array) -> Array:
-    """Σ_j coefs[j] ρ^j by Horner's rule (broadcast)."""
-    out = np.zeros(np.broadcast_shapes(np.shape(rho), *(np.shape(c) for c in coefs)))
+    """Σ_j coefs[j] ρ^j by Horner's rule (broadcast), from 0: (0·ρ + c_d)ρ + ...
+
+    The zero is a number: 0.0·ρ is the product of an array of zeros of the broadcast shape
+    with ρ, element by element, and the first coefficient's sum gives the broadcast shape.
+    """
+    out: Any = np.float64(0.0)
     for c in reversed(coefs):
         out = out * rho + c
-    return out
+    return np.asarray(out)
 
 
 def response(theta: Array, co: Coefficients, m: int, ka: Array) -> npt.NDArray[np.complex128]:
@@ -143,7 +148,30 @@ def sampled_response(
     return response(th, co, m, ka).reshape(shape)
 
 
-def margin_bound(theta: Array, co: Coefficients, m: Array | int) -> tuple[Array, Array]:
+def circle_terms(theta: Array, m: Array | float) -> tuple[Array, Array, Array, Array]:
+    """ρ = 4 sin²(θ/2), |sin θ|, cos(mθ) and sin(mθ) sin θ at θ: what :func:`margin_bound` needs.
+
+    Parameters
+    ----------
+    theta : ndarray
+        θ, rad/sample (shape (n, k) with m of shape (n,), or any shape with a number m).
+    m : float or ndarray, shape (n,)
+        Whole samples of delay.
+
+    Returns
+    -------
+    (ndarray, ndarray, ndarray, ndarray)
+        ρ, |sin θ|, cos(mθ), sin(mθ) sin θ.
+    """
+    rho = 4.0 * np.sin(0.5 * theta) ** 2
+    st = np.sin(theta)
+    mm = np.asarray(m, dtype=float)
+    mcol = mm[:, None] if mm.ndim else mm
+    return rho, np.abs(st), np.cos(mcol * theta), np.sin(mcol * theta) * st
+
+
+def margin_bound(theta: Array, co: Coefficients, m: Array | int,
+                 circle: tuple[Array, Array, Array, Array] | None = None) -> tuple[Array, Array]:
     """(lower bound of g_H over the coefficient cell, round-off slack) at θ.
 
     For point coefficients the lower bound is g_H itself.  The slack is
@@ -159,18 +187,21 @@ def margin_bound(theta: Array, co: Coefficients, m: Array | int) -> tuple[Array,
         Of :class:`~stringstab.certify.interval.Interval` entries.
     m : int or ndarray, shape (n,)
         Whole samples of delay.
+    circle : tuple of ndarray, optional
+        :func:`circle_terms` of θ and m, computed before (e.g. once for the branch and
+        bound's initial grid, broadcast over the rows); default: computed here.
 
     Returns
     -------
     (ndarray, ndarray)
         The lower bound of g_H and the slack, of the shape of ``theta``.
     """
-    rho = 4.0 * np.sin(0.5 * theta) ** 2
-    st = np.sin(theta)
+    rho, ast, cm, f = circle_terms(theta, m) if circle is None else circle
     mm = np.asarray(m, dtype=float)
     mcol = mm[:, None] if mm.ndim else mm
-    cm = np.cos(mcol * theta)
-    f = np.sin(mcol * theta) * st
+    S = point_stack(co) if np.ndim(theta) == 2 else None
+    if S is not None:
+        return point_margin(S, (rho, ast, cm, f), mcol)
 
     def col(x: Array) -> Array:
         return x[:, None] if np.ndim(x) and np.ndim(theta) == 2 else x
@@ -178,9 +209,10 @@ def margin_bound(theta: Array, co: Coefficients, m: Array | int) -> tuple[Array,
     P_lo = _polyval([col(c.lo) for c in co.P], rho)
     Yr_lo = _polyval([col(c.lo) for c in co.Yr], rho)
     Yi_lo = _polyval([col(c.lo) for c in co.Yi], rho)
-    mag = (_polyval([col(c.mag) for c in co.P], rho)
-           + (1.0 + mcol) * (_polyval([col(c.mag) for c in co.Yr], rho)
-                             + np.abs(st) * _polyval([col(c.mag) for c in co.Yi], rho)))
+    P_mag = _polyval([col(c.mag) for c in co.P], rho)
+    Yr_mag = _polyval([col(c.mag) for c in co.Yr], rho)
+    Yi_mag = _polyval([col(c.mag) for c in co.Yi], rho)
+    mag = P_mag + (1.0 + mcol) * (Yr_mag + ast * Yi_mag)
     slack = ROUNDOFF_SLACK * (1.0 + mcol) * mag
     if all(c.point for c in (*co.P, *co.Yr, *co.Yi)):
         return P_lo + cm * Yr_lo + f * Yi_lo, slack
@@ -189,6 +221,37 @@ def margin_bound(theta: Array, co: Coefficients, m: Array | int) -> tuple[Array,
     low = (P_lo + np.where(cm >= 0, cm * Yr_lo, cm * Yr_hi)
            + np.where(f >= 0, f * Yi_lo, f * Yi_hi))
     return np.asarray(low), slack
+
+
+def point_margin(S: Array, circle: tuple[Array, Array, Array, Array],
+                 mcol: Array) -> tuple[Array, Array]:
+    """g_H and its round-off slack from stacked point coefficients (:func:`margin_bound`'s point path).
+
+    One Horner pass over the stack: every polynomial's values and magnitude companions, the
+    same operations as polynomial by polynomial (a zero at the top adds +0 first: 0·ρ + 0 =
+    +0, then +0·ρ + c is the same number as the first step 0·ρ + c of the shorter one).
+
+    Parameters
+    ----------
+    S : ndarray, shape (3, k, 2, n)
+        :func:`point_stack`.
+    circle : tuple of ndarray
+        :func:`circle_terms` at θ (shape (n, j), or (1, j) broadcast over the rows).
+    mcol : ndarray, shape (n, 1)
+        Whole samples of delay, as a column.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        g_H and the slack :data:`~stringstab.certify.verdicts.ROUNDOFF_SLACK` (1 + m) × the
+        magnitude, shape (n, j).
+    """
+    rho, ast, cm, f = circle
+    V = _polyval([S[:, j, :, :, None] for j in range(S.shape[1])], rho)
+    (P_lo, P_mag), (Yr_lo, Yr_mag), (Yi_lo, Yi_mag) = V
+    mag = P_mag + (1.0 + mcol) * (Yr_mag + ast * Yi_mag)
+    slack = ROUNDOFF_SLACK * (1.0 + mcol) * mag
+    return P_lo + cm * Yr_lo + f * Yi_lo, slack
 
 
 def sampled_margin(
@@ -296,90 +359,3 @@ def margin_spread(theta: Array, co: Coefficients, m: Array, hw: Array) -> Array:
         nlo, _ = margin_bound(theta, gi.map(lambda v: -v), m)
         out[..., i] = (np.maximum(-lo, -nlo) + Ei) * hw[:, i][:, None]
     return out
-
-
-# ---------------------------------------------------------------------------
-# The curvature bound of the branch and bound
-# ---------------------------------------------------------------------------
-def _bounds_poly(a: list[Array], rho_r: Array) -> tuple[Array, Array, Array]:
-    """(max|Q|, max|Q_ρ|, max|Q_ρρ|) over ρ ∈ [0, ρ_r] for Q whose |coefficients| are ≤ a."""
-    A0 = np.zeros_like(rho_r)
-    A1 = np.zeros_like(rho_r)
-    A2 = np.zeros_like(rho_r)
-    for j, aj in enumerate(a):
-        aj = aj[:, None] if rho_r.ndim == 2 else aj
-        A0 = A0 + aj * rho_r**j
-        if j >= 1:
-            A1 = A1 + j * aj * rho_r ** (j - 1)
-        if j >= 2:
-            A2 = A2 + j * (j - 1) * aj * rho_r ** (j - 2)
-    return A0, A1, A2
-
-
-def _magnitudes(c: list[Interval]) -> list[Array]:
-    """max(|lo|, |hi|) + the round-off slack of each coefficient: bounds on |coefficient|."""
-    return [np.maximum(np.abs(q.lo), np.abs(q.hi)) + ROUNDOFF_SLACK * q.mag for q in c]
-
-
-def margin_curvature(co: Coefficients, m: Array, L: Array, R: Array) -> Array:
-    """M ≥ |g_H''(θ)| on [L, R] (module docstring; derivation in docs/sampled.md).
-
-    Parameters
-    ----------
-    co : Coefficients
-        Of :class:`~stringstab.certify.interval.Interval` entries (points, or enclosures
-        over cells), n rows.
-    m : ndarray, shape (n,)
-        Whole samples of delay.
-    L, R : ndarray, shape (n, k)
-        The intervals' ends, 0 ≤ L ≤ R ≤ π.
-
-    Returns
-    -------
-    ndarray, shape (n, k)
-        The bound on each interval (:func:`curvature_bound` of the coefficients' magnitudes).
-    """
-    return curvature_bound(_magnitudes(co.P), _magnitudes(co.Yr), _magnitudes(co.Yi), m, L, R)
-
-
-def curvature_bound(aP: list[Array], aYr: list[Array], aYi: list[Array], m: Array, L: Array,
-                    R: Array) -> Array:
-    """M ≥ |f''(θ)| on [L, R] for f = P(ρ) + cos(mθ)Y_r(ρ) + sin(mθ) sin θ Y_i(ρ).
-
-    For every P, Y_r, Y_i whose coefficients (in ρ = 4 sin²(θ/2), constant term first) are
-    bounded in absolute value by ``aP``, ``aYr``, ``aYi``: g_H of one triple or of every
-    member of a cell (:func:`margin_curvature`), or the split form's F and G
-    (:mod:`stringstab.certify.sampled_split`, with Y_r = Y_i = 0 for F).  Derivation in
-    docs/sampled.md: bounds on P, Y_r, Y_i and their ρ-derivatives at ρ(R), |sin θ| on
-    [L, R] and the factors m, m² of the oscillating terms.
-
-    Parameters
-    ----------
-    aP, aYr, aYi : list of ndarray, shape (n,)
-        Bounds on the absolute values of the coefficients (empty lists for none).
-    m : ndarray, shape (n,)
-        Whole samples of delay.
-    L, R : ndarray, shape (n, k)
-        The intervals' ends, 0 ≤ L ≤ R ≤ π.
-
-    Returns
-    -------
-    ndarray, shape (n, k)
-        The bound on each interval.
-    """
-    rho_r = 4.0 * np.sin(0.5 * R) ** 2
-    S1 = np.where(R <= 0.5 * np.pi, np.sin(R), np.where(L >= 0.5 * np.pi, np.sin(L), 1.0))
-    mm = m[:, None] if (np.ndim(m) and R.ndim == 2) else m
-
-    def d2(a: list[Array]) -> tuple[Array, Array, Array]:
-        A0, A1, A2 = _bounds_poly(a, rho_r)
-        return A0, 2.0 * S1 * A1, 4.0 * S1 * S1 * A2 + 2.0 * A1
-
-    _, _, p2 = d2(aP)
-    r0, r1, r2 = d2(aYr)
-    i0, i1, i2 = d2(aYi)
-    f0 = S1
-    f1 = mm * S1 + 1.0
-    f2 = (mm * mm + 1.0) * S1 + 2.0 * mm
-    return np.asarray(p2 + (mm * mm * r0 + 2.0 * mm * r1 + r2)
-                      + (f2 * i0 + 2.0 * f1 * i1 + f0 * i2))

@@ -52,7 +52,7 @@ import numpy.typing as npt
 
 from .interval import IntervalAD, poly_add, poly_scale
 from .interval_stack import StackedAD, exp_neg_stacked, phi_stacked, ratio_stacked
-from .sampled_frequency import curvature_bound
+from .sampled_curvature import curvature_bound
 from .verdicts import ROUNDOFF_SLACK
 from .zoh import (
     abs2_over_rho,
@@ -461,7 +461,7 @@ def split_curvature(aF: Array, aG: Array, m: Array, L: Array, R: Array) -> Array
     Returns
     -------
     ndarray, shape (r, k)
-        |F''| + |G''| bounded by :func:`stringstab.certify.sampled_frequency.curvature_bound`
+        |F''| + |G''| bounded by :func:`stringstab.certify.sampled_curvature.curvature_bound`
         (F has no oscillating terms).
     """
     J = aF.shape[1]

@@ -23,8 +23,8 @@ import numpy.typing as npt
 
 from ..params import Params, as_gains, check_params
 from ..params import sample_time as _sample_time
-from .interval import Interval
-from .zoh import phi, point_coefficients
+from .interval import Interval, Point
+from .zoh import phi, point_coefficients, schur_terms
 
 __all__ = [
     "SCHUR_RTOL",
@@ -33,7 +33,6 @@ __all__ = [
     "schur",
     "schur_bands",
     "schur_margins",
-    "schur_terms",
     "spectral_radius",
     "spectral_radius_of",
 ]
@@ -45,38 +44,17 @@ Array = npt.NDArray[np.float64]
 SCHUR_RTOL = 1e-12
 
 
-def schur_terms(delta: list[Any]) -> list[Any]:
-    """The five quantities of :func:`stringstab.derive.sampled_symbolic.schur_conditions`.
-
-    Δ is Schur iff each is > 0 (the bilinear conditions in the w-form).
-
-    Parameters
-    ----------
-    delta : list
-        δ0, δ1, δ2 of Δ(w), in any arithmetic of :mod:`stringstab.certify.interval`
-        (points, intervals over cells, or derivative enclosures).
-
-    Returns
-    -------
-    list
-        b0, b1, b2, b3 and the Hurwitz determinant h2, in the arithmetic of ``delta``.
-    """
-    d0, d1, d2 = delta
-    b0 = d0
-    b1 = 2.0 * d1 - 3.0 * d0
-    b2 = 3.0 * d0 - 4.0 * d1 + 4.0 * d2
-    b3 = 8.0 - d0 + 2.0 * d1 - 4.0 * d2
-    h2 = 8.0 * (d1 * d2 - d0 * d2 - d1 * d1 + 2.0 * (d0 * d1) - d0 * d0 - d0)
-    return [b0, b1, b2, b3, h2]
-
-
-def schur_bands(delta: list[Interval]) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+def schur_bands(delta: list[Interval], terms: list[Interval] | None = None,
+                ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
     """(surely Schur, surely not Schur), with a band of :data:`SCHUR_RTOL` around the boundary.
 
     Parameters
     ----------
     delta : list of Interval
         δ0, δ1, δ2 of Δ(w) (points or intervals), one row per triple.
+    terms : list of Interval, optional
+        :func:`schur_terms` of ``delta``, computed before (``Coefficients.schur`` of
+        :func:`stringstab.certify.zoh.point_coefficients`); default: computed here.
 
     Returns
     -------
@@ -84,7 +62,15 @@ def schur_bands(delta: list[Interval]) -> tuple[npt.NDArray[np.bool_], npt.NDArr
         Every condition above its band; some condition at or below minus its band (a root
         on |z| = 1 is not Schur).  Rows with neither are left undecided.
     """
-    terms = schur_terms(delta)
+    terms = schur_terms(delta) if terms is None else terms
+    pts = [t for t in terms if type(t) is Point]
+    if len(pts) == len(terms) and all(t.s.shape == pts[0].s.shape for t in pts):
+        # stacked points: the five conditions' rows (value, magnitude) as one array, the
+        # same comparisons
+        s = np.stack([t.s for t in pts])
+        band = SCHUR_RTOL * s[:, 1]
+        return (np.asarray((s[:, 0] > band).all(axis=0)),
+                np.asarray((s[:, 0] <= -band).any(axis=0)))
     sure = np.ones(np.shape(delta[0].lo), dtype=bool)
     fail = np.zeros_like(sure)
     for t in terms:

@@ -48,7 +48,8 @@ import numpy.typing as npt
 
 from ..params import Params, check_params, positive
 from ..params import sample_time as _sample_time
-from .interval import Interval, IntervalAD, interval, poly_add, poly_scale
+from .interval import Interval, IntervalAD, Point, interval, poly_add, poly_scale
+from .point_program import Program, record
 
 __all__ = [
     "WHOLE_SAMPLE_RTOL",
@@ -60,12 +61,14 @@ __all__ = [
     "cross_terms",
     "exp_neg_ad",
     "loop_parameters",
+    "parameter_primitives",
     "phi",
     "phi_ad",
     "phi_interval",
     "point_coefficients",
     "primitives",
     "ratio_ad",
+    "schur_terms",
     "split_delay",
 ]
 
@@ -160,6 +163,10 @@ class Coefficients:
     P: list[Any]
     Yr: list[Any]
     Yi: list[Any]
+    #: The Schur conditions of δ (:func:`schur_terms`), when computed
+    #: with the coefficients (:func:`point_coefficients`); None otherwise (not kept by
+    #: :meth:`map` and :meth:`take`).
+    schur: list[Any] | None = None
 
     def map(self, f: Callable[[Any], Any]) -> Coefficients:
         """Every entry through ``f`` (e.g. the centre values ``lambda v: v.c`` of a cell)."""
@@ -332,6 +339,34 @@ def build(q: dict[str, Any], H: float) -> Coefficients:
     yr, yi = cross_terms(ell, nu)
     k2 = 2.0 * (B2 * K_a)
     return Coefficients([d0, d1, d2], nu, ell, f1, f1p, P, poly_scale(k2, yr), poly_scale(k2, yi))
+
+
+def schur_terms(delta: list[Any]) -> list[Any]:
+    """The five quantities of :func:`stringstab.derive.sampled_symbolic.schur_conditions`.
+
+    Decided by :func:`stringstab.certify.schur.schur_bands` (which re-exports this function);
+    here, with the coefficients, so that :func:`point_coefficients` records them too.
+
+    Δ is Schur iff each is > 0 (the bilinear conditions in the w-form).
+
+    Parameters
+    ----------
+    delta : list
+        δ0, δ1, δ2 of Δ(w), in any arithmetic of :mod:`stringstab.certify.interval`
+        (points, intervals over cells, or derivative enclosures).
+
+    Returns
+    -------
+    list
+        b0, b1, b2, b3 and the Hurwitz determinant h2, in the arithmetic of ``delta``.
+    """
+    d0, d1, d2 = delta
+    b0 = d0
+    b1 = 2.0 * d1 - 3.0 * d0
+    b2 = 3.0 * d0 - 4.0 * d1 + 4.0 * d2
+    b3 = 8.0 - d0 + 2.0 * d1 - 4.0 * d2
+    h2 = 8.0 * (d1 * d2 - d0 * d2 - d1 * d1 + 2.0 * (d0 * d1) - d0 * d0 - d0)
+    return [b0, b1, b2, b3, h2]
 
 
 def coefficients(
@@ -557,19 +592,52 @@ def point_coefficients(kx: Array, kv: Array, ka: Array, p: Params, H: float,
     m, eps = split_delay(p.delta, H)
     n = kx.size
     # the parameters' quantities once per parameter set, on one element: each row's numbers
-    # are those of the full arrays (the same operations on the same values, broadcast)
-    q = dict(_parameter_primitives(float(p.tau), float(tp), float(eps), float(H)))
+    # are those of the full arrays (the same operations on the same values, broadcast); the
+    # build in the stacked point arithmetic (Point: the same numbers as Interval's points,
+    # one array operation per step instead of two),
+    # build recorded once per loop and replayed on the gains (point_program: every step the
+    # same operation on the same operands, so the same bits)
+    prog = _program(float(p.tau), float(tp), float(eps), float(H))
     c = kv + p.headway * kx
-    q.update(K_x=Interval(kx), K_v=Interval(kv), K_a=Interval(ka), Cc=Interval(c))
-    co = build(q, H)
+    X = np.stack((kx, kv, ka, c))
+    rows = np.stack((X, np.abs(X)), axis=1)  # each input's rows (value, magnitude)
+    regs = prog.run(list(rows))
     one = np.ones(n)
-    return co.map(lambda v: v if v.lo.shape == (n,) else
-                  Interval(v.lo * one, None, np.asarray(v.mag) * one)), m
+
+    def point(i: int) -> Point:
+        return Point(regs[i]) if regs[i].shape[1:] == (n,) else Point(regs[i] * one)
+
+    co = prog.outputs.map(point)
+    co.schur = [point(i) for i in prog.schur]
+    return co, m
 
 
 @lru_cache(maxsize=64)
-def _parameter_primitives(tau: float, tau_p: float, eps: float, H: float) -> dict[str, Interval]:
-    """The parameter-only primitives of :func:`primitives` at one point (one element)."""
+def _program(tau: float, tau_p: float, eps: float, H: float) -> Program:
+    """:func:`build` and :func:`schur_terms` recorded at the loop (τ, τ_p, ε, H) (point_program)."""
+
+    def build_and_terms(q: dict[str, Any]) -> tuple[Coefficients, list[Any]]:
+        co = build(q, H)
+        return co, schur_terms(co.delta)
+
+    return record(build_and_terms, parameter_primitives(tau, tau_p, eps, H),
+                  ("K_x", "K_v", "K_a", "Cc"))
+
+
+@lru_cache(maxsize=64)
+def parameter_primitives(tau: float, tau_p: float, eps: float, H: float) -> dict[str, Point]:
+    """The parameter-only primitives of :func:`primitives` at one point (one element).
+
+    Parameters
+    ----------
+    tau, tau_p, eps, H : float
+        τ, τ_p, ε and H (s; ε of δ = (m + ε)H).
+
+    Returns
+    -------
+    dict of str to Point
+        Keyed as :func:`build` reads them (the gains' entries left out).
+    """
     t, t_p, e, one = np.array([tau]), np.array([tau_p]), np.array([eps]), np.ones(1)
     q = primitives(one, one, one, H=H, tau=(t, t), tau_p=(t_p, t_p), eps=(e, e), c=(one, one))
-    return {k: v for k, v in q.items() if k not in ("K_x", "K_v", "K_a", "Cc")}
+    return {k: Point.of(v) for k, v in q.items() if k not in ("K_x", "K_v", "K_a", "Cc")}

@@ -359,7 +359,8 @@ def test_cli_certify_loads_no_heavy_module():
 #: loop (its certificate and the modules of its arithmetic) and the robust one (the way in,
 #: the continuous box and the sampled box).
 SAMPLED_LOOP = ("stringstab.certify.sampled", "stringstab.certify.zoh", "stringstab.certify.interval",
-                "stringstab.certify.schur", "stringstab.certify.sampled_frequency",
+                "stringstab.certify.point_program", "stringstab.certify.schur",
+                "stringstab.certify.sampled_curvature", "stringstab.certify.sampled_frequency",
                 "stringstab.certify.sampled_excess")
 OTHER_LOOPS = (*SAMPLED_LOOP, "stringstab.certify.robust", "stringstab.certify.robust_continuous",
                "stringstab.certify.robust_sampled", "stringstab.derive.sampled_symbolic")
