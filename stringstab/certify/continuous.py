@@ -67,7 +67,7 @@ from .criteria import (
 )
 from .excess import EXCESS_SEARCH, col, excess_squared
 from .excess import violation_peak as _violation_peak
-from .frequency import gain_squared
+from .frequency import gain_squared, resonances
 from .verdicts import (
     CERTIFIED,
     INCONCLUSIVE,
@@ -171,13 +171,8 @@ def _peak(
     with np.errstate(divide="ignore", invalid="ignore"):
         G2 = np.where(D2 > 0, 1.0 - w2 * G / D2, np.inf)
     G2[:, 0] = np.where(kx != 0, 1.0, np.inf)  # Γ(0) = k_x/k_x
-    # resonances: the roots of d|D|²/dx = 3p0 x² + 2p1 x + p2
-    qa, qb, qc = 3.0 * p0, 2.0 * p1, p2
-    disc = qb * qb - 4.0 * qa * qc
-    sq = np.sqrt(np.maximum(disc, 0.0))
-    extra = np.stack([np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0)
-                      for x in ((-qb + sq) / (2.0 * qa), (-qb - sq) / (2.0 * qa))]
-                     + [worst], axis=1)  # and the branch and bound's witness, min g
+    # the resonances (the roots of d|D|²/dx) and the branch and bound's witness, min g
+    extra = np.concatenate([resonances(p0, p1, p2), worst[:, None]], axis=1)
     Ge = gain_squared(extra, col(kx), col(kv), col(ka), tau=tau, delta=delta, headway=headway)
     Wall = np.concatenate([W, extra], axis=1)
     Gall = np.concatenate([G2, Ge], axis=1)

@@ -22,7 +22,7 @@ import numpy.typing as npt
 from ..derive import generated as _gen
 from . import margin as _margin
 
-__all__ = ["gain", "gain_squared", "gamma_jw", "margin_g", "margin_g_coefficients"]
+__all__ = ["gain", "gain_squared", "gamma_jw", "margin_g", "margin_g_coefficients", "resonances"]
 
 ArrayLike = npt.ArrayLike
 Array = npt.NDArray[np.float64]
@@ -123,6 +123,37 @@ def gain_squared(
     with np.errstate(divide="ignore", invalid="ignore"):
         out = num / den
     return np.asarray(np.where(den > 0, out, np.inf))
+
+
+def resonances(p0: ArrayLike, p1: ArrayLike, p2: ArrayLike) -> Array:
+    """The frequencies where |D(jω)|² is stationary: where |Γ(jω)| peaks (reporting only).
+
+    |D(jω)|² = p0 x³ + p1 x² + p2 x + p3 with x = ω² (its coefficients from
+    :func:`stringstab.derive.generated.denominator_abs2_coefficients`), so its minimisers over
+    ω > 0 are the positive roots x of d|D|²/dx = 3 p0 x² + 2 p1 x + p2: at most two, the
+    resonance frequencies ω = √x near which |Γ(jω)| = |N|/|D| has its peaks.
+
+    Parameters
+    ----------
+    p0, p1, p2 : array_like
+        The three leading coefficients of |D(jω)|² in x = ω² (broadcast together).
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        The two candidate frequencies, rad/s; 0 where a root is complex or not positive.
+
+    Examples
+    --------
+    >>> resonances(1.0, -3.0, 0.0).tolist()  # d/dx = 3x² − 6x: x = 2 and x = 0
+    [1.4142135623730951, 0.0]
+    """
+    qa, qb, qc = 3.0 * np.asarray(p0, float), 2.0 * np.asarray(p1, float), np.asarray(p2, float)
+    disc = qb * qb - 4.0 * qa * qc
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.stack([np.where((disc >= 0) & (x > 0), np.sqrt(np.abs(x)), 0.0)
+                         for x in ((-qb + sq) / (2.0 * qa), (-qb - sq) / (2.0 * qa))], axis=-1)
 
 
 def margin_g_coefficients(

