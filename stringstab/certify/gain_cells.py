@@ -393,7 +393,7 @@ class CertifiedCells:
         i -= 1
         np.maximum(i, 0, out=i)  # clipped into [0, m − 1] (two ufuncs: cheaper than np.clip)
         np.minimum(i, m - 1, out=i)
-        return i, ((g[i] <= K) & (K <= g[i + 1])).all(axis=1)
+        return i, np.asarray(((g[i] <= K) & (K <= g[i + 1])).all(axis=1))
 
     def _prove_block(self, block: int) -> None:
         """Prove the candidate cells of one block (a call of its own)."""
