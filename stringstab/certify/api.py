@@ -35,6 +35,7 @@ import numpy.typing as npt
 from ..errors import StringStabError
 from ..params import Box, Params, as_gains, parameter_model, positive
 from ..params import sample_time as checked_sample_time
+from ..ranges import RANGES
 from . import continuous
 from .continuous import Certificate, CertificateBatch
 from .verdicts import Check, one_triple
@@ -268,6 +269,34 @@ class Loop:
         """
         return _check(self, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                       max_intervals=max_intervals)
+
+    def check_rows(self, K: npt.NDArray[np.float64]) -> Check:
+        """:meth:`check` of the rows (k_x, k_v, k_a) of one float64 array, default settings.
+
+        The way in of an internal caller whose rows are already finite floats (the training
+        repair, :class:`stringstab.tuning.GainRepair`): one comparison of max |K| with the
+        gain range (:data:`stringstab.ranges.RANGES`, false for NaN) replaces
+        :func:`gains`' per-array checks; rows failing it take :meth:`check`'s way (and its
+        error).  The kernel is given the same numbers, so the verdicts are :meth:`check`'s.
+
+        Parameters
+        ----------
+        K : ndarray of float64, shape (n, 3)
+            Gain triples of IDL eq 4.
+
+        Returns
+        -------
+        Check
+            As :meth:`check` of ``K[:, 0], K[:, 1], K[:, 2]``.
+        """
+        K = np.asarray(K, dtype=np.float64)
+        if K.ndim != 2 or K.shape[1] != 3:
+            raise StringStabError(f"check_rows expects gains of shape (n, 3); got {K.shape}")
+        if not np.abs(K).max(initial=0.0) <= RANGES["gain"][1]:
+            return self.check(K[:, 0], K[:, 1], K[:, 2])
+        return _check(self, np.ascontiguousarray(K[:, 0]), np.ascontiguousarray(K[:, 1]),
+                      np.ascontiguousarray(K[:, 2]), n_grid=None, max_rounds=30,
+                      max_intervals=1024)
 
 
 # ---------------------------------------------------------------------------

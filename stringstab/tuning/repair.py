@@ -312,7 +312,7 @@ class GainRepair:
     def _judge(self, loop: Any, K: Array) -> npt.NDArray[np.bool_]:
         """Rows of K that ``loop``'s exact certificate certifies (one vectorised call)."""
         self.stats["certificate_calls"] += 1
-        c = loop.check(K[:, 0], K[:, 1], K[:, 2])
+        c = loop.check_rows(K)  # the rows are clipped finite floats (:meth:`__call__`)
         return np.asarray(c.verdict == Verdict.CERTIFIED.value)
 
     def certified(self, K: npt.ArrayLike) -> npt.NDArray[np.bool_]:
