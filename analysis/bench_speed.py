@@ -390,6 +390,21 @@ def work_replay(inp: dict, out: dict) -> None:
             sampled["rows"].append(np.stack([np.asarray(kx), np.asarray(kv), np.asarray(ka)], 1))
 
     Loop.check = chk  # type: ignore[method-assign]
+    orig_rows = getattr(Loop, "check_rows", None)  # the repair's way in since the fifth pass
+
+    def chk_rows(self, K):
+        if self.sample_time is None:
+            return orig_rows(self, K)
+        c = time.process_time()
+        try:
+            return orig_rows(self, K)
+        finally:
+            sampled["seconds"] += time.process_time() - c
+            sampled["calls"] += 1
+            sampled["rows"].append(np.array(K, dtype=float).reshape(-1, 3))
+
+    if orig_rows is not None:
+        Loop.check_rows = chk_rows  # type: ignore[method-assign]
     half = (len(P) // 16) * 8
     executed = [rep(P[i:i + 8]) for i in range(0, half, 8)]
     sampled.update(seconds=0.0, calls=0, rows=[])
@@ -398,6 +413,8 @@ def work_replay(inp: dict, out: dict) -> None:
     executed += [rep(P[i:i + 8]) for i in range(half, len(P), 8)]
     c_rep = time.process_time() - c0
     Loop.check = orig  # type: ignore[method-assign]
+    if orig_rows is not None:
+        Loop.check_rows = orig_rows  # type: ignore[method-assign]
     np.save(inp["executed_out"], np.concatenate(executed))
     rows = np.concatenate(sampled["rows"]) if sampled["rows"] else np.zeros((0, 3))
     loop = Loop.of(0.1, 0.2, 1.1, sample_time=0.1)
