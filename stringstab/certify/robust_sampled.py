@@ -38,12 +38,12 @@ import numpy.typing as npt
 
 from ..params import Box
 from .excess import EXCESS_SEARCH, searched_excess
-from .interval_stack import StackedAD, phi_stacked, ratio_stacked
+from .interval_stack import StackedAD
 from .robust_split import split_search
 from .sampled import check_members
 from .sampled_excess import peak_gain, violation_peak
 from .sampled_frequency import margin_bound
-from .sampled_split import delay_ends
+from .sampled_split import delay_ends, follower_primitives
 from .schur import SCHUR_RTOL
 from .verdicts import CERTIFIED, INCONCLUSIVE, NOT_CERTIFIED, ROUNDOFF_SLACK
 from .zoh import Coefficients, coefficients, schur_terms, split_delay
@@ -93,11 +93,8 @@ def _delta_cells(kx: Array, kv: Array, *, H: float, tau: Array, headway: Array) 
         [δ0, δ1, δ2], derivatives in the order (τ, T*) (the numbers of IntervalAD, in the
         stacked arrays of :mod:`stringstab.certify.interval_stack`).
     """
-    T = StackedAD.variable(tau[:, 0], tau[:, 1], 0, 2)
-    Th = StackedAD.variable(headway[:, 0], headway[:, 1], 1, 2)
-    K_x, K_v = T.const(kx), T.const(kv)
-    Cc = K_v + Th * K_x
-    f1, p2, p3 = phi_stacked(ratio_stacked(T, H))[0]
+    q = follower_primitives(kx, kv, H=H, tau=tau, headway=headway)
+    K_x, Cc, T, f1, p2, p3 = (q[k] for k in ("K_x", "Cc", "T", "f1", "p2", "p3"))
     Hs = float(H)
     d0 = K_x * (Hs * Hs) * f1
     d1 = Hs * (Cc * f1 + K_x * (T * p2 + (0.5 * Hs) * f1))

@@ -69,6 +69,7 @@ __all__ = [
     "follower_margins",
     "follower_of",
     "follower_points",
+    "follower_primitives",
     "follower_stacked",
     "follower_terms",
     "predecessor_margins",
@@ -213,6 +214,36 @@ def predecessor_terms(kx: Array, kv: Array, ka: Array, *, H: float, tau_p: Array
     }, H)
 
 
+def follower_primitives(kx: Array, kv: Array, *, H: float, tau: Array,
+                        headway: Array) -> dict[str, StackedAD]:
+    """The primitives of F over cells of (τ, T*) in stacked arrays (:class:`StackedAD`).
+
+    ``K_x``, ``Cc`` = K_v + T* K_x, ``T``, and φ1, ψ2, ψ3 of H/τ (``f1``, ``p2``, ``p3``):
+    what :func:`follower_of` takes, and what the characteristic polynomial's δ0, δ1, δ2 are
+    made of (:func:`stringstab.certify.robust_sampled`'s Schur box); derivatives along
+    (τ, T*), the numbers of :func:`follower_terms`' IntervalAD arithmetic, bit for bit.
+
+    Parameters
+    ----------
+    kx, kv : ndarray
+        The gains, one per cell.
+    H : float
+        Sample time, s.
+    tau, headway : ndarray, shape (n, 2)
+        The cells' bounds of τ and T*.
+
+    Returns
+    -------
+    dict of str to StackedAD
+        ``K_x``, ``Cc``, ``T``, ``f1``, ``p2``, ``p3``.
+    """
+    T = StackedAD.variable(tau[:, 0], tau[:, 1], 0, 2)
+    Th = StackedAD.variable(headway[:, 0], headway[:, 1], 1, 2)
+    K_x, K_v = T.const(kx), T.const(kv)
+    f1, p2, p3 = phi_stacked(ratio_stacked(T, H))[0]
+    return {"K_x": K_x, "Cc": K_v + Th * K_x, "T": T, "f1": f1, "p2": p2, "p3": p3}
+
+
 def follower_stacked(kx: Array, kv: Array, *, H: float, tau: Array,
                      headway: Array) -> list[StackedAD]:
     """:func:`follower_terms` in stacked arrays (:class:`StackedAD`): the same numbers, bit for bit.
@@ -231,12 +262,7 @@ def follower_stacked(kx: Array, kv: Array, *, H: float, tau: Array,
     list of StackedAD
         The three coefficients of F in ρ (:func:`follower_of`); derivatives along (τ, T*).
     """
-    T = StackedAD.variable(tau[:, 0], tau[:, 1], 0, 2)
-    Th = StackedAD.variable(headway[:, 0], headway[:, 1], 1, 2)
-    K_x, K_v = T.const(kx), T.const(kv)
-    f1, p2, p3 = phi_stacked(ratio_stacked(T, H))[0]
-    return follower_of({"K_x": K_x, "Cc": K_v + Th * K_x, "T": T, "f1": f1, "p2": p2,
-                        "p3": p3}, H)
+    return follower_of(follower_primitives(kx, kv, H=H, tau=tau, headway=headway), H)
 
 
 def predecessor_stacked(kx: Array, kv: Array, ka: Array, *, H: float, tau_p: Array,
