@@ -270,8 +270,11 @@ class Loop:
         return _check(self, *gains(k_x, k_v, k_a), n_grid=n_grid, max_rounds=max_rounds,
                       max_intervals=max_intervals)
 
-    def check_rows(self, K: npt.NDArray[np.float64]) -> Check:
-        """:meth:`check` of the rows (k_x, k_v, k_a) of one float64 array, default settings.
+    def check_rows(
+        self, K: npt.NDArray[np.float64], *, n_grid: int | None = None, max_rounds: int = 30,
+        max_intervals: int = 1024,
+    ) -> Check:
+        """:meth:`check` of the rows (k_x, k_v, k_a) of one float64 array.
 
         The way in of an internal caller whose rows are already finite floats (the training
         repair, :class:`stringstab.tuning.GainRepair`): one comparison of max |K| with the
@@ -283,6 +286,8 @@ class Loop:
         ----------
         K : ndarray of float64, shape (n, 3)
             Gain triples of IDL eq 4.
+        n_grid, max_rounds, max_intervals : int
+            As for :meth:`check` (the same defaults).
 
         Returns
         -------
@@ -293,10 +298,11 @@ class Loop:
         if K.ndim != 2 or K.shape[1] != 3:
             raise StringStabError(f"check_rows expects gains of shape (n, 3); got {K.shape}")
         if not np.abs(K).max(initial=0.0) <= RANGES["gain"][1]:
-            return self.check(K[:, 0], K[:, 1], K[:, 2])
+            return self.check(K[:, 0], K[:, 1], K[:, 2], n_grid=n_grid, max_rounds=max_rounds,
+                              max_intervals=max_intervals)
         return _check(self, np.ascontiguousarray(K[:, 0]), np.ascontiguousarray(K[:, 1]),
-                      np.ascontiguousarray(K[:, 2]), n_grid=None, max_rounds=30,
-                      max_intervals=1024)
+                      np.ascontiguousarray(K[:, 2]), n_grid=n_grid, max_rounds=max_rounds,
+                      max_intervals=max_intervals)
 
 
 # ---------------------------------------------------------------------------
