@@ -376,35 +376,31 @@ def work_replay(inp: dict, out: dict) -> None:
     rep.cells()
     rep.continuous_cells()
     sampled = {"seconds": 0.0, "calls": 0, "rows": []}
-    orig = Loop.check
+    # the sampled checks timed, through check and through check_rows (the repair's way in
+    # since the fifth pass; absent on older bases)
+    origs = {name: getattr(Loop, name) for name in ("check", "check_rows") if hasattr(Loop, name)}
 
-    def chk(self, kx, kv, ka, **kw):
-        if self.sample_time is None:
-            return orig(self, kx, kv, ka, **kw)
-        c = time.process_time()
-        try:
-            return orig(self, kx, kv, ka, **kw)
-        finally:
-            sampled["seconds"] += time.process_time() - c
-            sampled["calls"] += 1
-            sampled["rows"].append(np.stack([np.asarray(kx), np.asarray(kv), np.asarray(ka)], 1))
+    def timed(f, rows_of):
+        def call(self, *args, **kw):
+            if self.sample_time is None:
+                return f(self, *args, **kw)
+            c = time.process_time()
+            try:
+                return f(self, *args, **kw)
+            finally:
+                sampled["seconds"] += time.process_time() - c
+                sampled["calls"] += 1
+                sampled["rows"].append(rows_of(*args))
+        return call
 
-    Loop.check = chk  # type: ignore[method-assign]
-    orig_rows = getattr(Loop, "check_rows", None)  # the repair's way in since the fifth pass
+    def rows_of_check(kx, kv, ka):
+        return np.stack([np.asarray(kx), np.asarray(kv), np.asarray(ka)], 1)
 
-    def chk_rows(self, K):
-        if self.sample_time is None:
-            return orig_rows(self, K)
-        c = time.process_time()
-        try:
-            return orig_rows(self, K)
-        finally:
-            sampled["seconds"] += time.process_time() - c
-            sampled["calls"] += 1
-            sampled["rows"].append(np.array(K, dtype=float).reshape(-1, 3))
+    def rows_of_rows(K):
+        return np.array(K, dtype=float).reshape(-1, 3)
 
-    if orig_rows is not None:
-        Loop.check_rows = chk_rows  # type: ignore[method-assign]
+    for name, f in origs.items():
+        setattr(Loop, name, timed(f, rows_of_check if name == "check" else rows_of_rows))
     half = (len(P) // 16) * 8
     executed = [rep(P[i:i + 8]) for i in range(0, half, 8)]
     sampled.update(seconds=0.0, calls=0, rows=[])
@@ -412,9 +408,8 @@ def work_replay(inp: dict, out: dict) -> None:
     c0 = time.process_time()
     executed += [rep(P[i:i + 8]) for i in range(half, len(P), 8)]
     c_rep = time.process_time() - c0
-    Loop.check = orig  # type: ignore[method-assign]
-    if orig_rows is not None:
-        Loop.check_rows = orig_rows  # type: ignore[method-assign]
+    for name, f in origs.items():
+        setattr(Loop, name, f)
     np.save(inp["executed_out"], np.concatenate(executed))
     rows = np.concatenate(sampled["rows"]) if sampled["rows"] else np.zeros((0, 3))
     loop = Loop.of(0.1, 0.2, 1.1, sample_time=0.1)
