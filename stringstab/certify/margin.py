@@ -28,6 +28,7 @@ algebraischen Gleichung", Tohoku Math. J. 10 (1916) 167-171.
 
 from __future__ import annotations
 
+import math
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -374,6 +375,8 @@ def quartic_tail_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     True
     """
     A, B, C = (np.asarray(v, dtype=float) for v in (A, B, C))
+    if A.size <= SMALL_TAIL_BATCH and A.shape == B.shape == C.shape:
+        return _quartic_tail_bound_small(A, B, C)
     w = np.maximum(fujiwara_bound(A, B, C), 1e-3)
     for _ in range(30):
         L = ((w * w - A) * w - B) * w - C
@@ -389,6 +392,45 @@ def quartic_tail_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     if bad.any():  # pragma: no cover - defensive: fall back to the raw Fujiwara bound
         W = np.where(bad, fujiwara_bound(A, B, C) + 1.0, W)
     return np.asarray(W)
+
+
+#: Up to this many quartics, :func:`quartic_tail_bound` iterates on Python floats (the point
+#: certificate's one-row calls): the same operations, hence the same bits, without the cost
+#: of numpy on arrays of one element.
+SMALL_TAIL_BATCH = 8
+
+
+def _quartic_tail_bound_small(A: Array, B: Array, C: Array) -> Array:
+    """:func:`quartic_tail_bound` of a few quartics, on Python floats, bit for bit.
+
+    Every operation is the vectorised one's, in its order and in IEEE double (``math.sqrt``
+    and ``math.cbrt`` are the C library's, as numpy's are), and the iteration stops at the same
+    step for all (the vectorised stopping rule), so the result is the same to the bit
+    (``tests/certify/test_margin.py`` compares them).
+    """
+    a, b, c = A.ravel().tolist(), B.ravel().tolist(), C.ravel().tolist()
+    n = len(a)
+    w = [max(2.0 * max(max(math.sqrt(a[i]), math.cbrt(b[i])), math.sqrt(math.sqrt(c[i] / 2.0))),
+             1e-3) for i in range(n)]
+    for _ in range(30):
+        settled = True
+        for i in range(n):
+            wi = w[i]
+            L = ((wi * wi - a[i]) * wi - b[i]) * wi - c[i]
+            dL = (4.0 * wi * wi - 2.0 * a[i]) * wi - b[i]
+            step = L / dL if dL > 0 else 0.0
+            w[i] = max(wi - step, 1e-3)
+            settled = settled and step <= 1e-6 * w[i]
+        if settled:
+            break
+    out = []
+    for i in range(n):
+        W = w[i] * (1.0 + 1e-9) + 1e-12
+        Lw = ((W * W - a[i]) * W - b[i]) * W - c[i]
+        if not Lw > 0 and (a[i] > 0 or b[i] > 0 or c[i] > 0):  # pragma: no cover - defensive
+            W = float(fujiwara_bound(a[i], b[i], c[i])) + 1.0
+        out.append(W)
+    return np.array(out, dtype=float).reshape(A.shape)
 
 
 # --------------------------------------------------------------------------- dips

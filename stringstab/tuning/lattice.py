@@ -41,7 +41,9 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     The points :func:`stringstab.certify.grid.certified_lattice` returns for this loop (with
     ``also_continuous``): the screen of :mod:`stringstab.certify.screen` first, then the exact
     certificate (:func:`stringstab.certify.api.check`) decides; with ``sample_time``,
-    the sampled-data certificate at that step must certify the point too.  The grid has
+    the sampled-data certificate at that step must certify the point too (checked on the
+    points of the continuous lattice, itself cached: the same calls, row for row, as
+    ``also_continuous``, and the repair's continuous cells reuse it).  The grid has
     round((hi − lo)/resolution) + 1 points per axis, so its spacing is ``resolution`` only
     when that divides hi − lo.  Cached (8 entries).
 
@@ -95,6 +97,14 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
             keep = grid.certified(base, theta)
         pts = np.array(base[keep])
         pts.flags.writeable = False
+    elif sample_time is not None:
+        # the continuous lattice first (cached: the repair's continuous cells need it too),
+        # then the sampled check on its points: the calls of grid.certified_lattice with
+        # also_continuous, row for row, without computing the continuous lattice twice
+        base = certified_lattice(tau, delta, headway, lo, hi, resolution)
+        keep = grid.certified(base, Params(tau, delta, headway), sample_time=sample_time)
+        pts = np.ascontiguousarray(base[keep])
+        pts.setflags(write=False)
     else:
         pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway),
                                      sample_time=sample_time, also_continuous=True)

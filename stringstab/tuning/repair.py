@@ -72,7 +72,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..certify.gain_cells import CertifiedCells
-from ..certify.screen import surely_uncertifiable
+from ..certify.screen import sampled_screen, surely_uncertifiable
 from ..certify.verdicts import Verdict
 from ..constants import GAIN_BOUNDS
 from ..errors import StringStabError
@@ -120,7 +120,8 @@ class GainRepair:
         (``"projection-exact"``/``"region-growing"`` outputs not certified, replaced by the
         lookup's), ``seconds`` (time spent in the repair), ``checked`` (rows asked of the point
         certificates), ``reused`` (of them, answered by a kept verdict) and
-        ``certificate_calls`` (vectorised point-certificate calls).
+        ``screened`` (of the rest, rows the sampled loop's screen proves uncertifiable, without a
+        point check) and ``certificate_calls`` (vectorised point-certificate calls).
 
     Examples
     --------
@@ -164,7 +165,7 @@ class GainRepair:
         self._verdicts: dict[bytes, bool] = {}
         self.stats: dict[str, float] = {"calls": 0, "rows": 0, "unchanged": 0, "repaired": 0,
                                         "fallbacks": 0, "seconds": 0.0, "checked": 0,
-                                        "reused": 0, "certificate_calls": 0}
+                                        "reused": 0, "screened": 0, "certificate_calls": 0}
 
     def describe(self) -> dict[str, Any]:
         """The settings, for logs and JSON (``reaction_delay`` only when θ_r > 0)."""
@@ -315,6 +316,20 @@ class GainRepair:
         c = loop.check_rows(K)  # the rows are clipped finite floats (:meth:`__call__`)
         return np.asarray(c.verdict == Verdict.CERTIFIED.value)
 
+    def _screened(self, K: Array) -> npt.NDArray[np.bool_]:
+        """Rows of K the sampled loop's screen flags: surely not certified at H (counted).
+
+        :meth:`stringstab.certify.screen.SampledScreen.surely_uncertifiable` of the loop at H
+        (sound: a flagged row is never certified by the sampled certificate, so never by both);
+        none with θ_r > 0 (the screen is of the loop without θ_r).
+        """
+        if self.reaction_delay or self.sample_time is None:
+            return np.zeros(K.shape[0], dtype=bool)
+        p = self.params
+        flagged = sampled_screen(p.tau, p.delta, p.headway, self.sample_time).surely_uncertifiable(K)
+        self.stats["screened"] += int(flagged.sum())
+        return flagged
+
     def certified(self, K: npt.ArrayLike) -> npt.NDArray[np.bool_]:
         """Which rows of K this repair's certificates all certify, point by point (cached).
 
@@ -358,7 +373,11 @@ class GainRepair:
             cont, samp = self._certificate_loops()
             ok = np.ones(idx.size, dtype=bool)
             if samp is not None:
-                ok = self._judge(samp, K[idx])
+                # rows the sampled screen flags cannot be certified (sound, no point check)
+                ok = ~self._screened(K[idx])
+                j = np.flatnonzero(ok)
+                if j.size:
+                    ok[j] = self._judge(samp, K[idx[j]])
             j = np.flatnonzero(ok)
             if j.size and samp is not None and not self.reaction_delay:
                 # a row in a proven cell of the continuous certificate needs no point check

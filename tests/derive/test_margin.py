@@ -223,6 +223,40 @@ def test_tail_bound_and_fujiwara_bound(kx, kv, ka, tau, delta, headway):
     assert Om <= max(float(margin.fujiwara_bound(A, B, C)), 1e-3) * (1 + 1e-8) + 1e-11
 
 
+def _vectorised_tail_bound(A, B, C, monkeypatch):
+    """quartic_tail_bound's numpy path, whatever the batch size."""
+    monkeypatch.setattr(margin, "SMALL_TAIL_BATCH", -1)
+    try:
+        return margin.quartic_tail_bound(A, B, C)
+    finally:
+        monkeypatch.undo()
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 8])
+def test_small_quartic_tail_bound_is_the_vectorised_one_bit_for_bit(n, monkeypatch):
+    """The Python-float path of a few quartics returns the numpy path's bits (and is a bound).
+
+    The inputs: random coefficients over many magnitudes, zeros (the floor 1e-3), and the
+    (A, B, C) of random gains of the Table-2 box; the numpy path on the same batch (the same
+    stopping step) is the reference.
+    """
+    rng = np.random.default_rng(n)
+    for trial in range(300):
+        if trial % 3 == 0:
+            K = rng.uniform(-2, 2, (n, 3))
+            co = margin.coefficients(K[:, 0], K[:, 1], K[:, 2], tau=0.1, delta=0.2, headway=1.1)
+            A, B, C = margin.tail_coefficients(*co)
+        else:
+            A, B, C = (10.0 ** rng.uniform(-12, 6, n) * (rng.random(n) < 0.8) for _ in range(3))
+        small = margin.quartic_tail_bound(A, B, C)
+        ref = _vectorised_tail_bound(A, B, C, monkeypatch)
+        assert small.shape == ref.shape and small.tobytes() == ref.tobytes()
+        L = ((small**2 - A) * small - B) * small - C
+        assert np.all((L > 0) | ((A == 0) & (B == 0) & (C == 0)))
+    # a 0-d input stays 0-d
+    assert margin.quartic_tail_bound(4.0, 0.0, 0.0).shape == ()
+
+
 def test_local_minima_finds_the_dip_a_sweep_finds():
     K = (0.9, -0.5, 1.1)
     gmin, dips = margin.local_minima(K, tau=0.1, delta=0.2, headway=1.1, threshold=0.0)
