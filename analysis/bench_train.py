@@ -96,10 +96,10 @@ def main() -> None:
           f"(load {os.getloadavg()[0]:.2f})")
     # the certified lattice is built once per process (lru_cache) by the first arm that repairs;
     # build it here, timed before and after, so that no arm pays for it
-    from stringstab.tuning.lattice import certified_lattice
+    from stringstab.tuning.lattice import clear_caches
 
     for label, ctx in (("before", sampled_before), ("after", contextlib.nullcontext)):
-        certified_lattice.cache_clear()
+        clear_caches()
         with ctx():
             t0 = time.perf_counter()
             n = GainRepair(tau=0.1, delta=0.2, headway=1.1, sample_time=0.1).lattice().shape[0]

@@ -27,12 +27,29 @@ from ..certify.gain_cells import CertifiedCells
 from ..errors import StringStabError
 from ..params import Params
 
-__all__ = ["certified_cells", "certified_lattice"]
+__all__ = ["certified_cells", "certified_lattice", "clear_caches"]
 
 Array = npt.NDArray[np.float64]
 
 
-@lru_cache(maxsize=8)
+def _key(tau: float, delta: float, headway: float, lo: float, hi: float, resolution: float,
+         sample_time: float | None) -> tuple[float, float, float, float, float, float,
+                                             float | None]:
+    """The arguments as the caches' keys: floats, every one given (positionally or not).
+
+    An ``lru_cache`` keys on the call's form, so ``f(..., None)`` and ``f(...)`` would be two
+    entries, and the lattice (seconds of certificate calls) would be built twice.
+    """
+    return (float(tau), float(delta), float(headway), float(lo), float(hi), float(resolution),
+            None if sample_time is None else float(sample_time))
+
+
+def clear_caches() -> None:
+    """Forget the cached lattices and cells (benchmarks that time their construction)."""
+    _certified_lattice.cache_clear()
+    _certified_cells.cache_clear()
+
+
 def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
                       resolution: float, sample_time: float | None = None,
                       reaction_delay: float = 0.0) -> Array:
@@ -86,6 +103,15 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     >>> pts.shape[1], bool((pts[:, 0] > 0).all())
     (3, True)
     """
+    return _certified_lattice(*_key(tau, delta, headway, lo, hi, resolution, sample_time),
+                              float(reaction_delay))
+
+
+@lru_cache(maxsize=8)
+def _certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: float,
+                       resolution: float, sample_time: float | None,
+                       reaction_delay: float) -> Array:
+    """:func:`certified_lattice`, cached by its normalised arguments (:func:`_key`)."""
     n = round((hi - lo) / resolution) + 1
     if reaction_delay:
         theta = Params(tau, delta, headway, reaction_delay=reaction_delay)
@@ -116,7 +142,6 @@ def certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: f
     return pts
 
 
-@lru_cache(maxsize=8)
 def certified_cells(tau: float, delta: float, headway: float, lo: float, hi: float,
                     resolution: float, sample_time: float | None = None) -> CertifiedCells:
     """The cells of the repair's lattice, proven on demand (:class:`~stringstab.certify.gain_cells.CertifiedCells`).
@@ -141,6 +166,13 @@ def certified_cells(tau: float, delta: float, headway: float, lo: float, hi: flo
     -------
     CertifiedCells
     """
+    return _certified_cells(*_key(tau, delta, headway, lo, hi, resolution, sample_time))
+
+
+@lru_cache(maxsize=8)
+def _certified_cells(tau: float, delta: float, headway: float, lo: float, hi: float,
+                     resolution: float, sample_time: float | None) -> CertifiedCells:
+    """:func:`certified_cells`, cached by its normalised arguments (:func:`_key`)."""
     n = round((hi - lo) / resolution) + 1
     pts = certified_lattice(tau, delta, headway, lo, hi, resolution, sample_time)
     g = np.linspace(lo, hi, n)

@@ -87,6 +87,10 @@ Array = npt.NDArray[np.float64]
 #: about 150 bytes each).
 VERDICT_CACHE = 200_000
 
+#: Up to this many ``refine`` steps, :meth:`GainRepair._nearest` looks up every point the
+#: bisection may visit (2^refine − 1 per row) in one call, then walks the table.
+TABLE_REFINE = 6
+
 #: Repair methods of the IDL action (``"off"``: the ablation without repair).
 REPAIR_METHODS: tuple[str, ...] = ("projection", "projection-exact", "region-growing", "off")
 
@@ -407,6 +411,8 @@ class GainRepair:
         """
         P = self._nearest_certified(K0) if self._lazy() else \
             np.array(self.lattice()[np.asarray(self._kdtree().query(K0)[1])], dtype=np.float64)
+        if self.refine and not self.reaction_delay and self.refine <= TABLE_REFINE:
+            return self._bisect_table(P, K0)
         if self.refine:
             lo = np.zeros(K0.shape[0])
             hi = np.ones(K0.shape[0])
@@ -420,6 +426,32 @@ class GainRepair:
                 hi = np.where(ok, hi, mid)
             P = best
         return P
+
+    def _bisect_table(self, P: Array, K0: Array) -> Array:
+        """:meth:`_nearest`'s bisection from P towards K0, with one lookup for all its points.
+
+        The bisection's midpoints are the dyadic fractions k/2^refine, so every point it can
+        visit, P + (k/2^refine)(K0 − P), is computed (the same floats as the step by step
+        bisection) and looked up in one :meth:`CertifiedCells.contains` call; the bisection
+        then walks that table.  The result is the step-by-step bisection's: a cell is proven or
+        not whatever was asked before (its block alone decides), so looking up points the
+        bisection does not visit changes nothing but the blocks proven.
+        """
+        n = 1 << self.refine
+        mids = np.arange(1, n, dtype=np.float64) / n  # exact: n is a power of 2
+        C = P[:, None, :] + mids[None, :, None] * (K0 - P)[:, None, :]
+        table = self.cells().contains(C.reshape(-1, 3)).reshape(P.shape[0], n - 1)
+        rows = np.arange(P.shape[0])
+        lo = np.zeros(P.shape[0], dtype=np.intp)
+        hi = np.full(P.shape[0], n, dtype=np.intp)
+        best = P.copy()
+        for _ in range(self.refine):
+            mid = (lo + hi) // 2
+            ok = table[rows, mid - 1]
+            best[ok] = C[rows[ok], mid[ok] - 1]
+            lo = np.where(ok, mid, lo)
+            hi = np.where(ok, hi, mid)
+        return best
 
     def _nearest_certified(self, K0: Array) -> Array:
         """The nearest points of :meth:`_candidates` that :meth:`certified` certifies (lazy).
