@@ -152,10 +152,17 @@ def _sampled_thetas(H: float) -> Array:
 _MONOMIALS = [(a, b) for a in range(4) for b in range(a, 4)]
 
 
+#: The factors of each monomial of :data:`_MONOMIALS`, as column indices of K̃.
+_FIRST = np.array([a for a, _ in _MONOMIALS])
+_SECOND = np.array([b for _, b in _MONOMIALS])
+
+
 def _monomials(K: Array) -> Array:
-    """The 10 monomials of degree ≤ 2 of each row of K, shape (n, 10)."""
-    Kt = np.concatenate([np.ones((K.shape[0], 1)), K], axis=1)
-    return np.stack([Kt[:, a] * Kt[:, b] for a, b in _MONOMIALS], axis=1)
+    """The 10 monomials of degree ≤ 2 of each row of K, shape (n, 10) (one product each)."""
+    Kt = np.empty((K.shape[0], 4))
+    Kt[:, 0] = 1.0
+    Kt[:, 1:] = K
+    return Kt[:, _FIRST] * Kt[:, _SECOND]
 
 
 class SampledScreen:
