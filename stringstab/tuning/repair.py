@@ -17,7 +17,9 @@ so calling them per environment step would dominate training.  The default metho
     2. the others are checked point by point by the exact certificates
        (:meth:`GainRepair.certified`): with a sample time H the sampled-data certificate at H
        first (one vectorised :meth:`stringstab.certify.api.Loop.check` call for the step's
-       rows), then the continuous one on the rows it certifies — except rows inside a proven
+       rows, except the rows its screen proves uncertifiable,
+       :meth:`stringstab.certify.screen.SampledScreen.surely_uncertifiable`: about 97 % of the
+       uncertified rows of the default training, answered without a certificate call), then the continuous one on the rows it certifies — except rows inside a proven
        cell of the continuous certificate alone (the cells of :func:`certified_cells` without
        H, whose 8 corners the continuous certificate certifies: near the sampled loop's
        boundary the continuous region is wider, so most such rows are); every verdict is kept
@@ -123,9 +125,9 @@ class GainRepair:
         ``calls``, ``rows``, ``unchanged`` (certified as proposed), ``repaired``, ``fallbacks``
         (``"projection-exact"``/``"region-growing"`` outputs not certified, replaced by the
         lookup's), ``seconds`` (time spent in the repair), ``checked`` (rows asked of the point
-        certificates), ``reused`` (of them, answered by a kept verdict) and
-        ``screened`` (of the rest, rows the sampled loop's screen proves uncertifiable, without a
-        point check) and ``certificate_calls`` (vectorised point-certificate calls).
+        certificates), ``reused`` (of them, answered by a kept verdict), ``screened`` (of the
+        rest, rows the sampled loop's screen proves uncertifiable, without a point check) and
+        ``certificate_calls`` (vectorised point-certificate calls).
 
     Examples
     --------
