@@ -11,8 +11,9 @@ once after a warm-up (SymPy lambdify caches built):
 Targets on 2 cores: Taylor 201³ < 1 s, exact 801² < 10 s, exact 101³ < 60 s.
 
 ``--only cli`` (issues 9 and 31): the 801² slice through the command line with its
-**default outputs** (every method, the NPZ, the CSV, the default figures in the default
-formats, the report): ``stringstab region --fix k_a=0.5 --n 801 --workers 2``, a fresh process, against
+**default outputs** (every method, the NPZ, the default figures in the default formats, the
+report; the CSV only up to ``stringstab.plots.outputs.CSV_MAX_POINTS`` points, so not for
+801², since issue 31's sixth pass): ``stringstab region --fix k_a=0.5 --n 801 --workers 2``, a fresh process, against
 :func:`region_map` alone on the same grid with the same methods and workers (timed in a fresh
 process too, after a warm-up), ``--reps`` times, every variant alternated within a rep, with
 the load beside each: wall and CPU time (all processes), and the median ratios CLI / map
@@ -22,7 +23,8 @@ interpreter), *after* this checkout; *after, forkserver* this checkout with
 ``STRINGSTAB_START_METHOD=forkserver`` (the other start method of the policy, measured for the
 choice); *after, png,pdf* this checkout with the figure formats of the base; *after, figures
 all* this checkout with every method's class map (``--figures all``: the figures of the base
-before the fifth pass of issue 31).
+before the fifth pass of issue 31); *after, --csv* this checkout with the 60 MB CSV the base
+writes by default (``--csv``).
 For the exact maps it also times :func:`stringstab.certify.api.certify_batch`
 alone, in this process, on a 20 000-point sample of the same grid: the
 certificate's own cost per point, which bounds what the map can reach.
@@ -178,6 +180,7 @@ def _region_cli(n: int, reps: int, workers: int | None, base: str) -> None:
         "after, forkserver": ({**here, "STRINGSTAB_START_METHOD": "forkserver"}, [], "after"),
         "after, png,pdf": (here, ["--format", "png,pdf"], "after"),
         "after, figures all": (here, ["--figures", "all"], "after"),
+        "after, --csv": (here, ["--csv"], "after"),
     }
     print(f"region CLI target (issue 31): {n}x{n} slice, default outputs: stringstab region "
           f"{' '.join(cli[4:])} --out DIR; before = {base} ({base_dir}), after = this checkout")

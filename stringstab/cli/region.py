@@ -2,7 +2,8 @@
 
 Parses the grid, calls :func:`stringstab.regions.region_map`, saves the data
 (:meth:`~stringstab.regions.RegionMap.save_npz`, and ``save_csv`` for a 2-D
-slice) and the figures (:func:`stringstab.plots.save_figures`), and prints the
+slice of at most :data:`stringstab.plots.outputs.CSV_MAX_POINTS` points unless ``--csv``)
+and the figures (:func:`stringstab.plots.save_figures`), and prints the
 class shares per method and the disagreements.  Bad input: a one-line error,
 exit code 2 and nothing written.
 """
@@ -33,6 +34,9 @@ DEFAULT_N_3D = 61
 #: ``--figures``: as :data:`stringstab.plots.outputs.FIGURE_SETS` (not imported: the parser
 #: stays free of the plotting code; a test compares the two).
 FIGURE_SETS = ("default", "all")
+#: The CSV size rule in the help: :data:`stringstab.plots.outputs.CSV_MAX_POINTS` (not imported:
+#: as FIGURE_SETS; a test compares the two).
+CSV_MAX_POINTS = 300_000
 
 _EPILOG = f"""\
 examples:
@@ -49,7 +53,9 @@ examples:
   stringstab region --fix k_a=0.5 --reaction-delay 0.2 --sample-time 0.1 --n 41 --out maps_rH/
 
 outputs in --out: <prefix>.npz (all per-point fields, parameters and tool version
-in 'metadata'), <prefix>.csv (2-D only), and per --format: <prefix>_class_<method>
+in 'metadata'), <prefix>.csv (2-D only; by default only for a map of at most
+{CSV_MAX_POINTS:,} points, e.g. --n 547: --csv writes it whatever the size, --no-csv
+never; the NPZ holds the same columns), and per --format: <prefix>_class_<method>
 (the first method's; every method's with --figures all), <prefix>_compare,
 <prefix>_sup_gain, <prefix>_overlay (2-D) or <prefix>_slices_<method>,
 <prefix>_3d_<method> (3-D); report.md and report.html.
@@ -123,6 +129,13 @@ def add_parser(sub: Any) -> None:
                    help="the class maps of a 2-D map with two or more methods: the first "
                         "method's beside the comparison and sup|Γ| maps (default), or every "
                         "method's (all); the data files hold every method's either way")
+    csv = p.add_mutually_exclusive_group()
+    csv.add_argument("--csv", dest="csv", action="store_const", const=True, default=None,
+                     help=f"write the CSV table of a 2-D map (PREFIX.csv) whatever the map's "
+                          f"size (default: only for at most {CSV_MAX_POINTS:,} points; the NPZ "
+                          f"holds the same columns)")
+    csv.add_argument("--no-csv", dest="csv", action="store_const", const=False,
+                     help="never write the CSV table (PREFIX.csv)")
     p.add_argument("--dpi", default="150", metavar="N", help="resolution of PNG figures (default: 150)")
     p.add_argument("--workers", metavar="N", help="worker processes (default: all cores for long maps)")
     p.add_argument("--scheduler", metavar="ADDRESS|local",
@@ -333,6 +346,9 @@ def run(args: argparse.Namespace) -> int:
         from ..io.gains import read_gains
 
         gains = read_gains(args.overlay)
+    if args.csv and args.three_d:
+        raise StringStabError("--csv writes the table of a 2-D map; got --3d (the NPZ holds "
+                              "the volume's fields)")
     if Path(args.out).is_file():
         raise StringStabError(f"--out {args.out}: expected a directory; found a file")
     out = OutputDir(args.out, command="region", what="--out")
@@ -366,7 +382,17 @@ def run(args: argparse.Namespace) -> int:
         written = _write(rmap, out, args, formats, gains, dpi, helper, t0)
     print(rmap.report())
     print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
+    _say_csv_skipped(rmap, args, f"{args.prefix}.csv", f"{args.prefix}.npz")
     return 0
+
+
+def _say_csv_skipped(rmap: Any, args: argparse.Namespace, csv_name: str, npz_name: str) -> None:
+    """One line when the size rule (:func:`stringstab.plots.writes_csv`) left the CSV out."""
+    from ..plots import outputs
+
+    if args.csv is None and rmap.ndim == 2 and not outputs.writes_csv(rmap):
+        print(f"{csv_name} not written: {rmap.size:,} points > {outputs.CSV_MAX_POINTS:,} "
+              f"(pass --csv; {npz_name} holds the same columns)")
 
 
 def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], gains: Any,
@@ -385,7 +411,7 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
                                       verdicts=verdicts, dpi=dpi, helper=helper,
-                                      figures=args.figures)
+                                      figures=args.figures, csv=args.csv)
         # after the figures: the HTML report embeds them (written while they were drawn, it
         # embedded empty images)
         region_report(rmap, written, command=command_line(args), started=t0).write(out)
@@ -401,8 +427,11 @@ def _write_sweep(sweep: Any, out: Any, args: argparse.Namespace, formats: list[s
 
     with out:
         written = save_reaction_sweep_outputs(sweep, out, prefix=args.prefix, formats=formats,
-                                              dpi=dpi, figures=args.figures)
+                                              dpi=dpi, figures=args.figures, csv=args.csv)
         reaction_sweep_report(sweep, written, command=command_line(args), started=t0).write(out)
     print(sweep.report())
     print(f"wrote {len(written)} files to {out.root}: " + ", ".join(p.name for p in written))
+    # every θ_r's map has the same grid, so the same rule
+    _say_csv_skipped(sweep.maps[0], args, f"{args.prefix}_theta_r_*.csv",
+                     f"each {args.prefix}_theta_r_*.npz")
     return 0

@@ -24,6 +24,7 @@ module / function              shows
 **files of a map**             (:mod:`stringstab.plots.outputs`)
 :func:`save_figures`           the standard figures of a map, in every format
 :func:`save_region_outputs`    a map's NPZ, CSV and figures, shared by two processes
+:func:`writes_csv`             whether it writes the CSV (2-D, <= CSV_MAX_POINTS unless asked)
 :func:`start_output_helper`    the second of those processes, started (and warming up) early
 **gain repair**                (:mod:`stringstab.plots.tuning`)
 :func:`moves_projection`       the certified region over the repairs' k_a (compute)
@@ -55,12 +56,14 @@ from ._common import (
 )
 from .mixed import plot_head_to_tail, plot_replay_energy, plot_replay_speeds
 from .outputs import (
+    CSV_MAX_POINTS,
     FIGURE_SETS,
     draw_figure,
     figure_stems,
     save_figures,
     save_region_outputs,
     start_output_helper,
+    writes_csv,
 )
 from .reaction_sweep import plot_certified_share, save_reaction_sweep_outputs
 from .region_sets import plot_boundaries, plot_facets
@@ -72,6 +75,7 @@ from .tuning import moves_projection, moves_region, plot_moves
 
 __all__ = [
     "CLASS_COLORS",
+    "CSV_MAX_POINTS",
     "FIGURE_FORMATS",
     "FIGURE_SETS",
     "GAIN_LABELS",
@@ -105,4 +109,5 @@ __all__ = [
     "start_output_helper",
     "trajectory_verdicts",
     "warm_up",
+    "writes_csv",
 ]

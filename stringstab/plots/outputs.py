@@ -5,7 +5,8 @@
 optionally in worker processes (:func:`stringstab.parallel.map_processes`).
 
 :func:`save_region_outputs` writes what ``stringstab region`` writes — the NPZ archive, the
-CSV table (2-D maps) and the standard figures — and splits that work between this process
+CSV table (2-D maps of at most :data:`CSV_MAX_POINTS` points unless asked, :func:`writes_csv`)
+and the standard figures — and splits that work between this process
 and a helper process: this one writes the data files (the NPZ, the CSV), the helper the
 figures, shared among processes forked from it (two on a machine with two cores), which
 inherit its warm plotting code: matplotlib is imported once.  The helper is a
@@ -37,8 +38,15 @@ from .regions import plot_class_map, plot_comparison, plot_sup_gain
 from .regions_3d import plot_region_3d, plot_slices
 from .trajectory import gain_rows, plot_trajectory
 
-__all__ = ["FIGURE_SETS", "draw_figure", "figure_stems", "save_figures", "save_region_outputs",
-           "start_output_helper"]
+__all__ = ["CSV_MAX_POINTS", "FIGURE_SETS", "draw_figure", "figure_stems", "save_figures",
+           "save_region_outputs", "start_output_helper", "writes_csv"]
+
+#: The largest 2-D map whose CSV table :func:`save_region_outputs` writes by default (issue 31):
+#: 300,000 points (a 547 x 547 slice, a CSV of about 28 MB).  Above it the CSV is written only
+#: when asked (``csv=True``, ``stringstab region --csv``): an 801 x 801 map's is 60 MB and costs
+#: more than every other file written after the map, while the NPZ (about 5 MB) holds the same
+#: columns (:func:`stringstab.regions.load_npz`).
+CSV_MAX_POINTS = 300_000
 
 
 #: The figure sets of a 2-D map (issue 31): ``default`` draws the class map of the first method
@@ -309,10 +317,49 @@ def _draw_all(rmap: RegionMap, folder: Path, prefix: str, formats: Sequence[str]
                  dpi=dpi, stems=order, workers=drawers)
 
 
-def _write_data(rmap: RegionMap, folder: Path, prefix: str) -> None:
-    """The NPZ archive and, for a 2-D map, the CSV table."""
+def writes_csv(rmap: RegionMap, csv: bool | None = None) -> bool:
+    """Whether :func:`save_region_outputs` writes the CSV table of ``rmap``: the one rule.
+
+    A 3-D map: never.  A 2-D map: with ``csv=None`` (default) when it has at most
+    :data:`CSV_MAX_POINTS` points, always with ``True``, never with ``False``.
+
+    Parameters
+    ----------
+    rmap : RegionMap
+        The map.
+    csv : bool or None, default None
+        ``None``: the size rule; ``True``: always (2-D); ``False``: never.
+
+    Returns
+    -------
+    bool
+        True when the CSV is written.
+
+    Raises
+    ------
+    StringStabError
+        When ``csv`` is not None, True or False.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from stringstab.regions import region_map
+    >>> m = region_map({"k_x": np.linspace(-2, 2, 3), "k_v": np.linspace(-2, 2, 3)},
+    ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods="taylor")
+    >>> writes_csv(m), writes_csv(m, False)
+    (True, False)
+    """
+    if csv is not None and not isinstance(csv, bool):
+        raise StringStabError(f"csv must be None, True or False; got {csv!r}")
+    if rmap.ndim != 2:
+        return False
+    return rmap.size <= CSV_MAX_POINTS if csv is None else csv
+
+
+def _write_data(rmap: RegionMap, folder: Path, prefix: str, csv: bool) -> None:
+    """The NPZ archive and, when ``csv`` (:func:`writes_csv`), the CSV table."""
     rmap.save_npz(folder / f"{prefix}.npz")
-    if rmap.ndim == 2:
+    if csv:
         rmap.save_csv(folder / f"{prefix}.csv")
 
 
@@ -329,11 +376,13 @@ def _final(out: Any, name: str) -> Path:
 def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
-    helper: Helper | None = None, figures: str = "default",
+    helper: Helper | None = None, figures: str = "default", csv: bool | None = None,
 ) -> list[Path]:
-    """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps) and the standard figures.
+    """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps, :func:`writes_csv`) and the figures.
 
-    The data files hold every method's fields; the figures are :func:`figure_stems`
+    The CSV of a 2-D map is written by default when the map has at most
+    :data:`CSV_MAX_POINTS` points (issue 31: an 801 x 801 map's is 60 MB; the NPZ holds the
+    same columns).  The data files hold every method's fields; the figures are :func:`figure_stems`
     ``(rmap, gains is not None, figures)``: on a 2-D map with two or more methods, by default
     the first method's class map, the comparison and the sup|Γ| map (issue 31).
 
@@ -356,17 +405,21 @@ def save_region_outputs(
     figures : {"default", "all"}, default "default"
         The class maps of a 2-D map with two or more methods: the first method's only, or
         every method's (:func:`figure_stems`).
+    csv : bool or None, default None
+        The CSV table of a 2-D map: ``None`` writes it when the map has at most
+        :data:`CSV_MAX_POINTS` points, ``True`` always, ``False`` never (:func:`writes_csv`;
+        a 3-D map has none).
 
     Returns
     -------
     list of Path
-        The files written (their final paths): the NPZ, the CSV, then the figures.
+        The files written (their final paths): the NPZ, the CSV when written, then the figures.
 
     Raises
     ------
     StringStabError
-        On a bad format or figure set, ``gains`` without ``verdicts``, or when a file cannot be
-        written (in either process).
+        On a bad format, figure set or ``csv``, ``gains`` without ``verdicts``, or when a file
+        cannot be written (in either process).
 
     Examples
     --------
@@ -376,11 +429,15 @@ def save_region_outputs(
     ...                {"k_a": 0.5}, tau=0.1, delta=0.2, headway=1.1, methods="taylor")
     >>> [p.name for p in save_region_outputs(m, tempfile.mkdtemp(), formats=("png",), dpi=20)]
     ['region.npz', 'region.csv', 'region_class_taylor.png']
+    >>> [p.name for p in save_region_outputs(m, tempfile.mkdtemp(), formats=("png",), dpi=20,
+    ...                                      csv=False)]
+    ['region.npz', 'region_class_taylor.png']
     """
     formats = check_figure_formats(formats)
     _need_verdicts(gains, verdicts)
+    with_csv = writes_csv(rmap, csv)
     stems = figure_stems(rmap, gains is not None, figures)
-    names = [f"{prefix}.npz", *([f"{prefix}.csv"] if rmap.ndim == 2 else []),
+    names = [f"{prefix}.npz", *([f"{prefix}.csv"] if with_csv else []),
              *(f"{prefix}_{s}.{f}" for s in stems for f in formats)]
     folder = Path()
     for name in names:  # register every output here, whichever process writes it
@@ -388,13 +445,13 @@ def save_region_outputs(
     drawing = (rmap, folder, prefix, formats, stems, gains, verdicts, dpi)
     final = [_final(out, n) for n in names]
     if helper is None and (int(processes) <= 1 or not stems):
-        _write_data(rmap, folder, prefix)
+        _write_data(rmap, folder, prefix, with_csv)
         _draw_all(*drawing, 1)
         return final
     if helper is None:
         helper = start_helper()
     with helper:  # the figures there (in its forked drawers), the data files here
         helper.submit(_draw_all, *drawing, min(max(2, cpu_count() - 1), len(stems)))
-        _write_data(rmap, folder, prefix)
+        _write_data(rmap, folder, prefix, with_csv)
         helper.result()
     return final

@@ -4,7 +4,7 @@
 against θ_r (:class:`stringstab.regions.ReactionSweep`, computed beforehand);
 :func:`save_reaction_sweep_outputs` writes what ``stringstab region --reaction-delay A,B,...``
 writes: each θ_r's map files (:func:`stringstab.plots.save_region_outputs`, prefix
-``<prefix>_theta_r_<θ_r>``), the table ``<prefix>_share_vs_theta_r.csv`` and that figure.
+``<prefix>_theta_r_<θ_r>``, with its rule for the CSV), the table ``<prefix>_share_vs_theta_r.csv`` and that figure.
 """
 
 from __future__ import annotations
@@ -96,6 +96,7 @@ def _table(sweep: ReactionSweep) -> str:
 def save_reaction_sweep_outputs(
     sweep: ReactionSweep, out: Any, *, prefix: str = "region",
     formats: Sequence[str] = ("png", "pdf"), dpi: int = 150, figures: str = "default",
+    csv: bool | None = None,
 ) -> list[Path]:
     """Write every θ_r's map files, the share table and the share-vs-θ_r figure.
 
@@ -114,6 +115,10 @@ def save_reaction_sweep_outputs(
     figures : {"default", "all"}, default "default"
         Each map's class maps: the first method's only, or every method's
         (:func:`~stringstab.plots.figure_stems`).
+    csv : bool or None, default None
+        Each 2-D map's CSV table: by the size rule of :func:`~stringstab.plots.writes_csv`
+        (``None``: at most :data:`~stringstab.plots.outputs.CSV_MAX_POINTS` points), always
+        (``True``) or never (``False``).
 
     Returns
     -------
@@ -141,5 +146,5 @@ def save_reaction_sweep_outputs(
     written = [final(table), *(final(f"{stem}.{f}") for f in formats)]
     for th, m in zip(sweep.reaction_delays, sweep.maps):
         written += save_region_outputs(m, out, prefix=sweep_prefix(prefix, float(th)),
-                                       formats=formats, dpi=dpi, figures=figures)
+                                       formats=formats, dpi=dpi, figures=figures, csv=csv)
     return written
