@@ -404,14 +404,15 @@ def _quartic_tail_bound_small(A: Array, B: Array, C: Array) -> Array:
     """:func:`quartic_tail_bound` of a few quartics, on Python floats, bit for bit.
 
     Every operation is the vectorised one's, in its order and in IEEE double (``math.sqrt``
-    and ``math.cbrt`` are the C library's, as numpy's are), and the iteration stops at the same
+    is correctly rounded, as numpy's is; the cube roots are numpy's), and the iteration stops at the same
     step for all (the vectorised stopping rule), so the result is the same to the bit
     (``tests/certify/test_margin.py`` compares them).
     """
     a, b, c = A.ravel().tolist(), B.ravel().tolist(), C.ravel().tolist()
+    cb = np.cbrt(B).ravel().tolist()  # numpy's cube root (math.cbrt is Python 3.11+)
     n = len(a)
-    w = [max(2.0 * max(max(math.sqrt(a[i]), math.cbrt(b[i])), math.sqrt(math.sqrt(c[i] / 2.0))),
-             1e-3) for i in range(n)]
+    w = [max(2.0 * max(max(math.sqrt(a[i]), cb[i]), math.sqrt(math.sqrt(c[i] / 2.0))), 1e-3)
+         for i in range(n)]
     for _ in range(30):
         settled = True
         for i in range(n):
