@@ -18,7 +18,7 @@ The bounds, each proven term by term from the basis:
 * **tail** (:func:`tail_bound`): bounding every trigonometric factor by 1 in magnitude,
   g_θ(ω) ≥ τ²ω⁴ − Aω² − Bω − C with A = max(|r_2| − a, 0), B = |c_v| + |r_1|,
   C = max(|c_x| + |r_0| − b, 0), so g_θ > 0 beyond the quartic's positive root
-  (:func:`stringstab.certify.margin.quartic_tail_bound`: Fujiwara, then Newton from above);
+  (:func:`stringstab.certify.quartic_tail.quartic_tail_bound`: Fujiwara, then Newton from above);
 * **curvature** (:func:`curvature_bound`): |d²/dω² ω^k f(dω)| ≤ k(k−1)r^{k−2} + 2kd r^{k−1}
   + d²r^k for f = cos, sin and a delay d ∈ {δ, θ_r}, so M ≥ |g_θ''| on [0, r];
 * **round-off** (:func:`g_and_slack`): 10⁻¹³ times the sum of the magnitudes of the terms,
@@ -37,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..derive import generated as _gen
-from .margin import quartic_tail_bound
+from .quartic_tail import quartic_tail_bound
 from .verdicts import ROUNDOFF_SLACK
 
 __all__ = [
