@@ -408,13 +408,22 @@ def _write(rmap: Any, out: Any, args: argparse.Namespace, formats: list[str], ga
     from ..report import command_line
     from ..report.commands import region_report
 
+    reports: list[Any] = []
+
+    def prepare(files: list[Path]) -> None:
+        # while the helper draws: the report built (its tables) and its renderer imported
+        from ..report.render import warm_renderer
+
+        warm_renderer()
+        reports.append(region_report(rmap, files, command=command_line(args), started=t0))
+
     with out:
         written = save_region_outputs(rmap, out, prefix=args.prefix, formats=formats, gains=gains,
                                       verdicts=verdicts, dpi=dpi, helper=helper,
-                                      figures=args.figures, csv=args.csv)
-        # after the figures: the HTML report embeds them (written while they were drawn, it
-        # embedded empty images)
-        region_report(rmap, written, command=command_line(args), started=t0).write(out)
+                                      figures=args.figures, csv=args.csv, meanwhile=prepare)
+        # written after the figures: the HTML report embeds them (written while they were
+        # drawn, it embedded empty images)
+        reports[0].write(out)
     return written
 
 

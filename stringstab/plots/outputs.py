@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -377,6 +377,7 @@ def save_region_outputs(
     rmap: RegionMap, out: Any, *, prefix: str = "region", formats: Sequence[str] = ("png", "pdf"),
     gains: Any = None, verdicts: Any = None, dpi: int = 150, processes: int = 2,
     helper: Helper | None = None, figures: str = "default", csv: bool | None = None,
+    meanwhile: Callable[[list[Path]], Any] | None = None,
 ) -> list[Path]:
     """Write ``<prefix>.npz``, ``<prefix>.csv`` (2-D maps, :func:`writes_csv`) and the figures.
 
@@ -409,6 +410,10 @@ def save_region_outputs(
         The CSV table of a 2-D map: ``None`` writes it when the map has at most
         :data:`CSV_MAX_POINTS` points, ``True`` always, ``False`` never (:func:`writes_csv`;
         a 3-D map has none).
+    meanwhile : callable, optional
+        Called here with the files' final paths once the data files are written, while the
+        figures are still drawn (e.g. to build a report of them: ``stringstab region``);
+        when the figures are drawn here, after them.
 
     Returns
     -------
@@ -447,11 +452,15 @@ def save_region_outputs(
     if helper is None and (int(processes) <= 1 or not stems):
         _write_data(rmap, folder, prefix, with_csv)
         _draw_all(*drawing, 1)
+        if meanwhile is not None:
+            meanwhile(final)
         return final
     if helper is None:
         helper = start_helper()
     with helper:  # the figures there (in its forked drawers), the data files here
         helper.submit(_draw_all, *drawing, min(max(2, cpu_count() - 1), len(stems)))
         _write_data(rmap, folder, prefix, with_csv)
+        if meanwhile is not None:
+            meanwhile(final)
         helper.result()
     return final

@@ -27,7 +27,20 @@ from typing import Any
 from .captions import caption_for
 from .maths import split_maths, typeset_html
 
-__all__ = ["Report", "Section", "command_line", "format_value"]
+__all__ = ["Report", "Section", "command_line", "format_value", "warm_renderer"]
+
+
+def warm_renderer() -> None:
+    """Import and build what :meth:`Report.write` renders with: Markdown and the templates.
+
+    A command that waits on other work (``stringstab region`` while its figures are drawn)
+    pays for these imports then, not after.
+    """
+    import markdown  # noqa: F401  (imported for its cost now; used by Report.html)
+
+    from .templates import environment
+
+    environment()
 
 
 def format_value(v: Any, digits: int = 4) -> str:

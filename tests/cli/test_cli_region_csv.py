@@ -127,3 +127,20 @@ def test_cli_reaction_sweep_applies_the_same_rule(tmp_path, capsys, monkeypatch)
     assert "not written" not in capsys.readouterr().out
     names = {p.name for p in (tmp_path / "c").iterdir()}
     assert {"region_theta_r_0.csv", "region_theta_r_0.1.csv"} <= names
+
+
+@pytest.mark.parametrize("processes", [1, 2])
+def test_meanwhile_is_called_once_with_the_final_paths(tmp_path, small_map, processes):
+    """``meanwhile`` (the CLI builds its report there) gets the files' final paths, once:
+    with a helper after the data files and before the figures are waited for; alone, after
+    everything (the NPZ is on disk when it is called, in both cases)."""
+    seen = []
+
+    def meanwhile(files):
+        seen.append((list(files), (tmp_path / "region.npz").is_file()))
+
+    out = save_region_outputs(small_map, tmp_path, formats=("png",), dpi=20,
+                              processes=processes, meanwhile=meanwhile)
+    assert seen == [(out, True)]
+    assert [p.name for p in out] == ["region.npz", "region.csv", "region_class_taylor.png"]
+    assert all(p.is_file() for p in out)
