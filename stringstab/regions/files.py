@@ -14,9 +14,11 @@ formats, not the map: :class:`stringstab.regions.RegionMap` hands it arrays and 
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import zipfile
+import zlib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -28,7 +30,8 @@ from ..errors import StringStabError
 from ..io import atomic_path, format_results
 from ..io.text_formats import write_csv as write_csv_rows
 
-__all__ = ["FORMAT", "csv_text", "read_npz", "write_csv", "write_npz"]
+__all__ = ["DEFLATE_RATIO", "FORMAT", "SAMPLE_CHUNK", "SAMPLE_CHUNKS", "compresses", "csv_text", "read_npz",
+           "write_csv", "write_npz"]
 
 #: The ``format`` entry of a region map's metadata.
 FORMAT = "stringstab-region-map/1"
@@ -38,8 +41,9 @@ def write_npz(path: str | os.PathLike[str], axes: Mapping[str, npt.NDArray[Any]]
               fields: Mapping[str, npt.NDArray[Any]], metadata: Mapping[str, Any]) -> Path:
     """Write ``axis_<gain>`` coordinates, the fields and the metadata (JSON) to ``path``.
 
-    The archive is a zip of ``.npy`` members (what :func:`numpy.load` reads) compressed at
-    zlib level 1, written atomically (a temporary file renamed into place).
+    The archive is a zip of ``.npy`` members (what :func:`numpy.load` reads), each
+    compressed at zlib level 1 unless zlib hardly shrinks it (:func:`compresses`: then stored),
+    written atomically (a temporary file renamed into place).
 
     Parameters
     ----------
@@ -62,13 +66,56 @@ def write_npz(path: str | os.PathLike[str], axes: Mapping[str, npt.NDArray[Any]]
     arrays: dict[str, npt.NDArray[Any]] = {f"axis_{n}": a for n, a in axes.items()}
     arrays.update(fields)
     arrays["metadata"] = np.array(json.dumps(metadata))
-    # numpy.savez_compressed at zlib level 1: a third faster than its default level, 0.1 % larger
+    # numpy.savez_compressed at zlib level 1: a third faster than its default level, 0.1 % larger;
+    # a member that zlib hardly shrinks (a field of assorted floats) is stored as it is
     with atomic_path(path, what="region map") as tmp, \
             zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as z:
         for name, a in arrays.items():
-            with z.open(f"{name}.npy", "w", force_zip64=True) as fh:
-                np.lib.format.write_array(fh, np.asanyarray(a), allow_pickle=False)
+            a = np.asanyarray(a)
+            if compresses(a):
+                with z.open(f"{name}.npy", "w", force_zip64=True) as fh:
+                    np.lib.format.write_array(fh, a, allow_pickle=False)
+            else:
+                buf = io.BytesIO()
+                np.lib.format.write_array(buf, a, allow_pickle=False)
+                z.writestr(f"{name}.npy", buf.getbuffer(), compress_type=zipfile.ZIP_STORED)
     return Path(path)
+
+
+#: :func:`compresses`: the sample's bytes, as chunks of this many bytes spread over the array.
+SAMPLE_CHUNK = 4096
+#: :func:`compresses`: how many chunks the sample holds at most.
+SAMPLE_CHUNKS = 32
+#: :func:`compresses`: the largest compressed/raw size of the sample at which a member is deflated.
+DEFLATE_RATIO = 0.75
+
+
+def compresses(a: npt.NDArray[Any]) -> bool:
+    """Whether zlib (level 1) shrinks ``a``'s bytes by at least a quarter, on a spread sample.
+
+    :func:`write_npz` deflates such members and stores the others (a field of assorted
+    floats, such as an 801² map's margin, shrinks by 15 % for most of the archive's time).
+    The sample is :data:`SAMPLE_CHUNKS` chunks of :data:`SAMPLE_CHUNK` bytes evenly spread
+    over the array (its first rows alone can be a constant region); an array of at most that
+    many bytes is taken whole.  Either way the archive is one ``numpy.load`` reads.
+
+    Parameters
+    ----------
+    a : ndarray
+        A member of the archive.
+
+    Returns
+    -------
+    bool
+        True when the sample deflates to at most :data:`DEFLATE_RATIO` of its size (small
+        arrays: always; an object array, which is never written: True).
+    """
+    if a.dtype.hasobject or a.nbytes <= SAMPLE_CHUNK * SAMPLE_CHUNKS:
+        return True
+    raw = np.ascontiguousarray(a).reshape(-1).view(np.uint8)
+    starts = np.linspace(0, raw.size - SAMPLE_CHUNK, SAMPLE_CHUNKS).astype(np.intp)
+    sample = b"".join(raw[s:s + SAMPLE_CHUNK].tobytes() for s in starts)
+    return len(zlib.compress(sample, 1)) <= DEFLATE_RATIO * len(sample)
 
 
 def read_npz(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, npt.NDArray[Any]]]:
