@@ -32,7 +32,8 @@ def fujiwara_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     Parameters
     ----------
     A, B, C : array_like
-        Non-negative coefficients of ω⁴ − Aω² − Bω − C (:func:`tail_coefficients`).
+        Non-negative coefficients of ω⁴ − Aω² − Bω − C
+        (:func:`~stringstab.certify.margin.tail_coefficients`).
 
     Returns
     -------
@@ -53,7 +54,7 @@ def fujiwara_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
 def quartic_tail_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     """Ω ≥ the positive root of L(ω) = ω⁴ − Aω² − Bω − C (A, B, C ≥ 0), so L > 0 beyond Ω.
 
-    The quartic minorant of :func:`tail_bound` (and of the reaction-delay margin,
+    The quartic minorant of :func:`~stringstab.certify.margin.tail_bound` (and of the reaction-delay margin,
     :mod:`stringstab.certify.margin_reaction`): Newton's method from Fujiwara's bound
     (:func:`fujiwara_bound`) decreases monotonically to the one positive root (L is convex
     beyond it), and every iterate is ≥ it, so the iteration may stop at any step.
@@ -61,7 +62,8 @@ def quartic_tail_bound(A: ArrayLike, B: ArrayLike, C: ArrayLike) -> Array:
     Parameters
     ----------
     A, B, C : array_like
-        Non-negative coefficients of the minorant (e.g. :func:`tail_coefficients`).
+        Non-negative coefficients of the minorant
+        (e.g. :func:`~stringstab.certify.margin.tail_coefficients`).
 
     Returns
     -------
