@@ -97,7 +97,8 @@ def compresses(a: npt.NDArray[Any]) -> bool:
     floats, such as an 801² map's margin, shrinks by 15 % for most of the archive's time).
     The sample is :data:`SAMPLE_CHUNKS` chunks of :data:`SAMPLE_CHUNK` bytes evenly spread
     over the array (its first rows alone can be a constant region); an array of at most that
-    many bytes is taken whole.  Either way the archive is one ``numpy.load`` reads.
+    many bytes is deflated without a test (it costs little either way).  Either way the
+    archive is one ``numpy.load`` reads.
 
     Parameters
     ----------

@@ -113,27 +113,19 @@ def _certified_lattice(tau: float, delta: float, headway: float, lo: float, hi: 
                        reaction_delay: float) -> Array:
     """:func:`certified_lattice`, cached by its normalised arguments (:func:`_key`)."""
     n = round((hi - lo) / resolution) + 1
-    if reaction_delay:
-        theta = Params(tau, delta, headway, reaction_delay=reaction_delay)
-        if sample_time is not None:  # the continuous lattice at θ_r, then the sampled check
-            base = certified_lattice(tau, delta, headway, lo, hi, resolution, None, reaction_delay)
-            keep = grid.certified(base, theta, sample_time=sample_time)
-        else:
-            base = certified_lattice(tau, delta, headway, lo, hi, resolution)
-            keep = grid.certified(base, theta)
-        pts = np.array(base[keep])
-        pts.flags.writeable = False
-    elif sample_time is not None:
-        # the continuous lattice first (cached: the repair's continuous cells need it too),
-        # then the sampled check on its points: the calls of grid.certified_lattice with
-        # also_continuous, row for row, without computing the continuous lattice twice
-        base = certified_lattice(tau, delta, headway, lo, hi, resolution)
-        keep = grid.certified(base, Params(tau, delta, headway), sample_time=sample_time)
+    if reaction_delay or sample_time is not None:
+        # the points of a cached continuous lattice that the other certificate certifies too:
+        # with H, the continuous lattice at θ_r (the repair's continuous cells reuse it at
+        # θ_r = 0: the calls of grid.certified_lattice with also_continuous, row for row);
+        # with θ_r alone, the lattice without θ_r
+        base = certified_lattice(tau, delta, headway, lo, hi, resolution, None,
+                                 reaction_delay if sample_time is not None else 0.0)
+        keep = grid.certified(base, Params(tau, delta, headway, reaction_delay=reaction_delay),
+                              sample_time=sample_time)
         pts = np.ascontiguousarray(base[keep])
         pts.setflags(write=False)
     else:
-        pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway),
-                                     sample_time=sample_time, also_continuous=True)
+        pts = grid.certified_lattice(lo, hi, n, Params(tau, delta, headway))
     if not pts.shape[0]:
         extra = f", reaction_delay={reaction_delay:g}" if reaction_delay else ""
         raise StringStabError(

@@ -19,7 +19,8 @@ so calling them per environment step would dominate training.  The default metho
        first (one vectorised :meth:`stringstab.certify.api.Loop.check` call for the step's
        rows, except the rows its screen proves uncertifiable,
        :meth:`stringstab.certify.screen.SampledScreen.surely_uncertifiable`: about 97 % of the
-       uncertified rows of the default training, answered without a certificate call), then the continuous one on the rows it certifies — except rows inside a proven
+       uncertified rows of the default training, answered without a certificate call), then
+       the continuous one on the rows it certifies — except rows inside a proven
        cell of the continuous certificate alone (the cells of :func:`certified_cells` without
        H, whose 8 corners the continuous certificate certifies: near the sampled loop's
        boundary the continuous region is wider, so most such rows are); every verdict is kept
